@@ -1,0 +1,35 @@
+// polydyn — errors of bad input, and the assertion used for misuse of the API.
+//
+// Three tiers (style-anchors §6.7):
+// - misuse of the API by a programmer: PD_ASSERT, fatal;
+// - numerical trouble during a run: counted warnings in pdState (see state.h), with a safe recovery;
+// - bad input (scene files, CLI arguments): a pdError with `FILE:LINE:COL: message`, never an assert.
+#pragma once
+
+#include <stdio.h>
+#include <stdlib.h>
+
+enum { PD_ERROR_MESSAGE_MAX = 512 };
+
+typedef struct pdError {
+  char file[PD_ERROR_MESSAGE_MAX];     // file name as given by the caller ("" when none)
+  int line;                            // 1-based; 0 when the problem has no line (e.g. cannot open)
+  int col;                             // 1-based; 0 when unknown
+  char message[PD_ERROR_MESSAGE_MAX];  // one line, no trailing newline
+} pdError;
+
+// Fills err (if not NULL) with a location and a printf-style message.
+void pd_error_set(pdError* err, const char* file, int line, int col, const char* fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+
+// Writes `FILE:LINE:COL: message\n` (or `FILE: message` when the line is unknown) to `out`.
+void pd_error_print(const pdError* err, FILE* out);
+
+#define PD_ASSERT(cond)                                                                         \
+  do {                                                                                          \
+    if (!(cond)) {                                                                              \
+      fprintf(stderr, "%s:%d: polydyn API misuse: assertion `%s` failed\n", __FILE__, __LINE__, \
+              #cond);                                                                           \
+      abort();                                                                                  \
+    }                                                                                           \
+  } while (0)

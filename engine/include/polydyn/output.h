@@ -1,0 +1,47 @@
+// polydyn — run directories (DESIGN §4.2): trajectory.csv and summary.json.
+//
+// A run directory is written under a temporary name beside the target (`DIR.partial-PID`) and
+// renamed to DIR only when complete, so an interrupted run never leaves a directory that looks
+// complete. An existing DIR is replaced only if it is a previous run directory (has summary.json).
+//
+// trajectory.csv: header `t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz`; one row per moving body per
+// sample, bodies in scene order; numbers printed with %.17g so they round-trip exactly.
+#pragma once
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "polydyn/error.h"
+#include "polydyn/model.h"
+#include "polydyn/state.h"
+
+typedef struct pdRunWriter pdRunWriter;
+
+// Starts a run directory for `dir`. Returns NULL and fills err on failure (nothing left behind).
+pdRunWriter* pd_run_open(const char* dir, const pdModel* model, pdError* err);
+
+// Observer that appends the current sample to trajectory.csv; `user` is the pdRunWriter.
+bool pd_run_observe(const pdModel* model, const pdState* state, void* user);
+
+// Writes one trajectory row per moving body at the state's time.
+void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state);
+void pd_write_trajectory_header(FILE* out);
+
+typedef struct pdRunInfo {
+  const char* engine;     // e.g. "polydyn-soft"
+  double energyStart;     // J
+  double energyEnd;       // J
+  double wallSeconds;     // wall time of pd_advance
+  bool completed;         // reached tend
+} pdRunInfo;
+
+// Writes summary.json, closes every file and renames the directory into place. Returns false and
+// fills err on an I/O failure (then the temporary directory is removed).
+bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state, const pdRunInfo* info,
+                   pdError* err);
+
+// Removes the temporary directory and frees the writer.
+void pd_run_abort(pdRunWriter* run);
+
+// Writes the summary JSON object to `out` (also used by `polydyn check --json` later).
+void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state, const pdRunInfo* info);

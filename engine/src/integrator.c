@@ -1,0 +1,210 @@
+// polydyn — the integration loop (paper §2 and Fig. 8, DESIGN §3.5).
+//
+// Design note. pd_advance walks from state->t to tEnd in steps of classic fourth-order Runge–Kutta.
+// The adaptive stepper estimates the local error by step doubling: one step of h and two of h/2
+// from the same start; their difference is 15/16 of the full step's error, so
+//   err_i = (y_half,i − y_full,i) / 15
+// estimates the error of the two-half-step result, which is the one accepted (plain fourth order:
+// no Richardson extrapolation, so the estimate describes the value we keep). The error norm is the
+// max over components of |err_i| / weight_i, where weight_i is the component's characteristic scale
+// (state.c: body size for positions, vmax for velocities, vmax/size for angular velocities, 1 for
+// quaternion components). A step is accepted when norm <= tol, or when h is already at dtmin (then
+// a warning is counted). The next step is h · clamp(0.9 (tol/norm)^(1/5), 0.2, 5), within
+// [dtmin, dtmax].
+//
+// Output samples fall exactly on t = k / sampleRate: a step that would pass the next sample is cut
+// to end on it (the time is then set to the sample time itself, so stamps never drift), and the
+// step size the controller wanted is kept for the step after.
+//
+// Numerical trouble: a trial step that produces a non-finite number is rejected and retried four
+// times smaller (warning counted). At dtmin the run stops with state->failed set; the state keeps
+// its last finite value, so nothing non-finite ever reaches the observer.
+//
+// Memory: every vector lives in state->work, allocated by pd_state_create.
+#include <float.h>
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#include "polydyn/state.h"
+#include "state_layout.h"
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void derivative(const pdModel* model, pdState* s, double t, const double* y, double* dydt) {
+  double t0 = now_seconds();
+  pd_state_derivative(model, t, y, dydt);
+  s->stageSeconds[pd_stageDerivative] += now_seconds() - t0;
+  ++s->count.derivatives;
+}
+
+// Scratch vectors inside state->work.
+typedef struct stepperWork {
+  double *k1, *ktmp, *ytmp, *acc, *full, *half, *k1half, *trial;
+} stepperWork;
+
+static stepperWork work_of(pdState* s) {
+  double* w = s->work;
+  size_t n = (size_t)s->n;
+  return (stepperWork){w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n};
+}
+
+// One classic RK4 step of size h from (t, y) whose derivative k1 is known; result in `out`.
+static void rk4(const pdModel* model, pdState* s, stepperWork* w, double t, const double* y, const double* k1,
+                double h, double* out) {
+  int n = s->n;
+  for (int i = 0; i < n; ++i) {
+    w->acc[i] = k1[i];
+    w->ytmp[i] = y[i] + 0.5 * h * k1[i];
+  }
+  derivative(model, s, t + 0.5 * h, w->ytmp, w->ktmp);
+  for (int i = 0; i < n; ++i) {
+    w->acc[i] += 2.0 * w->ktmp[i];
+    w->ytmp[i] = y[i] + 0.5 * h * w->ktmp[i];
+  }
+  derivative(model, s, t + 0.5 * h, w->ytmp, w->ktmp);
+  for (int i = 0; i < n; ++i) {
+    w->acc[i] += 2.0 * w->ktmp[i];
+    w->ytmp[i] = y[i] + h * w->ktmp[i];
+  }
+  derivative(model, s, t + h, w->ytmp, w->ktmp);
+  for (int i = 0; i < n; ++i) out[i] = y[i] + (h / 6.0) * (w->acc[i] + w->ktmp[i]);
+}
+
+static bool all_finite(const double* y, int n) {
+  for (int i = 0; i < n; ++i)
+    if (!isfinite(y[i])) return false;
+  return true;
+}
+
+static void renormalise_quaternions(const pdModel* model, double* y) {
+  for (int k = 0; k < model->movingCount; ++k) {
+    double* q = y + PD_BODY_STATE_SIZE * k + PD_Y_Q;
+    double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int i = 0; i < 4; ++i) q[i] /= norm;
+  }
+}
+
+// Step-size controller bounds: never grow more than 5× or shrink below 1/5 per accepted step
+// (smooth step sequences), 0.9 safety so the next step is likely accepted.
+#define STEP_SAFETY 0.9
+#define STEP_GROW_MAX 5.0
+#define STEP_SHRINK_MIN 0.2
+#define STEP_REJECT_SHRINK_MIN 0.1
+#define NONFINITE_SHRINK 0.25
+// A step ending this many units of rounding short of a sample time is taken as landing on it.
+#define TIME_SNAP_ULPS 16.0
+
+// Takes one accepted step of at most `hMax` from state->t. Returns the step taken (0 on failure).
+static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
+  const pdSettings* set = &model->settings;
+  stepperWork w = work_of(s);
+  int n = s->n;
+  derivative(model, s, s->t, s->y, w.k1);
+  for (;;) {
+    // a step cut short to meet a sample says nothing about a longer one: s->h keeps the wanted size
+    bool cut = hMax < s->h;
+    double h = cut ? hMax : s->h;
+    bool atMinimum = h <= set->dtmin;
+    double t0 = now_seconds();
+    double tDerivative = s->stageSeconds[pd_stageDerivative];
+
+    rk4(model, s, &w, s->t, s->y, w.k1, h, w.full);
+    rk4(model, s, &w, s->t, s->y, w.k1, 0.5 * h, w.half);
+    derivative(model, s, s->t + 0.5 * h, w.half, w.k1half);
+    rk4(model, s, &w, s->t + 0.5 * h, w.half, w.k1half, 0.5 * h, w.trial);
+
+    double norm = 0.0;
+    for (int i = 0; i < n; ++i) norm = fmax(norm, fabs(w.trial[i] - w.full[i]) / (15.0 * s->weight[i]));
+    bool finite = isfinite(norm) && all_finite(w.trial, n);
+    s->stageSeconds[pd_stageIntegrate] += (now_seconds() - t0) - (s->stageSeconds[pd_stageDerivative] - tDerivative);
+
+    if (!finite) {
+      ++s->warnings[pd_warnNonFinite];
+      ++s->count.rejected;
+      if (atMinimum) {
+        s->failed = true;
+        return 0.0;
+      }
+      s->h = fmax(set->dtmin, NONFINITE_SHRINK * h);
+      continue;
+    }
+    if (norm > set->tol && !atMinimum) {
+      ++s->count.rejected;
+      double shrink = fmax(STEP_REJECT_SHRINK_MIN, STEP_SAFETY * pow(set->tol / norm, 0.25));
+      s->h = fmax(set->dtmin, shrink * h);
+      continue;
+    }
+    if (norm > set->tol) ++s->warnings[pd_warnStepAtMinimum];
+    memcpy(s->y, w.trial, (size_t)n * sizeof *s->y);
+    renormalise_quaternions(model, s->y);
+    ++s->count.accepted;
+    if (!cut) {
+      double grow = norm > 0.0 ? STEP_SAFETY * pow(set->tol / norm, 0.2) : STEP_GROW_MAX;
+      grow = fmin(STEP_GROW_MAX, fmax(STEP_SHRINK_MIN, grow));
+      s->h = fmin(set->dtmax, fmax(set->dtmin, grow * h));
+    }
+    return h;
+  }
+}
+
+static double fixed_step(const pdModel* model, pdState* s, double hMax) {
+  stepperWork w = work_of(s);
+  double h = fmin(model->settings.dt, hMax);
+  derivative(model, s, s->t, s->y, w.k1);
+  double t0 = now_seconds();
+  double tDerivative = s->stageSeconds[pd_stageDerivative];
+  rk4(model, s, &w, s->t, s->y, w.k1, h, w.trial);
+  s->stageSeconds[pd_stageIntegrate] += (now_seconds() - t0) - (s->stageSeconds[pd_stageDerivative] - tDerivative);
+  if (!all_finite(w.trial, s->n)) {
+    ++s->warnings[pd_warnNonFinite];
+    s->failed = true;
+    return 0.0;
+  }
+  memcpy(s->y, w.trial, (size_t)s->n * sizeof *s->y);
+  renormalise_quaternions(model, s->y);
+  ++s->count.accepted;
+  return h;
+}
+
+static double sample_time(const pdModel* model, long k) { return (double)k / model->settings.sampleRate; }
+
+static void observe(const pdModel* model, pdState* s, pdObserverFcn* observer, void* user) {
+  double t0 = now_seconds();
+  if (observer && !observer(model, s, user)) s->stopped = true;
+  ++s->count.samples;
+  ++s->nextSample;
+  s->stageSeconds[pd_stageObserve] += now_seconds() - t0;
+}
+
+bool pd_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
+  PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
+  if (s->failed) return false;
+  s->stopped = false;
+  // skip samples already behind us (a state advanced without an observer, then with one)
+  while (sample_time(model, s->nextSample) < s->t) ++s->nextSample;
+  if (sample_time(model, s->nextSample) == s->t) observe(model, s, observer, user);
+  while (s->t < tEnd && !s->stopped) {
+    double tSample = sample_time(model, s->nextSample);
+    double target = fmin(tEnd, tSample);
+    double taken = 0.0;
+    if (s->n == 0) {
+      taken = target - s->t;  // nothing moves: jump to the next sample
+    } else {
+      taken = s->stepper == pd_stepperRK4Fixed ? fixed_step(model, s, target - s->t)
+                                                : adaptive_step(model, s, target - s->t);
+    }
+    if (s->failed) return false;
+    // a step cut to the target lands exactly on it, so sample stamps never drift; so does a step that
+    // ends within rounding of it (a fixed dt equal to the sample interval), else a ~1e-19 s sliver follows
+    double next = s->t + taken;
+    bool lands = taken >= target - s->t || target - next <= TIME_SNAP_ULPS * DBL_EPSILON * fabs(target);
+    s->t = lands ? target : next;
+    if (s->t == tSample) observe(model, s, observer, user);
+  }
+  return !s->stopped;
+}

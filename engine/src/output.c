@@ -1,0 +1,341 @@
+// polydyn — run directories: trajectory.csv and summary.json, written atomically.
+#include "polydyn/output.h"
+
+#include <errno.h>
+#include <ftw.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+struct pdRunWriter {
+  char* dir;         // final name
+  char* tmp;         // temporary directory being written
+  FILE* trajectory;  // tmp/trajectory.csv
+  bool ioError;      // a write failed
+};
+
+static char* join(const char* a, const char* b) {
+  size_t n = strlen(a) + strlen(b) + 2;
+  char* s = malloc(n);
+  PD_ASSERT(s != NULL);
+  snprintf(s, n, "%s/%s", a, b);
+  return s;
+}
+
+static char* with_suffix(const char* a, const char* suffix) {
+  size_t n = strlen(a) + strlen(suffix) + 1;
+  char* s = malloc(n);
+  PD_ASSERT(s != NULL);
+  snprintf(s, n, "%s%s", a, suffix);
+  return s;
+}
+
+static int remove_entry(const char* path, const struct stat* sb, int flag, struct FTW* ftw) {
+  (void)sb, (void)flag, (void)ftw;
+  return remove(path);
+}
+
+static void remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
+
+static void write_number(FILE* out, double x) {
+  // the engine never lets a non-finite number reach an output; should one get here, JSON stays valid
+  if (isfinite(x))
+    fprintf(out, "%.17g", x);
+  else
+    fputs("null", out);
+}
+
+// CSV field: quoted (RFC 4180) only when it holds a comma, a quote or a line break.
+static void write_csv_text(FILE* out, const char* s) {
+  if (!strpbrk(s, ",\"\r\n")) {
+    fputs(s, out);
+    return;
+  }
+  fputc('"', out);
+  for (; *s; ++s) {
+    if (*s == '"') fputc('"', out);
+    fputc(*s, out);
+  }
+  fputc('"', out);
+}
+
+void pd_write_trajectory_header(FILE* out) { fputs("t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", out); }
+
+void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state) {
+  for (int k = 0; k < model->movingCount; ++k) {
+    int i = model->movingBodies[k];
+    pdBodyState b = pd_state_body(model, state, i);
+    const double row[13] = {b.x.x, b.x.y, b.x.z, b.q.w, b.q.x, b.q.y, b.q.z, b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z};
+    write_number(out, state->t);
+    fputc(',', out);
+    write_csv_text(out, model->bodies[i].name);
+    for (int c = 0; c < 13; ++c) {
+      fputc(',', out);
+      write_number(out, row[c]);
+    }
+    fputc('\n', out);
+  }
+}
+
+pdRunWriter* pd_run_open(const char* dir, const pdModel* model, pdError* err) {
+  (void)model;
+  struct stat st;
+  if (stat(dir, &st) == 0) {
+    char* summary = join(dir, "summary.json");
+    bool isRun = S_ISDIR(st.st_mode) && access(summary, F_OK) == 0;
+    free(summary);
+    if (!isRun) {
+      pd_error_set(err, dir, 0, 0, "exists and is not a polydyn run directory (no summary.json); not replacing it");
+      return NULL;
+    }
+  }
+  pdRunWriter* run = calloc(1, sizeof *run);
+  PD_ASSERT(run != NULL);
+  run->dir = with_suffix(dir, "");
+  run->tmp = with_suffix(dir, ".partial-XXXXXX");
+  if (mkdtemp(run->tmp)) {
+    // mkdtemp makes the directory private; a finished run directory gets the usual permissions
+    mode_t mask = umask(0);
+    umask(mask);
+    chmod(run->tmp, 0777 & ~mask);
+  } else {
+    pd_error_set(err, dir, 0, 0, "cannot create the output directory: %s", strerror(errno));
+    free(run->dir);
+    free(run->tmp);
+    free(run);
+    return NULL;
+  }
+  char* path = join(run->tmp, "trajectory.csv");
+  run->trajectory = fopen(path, "w");
+  free(path);
+  if (!run->trajectory) {
+    pd_error_set(err, dir, 0, 0, "cannot write trajectory.csv: %s", strerror(errno));
+    pd_run_abort(run);
+    return NULL;
+  }
+  // a large buffer: the trajectory is the bulk of the output
+  setvbuf(run->trajectory, NULL, _IOFBF, 1 << 20);
+  pd_write_trajectory_header(run->trajectory);
+  return run;
+}
+
+bool pd_run_observe(const pdModel* model, const pdState* state, void* user) {
+  pdRunWriter* run = user;
+  pd_write_trajectory_rows(run->trajectory, model, state);
+  if (ferror(run->trajectory)) run->ioError = true;
+  return !run->ioError;
+}
+
+static void write_json_string(FILE* out, const char* s) {
+  fputc('"', out);
+  for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
+    if (*p == '"' || *p == '\\')
+      fprintf(out, "\\%c", *p);
+    else if (*p < 0x20)
+      fprintf(out, "\\u%04x", *p);
+    else
+      fputc(*p, out);
+  }
+  fputc('"', out);
+}
+
+static void write_vec(FILE* out, pdVec3 v) {
+  fputc('[', out);
+  write_number(out, v.x);
+  fputc(',', out);
+  write_number(out, v.y);
+  fputc(',', out);
+  write_number(out, v.z);
+  fputc(']', out);
+}
+
+static void write_mat(FILE* out, const pdMat3* m) {
+  fputc('[', out);
+  for (int i = 0; i < 3; ++i) {
+    if (i) fputc(',', out);
+    write_vec(out, (pdVec3){m->m[i][0], m->m[i][1], m->m[i][2]});
+  }
+  fputc(']', out);
+}
+
+static void write_material(FILE* out, const pdMaterial* m) {
+  fputs("{\"mu\": ", out);
+  write_number(out, m->mu);
+  fputs(", \"kn\": ", out);
+  write_number(out, m->kn);
+  fputs(", \"kt\": ", out);
+  write_number(out, m->kt);
+  fputs(", \"cn\": ", out);
+  write_number(out, m->cn);
+  fputs(", \"ct\": ", out);
+  write_number(out, m->ct);
+  fputs(", \"restitution\": ", out);
+  if (m->restitution >= 0.0)
+    write_number(out, m->restitution);
+  else
+    fputs("null", out);
+  fputc('}', out);
+}
+
+static const char* primitive_name(pdPrimitiveKind kind) {
+  switch (kind) {
+    case pd_primCube: return "cube";
+    case pd_primPrism: return "prism";
+    case pd_primTprism: return "tprism";
+    case pd_primSphere: return "sphere";
+    case pd_primHull: return "hull";
+  }
+  return "?";
+}
+
+static void write_body(FILE* out, const pdBody* b) {
+  fputs("    {\"name\": ", out);
+  write_json_string(out, b->name);
+  fputs(", \"color\": ", out);
+  write_json_string(out, b->color);
+  fprintf(out, ", \"primitive\": \"%s\", \"fixed\": %s,\n", primitive_name(b->kind), b->fixed ? "true" : "false");
+  fputs("     \"mass\": ", out);
+  write_number(out, b->mass);
+  fputs(", \"volume\": ", out);
+  write_number(out, b->volume);
+  fputs(", \"density\": ", out);
+  write_number(out, b->density);
+  fputs(", \"size\": ", out);
+  write_number(out, b->size);
+  fputs(",\n     \"geometric_centre\": ", out);
+  write_vec(out, b->geometricCentre);
+  fputs(", \"inertia\": ", out);
+  write_mat(out, &b->inertia);
+  fputs(",\n     \"principal_moments\": ", out);
+  write_vec(out, (pdVec3){b->principal[0], b->principal[1], b->principal[2]});
+  fputs(", \"principal_axes\": ", out);
+  write_mat(out, &b->principalAxes);
+  fputs(",\n     \"initial\": {\"x\": ", out);
+  write_vec(out, b->x0);
+  fputs(", \"q\": [", out);
+  write_number(out, b->q0.w);
+  fputc(',', out);
+  write_vec(out, (pdVec3){b->q0.x, b->q0.y, b->q0.z});
+  fputs("], \"v\": ", out);
+  write_vec(out, b->v0);
+  fputs(", \"w\": ", out);
+  write_vec(out, b->w0);
+  fputs("},\n     \"material\": {\"requested\": ", out);
+  write_material(out, &b->requested);
+  fputs(", \"used\": ", out);
+  write_material(out, &b->used);
+  fputs(", \"adjustments\": []},\n", out);
+  // the shape in the body frame (origin at the centre of mass), for viewers and other engines
+  fprintf(out, "     \"shape\": {\"V\": %d, \"E\": %d, \"F\": %d, \"vertices\": [", b->shape.vertexCount,
+          b->shape.edgeCount, b->shape.faceCount);
+  for (int v = 0; v < b->shape.vertexCount; ++v) {
+    if (v) fputc(',', out);
+    write_vec(out, b->shape.vertices[v]);
+  }
+  fputs("], \"faces\": [", out);
+  for (int f = 0; f < b->shape.faceCount; ++f) {
+    const pdFace* face = &b->shape.faces[f];
+    fputs(f ? ",[" : "[", out);
+    for (int i = 0; i < face->count; ++i) fprintf(out, i ? ",%d" : "%d", b->shape.faceVertices[face->first + i]);
+    fputc(']', out);
+  }
+  fputs("]}}", out);
+}
+
+void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state, const pdRunInfo* info) {
+  const pdSettings* s = &model->settings;
+  fputs("{\n  \"engine\": ", out);
+  write_json_string(out, info->engine);
+  fputs(",\n  \"version\": \"" PD_VERSION "\",\n  \"scene\": ", out);
+  write_json_string(out, model->scenePath);
+  fprintf(out, ",\n  \"stepper\": \"%s\",\n", state->stepper == pd_stepperRK4Fixed ? "rk4-fixed" : "rk4-adaptive");
+  fputs("  \"settings\": {\"gravity\": ", out);
+  write_vec(out, s->gravity);
+  const struct {
+    const char* name;
+    double value;
+  } scalars[] = {{"tend", s->tend}, {"tol", s->tol},          {"dt", s->dt},     {"dtmin", s->dtmin},
+                 {"dtmax", s->dtmax}, {"sample", s->sampleRate}, {"vmax", s->vmax}, {"deflection", s->deflection}};
+  for (size_t i = 0; i < sizeof scalars / sizeof scalars[0]; ++i) {
+    fprintf(out, ", \"%s\": ", scalars[i].name);
+    write_number(out, scalars[i].value);
+  }
+  fprintf(out, ", \"vmax_estimated\": %s},\n", s->vmaxEstimated ? "true" : "false");
+  fputs("  \"bodies\": [\n", out);
+  for (int i = 0; i < model->bodyCount; ++i) {
+    write_body(out, &model->bodies[i]);
+    fputs(i + 1 < model->bodyCount ? ",\n" : "\n", out);
+  }
+  fputs("  ],\n", out);
+  fprintf(out,
+          "  \"counts\": {\"accepted_steps\": %ld, \"rejected_steps\": %ld, \"derivative_evaluations\": %ld, "
+          "\"samples\": %ld, \"contact_events\": 0},\n",
+          state->count.accepted, state->count.rejected, state->count.derivatives, state->count.samples);
+  fputs("  \"warnings\": {", out);
+  for (int w = 0; w < pd_warnCount; ++w) fprintf(out, "%s\"%s\": %ld", w ? ", " : "", pdWarningNames[w], state->warnings[w]);
+  fputs("},\n  \"t_reached\": ", out);
+  write_number(out, state->t);
+  fprintf(out, ", \"completed\": %s,\n  \"energy\": {\"start\": ", info->completed ? "true" : "false");
+  write_number(out, info->energyStart);
+  fputs(", \"end\": ", out);
+  write_number(out, info->energyEnd);
+  // timing last: the only part of a run directory that differs between two identical runs
+  fputs("},\n  \"timing\": {\"wall_seconds\": ", out);
+  write_number(out, info->wallSeconds);
+  fputs(", \"stages\": {", out);
+  for (int k = 0; k < pd_stageCount; ++k) {
+    fprintf(out, "%s\"%s\": ", k ? ", " : "", pdStageNames[k]);
+    write_number(out, state->stageSeconds[k]);
+  }
+  fputs("}}\n}\n", out);
+}
+
+bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state, const pdRunInfo* info, pdError* err) {
+  bool ok = !run->ioError && !ferror(run->trajectory);
+  ok = (fclose(run->trajectory) == 0) && ok;
+  run->trajectory = NULL;
+  char* path = join(run->tmp, "summary.json");
+  FILE* out = ok ? fopen(path, "w") : NULL;
+  free(path);
+  if (out) {
+    pd_write_summary_json(out, model, state, info);
+    ok = !ferror(out);
+    ok = (fclose(out) == 0) && ok;
+  } else {
+    ok = false;
+  }
+  if (ok) {
+    // replace a previous run directory: move it aside, move ours in, then delete the old one
+    struct stat st;
+    char* old = NULL;
+    if (stat(run->dir, &st) == 0) {
+      old = with_suffix(run->dir, ".old-XXXXXX");
+      ok = mkdtemp(old) != NULL && rename(run->dir, old) == 0;
+    }
+    ok = ok && rename(run->tmp, run->dir) == 0;
+    if (old) {
+      if (ok) remove_tree(old);
+      free(old);
+    }
+  }
+  if (!ok) {
+    pd_error_set(err, run->dir, 0, 0, "cannot write the run directory: %s", strerror(errno));
+    pd_run_abort(run);
+    return false;
+  }
+  free(run->dir);
+  free(run->tmp);
+  free(run);
+  return true;
+}
+
+void pd_run_abort(pdRunWriter* run) {
+  if (!run) return;
+  if (run->trajectory) fclose(run->trajectory);
+  remove_tree(run->tmp);
+  free(run->dir);
+  free(run->tmp);
+  free(run);
+}

@@ -1,0 +1,78 @@
+// polydyn — the mutable state: creation, reset, read-out.
+#include "polydyn/state.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "state_layout.h"
+
+const char* const pdStageNames[pd_stageCount] = {"derivative", "integrate", "observe"};
+const char* const pdWarningNames[pd_warnCount] = {"step_at_minimum", "non_finite_step"};
+
+pdState* pd_state_create(const pdModel* model) {
+  pdState* s = calloc(1, sizeof *s);
+  PD_ASSERT(s != NULL);
+  s->n = PD_BODY_STATE_SIZE * model->movingCount;
+  size_t n = (size_t)(s->n > 0 ? s->n : 1);
+  s->y = calloc(n, sizeof *s->y);
+  s->weight = calloc(n, sizeof *s->weight);
+  s->work = calloc(n * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
+  PD_ASSERT(s->y && s->weight && s->work);
+  pd_state_reset(model, s);
+  return s;
+}
+
+void pd_state_reset(const pdModel* model, pdState* s) {
+  const pdSettings* set = &model->settings;
+  s->t = 0.0;
+  s->h = set->dt;
+  s->stepper = pd_stepperRK4Adaptive;
+  s->nextSample = 0;
+  s->failed = false;
+  s->stopped = false;
+  memset(&s->count, 0, sizeof s->count);
+  memset(s->warnings, 0, sizeof s->warnings);
+  memset(s->stageSeconds, 0, sizeof s->stageSeconds);
+  for (int k = 0; k < model->movingCount; ++k) {
+    const pdBody* b = &model->bodies[model->movingBodies[k]];
+    double* y = s->y + PD_BODY_STATE_SIZE * k;
+    double* w = s->weight + PD_BODY_STATE_SIZE * k;
+    pd_layout_store(y, b->v0, b->w0, b->x0, b->q0);
+    // error weights: velocities over the characteristic speed, angular velocities over that speed
+    // per body size, positions over the body size, quaternion components are already O(1)
+    double L = b->size, V = set->vmax;
+    for (int i = 0; i < 3; ++i) {
+      w[PD_Y_V + i] = V;
+      w[PD_Y_W + i] = V / L;
+      w[PD_Y_X + i] = L;
+    }
+    for (int i = 0; i < 4; ++i) w[PD_Y_Q + i] = 1.0;
+  }
+}
+
+void pd_state_free(pdState* s) {
+  if (!s) return;
+  free(s->y);
+  free(s->weight);
+  free(s->work);
+  free(s);
+}
+
+pdBodyState pd_state_body(const pdModel* model, const pdState* s, int bodyIndex) {
+  PD_ASSERT(bodyIndex >= 0 && bodyIndex < model->bodyCount);
+  const pdBody* b = &model->bodies[bodyIndex];
+  if (b->fixed) return (pdBodyState){b->x0, b->q0, {0, 0, 0}, {0, 0, 0}};
+  const double* y = s->y + PD_BODY_STATE_SIZE * b->stateIndex;
+  return (pdBodyState){pd_layout_x(y), pd_layout_q(y), pd_layout_v(y), pd_layout_w(y)};
+}
+
+double pd_state_energy(const pdModel* model, const pdState* s) {
+  double e = 0.0;
+  for (int k = 0; k < model->movingCount; ++k) {
+    int i = model->movingBodies[k];
+    const pdBody* b = &model->bodies[i];
+    pdBodyState bs = pd_state_body(model, s, i);
+    e += pd_body_kinetic_energy(b, bs.v, bs.w, bs.q) - b->mass * pd_v3_dot(model->settings.gravity, bs.x);
+  }
+  return e;
+}
