@@ -123,6 +123,12 @@ int pd_cmd_run(int argc, char** argv) {
     mkdir("out", 0777);  // may exist already; a real failure shows when the run directory is made
     out = defaultOut;
   }
+  // from here on an interrupt must remove the partial directory, so catch it before making one
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
   pdError err = {0};
   pdRunWriter* writer = pd_run_open(out, model, &err);
   if (!writer) {
@@ -131,12 +137,6 @@ int pd_cmd_run(int argc, char** argv) {
     pd_model_free(model);
     return PD_EXIT_BAD_INPUT;
   }
-
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
 
   pdState* state = pd_state_create(model);
   state->stepper = stepper;

@@ -336,7 +336,7 @@ static bool number(Parser* ps, const Token* t, const char* what, double* out) {
 typedef enum Range { range_any, range_pos, range_nonneg, range_open01, range_half01, range_closed01, range_mu } Range;
 
 static bool ranged(Parser* ps, const Token* t, const char* what, Range r, double* out) {
-  double v;
+  double v = 0.0;
   if (!number(ps, t, what, &v)) return false;
   const char* need = NULL;
   switch (r) {
@@ -357,7 +357,7 @@ static bool ranged(Parser* ps, const Token* t, const char* what, Range r, double
 }
 
 static bool size_arg(Parser* ps, const Token* t, double* out) {
-  double v;
+  double v = 0.0;
   if (!ranged(ps, t, "size", range_pos, &v)) return false;
   if (v > MAX_SIZE) {
     char buf[SHOWN_BUF];
@@ -521,7 +521,7 @@ static bool hull_command(Parser* ps) {
       fail(ps, t[3].loc, "hull has more than %d points", PD_HULL_MAX_POINTS);
       goto refuse;
     }
-    double v;
+    double v = 0.0;
     if (!number(ps, &t[3], "hull coordinate", &v)) goto refuse;
     if (fabs(v) > MAX_SIZE) {
       char buf[SHOWN_BUF];

@@ -39,11 +39,10 @@ typedef struct pdPolyhedron {
 
 // Geometric tolerances, relative to the polyhedron's size (largest vertex distance from the
 // vertex average), with the reason for each.
-// Coplanar facets: qhull's merged facets and our own checks agree to this; below it two adjacent
-// facets are one face, since a dihedral angle this close to 180° carries no contact information.
+// Coplanar facets: qhull pre-merges facets within this distance of a neighbour's plane, and the
+// validation checks planarity to it; a dihedral angle this close to 180° carries no contact
+// information, and points this close together become one vertex.
 #define PD_PLANARITY_TOL_REL 1e-9
-// Points of a hull closer than this are one vertex (relative): qhull would merge them anyway.
-#define PD_DUPLICATE_POINT_TOL_REL 1e-12
 
 // Builds the convex hull of `count` points (xyz triples) with qhull. Returns false and fills
 // `why` (a short phrase, e.g. "the points are coplanar") when the hull is degenerate (fewer than 4

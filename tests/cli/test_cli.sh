@@ -1,0 +1,209 @@
+#!/usr/bin/env bash
+# End-to-end tests of the polydyn command (DESIGN §4.2, §4.3): help and usage errors, the run
+# directory (format, atomicity, determinism, replacement), bad scenes, overrides, interruption, check.
+#
+# usage: test_cli.sh POLYDYN_BINARY PROJECT_SOURCE_DIR
+set -u
+
+if [ $# -ne 2 ]; then
+  echo "usage: $0 POLYDYN_BINARY PROJECT_SOURCE_DIR" >&2
+  exit 2
+fi
+PD=$1
+SRC=$2
+DEMO=$SRC/cases/examples/demo.scene
+HEADER='t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz'
+
+SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_cli.XXXXXX") || exit 1
+trap 'rm -rf "$SCRATCH"' EXIT
+
+passed=0
+failed=0
+# check NAME CONDITION...: evaluates the condition (a shell command) and counts the result.
+check() {
+  local name=$1
+  shift
+  if eval "$@"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAIL: $name  [$*]"
+  fi
+}
+
+# run_pd OUT ERR ARGS...: runs polydyn with stdout/stderr to files; the exit status goes to $rc.
+run_pd() {
+  local out=$1 err=$2
+  shift 2
+  "$PD" "$@" >"$out" 2>"$err"
+  rc=$?
+}
+
+no_partial() { ! compgen -G "$1.partial-*" >/dev/null && ! compgen -G "$1.old-*" >/dev/null; }
+# message_at FILE ERRFILE line|file: the message starts with `FILE:LINE:COL: ` (line) or `FILE: ` (file)
+message_at() {
+  local text rest
+  text=$(cat "$2")
+  rest=${text#"$1":}
+  [ "$rest" != "$text" ] || return 1
+  if [ "$3" = line ]; then [[ $rest =~ ^[0-9]+:[0-9]+:\  ]]; else [[ $rest == " "* ]]; fi
+}
+line_count() { wc -l <"$1" | tr -d ' '; }
+# summary.json without its "timing" object (the only part allowed to differ between two runs)
+summary_without_timing() {
+  python3 -c 'import json, sys
+d = json.load(open(sys.argv[1]))
+d.pop("timing")
+print(json.dumps(d, sort_keys=True))' "$1"
+}
+
+OUT=$SCRATCH/stdout
+ERR=$SCRATCH/stderr
+
+# --- help and usage errors ----------------------------------------------------------------------
+run_pd "$OUT" "$ERR" --help
+check "polydyn --help exits 0" '[ $rc -eq 0 ]'
+check "polydyn --help prints usage" 'grep -q "^usage: polydyn" "$OUT"'
+run_pd "$OUT" "$ERR" run --help
+check "run --help exits 0" '[ $rc -eq 0 ]'
+check "run --help prints usage" 'grep -q "^usage: polydyn run" "$OUT"'
+run_pd "$OUT" "$ERR" check --help
+check "check --help exits 0" '[ $rc -eq 0 ]'
+check "check --help prints usage" 'grep -q "^usage: polydyn check" "$OUT"'
+run_pd "$OUT" "$ERR" frobnicate
+check "unknown command exits 2" '[ $rc -eq 2 ]'
+check "unknown command is named on stderr" 'grep -q "frobnicate" "$ERR"'
+run_pd "$OUT" "$ERR" run "$DEMO" --frobnicate
+check "unknown run option exits 2" '[ $rc -eq 2 ]'
+check "unknown run option is named on stderr" 'grep -q -- "--frobnicate" "$ERR"'
+run_pd "$OUT" "$ERR" check "$DEMO" --frobnicate
+check "unknown check option exits 2" '[ $rc -eq 2 ]'
+run_pd "$OUT" "$ERR"
+check "no command exits 2" '[ $rc -eq 2 ]'
+
+# --- a run of the demo -----------------------------------------------------------------------------
+RUN1=$SCRATCH/run1
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN1"
+check "demo run exits 0" '[ $rc -eq 0 ]'
+check "demo run has trajectory.csv" '[ -f "$RUN1/trajectory.csv" ]'
+check "demo run has summary.json" '[ -f "$RUN1/summary.json" ]'
+check "trajectory header is exact" '[ "$(head -n 1 "$RUN1/trajectory.csv")" = "$HEADER" ]'
+# demo: tend 1, sample 100 -> 101 samples; 3 moving bodies (the floor is fixed)
+check "trajectory has samples x moving bodies rows" '[ "$(line_count "$RUN1/trajectory.csv")" -eq $((1 + 101 * 3)) ]'
+check "trajectory rows have 15 fields" \
+  '[ "$(tail -n +2 "$RUN1/trajectory.csv" | awk -F, "NF != 15" | wc -l)" -eq 0 ]'
+check "trajectory lists bodies in scene order" \
+  '[ "$(sed -n "2,4p" "$RUN1/trajectory.csv" | cut -d, -f2 | tr "\n" " ")" = "box cone ball " ]'
+check "last sample is at t = 1" '[ "$(tail -n 1 "$RUN1/trajectory.csv" | cut -d, -f1)" = "1" ]'
+check "summary.json is valid JSON" 'python3 -m json.tool "$RUN1/summary.json" >/dev/null'
+check "no leftover partial directory" 'no_partial "$RUN1"'
+
+# --- determinism -------------------------------------------------------------------------------
+RUN2=$SCRATCH/run2
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN2"
+check "second demo run exits 0" '[ $rc -eq 0 ]'
+check "two runs give identical trajectory bytes" 'cmp -s "$RUN1/trajectory.csv" "$RUN2/trajectory.csv"'
+check "two runs give identical summaries apart from timing" \
+  '[ "$(summary_without_timing "$RUN1/summary.json")" = "$(summary_without_timing "$RUN2/summary.json")" ]'
+has_timing() { python3 -c 'import json, sys; sys.exit(0 if "timing" in json.load(open(sys.argv[1])) else 1)' "$1"; }
+check "summary has a timing object" 'has_timing "$RUN1/summary.json"'
+
+# --- bad scenes --------------------------------------------------------------------------------
+BAD=$SCRATCH/bad
+mkdir "$BAD"
+printf 'frob 1 2 3\n' >"$BAD/unknown_command.scene"
+printf 'cube a red 1 1\n' >"$BAD/wrong_arity.scene"
+printf 'cube a red 1 1 1\nloc 0 0\n' >"$BAD/wrong_property_arity.scene"
+printf 'cube a red 1 nan 1\n' >"$BAD/nan.scene"
+printf 'cube a red 1 1 1\nvel 0 0 inf\n' >"$BAD/infinite.scene"
+printf 'tend abc\ncube a red 1 1 1\n' >"$BAD/not_a_number.scene"
+printf 'cube a red 1 -1 1\n' >"$BAD/negative_size.scene"
+printf 'tol 0\ncube a red 1 1 1\n' >"$BAD/out_of_range.scene"
+printf 'loc 0 0 0\ncube a red 1 1 1\n' >"$BAD/property_before_object.scene"
+printf 'cube a red 1 1 1\ncube a blue 1 1 1\nloc 3 0 0\n' >"$BAD/duplicate_name.scene"
+printf 'hull h red 0 0 0  1 0 0  0 1 0  1 1 0\n' >"$BAD/coplanar_hull.scene"
+printf '# nothing here\n' >"$BAD/no_object.scene"
+head -c 4096 "$PD" >"$BAD/binary.scene"
+mkdir "$BAD/directory.scene"
+
+for scene in "$BAD"/*.scene "$BAD/missing.scene"; do
+  name=$(basename "$scene" .scene)
+  dir=$SCRATCH/out_$name
+  run_pd "$OUT" "$ERR" run "$scene" --out "$dir"
+  check "$name: exit 2" '[ $rc -eq 2 ]'
+  check "$name: exactly one line on stderr" '[ "$(line_count "$ERR")" -eq 1 ]'
+  case $name in
+    missing | directory | no_object) check "$name: message is FILE: ..." 'message_at "$scene" "$ERR" file' ;;
+    *) check "$name: message is FILE:LINE:COL: ..." 'message_at "$scene" "$ERR" line' ;;
+  esac
+  check "$name: nothing written" '[ ! -e "$dir" ] && no_partial "$dir"'
+done
+
+# --- overrides ---------------------------------------------------------------------------------
+RUN3=$SCRATCH/run3
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN3" --tend 0.5 --sample 10
+check "--tend 0.5 --sample 10 exits 0" '[ $rc -eq 0 ]'
+check "--tend 0.5 --sample 10 gives 6 samples per body" \
+  '[ "$(tail -n +2 "$RUN3/trajectory.csv" | awk -F, "\$2 == \"box\"" | wc -l)" -eq 6 ]'
+check "--tend 0.5 --sample 10 gives 6 x 3 rows" '[ "$(line_count "$RUN3/trajectory.csv")" -eq $((1 + 6 * 3)) ]'
+# k / 10 printed with %.17g
+TIMES="0 0.10000000000000001 0.20000000000000001 0.29999999999999999 0.40000000000000002 0.5 "
+sample_times() { tail -n +2 "$1" | cut -d, -f1 | uniq | tr "\n" " "; }
+check "samples at 0, 0.1, ..., 0.5" '[ "$(sample_times "$RUN3/trajectory.csv")" = "$TIMES" ]'
+for bad in "--tend abc" "--tend -1" "--tend nan" "--sample 0" "--tend"; do
+  dir=$SCRATCH/out_badopt
+  # shellcheck disable=SC2086
+  run_pd "$OUT" "$ERR" run "$DEMO" --out "$dir" $bad
+  check "run $bad exits 2" '[ $rc -eq 2 ]'
+  check "run $bad writes nothing" '[ ! -e "$dir" ] && no_partial "$dir"'
+done
+
+# --- output directory rules ----------------------------------------------------------------------
+KEEP=$SCRATCH/not_a_run
+mkdir "$KEEP"
+echo "precious" >"$KEEP/notes.txt"
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$KEEP"
+check "existing non-run directory is refused with 2" '[ $rc -eq 2 ]'
+check "refused directory is left untouched" \
+  '[ "$(ls -A "$KEEP")" = "notes.txt" ] && [ "$(cat "$KEEP/notes.txt")" = "precious" ]'
+check "refused directory: no partial left" 'no_partial "$KEEP"'
+echo "x" >"$SCRATCH/a_file"
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$SCRATCH/a_file"
+check "existing file as --out is refused with 2" '[ $rc -eq 2 ] && [ "$(cat "$SCRATCH/a_file")" = "x" ]'
+
+touch "$RUN3/stale-marker"
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN3"
+check "existing run directory is replaced (exit 0)" '[ $rc -eq 0 ]'
+check "replaced run directory holds the new run" '[ "$(line_count "$RUN3/trajectory.csv")" -eq $((1 + 101 * 3)) ]'
+check "replaced run directory lost the old contents" '[ ! -e "$RUN3/stale-marker" ]'
+check "replaced run directory: no partial or old copy left" 'no_partial "$RUN3"'
+
+# --- interruption --------------------------------------------------------------------------------
+# ~15 s of work (1e7 steps of 10 µs), 100 samples per simulated second so SIGINT is seen at once
+LONG=$SCRATCH/long.scene
+printf 'gravity 0 0 -9.81\ntend 100\ntol 1e-12\ndt 1e-5\ndtmax 1e-5\nsample 100\n%s\n%s\n' \
+  'cube box red 0.1 0.2 0.3' 'vel 1 0 2  720 1 2 3' >"$LONG"
+INT=$SCRATCH/interrupted
+"$PD" run "$LONG" --out "$INT" >"$OUT" 2>"$ERR" &
+pid=$!
+sleep 0.5
+kill -INT "$pid"
+wait "$pid"
+rc=$?
+check "SIGINT exits 130" '[ $rc -eq 130 ]'
+check "SIGINT says nothing was written" 'grep -q "interrupted" "$ERR"'
+check "SIGINT leaves no directory" '[ ! -e "$INT" ] && no_partial "$INT"'
+
+# --- check ---------------------------------------------------------------------------------------
+run_pd "$OUT" "$ERR" check "$DEMO"
+check "check demo exits 0" '[ $rc -eq 0 ]'
+check "check prints each body's mass" '[ "$(grep -c "^    mass " "$OUT")" -eq 4 ]'
+check "check prints the box's mass (0.2 x 0.3 x 0.4 x 1000 = 24 kg)" 'grep -q "^    mass            24 kg" "$OUT"'
+check "check prints V=8 E=12 F=6 for a cube" '[ "$(grep -c "V=8 E=12 F=6" "$OUT")" -eq 2 ]'
+check "check names every body" \
+  'grep -q "^  floor: " "$OUT" && grep -q "^  box: " "$OUT" && grep -q "^  cone: " "$OUT" && grep -q "^  ball: " "$OUT"'
+run_pd "$OUT" "$ERR" check "$BAD/coplanar_hull.scene"
+check "check on a bad scene exits 2" '[ $rc -eq 2 ]'
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
