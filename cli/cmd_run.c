@@ -59,6 +59,18 @@ static bool observe(const pdModel* model, const pdState* state, void* user) {
   return !interrupted;
 }
 
+// mkdir -p of the directories above `path`; a real failure shows when the run directory is made
+static void make_parents(const char* path) {
+  char* p = strdup(path);
+  if (!p) abort();
+  for (char* slash = strchr(p + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
+    *slash = '\0';
+    mkdir(p, 0777);
+    *slash = '/';
+  }
+  free(p);
+}
+
 // out/NAME for scene path .../NAME.ext
 static char* default_out_dir(const char* scene) {
   const char* base = strrchr(scene, '/');
@@ -120,9 +132,9 @@ int pd_cmd_run(int argc, char** argv) {
   char* defaultOut = NULL;
   if (!out) {
     defaultOut = default_out_dir(scene);
-    mkdir("out", 0777);  // may exist already; a real failure shows when the run directory is made
     out = defaultOut;
   }
+  make_parents(out);
   // from here on an interrupt must remove the partial directory, so catch it before making one
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);

@@ -98,6 +98,12 @@ check "last sample is at t = 1" '[ "$(tail -n 1 "$RUN1/trajectory.csv" | cut -d,
 check "summary.json is valid JSON" 'python3 -m json.tool "$RUN1/summary.json" >/dev/null'
 check "no leftover partial directory" 'no_partial "$RUN1"'
 
+NESTED=$SCRATCH/not/yet/there
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$NESTED" --tend 0.1
+check "run creates missing parent directories of --out" '[ $rc -eq 0 ] && [ -f "$NESTED/summary.json" ]'
+(cd "$SCRATCH" && "$PD" run "$DEMO" --tend 0.1 >/dev/null 2>&1)
+check "run without --out writes out/NAME in the working directory" '[ -f "$SCRATCH/out/demo/summary.json" ]'
+
 # --- determinism -------------------------------------------------------------------------------
 RUN2=$SCRATCH/run2
 run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN2"
