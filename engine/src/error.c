@@ -1,5 +1,6 @@
 // polydyn — errors of bad input: a location and a one-line message in fixed buffers.
 #include "polydyn/error.h"
+#include "why.h"
 
 #include <stdarg.h>
 #include <string.h>
@@ -49,4 +50,12 @@ void pd_error_print(const pdError* err, FILE* out) {
   } else {
     fprintf(out, "%s%s%d:%d: %s\n", err->file, sep, err->line, err->col, err->message);
   }
+}
+
+void pd_why(char* why, int whySize, const char* fmt, ...) {
+  if (!why || whySize <= 0) return;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(why, (size_t)whySize, fmt, ap);
+  va_end(ap);
 }

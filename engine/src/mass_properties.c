@@ -9,20 +9,12 @@
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "polydyn/polyhedron.h"
+#include "why.h"
 
-static void say(char* why, int whySize, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
-static void say(char* why, int whySize, const char* fmt, ...) {
-  if (!why || whySize <= 0) return;
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(why, (size_t)whySize, fmt, ap);
-  va_end(ap);
-}
 
 static void add_outer(double m[3][3], pdVec3 a, double s) {
   const double v[3] = {a.x, a.y, a.z};
@@ -91,7 +83,7 @@ bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties*
   }
   double volume = volume6 / 6.0;
   if (!(volume > 0.0) || !isfinite(volume)) {
-    say(why, whySize, "volume is not positive (%g m^3)", volume);
+    pd_why(why, whySize, "volume is not positive (%g m^3)", volume);
     return false;
   }
   pdVec3 offset = pd_v3_scale(first24, 1.0 / (24.0 * volume));  // centroid - r
@@ -114,7 +106,7 @@ bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties*
   bool ok = principal_axes(&out->inertia, out->principal, &out->principalAxes);
   gsl_set_error_handler(previous);
   if (!ok || !(out->principal[0] > 0.0)) {
-    say(why, whySize, "inertia tensor is not positive definite");
+    pd_why(why, whySize, "inertia tensor is not positive definite");
     return false;
   }
   return true;

@@ -13,19 +13,12 @@
 
 #include <libqhull_r/qhull_ra.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static void say(char* why, int whySize, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
-static void say(char* why, int whySize, const char* fmt, ...) {
-  if (!why || whySize <= 0) return;
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(why, (size_t)whySize, fmt, ap);
-  va_end(ap);
-}
+#include "why.h"
+
 
 static void* xcalloc(size_t n, size_t size) {
   void* p = calloc(n ? n : 1, size);
@@ -133,7 +126,7 @@ static bool pair_edges(const pdPolyhedron* p, pdEdge* edges, int* edgeCount, cha
     while (j < total && (h[j].a == h[i].a || h[j].a == h[i].b) && (h[j].b == h[i].a || h[j].b == h[i].b)) ++j;
     const halfEdge* fwd = &h[i];
     if (j - i != 2 || fwd->a == fwd->b || !(fwd->a < fwd->b && h[i + 1].a == fwd->b)) {
-      say(why, whySize, "edge %d-%d is not shared by exactly two faces walking it in opposite directions", fwd->a,
+      pd_why(why, whySize, "edge %d-%d is not shared by exactly two faces walking it in opposite directions", fwd->a,
           fwd->b);
       ok = false;
       break;
@@ -228,7 +221,7 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
   int at = 0;
   for (int f = 0; f < faceCount; ++f) {
     if (faces[f].count < 3) {
-      say(why, whySize, "a face has fewer than 3 corners (degenerate hull)");
+      pd_why(why, whySize, "a face has fewer than 3 corners (degenerate hull)");
       pd_polyhedron_free(out);
       return false;
     }
@@ -269,12 +262,12 @@ static double points_size(const double* points, int count) {
 bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char* why, int whySize) {
   memset(out, 0, sizeof *out);
   if (count < 4) {
-    say(why, whySize, "a hull needs at least 4 points, got %d", count);
+    pd_why(why, whySize, "a hull needs at least 4 points, got %d", count);
     return false;
   }
   for (int i = 0; i < 3 * count; ++i)
     if (!isfinite(points[i])) {
-      say(why, whySize, "a hull point is not finite");
+      pd_why(why, whySize, "a hull point is not finite");
       return false;
     }
 
@@ -301,7 +294,7 @@ bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char
     fflush(errfile);
     const char* text = messages ? messages : "";
     const char* code = strstr(text, "QH");
-    say(why, whySize, "degenerate hull: the points are coplanar, collinear or coincident (qhull %.6s)",
+    pd_why(why, whySize, "degenerate hull: the points are coplanar, collinear or coincident (qhull %.6s)",
         code ? code : "error");
   } else {
     // vertices in input order: mark which input points are hull vertices
@@ -435,11 +428,11 @@ static int side_position(const pdPolyhedron* p, int f, int a, int b) {
 
 bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
   if (p->vertexCount < 4 || p->faceCount < 4) {
-    say(why, whySize, "too few vertices or faces (V=%d, F=%d)", p->vertexCount, p->faceCount);
+    pd_why(why, whySize, "too few vertices or faces (V=%d, F=%d)", p->vertexCount, p->faceCount);
     return false;
   }
   if (p->vertexCount - p->edgeCount + p->faceCount != 2) {
-    say(why, whySize, "Euler characteristic V-E+F = %d, not 2", p->vertexCount - p->edgeCount + p->faceCount);
+    pd_why(why, whySize, "Euler characteristic V-E+F = %d, not 2", p->vertexCount - p->edgeCount + p->faceCount);
     return false;
   }
   pdVec3 centre = vertex_average(p->vertices, p->vertexCount);
@@ -450,13 +443,13 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
     const pdFace* face = &p->faces[f];
     const int* idx = p->faceVertices + face->first;
     if (face->count < 3 || fabs(pd_v3_norm(face->normal) - 1.0) > 1e-12) {
-      say(why, whySize, "face %d has %d vertices or a non-unit normal", f, face->count);
+      pd_why(why, whySize, "face %d has %d vertices or a non-unit normal", f, face->count);
       ok = false;
       break;
     }
     for (int i = 0; ok && i < face->count; ++i) {
       if (idx[i] < 0 || idx[i] >= p->vertexCount) {
-        say(why, whySize, "face %d refers to a vertex out of range", f);
+        pd_why(why, whySize, "face %d refers to a vertex out of range", f);
         ok = false;
         break;
       }
@@ -464,23 +457,23 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
       pdVec3 a = p->vertices[idx[i]], b = p->vertices[idx[(i + 1) % face->count]],
              c = p->vertices[idx[(i + 2) % face->count]];
       if (fabs(pd_v3_dot(face->normal, a) - face->offset) > tol) {
-        say(why, whySize, "face %d is not planar", f);
+        pd_why(why, whySize, "face %d is not planar", f);
         ok = false;
       } else if (pd_v3_dot(pd_v3_cross(pd_v3_sub(b, a), pd_v3_sub(c, b)), face->normal) <= 0.0) {
-        say(why, whySize, "face %d is not convex and counter-clockwise seen from outside", f);
+        pd_why(why, whySize, "face %d is not convex and counter-clockwise seen from outside", f);
         ok = false;
       }
     }
     // every vertex of the body lies behind every face plane
     for (int v = 0; ok && v < p->vertexCount; ++v)
       if (pd_v3_dot(face->normal, p->vertices[v]) > face->offset + tol) {
-        say(why, whySize, "not convex: vertex %d lies outside face %d", v, f);
+        pd_why(why, whySize, "not convex: vertex %d lies outside face %d", v, f);
         ok = false;
       }
   }
   for (int v = 0; ok && v < p->vertexCount; ++v)
     if (faceUses[v] < 3) {
-      say(why, whySize, "vertex %d belongs to %d faces (needs at least 3)", v, faceUses[v]);
+      pd_why(why, whySize, "vertex %d belongs to %d faces (needs at least 3)", v, faceUses[v]);
       ok = false;
     }
   free(faceUses);
@@ -488,7 +481,7 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
     int edgeCount = 0;
     ok = pair_edges(p, NULL, &edgeCount, why, whySize);
     if (ok && edgeCount != p->edgeCount) {
-      say(why, whySize, "edge list has %d edges, faces imply %d", p->edgeCount, edgeCount);
+      pd_why(why, whySize, "edge list has %d edges, faces imply %d", p->edgeCount, edgeCount);
       ok = false;
     }
   }
@@ -507,7 +500,7 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
         back = side_position(p, edge->f[1], edge->v[1], edge->v[0]);
       }
       if (fwd < 0 || back < 0 || listed[fwd] || listed[back]) {
-        say(why, whySize, "edge %d is not walked v0->v1 by its face f0 and v1->v0 by f1, or is listed twice", e);
+        pd_why(why, whySize, "edge %d is not walked v0->v1 by its face f0 and v1->v0 by f1, or is listed twice", e);
         ok = false;
       } else {
         listed[fwd] = listed[back] = 1;
@@ -519,7 +512,7 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
     const pdEdge* edge = &p->edges[e];
     pdVec3 n0 = p->faces[edge->f[0]].normal, n1 = p->faces[edge->f[1]].normal;
     if (pd_v3_norm(pd_v3_cross(n0, n1)) <= PD_PLANARITY_TOL_REL && pd_v3_dot(n0, n1) > 0.0) {
-      say(why, whySize, "faces %d and %d are coplanar neighbours", edge->f[0], edge->f[1]);
+      pd_why(why, whySize, "faces %d and %d are coplanar neighbours", edge->f[0], edge->f[1]);
       ok = false;
     }
   }

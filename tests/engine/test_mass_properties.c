@@ -12,6 +12,8 @@
 
 #include <cmocka.h>
 
+#include "test_random.h"
+
 #include "polydyn/model.h"
 #include "polydyn/polyhedron.h"
 #include "polydyn/scene.h"
@@ -55,17 +57,6 @@ static void mass_of(const pdPolyhedron* p, double density, pdMassProperties* mp)
   if (!pd_mass_properties(p, density, mp, why, sizeof why)) fail_msg("pd_mass_properties: %s", why);
 }
 
-// Fixed-seed linear congruential generator (Knuth's MMIX constants): reproducible on every libc.
-typedef struct lcg {
-  uint64_t s;
-} lcg;
-
-static double lcg_uniform(lcg* g) {  // [0, 1)
-  g->s = g->s * 6364136223846793005ULL + 1442695040888963407ULL;
-  return (double)(g->s >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static double lcg_range(lcg* g, double lo, double hi) { return lo + (hi - lo) * lcg_uniform(g); }
 
 // Points on (every third) and inside the ball of radius 0.5, rejection-sampled from the cube.
 static void ball_points(double* pts, int n, uint64_t seed) {

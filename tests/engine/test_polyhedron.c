@@ -13,6 +13,8 @@
 
 #include <cmocka.h>
 
+#include "test_random.h"
+
 #include "polydyn/polyhedron.h"
 #include "polydyn/vecmath.h"
 
@@ -31,17 +33,6 @@
 
 // ---------------------------------------------------------------- helpers
 
-// Fixed-seed linear congruential generator (Knuth's MMIX constants): reproducible on every libc.
-typedef struct lcg {
-  uint64_t s;
-} lcg;
-
-static double lcg_uniform(lcg* g) {  // [0, 1)
-  g->s = g->s * 6364136223846793005ULL + 1442695040888963407ULL;
-  return (double)(g->s >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static double lcg_range(lcg* g, double lo, double hi) { return lo + (hi - lo) * lcg_uniform(g); }
 
 // Uniform direction by rejection from the cube [-1, 1]³.
 static pdVec3 lcg_direction(lcg* g) {
