@@ -1,0 +1,334 @@
+// polydyn — contact analysis: VF and EE contacts of two convex polyhedra (paper §4.4, App. C).
+//
+// Design note. Soft contacts are shallow (penetration of the order of δ_max, about 1 % of a body's
+// size), so every contact is a pair of features that have just crossed:
+// - VF: a vertex of one body strictly inside the other. Its face is the one it keeps from the
+//   previous contact state (face continuity, §4.4.3); a new one takes, among the faces whose polygon
+//   contains the vertex's projection, the one it penetrates least (the one it just crossed).
+// - EE: an edge of each body whose Gauss-map arcs cross (the pair spans a face of the Minkowski
+//   difference, so the plane through both edges supports both bodies), whose infinite lines have
+//   their closest points strictly inside both edges, and which have crossed (depth > 0). Parallel
+//   edges never form an EE contact: their overlap is carried by the VF contacts at their ends.
+// - Degenerate coincidences (a vertex of each body at the same point, e.g. equal cubes face on face)
+//   give two VF contacts at one place; the one whose vertex belongs to the higher-numbered body is
+//   dropped so the pair does not count double.
+// All geometry is done in the frame of the first body given, so a pair's result does not depend on
+// where it sits in the world.
+#include "contact_analysis.h"
+
+#include <math.h>
+#include <stddef.h>
+
+// Relative tolerance (× body size) of "on the boundary": a point this close outside a face plane or
+// a face polygon counts as on it, so roundoff neither breaks a vertex sliding exactly along an edge
+// nor loses a corner resting exactly on a corner.
+#define BOUNDARY_TOL_REL 1e-12
+// Edge pairs whose direction cross product is below this (sine of the angle) are parallel: their
+// closest points are not unique and the VF contacts at the edge ends carry the contact.
+#define PARALLEL_SINE_TOL 1e-9
+
+static pdVec3 to_world(const pdPose* p, pdVec3 local) { return pd_v3_add(p->x, pd_mat3_mulv(&p->R, local)); }
+static pdVec3 to_local(const pdPose* p, pdVec3 world) { return pd_mat3_tmulv(&p->R, pd_v3_sub(world, p->x)); }
+
+int pd_contact_id_compare(const pdContactId* a, const pdContactId* b) {
+  int alo = a->body1 < a->body2 ? a->body1 : a->body2, ahi = a->body1 < a->body2 ? a->body2 : a->body1;
+  int blo = b->body1 < b->body2 ? b->body1 : b->body2, bhi = b->body1 < b->body2 ? b->body2 : b->body1;
+  if (alo != blo) return alo < blo ? -1 : 1;
+  if (ahi != bhi) return ahi < bhi ? -1 : 1;
+  if (a->kind != b->kind) return a->kind < b->kind ? -1 : 1;
+  if (a->body1 != b->body1) return a->body1 < b->body1 ? -1 : 1;
+  if (a->feat1 != b->feat1) return a->feat1 < b->feat1 ? -1 : 1;
+  if (a->feat2 != b->feat2) return a->feat2 < b->feat2 ? -1 : 1;
+  return 0;
+}
+
+// Is the projection of q (body frame) onto face f's plane inside the face polygon?
+static bool projects_inside(const pdPolyhedron* s, int f, pdVec3 q, double tol) {
+  const pdFace* face = &s->faces[f];
+  const int* idx = s->faceVertices + face->first;
+  for (int i = 0; i < face->count; ++i) {
+    pdVec3 a = s->vertices[idx[i]], b = s->vertices[idx[(i + 1) % face->count]];
+    pdVec3 e = pd_v3_sub(b, a);
+    // inward side of edge a→b in a CCW polygon seen from outside is n × e; distance scaled by |e|
+    double side = pd_v3_dot(pd_v3_cross(face->normal, e), pd_v3_sub(q, a));
+    if (side < -tol * pd_v3_norm(e)) return false;
+  }
+  return true;
+}
+
+// Depth of point q (body frame) below face f's plane (> 0 inside the half-space).
+static double face_depth(const pdPolyhedron* s, int f, pdVec3 q) { return s->faces[f].offset - pd_v3_dot(s->faces[f].normal, q); }
+
+// Is q (body frame) inside the body or on its boundary?
+static bool inside_body(const pdPolyhedron* s, pdVec3 q, double tol) {
+  for (int f = 0; f < s->faceCount; ++f)
+    if (face_depth(s, f, q) < -tol) return false;
+  return true;
+}
+
+// The face a vertex keeps from the previous contact state, or -1.
+static int previous_face(const pdContactId* previous, int count, int vertexBody, int vertex, int faceBody) {
+  for (int i = 0; i < count; ++i) {
+    const pdContactId* c = &previous[i];
+    if (c->kind == pd_contactVF && c->body1 == vertexBody && c->feat1 == vertex && c->body2 == faceBody) return c->feat2;
+  }
+  return -1;
+}
+
+// VF contacts of the vertices of body iv inside body jf.
+static int find_vf(const pdModel* m, int iv, const pdPose* pv, int jf, const pdPose* pf, const pdContactId* previous,
+                   int previousCount, pdContactGeom* out, int capacity, int n) {
+  const pdPolyhedron* sv = &m->bodies[iv].shape;
+  const pdPolyhedron* sf = &m->bodies[jf].shape;
+  double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
+  for (int i = 0; i < sv->vertexCount; ++i) {
+    pdVec3 p = to_world(pv, sv->vertices[i]);
+    pdVec3 q = to_local(pf, p);
+    // penetration: the distance to the nearest face plane. A face whose plane the vertex lies on, at
+    // the edge of that face's polygon, does not count: the vertex sits on an edge of the other body
+    // (a corner resting exactly on a corner of an equal cube lies on the side planes) and what it
+    // presses on is the face it is behind. A vertex on a face's interior only touches: no contact.
+    double penetration = INFINITY;
+    bool outside = false;
+    for (int f = 0; f < sf->faceCount && !outside; ++f) {
+      double d = face_depth(sf, f, q);
+      outside = d < -tol;
+      if (fabs(d) <= tol && !projects_inside(sf, f, q, -tol)) continue;
+      penetration = fmin(penetration, d);
+    }
+    if (outside || !(penetration > tol)) continue;
+    int face = previous_face(previous, previousCount, iv, i, jf);
+    if (face < 0) {
+      // the face it crossed: the shallowest one with positive depth whose polygon is over the vertex
+      double best = INFINITY, bestAny = INFINITY;
+      int any = 0;
+      for (int f = 0; f < sf->faceCount; ++f) {
+        double d = face_depth(sf, f, q);
+        if (!(d > tol)) continue;
+        if (d < bestAny) bestAny = d, any = f;
+        if (d < best && projects_inside(sf, f, q, tol)) best = d, face = f;
+      }
+      if (face < 0) face = any;
+    }
+    if (n < capacity)
+      out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, face}, p, pd_mat3_mulv(&pf->R, sf->faces[face].normal),
+                               face_depth(sf, face, q)};
+    ++n;
+  }
+  return n;
+}
+
+// Closest points of the lines P + s u and Q + t v; false when (nearly) parallel.
+static bool line_closest(pdVec3 P, pdVec3 u, pdVec3 Q, pdVec3 v, double* s, double* t) {
+  pdVec3 w = pd_v3_sub(P, Q);
+  double a = pd_v3_dot(u, u), b = pd_v3_dot(u, v), c = pd_v3_dot(v, v), d = pd_v3_dot(u, w), e = pd_v3_dot(v, w);
+  double den = a * c - b * b;
+  if (den <= PARALLEL_SINE_TOL * PARALLEL_SINE_TOL * a * c) return false;
+  *s = (b * e - c * d) / den;
+  *t = (a * e - b * d) / den;
+  return true;
+}
+
+// Gauss-map test: do the arcs (a, b) and (c, d) on the unit sphere cross? a, b are the face normals
+// around an edge of one body; c, d the negated face normals around an edge of the other
+// (D. Gregorius, "The Separating Axis Test between Convex Polyhedra", GDC 2013).
+static bool arcs_cross(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d) {
+  pdVec3 bxa = pd_v3_cross(b, a), dxc = pd_v3_cross(d, c);
+  double cba = pd_v3_dot(c, bxa), dba = pd_v3_dot(d, bxa), adc = pd_v3_dot(a, dxc), bdc = pd_v3_dot(b, dxc);
+  return cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0;
+}
+
+// Edge-edge geometry in body A's frame: B's edge given in A's frame. Fills depth, point (A frame) and
+// the normal from B into A (A frame). Returns false for parallel edges, and, when `interior`, unless
+// the closest points of the two lines lie strictly inside both edges.
+typedef struct edgeGeom {
+  double depth;
+  pdVec3 point;
+  pdVec3 normal;
+} edgeGeom;
+
+static bool edge_pair_geometry(const pdPolyhedron* sa, int ea, pdVec3 b0, pdVec3 b1, bool interior, edgeGeom* g) {
+  const pdEdge* e = &sa->edges[ea];
+  pdVec3 a0 = sa->vertices[e->v[0]], a1 = sa->vertices[e->v[1]];
+  pdVec3 u = pd_v3_sub(a1, a0), v = pd_v3_sub(b1, b0);
+  double s, t;
+  if (!line_closest(a0, u, b0, v, &s, &t)) return false;
+  if (interior && !(s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0)) return false;
+  pdVec3 pa = pd_v3_muladd(a0, s, u), pb = pd_v3_muladd(b0, t, v);
+  // outward from A: the side of A's two face normals at this edge
+  pdVec3 n = pd_v3_normalize(pd_v3_cross(u, v));
+  pdVec3 outward = pd_v3_add(sa->faces[e->f[0]].normal, sa->faces[e->f[1]].normal);
+  if (pd_v3_dot(n, outward) < 0.0) n = pd_v3_scale(n, -1.0);
+  g->depth = pd_v3_dot(n, pd_v3_sub(pa, pb));
+  g->point = pd_v3_scale(pd_v3_add(pa, pb), 0.5);
+  g->normal = pd_v3_scale(n, -1.0);
+  return true;
+}
+
+static int find_ee(const pdModel* m, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
+                   int capacity, int n) {
+  const pdPolyhedron* sa = &m->bodies[ia].shape;
+  const pdPolyhedron* sb = &m->bodies[ib].shape;
+  // B in A's frame: rotation R_aᵀ R_b, translation R_aᵀ (x_b − x_a)
+  pdMat3 RaT = pd_mat3_transpose(&pa->R);
+  pdMat3 rel = pd_mat3_mul(&RaT, &pb->R);
+  pdVec3 off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
+  double tolA = BOUNDARY_TOL_REL * m->bodies[ia].size, tolB = BOUNDARY_TOL_REL * m->bodies[ib].size;
+  for (int j = 0; j < sb->edgeCount; ++j) {
+    const pdEdge* eb = &sb->edges[j];
+    pdVec3 b0 = pd_v3_add(off, pd_mat3_mulv(&rel, sb->vertices[eb->v[0]]));
+    pdVec3 b1 = pd_v3_add(off, pd_mat3_mulv(&rel, sb->vertices[eb->v[1]]));
+    pdVec3 c = pd_v3_scale(pd_mat3_mulv(&rel, sb->faces[eb->f[0]].normal), -1.0);
+    pdVec3 d = pd_v3_scale(pd_mat3_mulv(&rel, sb->faces[eb->f[1]].normal), -1.0);
+    for (int i = 0; i < sa->edgeCount; ++i) {
+      const pdEdge* ea = &sa->edges[i];
+      if (!arcs_cross(sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal, c, d)) continue;
+      edgeGeom g;
+      if (!edge_pair_geometry(sa, i, b0, b1, true, &g) || !(g.depth > 0.0)) continue;
+      // a crossing, not an antipodal Minkowski face: each edge's closest point is inside the other body
+      pdVec3 onA = pd_v3_sub(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on A's edge
+      pdVec3 onB = pd_v3_add(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on B's edge
+      if (!inside_body(sa, onB, tolA) || !inside_body(sb, pd_mat3_tmulv(&rel, pd_v3_sub(onA, off)), tolB)) continue;
+      if (n < capacity)
+        out[n] = (pdContactGeom){{ia, ib, pd_contactEE, i, j}, to_world(pa, g.point), pd_mat3_mulv(&pa->R, g.normal),
+                                 g.depth};
+      ++n;
+    }
+  }
+  return n;
+}
+
+// Drops VF contacts whose vertex belongs to the higher-numbered body when a VF contact of the other
+// direction sits at the same place (within twice the larger depth): one physical touch, counted once.
+static int drop_coincident(pdContactGeom* c, int count, int lowBody) {
+  int kept = 0;
+  for (int i = 0; i < count; ++i) {
+    bool drop = false;
+    if (c[i].id.kind == pd_contactVF && c[i].id.body1 != lowBody) {
+      for (int j = 0; j < count && !drop; ++j) {
+        if (c[j].id.kind != pd_contactVF || c[j].id.body1 != lowBody) continue;
+        double reach = 2.0 * fmax(c[i].depth, c[j].depth);
+        drop = pd_v3_norm(pd_v3_sub(c[i].point, c[j].point)) <= reach;
+      }
+    }
+    if (!drop) c[kept++] = c[i];
+  }
+  return kept;
+}
+
+int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
+                     const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity) {
+  PD_ASSERT(ia != ib && ia >= 0 && ib >= 0 && ia < model->bodyCount && ib < model->bodyCount);
+  if (ia > ib) {
+    const pdPose* tp = pa;
+    pa = pb, pb = tp;
+    int ti = ia;
+    ia = ib, ib = ti;
+  }
+  int n = 0;
+  n = find_vf(model, ia, pa, ib, pb, previous, previousCount, out, capacity, n);
+  n = find_vf(model, ib, pb, ia, pa, previous, previousCount, out, capacity, n);
+  n = find_ee(model, ia, pa, ib, pb, out, capacity, n);
+  if (n > capacity) return n;
+  n = drop_coincident(out, n, ia);
+  // the contact state is kept sorted by id (§4.4): sort this pair's contacts (few: insertion sort)
+  for (int i = 1; i < n; ++i) {
+    pdContactGeom key = out[i];
+    int j = i - 1;
+    while (j >= 0 && pd_contact_id_compare(&out[j].id, &key.id) > 0) {
+      out[j + 1] = out[j];
+      --j;
+    }
+    out[j + 1] = key;
+  }
+  return n;
+}
+
+// EE contact geometry of a known edge pair at the given poses, computed in body 1's frame.
+static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                         bool interior, pdContactGeom* out) {
+  const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
+  const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
+  pdMat3 R1T = pd_mat3_transpose(&p1->R);
+  pdMat3 rel = pd_mat3_mul(&R1T, &p2->R);
+  pdVec3 off = pd_mat3_mulv(&R1T, pd_v3_sub(p2->x, p1->x));
+  const pdEdge* e2 = &s2->edges[id->feat2];
+  pdVec3 b0 = pd_v3_add(off, pd_mat3_mulv(&rel, s2->vertices[e2->v[0]]));
+  pdVec3 b1 = pd_v3_add(off, pd_mat3_mulv(&rel, s2->vertices[e2->v[1]]));
+  edgeGeom g;
+  if (!edge_pair_geometry(s1, id->feat1, b0, b1, interior, &g)) return false;
+  out->id = *id;
+  out->point = to_world(p1, g.point);
+  out->normal = pd_mat3_mulv(&p1->R, g.normal);
+  out->depth = g.depth;
+  return true;
+}
+
+bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                      pdContactGeom* out) {
+  const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
+  const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
+  out->id = *id;
+  if (id->kind == pd_contactVF) {
+    // (18a) the vertex rides with body 1; (18b) the normal with body 2
+    pdVec3 p = to_world(p1, s1->vertices[id->feat1]);
+    pdVec3 q = to_local(p2, p);
+    out->point = p;
+    out->normal = pd_mat3_mulv(&p2->R, s2->faces[id->feat2].normal);
+    out->depth = face_depth(s2, id->feat2, q);
+    return projects_inside(s2, id->feat2, q, BOUNDARY_TOL_REL * model->bodies[id->body2].size);
+  }
+  return edge_contact(model, id, p1, p2, true, out);
+}
+
+// Smallest root of a t² + b t + c = 0 in [0, 1], or -1.
+static double first_root_in_unit(double a, double b, double c) {
+  double roots[2];
+  int count = 0;
+  if (fabs(a) <= 1e-12 * (fabs(b) + fabs(c))) {
+    if (b != 0.0) roots[count++] = -c / b;
+  } else {
+    double disc = b * b - 4.0 * a * c;
+    if (disc >= 0.0) {
+      // numerically stable pair
+      double qr = -0.5 * (b + copysign(sqrt(disc), b));
+      roots[count++] = qr / a;
+      if (qr != 0.0) roots[count++] = c / qr;
+    }
+  }
+  double best = -1.0;
+  for (int i = 0; i < count; ++i)
+    if (roots[i] >= 0.0 && roots[i] <= 1.0 && (best < 0.0 || roots[i] < best)) best = roots[i];
+  return best;
+}
+
+double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPose* body1Start,
+                        const pdPose* body1End, const pdPose* body2Start, const pdPose* body2End) {
+  if (id->kind == pd_contactVF) {
+    const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
+    const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
+    // App. C (23)–(25): vertex v, a point u of the face and its normal n move linearly over the step
+    pdVec3 v1 = to_world(body1Start, s1->vertices[id->feat1]), v2 = to_world(body1End, s1->vertices[id->feat1]);
+    pdVec3 faceLocal = s2->vertices[s2->faceVertices[s2->faces[id->feat2].first]];
+    pdVec3 u1 = to_world(body2Start, faceLocal), u2 = to_world(body2End, faceLocal);
+    pdVec3 n1 = pd_mat3_mulv(&body2Start->R, s2->faces[id->feat2].normal);
+    pdVec3 n2 = pd_mat3_mulv(&body2End->R, s2->faces[id->feat2].normal);
+    pdVec3 dn = pd_v3_sub(n2, n1), rel = pd_v3_sub(pd_v3_sub(v2, v1), pd_v3_sub(u2, u1)), w1 = pd_v3_sub(v1, u1);
+    double a = pd_v3_dot(dn, rel), b = pd_v3_dot(dn, w1) + pd_v3_dot(n1, rel), c = pd_v3_dot(n1, w1);
+    if (c <= 0.0) return 0.0;  // already on or behind the face plane at the start: virtual contact
+    double t = first_root_in_unit(a, b, c);
+    if (t >= 0.0) return t;
+    // the linear model has no crossing (large rotation over the step): interpolate the distances
+    double c2 = pd_v3_dot(n2, pd_v3_sub(v2, u2));
+    return c2 < 0.0 ? c / (c - c2) : 1.0;
+  }
+  // App. C (26): the signed distance between the two edge lines at the start and at the end of the
+  // step, each measured in the bodies' relative pose (the same as holding body 2 fixed)
+  pdContactGeom end, start;
+  if (!edge_contact(model, id, body1End, body2End, false, &end) ||
+      !edge_contact(model, id, body1Start, body2Start, false, &start))
+    return 0.0;  // parallel at one end of the step: no interpolation possible, take the contact as it is
+  double d1 = -start.depth, d2 = -end.depth;  // separations
+  if (d1 <= 0.0) return 0.0;
+  return d2 < 0.0 ? d1 / (d1 - d2) : 1.0;
+}

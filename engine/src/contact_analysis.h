@@ -1,0 +1,67 @@
+// polydyn (internal) — contact analysis (paper §4.4, App. C): which vertex–face (VF) and edge–edge
+// (EE) contacts two interfering convex polyhedra have, where, and when each began.
+//
+// Conventions
+// - Body 1 carries the vertex (VF) or the first edge (EE); body 2 carries the face or the second edge.
+// - The contact normal n is a unit vector pointing from body 2 into body 1: the face's outward normal
+//   for VF; for EE the edge cross product oriented away from body 2.
+// - depth > 0 means the features interpenetrate (the vertex is behind the face plane; the edges
+//   have crossed), in m.
+// - Poses map body frames to the world: x_world = x + R · x_body.
+#pragma once
+
+#include <stdbool.h>
+
+#include "polydyn/model.h"
+#include "polydyn/vecmath.h"
+
+typedef enum pdContactKind {
+  pd_contactVF = 0,
+  pd_contactEE = 1,
+} pdContactKind;
+
+// The paper's 6-tuple (§4.4): the two bodies, the kinds of their features, the feature indices.
+// VF: feat1 is a vertex of body1, feat2 a face of body2. EE: feat1, feat2 are edges, body1 < body2.
+typedef struct pdContactId {
+  int body1, body2;
+  pdContactKind kind;
+  int feat1, feat2;
+} pdContactId;
+
+typedef struct pdPose {
+  pdVec3 x;
+  pdMat3 R;
+} pdPose;
+
+typedef struct pdContactGeom {
+  pdContactId id;
+  pdVec3 point;   // world point of application: the vertex (VF); midpoint of the closest points (EE)
+  pdVec3 normal;  // unit, from body 2 into body 1
+  double depth;   // m, > 0 when interpenetrating
+} pdContactGeom;
+
+// Total order of contact ids: by the unordered body pair, then kind, then body1, feat1, feat2.
+int pd_contact_id_compare(const pdContactId* a, const pdContactId* b);
+
+// Appends to out[] (at most capacity) the contacts between bodies ia and ib in the given poses, and
+// returns how many there are (which may exceed capacity: the caller grows its buffer and retries).
+// A vertex already in contact with a face of the other body in `previous` (sorted, nullable) keeps
+// that face (face continuity, §4.4.3). Equal-feature duplicates (a vertex of each body at the same
+// point, as when equal cubes meet face to face) are reported once.
+int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
+                     const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity);
+
+// Geometry of one known contact at the given poses (tracking, §4.4.2): VF by (18), EE by the
+// closest points of the two edge lines. Returns false when the contact must break for geometric
+// reasons: the vertex projected onto the face plane leaves the face polygon, or an EE closest point
+// leaves its edge.
+bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                      pdContactGeom* out);
+
+// Onset of a contact found at the end of a step (App. C): the fraction δ ∈ [0, 1] of the step at
+// which the features first touched, given the poses of body 1 and body 2 at the start and the end
+// of the step. VF by the quadratic (24)–(25) with linearly interpolated vertex, face point and normal;
+// EE by the linear interpolation (26) of the edge-line distances in body 2's frame. Returns 0 when
+// the features were already touching at the start (a virtual contact, §4.4.3).
+double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPose* body1Start,
+                        const pdPose* body1End, const pdPose* body2Start, const pdPose* body2End);

@@ -1,0 +1,269 @@
+// Contact analysis (engine/src/contact_analysis.c): VF and EE contacts, face continuity, tracking
+// and geometric breaking, onset interpolation (paper §4.4, App. C).
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "contact_analysis.h"
+#include "polydyn/model.h"
+#include "polydyn/scene.h"
+
+// Geometry here is exact up to a few roundoffs of lengths of order 0.1 m.
+#define GEOM_TOL 1e-12
+// Penetration used in the scenes: a soft-contact-sized overlap (about 1e-3 of the body size).
+#define DEPTH 1e-4
+#define SIDE 0.1
+#define PI 3.14159265358979323846
+
+static pdModel* compile(const char* text) {
+  pdError err = {0};
+  pdScene* scene = pd_scene_parse_buffer("test.scene", text, strlen(text), &err);
+  if (!scene) fail_msg("parse: %s:%d:%d: %s", err.file, err.line, err.col, err.message);
+  pdModel* m = pd_model_compile(scene, &err);
+  pd_scene_free(scene);
+  if (!m) fail_msg("compile: %s", err.message);
+  return m;
+}
+
+static pdPose pose(double x, double y, double z, double angleDeg, pdVec3 axis) {
+  pdQuat q = angleDeg != 0.0 ? pd_quat_from_axis_angle(axis, angleDeg * PI / 180.0) : pd_quat_identity();
+  return (pdPose){{x, y, z}, pd_quat_to_mat3(q)};
+}
+
+static void expect_near(double actual, double expected, double tol, const char* what) {
+  if (!(fabs(actual - expected) <= tol)) fail_msg("%s: got %.17g, expected %.17g (tol %g)", what, actual, expected, tol);
+}
+
+enum { CAPACITY = 64 };
+
+// body 0: a fixed floor slab with its top face at z = 0; body 1: a cube of side 0.1
+static const char* const cubeOnFloor =
+    "cube floor grey 1 1 0.1\nfixed\nloc 0 0 -0.05\n"
+    "cube box red 0.1 0.1 0.1\n";
+
+static void test_cube_resting_on_floor_gives_four_vf_contacts_with_the_floor_normal(void** state) {
+  (void)state;
+  pdModel* m = compile(cubeOnFloor);
+  pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
+  pdPose box = pose(0.2, -0.1, SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &floor, 1, &box, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 4);
+  for (int i = 0; i < n; ++i) {
+    assert_int_equal(c[i].id.kind, pd_contactVF);
+    assert_int_equal(c[i].id.body1, 1);  // the cube's vertex
+    assert_int_equal(c[i].id.body2, 0);  // in the floor's face
+    expect_near(c[i].depth, DEPTH, GEOM_TOL, "depth");
+    expect_near(c[i].normal.z, 1.0, GEOM_TOL, "normal z");
+    expect_near(c[i].point.z, -DEPTH, GEOM_TOL, "point z");
+    expect_near(fabs(c[i].point.x - 0.2), SIDE / 2, GEOM_TOL, "corner x");
+    if (i > 0) assert_true(pd_contact_id_compare(&c[i - 1].id, &c[i].id) < 0);
+  }
+  // the same pair asked the other way round gives the same contacts
+  pdContactGeom d[CAPACITY];
+  assert_int_equal(pd_contacts_find(m, 1, &box, 0, &floor, NULL, 0, d, CAPACITY), 4);
+  for (int i = 0; i < 4; ++i) assert_int_equal(pd_contact_id_compare(&c[i].id, &d[i].id), 0);
+  pd_model_free(m);
+}
+
+static void test_separated_or_just_touching_bodies_have_no_contact(void** state) {
+  (void)state;
+  pdModel* m = compile(cubeOnFloor);
+  pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  pdPose above = pose(0, 0, SIDE / 2 + 1e-9, 0, pd_v3(0, 0, 1));
+  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &above, NULL, 0, c, CAPACITY), 0);
+  pdPose touching = pose(0, 0, SIDE / 2, 0, pd_v3(0, 0, 1));
+  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &touching, NULL, 0, c, CAPACITY), 0);
+  pd_model_free(m);
+}
+
+static void test_equal_cubes_face_on_face_count_each_corner_once(void** state) {
+  (void)state;
+  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  pdPose b = pose(0, 0, SIDE - DEPTH, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  // each corner is a vertex of both cubes: four physical touches, not eight; edges are parallel
+  assert_int_equal(n, 4);
+  for (int i = 0; i < n; ++i) {
+    assert_int_equal(c[i].id.kind, pd_contactVF);
+    assert_int_equal(c[i].id.body1, 0);
+    assert_true(isfinite(c[i].depth) && isfinite(c[i].normal.x) && isfinite(c[i].point.z));
+    expect_near(c[i].depth, DEPTH, GEOM_TOL, "depth");
+  }
+  pd_model_free(m);
+}
+
+// Cube a turned 45° about x has a top edge along x at height s/√2; cube b turned 45° about y has a
+// bottom edge along y. Crossed, they touch at one point: one EE contact.
+static void test_crossed_edges_give_one_ee_contact_with_the_crossing_depth(void** state) {
+  (void)state;
+  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  double h = SIDE / sqrt(2.0);
+  pdPose a = pose(0, 0, 0, 45, pd_v3(1, 0, 0));
+  pdPose b = pose(0, 0, 2 * h - DEPTH, 45, pd_v3(0, 1, 0));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 1);
+  assert_int_equal(c[0].id.kind, pd_contactEE);
+  assert_int_equal(c[0].id.body1, 0);
+  assert_int_equal(c[0].id.body2, 1);
+  expect_near(c[0].depth, DEPTH, GEOM_TOL, "depth");
+  // normal from body 2 (the upper cube) into body 1 (the lower): straight down
+  expect_near(c[0].normal.z, -1.0, GEOM_TOL, "normal z");
+  expect_near(c[0].point.x, 0.0, GEOM_TOL, "point x");
+  expect_near(c[0].point.y, 0.0, GEOM_TOL, "point y");
+  expect_near(c[0].point.z, h - DEPTH / 2, GEOM_TOL, "point z");
+  pd_model_free(m);
+}
+
+static void test_sliding_vertex_keeps_its_face_and_breaks_past_the_face_edge(void** state) {
+  (void)state;
+  // floor of two fixed prisms would be clearer, but one face suffices: a small cube slides on a
+  // fixed cube's top face; past the face's edge the vertex leaves the polygon
+  pdModel* m = compile("cube base grey 0.2 0.2 0.2\nfixed\ncube box red 0.1 0.1 0.1\n");
+  pdPose base = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  pdPose box = pose(0, 0, 0.1 + SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &base, 1, &box, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 4);
+  pdContactId ids[4];
+  for (int i = 0; i < 4; ++i) ids[i] = c[i].id;
+  int topFace = c[0].id.feat2;
+
+  // the vertex keeps its face while it stays over the face polygon
+  pdPose slid = pose(0.04, 0, 0.1 + SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
+  n = pd_contacts_find(m, 0, &base, 1, &slid, ids, 4, c, CAPACITY);
+  assert_int_equal(n, 4);
+  for (int i = 0; i < 4; ++i) assert_int_equal(c[i].id.feat2, topFace);
+  pdContactGeom g;
+  for (int i = 0; i < 4; ++i) assert_true(pd_contact_track(m, &ids[i], &slid, &base, &g));
+
+  // moved 0.06 m, the two leading vertices (x = 0.11) are past the face edge at x = 0.1
+  pdPose past = pose(0.06, 0, 0.1 + SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
+  int broken = 0;
+  for (int i = 0; i < 4; ++i) broken += !pd_contact_track(m, &ids[i], &past, &base, &g);
+  assert_int_equal(broken, 2);
+  pd_model_free(m);
+}
+
+static void test_vf_onset_interpolates_the_crossing_time(void** state) {
+  (void)state;
+  pdModel* m = compile(cubeOnFloor);
+  pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
+  double gap = 3e-4;
+  pdPose start = pose(0, 0, SIDE / 2 + gap, 0, pd_v3(0, 0, 1));
+  pdPose end = pose(0, 0, SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &floor, 1, &end, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 4);
+  // straight-line motion: the crossing is at gap / (gap + depth) of the step
+  double t = pd_contact_onset(m, &c[0].id, &start, &end, &floor, &floor);
+  expect_near(t, gap / (gap + DEPTH), 1e-12, "onset fraction");
+  // already penetrating at the start: a virtual contact, onset 0
+  assert_true(pd_contact_onset(m, &c[0].id, &end, &end, &floor, &floor) == 0.0);
+  pd_model_free(m);
+}
+
+// The face body turns during the step: the quadratic (24) puts the vertex on the interpolated face
+// plane at the returned time.
+static void test_vf_onset_with_a_turning_face_solves_the_quadratic(void** state) {
+  (void)state;
+  pdModel* m = compile("cube plate grey 0.4 0.4 0.02\ncube box red 0.1 0.1 0.1\n");
+  pdPose plateStart = pose(0, 0, -0.01, 0, pd_v3(0, 0, 1));
+  pdPose plateEnd = pose(0, 0, -0.01, 3, pd_v3(1, 0, 0));
+  pdPose boxStart = pose(0.05, 0.12, 0.05 + 1e-3, 0, pd_v3(0, 0, 1));
+  pdPose boxEnd = pose(0.05, 0.12, 0.05 + 2e-4, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &plateEnd, 1, &boxEnd, NULL, 0, c, CAPACITY);
+  assert_true(n >= 1);
+  const pdContactGeom* vf = NULL;
+  for (int i = 0; i < n; ++i)
+    if (c[i].id.kind == pd_contactVF && c[i].id.body1 == 1) vf = &c[i];
+  assert_non_null(vf);
+  double t = pd_contact_onset(m, &vf->id, &boxStart, &boxEnd, &plateStart, &plateEnd);
+  assert_true(t > 0.0 && t < 1.0);
+  // recompute (23) at t: n(t)·(v(t) − u(t)) = 0
+  const pdPolyhedron* box = &m->bodies[1].shape;
+  const pdPolyhedron* plate = &m->bodies[0].shape;
+  pdVec3 vl = box->vertices[vf->id.feat1];
+  pdVec3 ul = plate->vertices[plate->faceVertices[plate->faces[vf->id.feat2].first]];
+  pdVec3 nl = plate->faces[vf->id.feat2].normal;
+  pdVec3 v1 = pd_v3_add(boxStart.x, pd_mat3_mulv(&boxStart.R, vl)), v2 = pd_v3_add(boxEnd.x, pd_mat3_mulv(&boxEnd.R, vl));
+  pdVec3 u1 = pd_v3_add(plateStart.x, pd_mat3_mulv(&plateStart.R, ul)), u2 = pd_v3_add(plateEnd.x, pd_mat3_mulv(&plateEnd.R, ul));
+  pdVec3 n1 = pd_mat3_mulv(&plateStart.R, nl), n2 = pd_mat3_mulv(&plateEnd.R, nl);
+  pdVec3 vt = pd_v3_add(pd_v3_scale(v1, 1 - t), pd_v3_scale(v2, t));
+  pdVec3 ut = pd_v3_add(pd_v3_scale(u1, 1 - t), pd_v3_scale(u2, t));
+  pdVec3 nt = pd_v3_add(pd_v3_scale(n1, 1 - t), pd_v3_scale(n2, t));
+  expect_near(pd_v3_dot(nt, pd_v3_sub(vt, ut)), 0.0, 1e-15, "interpolated distance at onset");
+  pd_model_free(m);
+}
+
+static void test_ee_onset_interpolates_the_line_distance(void** state) {
+  (void)state;
+  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  double h = SIDE / sqrt(2.0), gap = 2e-4;
+  pdPose a = pose(0, 0, 0, 45, pd_v3(1, 0, 0));
+  pdPose bStart = pose(0, 0, 2 * h + gap, 45, pd_v3(0, 1, 0));
+  pdPose bEnd = pose(0, 0, 2 * h - DEPTH, 45, pd_v3(0, 1, 0));
+  pdContactGeom c[CAPACITY];
+  assert_int_equal(pd_contacts_find(m, 0, &a, 1, &bEnd, NULL, 0, c, CAPACITY), 1);
+  double t = pd_contact_onset(m, &c[0].id, &a, &a, &bStart, &bEnd);
+  expect_near(t, gap / (gap + DEPTH), 1e-12, "onset fraction");
+  pd_model_free(m);
+}
+
+static void test_vertex_on_vertex_and_parallel_edges_give_finite_contacts(void** state) {
+  (void)state;
+  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  // b balanced on a corner over a's top corner: b's body diagonal vertical
+  pdQuat tilt = pd_quat_mul(pd_quat_from_axis_angle(pd_v3(1, -1, 0), acos(1.0 / sqrt(3.0))), pd_quat_identity());
+  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  pdPose b = {{0.05, 0.05, 0.05 + SIDE * sqrt(3.0) / 2 - DEPTH}, pd_quat_to_mat3(tilt)};
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  assert_true(n >= 1 && n <= CAPACITY);
+  for (int i = 0; i < n; ++i)
+    assert_true(isfinite(c[i].depth) && pd_v3_isfinite(c[i].normal) && pd_v3_isfinite(c[i].point));
+  // edge on edge, parallel: two cubes side by side, one lifted to share an edge line
+  pdPose side = pose(SIDE - DEPTH, 0, SIDE - DEPTH, 0, pd_v3(0, 0, 1));
+  n = pd_contacts_find(m, 0, &a, 1, &side, NULL, 0, c, CAPACITY);
+  for (int i = 0; i < n; ++i) {
+    assert_int_equal(c[i].id.kind, pd_contactVF);
+    assert_true(isfinite(c[i].depth) && pd_v3_isfinite(c[i].normal));
+  }
+  pd_model_free(m);
+}
+
+static void test_small_capacity_reports_the_needed_count(void** state) {
+  (void)state;
+  pdModel* m = compile(cubeOnFloor);
+  pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
+  pdPose box = pose(0, 0, SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[2];
+  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &box, NULL, 0, c, 2), 4);
+  pd_model_free(m);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_cube_resting_on_floor_gives_four_vf_contacts_with_the_floor_normal),
+      cmocka_unit_test(test_separated_or_just_touching_bodies_have_no_contact),
+      cmocka_unit_test(test_equal_cubes_face_on_face_count_each_corner_once),
+      cmocka_unit_test(test_crossed_edges_give_one_ee_contact_with_the_crossing_depth),
+      cmocka_unit_test(test_sliding_vertex_keeps_its_face_and_breaks_past_the_face_edge),
+      cmocka_unit_test(test_vf_onset_interpolates_the_crossing_time),
+      cmocka_unit_test(test_vf_onset_with_a_turning_face_solves_the_quadratic),
+      cmocka_unit_test(test_ee_onset_interpolates_the_line_distance),
+      cmocka_unit_test(test_vertex_on_vertex_and_parallel_edges_give_finite_contacts),
+      cmocka_unit_test(test_small_capacity_reports_the_needed_count),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
