@@ -1,0 +1,67 @@
+// polydyn (internal) — the force of one contact and the rates of its springs (paper §3.1, eqs. (1)–(10),
+// §3.1.5 zero damping, §3.1.6 mixed dampers), and the realignment of its springs after a step (§3.4).
+//
+// Conventions
+// - Body 1 carries the vertex (VF contact) or the first edge (EE contact); body 2 carries the face (or the
+//   second edge).
+// - n is the unit contact normal pointing from body 2 into body 1 (for VF: the face's outward normal).
+//   P_t is the tangent plane, ⊥ n.
+// - Δu = u1 − u2 is the relative velocity of the contact point: body 1's material point minus body 2's.
+//   Δu_n = Δu · n < 0 is approach; Δu_t = Δu − Δu_n n.
+// - F_c is the force body 2 applies to body 1 (body 2 receives −F_c): F_c = F_n n + F_t.
+// - The normal springs are scalars along n with eq. (1): F_n = −k1n s1n − c1n ṡ1n = k2n s2n + c2n ṡ2n, so
+//   compression (F_n > 0) means s1n < 0 < s2n. ṡ1n − ṡ2n = Δu_n (eq. (4)).
+// - The tangential springs s1t, s2t are world-frame 3-vectors lying in P_t, eq. (2):
+//   F_t = −k1t s1t − c1t ṡ1t = k2t s2t + c2t ṡ2t, ṡ1t − ṡ2t = Δu_t − Δw_t, with Δw_t = w1 − w2 the slip
+//   velocity of the surface elements and the friction law (7): |F_t| ≤ μ F_n⁺, Δw_t = −λ F_t, λ ≥ 0, where
+//   F_n⁺ = max(F_n, 0) (no friction without a normal push). Keeping the two tangential springs as plane
+//   vectors is the paper's "spring along the slip direction" with its direction kept in the vector.
+// - Damper branches are chosen by exact zeros (c == 0.0); the caller decides thresholds (paper §3.4).
+// - Friction is modelled only when μ > 0 and there is a tangential spring (k1t + k2t > 0); otherwise
+//   F_t = 0 and the tangential rates are 0 (DESIGN §3.6: frictionless contacts carry no tangential springs,
+//   and the caller may skip their tangential state entirely).
+#pragma once
+
+#include <stdbool.h>
+
+#include "polydyn/vecmath.h"
+
+// Spring and damper constants of one contact (body 1 side, body 2 side) and the pair friction coefficient.
+typedef struct pdContactParams {
+  double k1n, k2n, k1t, k2t;  // N/m, >= 0
+  double c1n, c2n, c1t, c2t;  // N·s/m, >= 0; an exact 0 selects the zero-damping branch
+  double mu;                  // pair friction coefficient √(μ₁μ₂), >= 0
+} pdContactParams;
+
+// The 8 numbers of a contact in the state vector: spring deflections, m.
+typedef struct pdSprings {
+  double s1n, s2n;   // along n; compression: s1n <= 0 <= s2n
+  pdVec3 s1t, s2t;   // in P_t, world frame
+} pdSprings;
+
+typedef struct pdContactForce {
+  double fn;        // F_n, N (>= 0 when the contact pushes; < 0: the normal springs would pull)
+  pdVec3 ft;        // F_t, N, in P_t
+  pdVec3 force;     // F_c = fn n + ft, applied to body 1 (body 2 gets −force), N
+  bool slip;        // the friction limit is active: |F_t| = μ F_n⁺ (see contact_force.c for each branch)
+  double lambda;    // λ of eq. (7)/(9), s/kg; 0 in stick; INFINITY when slipping with F_n⁺ = 0
+  pdVec3 dw;        // Δw_t = −λ F_t, the slip velocity of the surface elements, m/s (0 in stick)
+  pdSprings rate;   // ṡ1n, ṡ2n, ṡ1t, ṡ2t, m/s
+} pdContactForce;
+
+// Force of one contact and the rates of its springs. n must be a unit vector. Pure, allocation-free.
+// The tangential springs are used through their projection on the current P_t (an out-of-plane part
+// appears only while n turns inside an integration step; pd_springs_realign removes it), and the
+// tangential rates lie in P_t.
+void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du, pdContactForce* out);
+
+// The dynamics-side break (paper §4.2, DESIGN §3.3): true when the normal force would pull (fn < 0).
+static inline bool pd_contact_force_pulls(const pdContactForce* f) { return f->fn < 0.0; }
+
+// After an accepted step (paper §3.4): rotates the tangential springs from the old tangent plane (⊥ nOld)
+// into the new one (⊥ nNew) by the smallest rotation taking nOld to nNew, keeping each spring's length
+// exactly (a residual out-of-plane part is removed and the length restored); then clips each tangential
+// spring to the friction cone, |k_it s_it| <= mu max(fn, 0) (shortened along itself; a spring with
+// k_it = 0 carries no force and is left alone), and clamps the normal springs out of tension
+// (s1n <= 0 <= s2n). nOld and nNew must be unit vectors; fn is the normal force at the accepted state, N.
+void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const pdContactParams* p, double fn);
