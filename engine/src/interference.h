@@ -1,0 +1,74 @@
+// polydyn (internal) — interference of two convex polyhedra (paper §4.3, DESIGN §3.2): the
+// separating-axis test over the faces of their Minkowski difference, with a per-pair cache of the
+// last separating feature (temporal coherence, §7).
+//
+// Conventions
+// - Poses map body frames to the world: x_world = x + R · x_body (R a rotation matrix).
+// - Every axis u is a unit vector pointing from A to B. The overlap of A and B along u is
+//       overlap(u) = max_{p in A} u·p − min_{q in B} u·q      (m),
+//   the length by which B's projection would have to move along +u to stop overlapping A's.
+// - Candidate axes: each face normal of A (u = n_A); each face normal of B reversed (u = −n_B); and,
+//   for each edge pair (one edge of A, one of B) that forms a face of the Minkowski difference (their
+//   Gauss-map arcs cross), u = ±(e_A × e_B) / |e_A × e_B|, the sign making u an outward normal of A
+//   at its edge. These are exactly the face normals of the Minkowski difference A ⊖ B.
+// - depth = min over candidate axes of overlap(u), in m. depth > 0 means overlap: the bodies
+//   interpenetrate, and depth is the penetration depth (the shortest translation of B that separates
+//   them). depth < 0 means separated, and −depth is the gap along the best candidate axis (a lower
+//   bound on their distance). depth == 0 (exact touching) counts as interfering: bodies are closed.
+// - The verdict has no tolerance: separated ⇔ some candidate axis has overlap < 0 as computed.
+//   Edge pairs whose directions are parallel to PD_SAT_PARALLEL_TOL are skipped (see below).
+#pragma once
+
+#include <stdbool.h>
+
+#include "polydyn/polyhedron.h"
+#include "polydyn/vecmath.h"
+
+// Edge pairs with |e_A × e_B| < PD_SAT_PARALLEL_TOL · |e_A| · |e_B| (the sine of their angle, no unit)
+// are not candidate axes. Parallel edges never form a Minkowski face (their arcs lie on one great
+// circle; the face axes at the arcs' ends bound the overlap there), and near-parallel ones form a
+// sliver face whose normal the cross product gives only to ~1e-16/sin(angle): at sin < 1e-8 that
+// error (× the edge length) would exceed the sliver's own effect on the depth (~sin × edge length).
+#define PD_SAT_PARALLEL_TOL 1e-8
+
+// The feature that defines an axis.
+typedef enum pdSatFeature {
+  PD_SAT_NONE = 0,    // no axis (empty cache)
+  PD_SAT_FACE_A = 1,  // face `a` of A: u = n_A
+  PD_SAT_FACE_B = 2,  // face `b` of B: u = −n_B
+  PD_SAT_EDGES = 3,   // edge `a` of A and edge `b` of B: u ∝ e_A × e_B
+} pdSatFeature;
+
+// Per-pair cache (zero-initialised = empty): the feature of the last call's result axis. A stale or
+// foreign entry (indices out of range, or no longer a candidate axis) is ignored. Never changes the
+// verdict; changes the reported depth of a separated pair only in PD_SAT_FIRST_SEPARATING mode.
+typedef struct pdSatCache {
+  pdSatFeature kind;
+  int a, b;  // face or edge index in A (FACE_A, EDGES), face or edge index in B (FACE_B, EDGES); else -1
+} pdSatCache;
+
+typedef enum pdSatMode {
+  // Stop at the first separating axis, trying the cached feature first: the fast verdict for a
+  // simulation step. When separated, depth < 0 is that axis's overlap (not necessarily the minimum).
+  PD_SAT_FIRST_SEPARATING = 0,
+  // Evaluate every candidate axis: depth is the minimum whether separated or not. The cache is not used
+  // to shorten the search (it is still updated), so the result does not depend on it.
+  PD_SAT_MIN_DEPTH = 1,
+} pdSatMode;
+
+typedef struct pdSatResult {
+  bool separated;          // depth < 0
+  double depth;            // m, see the conventions above
+  pdVec3 axis;             // world, unit, from A to B: the axis achieving `depth`
+  pdSatFeature kind;       // the feature defining `axis`
+  int a, b;                // its indices (as in pdSatCache)
+  int minkowskiEdgePairs;  // edge pairs that passed the Gauss-map test and were evaluated (work counter)
+} pdSatResult;
+
+// Do A (at xA, RA) and B (at xB, RB) interfere? Fills *out and returns !out->separated. Equal-depth
+// ties go to the first axis in the order: faces of A, faces of B, edge pairs (B's edges outer, A's inner),
+// by index; so in PD_SAT_MIN_DEPTH mode the result is a function of the poses alone. `cache` may be
+// NULL; when given it is read first (PD_SAT_FIRST_SEPARATING) and overwritten with the result's feature.
+// No allocation; cost O(F_A·V_B + F_B·V_A + E_A·E_B) at worst.
+bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const pdPolyhedron* B, pdVec3 xB,
+                     const pdMat3* RB, pdSatMode mode, pdSatCache* cache, pdSatResult* out);

@@ -1,0 +1,420 @@
+// Broad phase (sweep and prune): the pair set equals the brute-force O(n²) set through coherent and
+// incoherent motion, with fixed bodies and margins; closed-box touching; capacity overflow; the
+// deterministic (a, b) order whatever the history; exact boxes of rotated polyhedra.
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "test_random.h"
+
+#include "broad_phase.h"
+#include "polydyn/polyhedron.h"
+#include "polydyn/vecmath.h"
+
+#define PI 3.14159265358979323846
+
+// ---------------------------------------------------------------- helpers
+
+// The reference: every pair a < b, not both fixed, by the header's closed test with the margin.
+static int brute_pairs(int n, const pdAabb* boxes, const bool* fixed, double margin, pdPair* out, int capacity) {
+  int count = 0;
+  for (int a = 0; a < n; ++a)
+    for (int b = a + 1; b < n; ++b) {
+      if (fixed && fixed[a] && fixed[b]) continue;
+      bool overlap = true;
+      for (int k = 0; k < 3 && overlap; ++k)
+        overlap = boxes[a].lo[k] <= boxes[b].hi[k] + margin && boxes[b].lo[k] <= boxes[a].hi[k] + margin;
+      if (!overlap) continue;
+      if (count < capacity) out[count] = (pdPair){a, b};
+      ++count;
+    }
+  return count;
+}
+
+static void check_sorted(const pdPair* p, int count, int n) {
+  for (int i = 0; i < count; ++i) {
+    if (!(p[i].a >= 0 && p[i].a < p[i].b && p[i].b < n)) fail_msg("pair %d is (%d, %d)", i, p[i].a, p[i].b);
+    if (i > 0 && !(p[i - 1].a < p[i].a || (p[i - 1].a == p[i].a && p[i - 1].b < p[i].b)))
+      fail_msg("pairs %d (%d, %d) and %d (%d, %d) out of order", i - 1, p[i - 1].a, p[i - 1].b, i, p[i].a, p[i].b);
+  }
+}
+
+// Sweep-and-prune pairs into a buffer grown until they fit (the caller's protocol), checked sorted.
+static int sap_pairs(pdBroadPhase* bp, int n, pdPair** buf, int* capacity) {
+  int count = pd_broad_phase_pairs(bp, *buf, *capacity);
+  if (count > *capacity) {
+    *capacity = 2 * count;
+    *buf = realloc(*buf, (size_t)*capacity * sizeof **buf);
+    assert_non_null(*buf);
+    assert_int_equal(pd_broad_phase_pairs(bp, *buf, *capacity), count);
+  }
+  check_sorted(*buf, count, n);
+  return count;
+}
+
+static void assert_same_pairs(const pdPair* got, int gotCount, const pdPair* want, int wantCount, const char* label) {
+  if (gotCount != wantCount) fail_msg("%s: %d pairs, brute force has %d", label, gotCount, wantCount);
+  for (int i = 0; i < gotCount; ++i)
+    if (got[i].a != want[i].a || got[i].b != want[i].b)
+      fail_msg("%s: pair %d is (%d, %d), brute force has (%d, %d)", label, i, got[i].a, got[i].b, want[i].a, want[i].b);
+}
+
+typedef struct mover {
+  double c[3], h[3];  // centre, half extents
+  double v[3];        // velocity per step
+} mover;
+
+static pdAabb box_of(const mover* m) {
+  pdAabb b;
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = m->c[k] - m->h[k];
+    b.hi[k] = m->c[k] + m->h[k];
+  }
+  return b;
+}
+
+// Speeds are per step, in box sizes (~0.5): a body crosses a box in ~10–20 steps, fast for a
+// simulation step but still coherent (each endpoint passes a few others per step).
+#define SPEED 0.03
+#define ACCEL 0.005
+
+static void random_movers(lcg* g, mover* m, int n, double side) {
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      m[i].c[k] = lcg_range(g, 0.0, side);
+      m[i].h[k] = lcg_range(g, 0.05, 0.5);
+      m[i].v[k] = lcg_range(g, -SPEED, SPEED);
+    }
+}
+
+// One coherent step: drift, small random accelerations, half extents breathing (a rotating body's box).
+static void move(lcg* g, mover* m, int n, const bool* fixed) {
+  for (int i = 0; i < n; ++i) {
+    if (fixed && fixed[i]) continue;
+    for (int k = 0; k < 3; ++k) {
+      m[i].v[k] = fmin(2 * SPEED, fmax(-2 * SPEED, m[i].v[k] + lcg_range(g, -ACCEL, ACCEL)));
+      m[i].c[k] += m[i].v[k];
+      m[i].h[k] = fmin(0.6, fmax(0.02, m[i].h[k] + lcg_range(g, -ACCEL, ACCEL)));
+    }
+  }
+}
+
+// n random boxes in a cube of `side`, `moves` coherent moves; SAP must equal brute force at every step.
+static void run_against_brute_force(int n, double side, int moves, double fixedFraction, double margin, uint64_t seed,
+                                    long long* pairsChecked, long long* fixedFixedExcluded) {
+  lcg g = {seed};
+  mover* m = malloc((size_t)n * sizeof *m);
+  pdAabb* boxes = malloc((size_t)n * sizeof *boxes);
+  bool* fixed = calloc((size_t)n, sizeof *fixed);
+  assert_true(m && boxes && fixed);
+  random_movers(&g, m, n, side);
+  for (int i = 0; i < n; ++i) fixed[i] = lcg_uniform(&g) < fixedFraction;
+  int wantCap = 1 << 16, capacity = 16;
+  pdPair* want = malloc((size_t)wantCap * sizeof *want);
+  pdPair* got = malloc((size_t)capacity * sizeof *got);
+  pdBroadPhase* bp = pd_broad_phase_create(n, fixed, margin);
+  assert_true(want && got && bp);
+  for (int step = 0; step <= moves; ++step) {
+    if (step > 0) move(&g, m, n, fixed);
+    for (int i = 0; i < n; ++i) boxes[i] = box_of(&m[i]);
+    pd_broad_phase_update(bp, boxes);
+    int gotCount = sap_pairs(bp, n, &got, &capacity);
+    int wantCount = brute_pairs(n, boxes, fixed, margin, want, wantCap);
+    assert_true(wantCount <= wantCap);
+    char label[64];
+    snprintf(label, sizeof label, "n %d, step %d", n, step);
+    assert_same_pairs(got, gotCount, want, wantCount, label);
+    for (int i = 0; i < gotCount; ++i) assert_false(fixed[got[i].a] && fixed[got[i].b]);
+    *pairsChecked += gotCount;
+    *fixedFixedExcluded += brute_pairs(n, boxes, NULL, margin, NULL, 0) - wantCount;
+    // coherent motion: after the first update, insertion sort alone
+    if (step > 0) assert_false(pd_broad_phase_stats(bp).fullSort);
+  }
+  pd_broad_phase_free(bp);
+  free(want);
+  free(got);
+  free(m);
+  free(boxes);
+  free(fixed);
+}
+
+// ---------------------------------------------------------------- tests
+
+static void test_pairs_equal_brute_force_for_2000_random_boxes_over_50_coherent_moves(void** state) {
+  (void)state;
+  long long checked = 0, excluded = 0;
+  run_against_brute_force(2000, 10.0, 50, 0.0, 0.0, 0x5a9e11ull, &checked, &excluded);
+  print_message("SAP = brute force over 51 updates of 2000 boxes: %lld pairs checked\n", checked);
+  assert_int_equal(excluded, 0);
+  assert_true(checked > 51 * 2000);  // a meaningful number of overlaps (~1.3 per body)
+}
+
+static void test_pairs_equal_brute_force_with_fixed_bodies_and_no_fixed_fixed_pair(void** state) {
+  (void)state;
+  long long checked = 0, excluded = 0;
+  // a dense cloud where many fixed bodies overlap each other: none of those pairs may appear
+  run_against_brute_force(2000, 9.0, 50, 0.3, 0.0, 0xf1c5edull, &checked, &excluded);
+  print_message("with 30%% fixed bodies: %lld pairs checked, %lld overlapping fixed-fixed pairs left out\n", checked,
+                excluded);
+  assert_true(checked > 51 * 2000 && excluded > 51 * 100);
+}
+
+static void test_pairs_equal_brute_force_with_a_margin(void** state) {
+  (void)state;
+  long long checked = 0, excluded = 0;
+  run_against_brute_force(800, 8.0, 20, 0.2, 0.15, 0x3a6f1ull, &checked, &excluded);
+  assert_true(checked > 21 * 400 && excluded > 0);
+}
+
+static void test_boxes_touching_exactly_count_as_overlapping(void** state) {
+  (void)state;
+  // body 0: the unit cube; 1: touches its +x face; 2: touches its +y face from the other side along x
+  // (edge contact); 3: touches its +z face only at the corner (1, 1, 1); 4: one ulp beyond +x.
+  pdAabb boxes[5] = {
+      {{0, 0, 0}, {1, 1, 1}},
+      {{1, 0.2, 0.2}, {2, 0.8, 0.8}},
+      {{-1, 1, 0.5}, {0, 2, 0.7}},
+      {{1, 1, 1}, {3, 3, 3}},
+      {{nextafter(1.0, 2.0), 0, 0}, {1.5, 1, 1}},
+  };
+  pdBroadPhase* bp = pd_broad_phase_create(5, NULL, 0.0);
+  pd_broad_phase_update(bp, boxes);
+  pdPair out[16];
+  int count = pd_broad_phase_pairs(bp, out, 16);
+  pdPair want[16];
+  int wantCount = brute_pairs(5, boxes, NULL, 0.0, want, 16);
+  assert_same_pairs(out, count, want, wantCount, "touching");
+  // by hand: (0,1) face, (0,2) edge, (0,3) corner; (0,4) apart by one ulp; (1,4) overlap;
+  // (3,4) touch on y and z while overlapping on x.
+  const pdPair expect[] = {{0, 1}, {0, 2}, {0, 3}, {1, 4}, {3, 4}};
+  assert_same_pairs(out, count, expect, 5, "touching, by hand");
+  pd_broad_phase_free(bp);
+
+  // the same along y and z (a different sweep axis): a row of unit boxes touching end to end
+  for (int axis = 0; axis < 3; ++axis) {
+    pdAabb row[4];
+    for (int i = 0; i < 4; ++i)
+      for (int k = 0; k < 3; ++k) {
+        row[i].lo[k] = k == axis ? (double)i : 0.0;
+        row[i].hi[k] = k == axis ? (double)(i + 1) : 1.0;
+      }
+    bp = pd_broad_phase_create(4, NULL, 0.0);
+    pd_broad_phase_update(bp, row);
+    assert_int_equal(pd_broad_phase_stats(bp).axis, axis);
+    count = pd_broad_phase_pairs(bp, out, 16);
+    const pdPair chain[] = {{0, 1}, {1, 2}, {2, 3}};
+    assert_same_pairs(out, count, chain, 3, "row");
+    pd_broad_phase_free(bp);
+  }
+
+  // with a margin: gap == margin overlaps, a gap one ulp wider does not (per the header's formula)
+  double margin = 0.25;
+  pdAabb gap[3] = {{{0, 0, 0}, {1, 1, 1}}, {{1.25, 0, 0}, {2, 1, 1}}, {{0, 0, nextafter(1.25, 2.0)}, {1, 1, 2}}};
+  bp = pd_broad_phase_create(3, NULL, margin);
+  pd_broad_phase_update(bp, gap);
+  count = pd_broad_phase_pairs(bp, out, 16);
+  const pdPair withMargin[] = {{0, 1}};  // (0,2) is one ulp too far apart along z, (1,2) 0.25 + ulp
+  assert_same_pairs(out, count, withMargin, 1, "margin");
+  pd_broad_phase_free(bp);
+}
+
+static void test_capacity_overflow_returns_the_needed_count_and_writes_at_most_capacity(void** state) {
+  (void)state;
+  enum { N = 40 };
+  pdAabb boxes[N];
+  lcg g = {77};
+  for (int i = 0; i < N; ++i)
+    for (int k = 0; k < 3; ++k) {
+      boxes[i].lo[k] = lcg_range(&g, 0, 1);
+      boxes[i].hi[k] = boxes[i].lo[k] + 1.0;  // all overlap: 780 pairs
+    }
+  pdBroadPhase* bp = pd_broad_phase_create(N, NULL, 0.0);
+  pd_broad_phase_update(bp, boxes);
+  assert_int_equal(pd_broad_phase_pairs(bp, NULL, 0), N * (N - 1) / 2);
+  enum { CAP = 100, GUARD = 8 };
+  pdPair buf[CAP + GUARD];
+  for (int i = 0; i < CAP + GUARD; ++i) buf[i] = (pdPair){-7, -7};
+  assert_int_equal(pd_broad_phase_pairs(bp, buf, CAP), N * (N - 1) / 2);
+  for (int i = CAP; i < CAP + GUARD; ++i) assert_true(buf[i].a == -7 && buf[i].b == -7);
+  check_sorted(buf, CAP, N);
+  // grown to the needed count: the full set (the result depends only on the last update)
+  pdPair full[N * (N - 1) / 2], want[N * (N - 1) / 2];
+  assert_int_equal(pd_broad_phase_pairs(bp, full, N * (N - 1) / 2), N * (N - 1) / 2);
+  int wantCount = brute_pairs(N, boxes, NULL, 0.0, want, N * (N - 1) / 2);
+  assert_same_pairs(full, N * (N - 1) / 2, want, wantCount, "after growing");
+  pd_broad_phase_free(bp);
+}
+
+static void test_order_is_sorted_and_independent_of_history(void** state) {
+  (void)state;
+  enum { N = 600, STEPS = 30 };
+  lcg g = {2024};
+  mover m[N];
+  random_movers(&g, m, N, 6.0);
+  pdAabb boxes[N], jumbled[N];
+  pdBroadPhase* coherent = pd_broad_phase_create(N, NULL, 0.0);
+  for (int s = 0; s < STEPS; ++s) {
+    move(&g, m, N, NULL);
+    for (int i = 0; i < N; ++i) boxes[i] = box_of(&m[i]);
+    pd_broad_phase_update(coherent, boxes);
+  }
+  // another instance: first fed unrelated boxes (teleports), then the same final boxes
+  pdBroadPhase* other = pd_broad_phase_create(N, NULL, 0.0);
+  for (int i = 0; i < N; ++i)
+    for (int k = 0; k < 3; ++k) {
+      jumbled[i].lo[k] = lcg_range(&g, -50, 50);
+      jumbled[i].hi[k] = jumbled[i].lo[k] + 1;
+    }
+  pd_broad_phase_update(other, jumbled);
+  pd_broad_phase_update(other, boxes);
+  int cap = N * 20;
+  pdPair* a = malloc((size_t)cap * sizeof *a);
+  pdPair* b = malloc((size_t)cap * sizeof *b);
+  int na = pd_broad_phase_pairs(coherent, a, cap), nb = pd_broad_phase_pairs(other, b, cap);
+  print_message("%d pairs after %d steps\n", na, STEPS);
+  assert_true(na <= cap && na > N / 2);
+  assert_int_equal(na, nb);
+  assert_memory_equal(a, b, (size_t)na * sizeof *a);
+  check_sorted(a, na, N);
+  // calling again without an update gives the same bytes
+  assert_int_equal(pd_broad_phase_pairs(coherent, b, cap), na);
+  assert_memory_equal(a, b, (size_t)na * sizeof *a);
+  free(a);
+  free(b);
+  pd_broad_phase_free(coherent);
+  pd_broad_phase_free(other);
+}
+
+static void test_teleports_and_axis_switches_fall_back_to_a_full_sort_and_stay_exact(void** state) {
+  (void)state;
+  enum { N = 500 };
+  lcg g = {99};
+  mover m[N];
+  pdAabb boxes[N];
+  pdPair want[N * 8], *got = malloc(16 * sizeof *got);
+  int capacity = 16;
+  random_movers(&g, m, N, 8.0);
+  for (int i = 0; i < N; ++i) m[i].c[0] *= 3.0;  // spread along x: the sweep axis is x
+  pdBroadPhase* bp = pd_broad_phase_create(N, NULL, 0.0);
+  for (int step = 0; step < 40; ++step) {
+    if (step == 10)  // every body teleports: insertion sort would be quadratic
+      for (int i = 0; i < N; ++i) m[i].c[0] = lcg_range(&g, 0, 24);
+    if (step == 20)  // the cloud becomes a column along z: the sweep axis switches
+      for (int i = 0; i < N; ++i) {
+        m[i].c[0] /= 6.0;
+        m[i].c[2] *= 5.0;
+      }
+    move(&g, m, N, NULL);
+    for (int i = 0; i < N; ++i) boxes[i] = box_of(&m[i]);
+    pd_broad_phase_update(bp, boxes);
+    pdBroadPhaseStats st = pd_broad_phase_stats(bp);
+    if (step == 0 || step == 10 || step == 20) assert_true(st.fullSort);
+    if (step == 19) assert_int_equal(st.axis, 0);
+    if (step == 20) assert_int_equal(st.axis, 2);
+    int count = sap_pairs(bp, N, &got, &capacity);
+    int wantCount = brute_pairs(N, boxes, NULL, 0.0, want, N * 8);
+    assert_true(wantCount <= N * 8);
+    assert_same_pairs(got, count, want, wantCount, "teleport/axis switch");
+  }
+  assert_int_equal(pd_broad_phase_stats(bp).fullSorts, 3);
+  free(got);
+  pd_broad_phase_free(bp);
+}
+
+static void test_zero_one_and_coincident_bodies(void** state) {
+  (void)state;
+  pdBroadPhase* bp = pd_broad_phase_create(0, NULL, 0.0);
+  pd_broad_phase_update(bp, NULL);
+  assert_int_equal(pd_broad_phase_pairs(bp, NULL, 0), 0);
+  pd_broad_phase_free(bp);
+
+  pdAabb one = {{0, 0, 0}, {1, 1, 1}};
+  bp = pd_broad_phase_create(1, NULL, 0.0);
+  assert_int_equal(pd_broad_phase_pairs(bp, NULL, 0), 0);  // before any update: nothing
+  pd_broad_phase_update(bp, &one);
+  assert_int_equal(pd_broad_phase_pairs(bp, NULL, 0), 0);
+  pd_broad_phase_free(bp);
+
+  // ten identical point boxes: all 45 pairs; with bodies 0..4 fixed, the 10 fixed-fixed pairs go
+  enum { N = 10 };
+  pdAabb same[N];
+  bool fixed[N];
+  for (int i = 0; i < N; ++i) {
+    same[i] = (pdAabb){{1, 2, 3}, {1, 2, 3}};
+    fixed[i] = i < 5;
+  }
+  pdPair out[64], want[64];
+  bp = pd_broad_phase_create(N, NULL, 0.0);
+  pd_broad_phase_update(bp, same);
+  int count = pd_broad_phase_pairs(bp, out, 64);
+  assert_same_pairs(out, count, want, brute_pairs(N, same, NULL, 0.0, want, 64), "identical");
+  assert_int_equal(count, 45);
+  pd_broad_phase_free(bp);
+  bp = pd_broad_phase_create(N, fixed, 0.0);
+  pd_broad_phase_update(bp, same);
+  count = pd_broad_phase_pairs(bp, out, 64);
+  assert_same_pairs(out, count, want, brute_pairs(N, same, fixed, 0.0, want, 64), "identical, half fixed");
+  assert_int_equal(count, 35);
+  pd_broad_phase_free(bp);
+}
+
+static void test_aabb_of_is_the_exact_box_of_the_rotated_vertices(void** state) {
+  (void)state;
+  char why[128];
+  pdPolyhedron cube;
+  assert_true(pd_polyhedron_cube(&cube, (const double[3]){2, 1, 1}, why, sizeof why));
+  // 45° about z: the 2×1 footprint becomes a 3/√2-wide square
+  pdMat3 R = pd_quat_to_mat3(pd_quat_from_axis_angle(pd_v3(0, 0, 1), PI / 4));
+  pdAabb b = pd_aabb_of(&cube, pd_v3(10, -5, 1), &R);
+  double h = 1.5 / sqrt(2.0);
+  assert_true(fabs(b.lo[0] - (10 - h)) < 1e-14 && fabs(b.hi[0] - (10 + h)) < 1e-14);
+  assert_true(fabs(b.lo[1] - (-5 - h)) < 1e-14 && fabs(b.hi[1] - (-5 + h)) < 1e-14);
+  assert_true(fabs(b.lo[2] - 0.5) < 1e-15 && fabs(b.hi[2] - 1.5) < 1e-15);
+  // random poses of a geodesic sphere: equal, bit for bit, to min/max over x + R·p, and attained
+  pdPolyhedron s;
+  assert_true(pd_polyhedron_sphere(&s, 1, (const double[3]){1, 2, 3}, why, sizeof why));
+  lcg g = {5};
+  for (int trial = 0; trial < 100; ++trial) {
+    pdQuat q = pd_quat_normalize(
+        (pdQuat){lcg_range(&g, -1, 1), lcg_range(&g, -1, 1), lcg_range(&g, -1, 1), lcg_range(&g, -1, 1)});
+    pdMat3 Rq = pd_quat_to_mat3(q);
+    pdVec3 x = pd_v3(lcg_range(&g, -10, 10), lcg_range(&g, -10, 10), lcg_range(&g, -10, 10));
+    pdAabb box = pd_aabb_of(&s, x, &Rq);
+    bool hitLo[3] = {false, false, false}, hitHi[3] = {false, false, false};
+    for (int v = 0; v < s.vertexCount; ++v) {
+      pdVec3 w = pd_v3_add(x, pd_mat3_mulv(&Rq, s.vertices[v]));
+      for (int k = 0; k < 3; ++k) {
+        double c = pd_v3_get(w, k);
+        assert_true(box.lo[k] <= c && c <= box.hi[k]);
+        hitLo[k] = hitLo[k] || c == box.lo[k];
+        hitHi[k] = hitHi[k] || c == box.hi[k];
+      }
+    }
+    for (int k = 0; k < 3; ++k) assert_true(hitLo[k] && hitHi[k]);
+  }
+  pd_polyhedron_free(&cube);
+  pd_polyhedron_free(&s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_pairs_equal_brute_force_for_2000_random_boxes_over_50_coherent_moves),
+      cmocka_unit_test(test_pairs_equal_brute_force_with_fixed_bodies_and_no_fixed_fixed_pair),
+      cmocka_unit_test(test_pairs_equal_brute_force_with_a_margin),
+      cmocka_unit_test(test_boxes_touching_exactly_count_as_overlapping),
+      cmocka_unit_test(test_capacity_overflow_returns_the_needed_count_and_writes_at_most_capacity),
+      cmocka_unit_test(test_order_is_sorted_and_independent_of_history),
+      cmocka_unit_test(test_teleports_and_axis_switches_fall_back_to_a_full_sort_and_stay_exact),
+      cmocka_unit_test(test_zero_one_and_coincident_bodies),
+      cmocka_unit_test(test_aabb_of_is_the_exact_box_of_the_rotated_vertices),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
