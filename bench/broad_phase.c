@@ -16,6 +16,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_common.h"
 #include "broad_phase.h"
 
 enum { MAX_SIZES = 16, MAX_REPEATS = 101 };
@@ -98,32 +99,9 @@ static int brute_pairs(int n, const pdAabb* b, pdPair* out, int capacity) {
   return count;
 }
 
-static double wall_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
-static int compare_double(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
 
-static double median(const double* v, int n) {
-  double tmp[MAX_REPEATS];
-  memcpy(tmp, v, (size_t)n * sizeof *v);
-  qsort(tmp, (size_t)n, sizeof *tmp, compare_double);
-  return n % 2 ? tmp[n / 2] : 0.5 * (tmp[n / 2 - 1] + tmp[n / 2]);
-}
 
-static bool parse_long(const char* s, long lo, long hi, long* out) {
-  char* end = NULL;
-  errno = 0;
-  long v = strtol(s, &end, 10);
-  if (end == s || *end != '\0' || errno || v < lo || v > hi) return false;
-  *out = v;
-  return true;
-}
 
 // Least-squares slope of log y against log x.
 static double loglog_slope(const double* x, const double* y, int n) {
@@ -171,23 +149,15 @@ int main(int argc, char** argv) {
     const char* v = argv[++i];
     bool ok = true;
     if (strcmp(a, "--bodies") == 0) {
-      sizeCount = 0;
-      char copy[256];
-      snprintf(copy, sizeof copy, "%s", v);
-      for (char* tok = strtok(copy, ","); tok && ok; tok = strtok(NULL, ",")) {
-        long n = 0;
-        ok = sizeCount < MAX_SIZES && parse_long(tok, 2, 1000000, &n);
-        if (ok) sizes[sizeCount++] = (int)n;
-      }
-      ok = ok && sizeCount > 0;
+      ok = bench_parse_sizes(v, sizes, MAX_SIZES, 2, 1000000, &sizeCount);
     } else if (strcmp(a, "--repeats") == 0) {
-      ok = parse_long(v, 1, MAX_REPEATS, &repeats);
+      ok = bench_parse_long(v, 1, MAX_REPEATS, &repeats);
     } else if (strcmp(a, "--updates") == 0) {
-      ok = parse_long(v, 1, 1000000, &updates);
+      ok = bench_parse_long(v, 1, 1000000, &updates);
     } else if (strcmp(a, "--brute-max") == 0) {
-      ok = parse_long(v, 0, 1000000, &bruteMax);
+      ok = bench_parse_long(v, 0, 1000000, &bruteMax);
     } else if (strcmp(a, "--seed") == 0) {
-      ok = parse_long(v, 0, 0x7FFFFFFFl, &seed);
+      ok = bench_parse_long(v, 0, 0x7FFFFFFFl, &seed);
     } else {
       ok = false;
     }
@@ -220,7 +190,7 @@ int main(int argc, char** argv) {
         long long fullSorts0 = pd_broad_phase_stats(bp).fullSorts;
         for (long u = 0; u < updates; ++u) {
           world_step(&w);
-          double t0 = wall_now();
+          double t0 = bench_wall_now();
           int count;
           if (method == 0) {
             pd_broad_phase_update(bp, w.boxes);
@@ -228,7 +198,7 @@ int main(int argc, char** argv) {
           } else {
             count = brute_pairs(n, w.boxes, out, capacity);
           }
-          t += wall_now() - t0;
+          t += bench_wall_now() - t0;
           if (count > capacity) {
             fprintf(stderr, "pd_bench_broad_phase: %d pairs overflow the buffer of %d\n", count, capacity);
             return 1;
@@ -251,7 +221,7 @@ int main(int argc, char** argv) {
         if (method == 0) printf("%lld", pd_broad_phase_stats(bp).fullSorts - fullSorts0);  // SAP only
         printf("\n");
         if (r == repeats - 1) {
-          double med = median(times, (int)repeats);
+          double med = bench_median(times, (int)repeats);
           printf("%s,%d,median,%.6g,%.6g,%.6g,\n", name, n, med, allPairs / (double)(updates * repeats),
                  allTests / (double)(updates * repeats));
           if (method == 0) axisTests[fits[0]] = allTests / (double)(updates * repeats);

@@ -13,6 +13,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_common.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
@@ -94,11 +95,6 @@ static char* random_scene(int count, double tend, unsigned long seed) {
   return t.data;
 }
 
-static double wall_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 typedef struct result {
   double wall, sim;
@@ -111,24 +107,8 @@ static void print_row(int bodies, const char* repeat, const result* r) {
          r->rejected);
 }
 
-static int compare_double(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
 
-static double median(double* v, int n) {
-  qsort(v, (size_t)n, sizeof *v, compare_double);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
-static bool parse_long(const char* s, long lo, long hi, long* out) {
-  char* end = NULL;
-  errno = 0;
-  long v = strtol(s, &end, 10);
-  if (end == s || *end != '\0' || errno || v < lo || v > hi) return false;
-  *out = v;
-  return true;
-}
 
 int main(int argc, char** argv) {
   int sizes[MAX_SIZES] = {1, 10, 100, 1000};
@@ -148,19 +128,11 @@ int main(int argc, char** argv) {
     const char* v = argv[++i];
     bool ok = true;
     if (strcmp(a, "--bodies") == 0) {
-      sizeCount = 0;
-      char copy[256];
-      snprintf(copy, sizeof copy, "%s", v);
-      for (char* tok = strtok(copy, ","); tok && ok; tok = strtok(NULL, ",")) {
-        long n = 0;
-        ok = sizeCount < MAX_SIZES && parse_long(tok, 1, 100000, &n);
-        if (ok) sizes[sizeCount++] = (int)n;
-      }
-      ok = ok && sizeCount > 0;
+      ok = bench_parse_sizes(v, sizes, MAX_SIZES, 1, 100000, &sizeCount);
     } else if (strcmp(a, "--repeats") == 0) {
-      ok = parse_long(v, 1, MAX_REPEATS, &repeats);
+      ok = bench_parse_long(v, 1, MAX_REPEATS, &repeats);
     } else if (strcmp(a, "--seed") == 0) {
-      ok = parse_long(v, 0, 0xFFFFFFFFl, &seed);
+      ok = bench_parse_long(v, 0, 0xFFFFFFFFl, &seed);
     } else if (strcmp(a, "--tend") == 0) {
       char* end = NULL;
       tend = strtod(v, &end);
@@ -193,9 +165,9 @@ int main(int argc, char** argv) {
     result r = {0};
     for (long k = 0; k < repeats; ++k) {
       pd_state_reset(model, state);
-      double t0 = wall_now();
+      double t0 = bench_wall_now();
       bool ok = pd_advance(model, state, model->settings.tend, NULL, NULL);
-      r.wall = wall_now() - t0;
+      r.wall = bench_wall_now() - t0;
       if (!ok) {
         fprintf(stderr, "pd_bench_free: the run failed at t = %g s\n", state->t);
         return 1;
@@ -210,7 +182,7 @@ int main(int argc, char** argv) {
       print_row(sizes[s], repeat, &r);
     }
     // the runs are deterministic: counts are the same every time, only the wall time varies
-    r.wall = median(walls, (int)repeats);
+    r.wall = bench_median(walls, (int)repeats);
     print_row(sizes[s], "median", &r);
     fflush(stdout);
     pd_state_free(state);
