@@ -9,8 +9,9 @@ if [ $# -ne 2 ]; then
   echo "usage: $0 POLYDYN_BINARY PROJECT_SOURCE_DIR" >&2
   exit 2
 fi
-PD=$1
-SRC=$2
+# absolute paths: some checks run from another working directory
+PD=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+SRC=$(cd "$2" && pwd)
 DEMO=$SRC/cases/examples/demo.scene
 HEADER='t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz'
 
