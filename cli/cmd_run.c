@@ -142,7 +142,7 @@ int pd_cmd_run(int argc, char** argv) {
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
   pdError err = {0};
-  pdRunWriter* writer = pd_run_open(out, model, &err);
+  pdRunWriter* writer = pd_run_open(out, &err);
   if (!writer) {
     pd_error_print(&err, stderr);
     free(defaultOut);

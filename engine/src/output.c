@@ -79,8 +79,7 @@ void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* st
   }
 }
 
-pdRunWriter* pd_run_open(const char* dir, const pdModel* model, pdError* err) {
-  (void)model;
+pdRunWriter* pd_run_open(const char* dir, pdError* err) {
   struct stat st;
   if (stat(dir, &st) == 0) {
     char* summary = join(dir, "summary.json");

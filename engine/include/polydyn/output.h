@@ -18,7 +18,7 @@
 typedef struct pdRunWriter pdRunWriter;
 
 // Starts a run directory for `dir`. Returns NULL and fills err on failure (nothing left behind).
-pdRunWriter* pd_run_open(const char* dir, const pdModel* model, pdError* err);
+pdRunWriter* pd_run_open(const char* dir, pdError* err);
 
 // Observer that appends the current sample to trajectory.csv; `user` is the pdRunWriter.
 bool pd_run_observe(const pdModel* model, const pdState* state, void* user);
