@@ -1,9 +1,13 @@
 // pd_bench_broad_phase — cost of the broad phase per step: n small boxes scattered at constant density
 // (1 body per m³: a cube of side n^(1/3) m) moving coherently, timed over U updates (update + pairs) for
-// sweep and prune and, up to --brute-max bodies, for the brute-force O(n²) test. R repeats per size;
-// the CSV on stdout has one row per repeat and a `median` row per size and method (median time; pairs
-// and axis tests averaged over all repeats); a summary with the fitted exponents (least-squares slope
-// of log time against log n) goes to stderr.
+// incremental sweep and prune and, up to --brute-max bodies, for the brute-force O(n²) test. R repeats
+// per size; the CSV on stdout has one row per repeat and a `median` row per size and method (median
+// time; pairs and work counters averaged over all repeats); a summary with the fitted exponents
+// (least-squares slope of log time, and of log swaps, against log n) goes to stderr.
+// The repeats go round-robin over the sizes and methods (each with its own world), so that a slow spell
+// of a shared machine is spread over all sizes. Checks, outside the timing: at the end of every repeat
+// the incremental pairs equal those of a fresh broad phase given the same boxes (its first update is a
+// full sort and rebuild sweep, a separate code path), and, up to --brute-max, those of brute force.
 //
 // usage: pd_bench_broad_phase [--bodies 100,300,1000,3000,10000] [--repeats 7] [--updates 100]
 //                             [--brute-max 3000] [--seed 12345]
@@ -27,7 +31,7 @@ static const char* const usage =
     "Times the broad phase (update + pairs) per step for N boxes (half extents 0.05-0.25 m) moving\n"
     "coherently (<= 0.02 m per step, reflected at the walls) in a cube of side N^(1/3) m, over U updates,\n"
     "R times per N; brute force too for N <= M. Prints CSV (a median row per N and method) and, on\n"
-    "stderr, the fitted exponents of time against N.\n"
+    "stderr, the fitted exponents of time and of insertion-sort swaps against N.\n"
     "Defaults: --bodies 100,300,1000,3000,10000 --repeats 7 --updates 100 --brute-max 3000 --seed 12345\n";
 
 // Knuth's MMIX LCG (the tests' generator): fixed and portable.
@@ -99,9 +103,73 @@ static int brute_pairs(int n, const pdAabb* b, pdPair* out, int capacity) {
   return count;
 }
 
+// The pairs of a fresh broad phase given `boxes` (a full sort and rebuild sweep) equal `pairs`.
+static bool same_as_fresh(int n, const pdAabb* boxes, const pdPair* pairs, int count, pdPair* buf, int capacity) {
+  pdBroadPhase* fresh = pd_broad_phase_create(n, NULL, 0.0);
+  if (!fresh || !pd_broad_phase_update(fresh, boxes)) abort();
+  int freshCount = pd_broad_phase_pairs(fresh, buf, capacity);
+  pd_broad_phase_free(fresh);
+  return freshCount == count && memcmp(buf, pairs, (size_t)(count < capacity ? count : capacity) * sizeof *buf) == 0;
+}
 
+// One size and method: its world, buffers and broad phase (SAP only), and per repeat the time and the
+// sums over its updates.
+typedef struct run {
+  int n, method;  // method 0: sweep and prune, 1: brute force
+  world w;
+  int capacity;
+  pdPair *out, *check;
+  pdBroadPhase* bp;
+  double times[MAX_REPEATS];    // us per update
+  double sum[MAX_REPEATS][4];   // pairs, swaps, min/max swaps, set changes
+  long long fullSorts[MAX_REPEATS];
+} run;
 
-
+// Repeat r of run u: `updates` timed steps, then the checks. False (with a message) on a disagreement.
+static bool repeat_run(run* u, long r, long updates, long bruteMax) {
+  int n = u->n;
+  double t = 0.0;
+  long long fullSorts0 = u->bp ? pd_broad_phase_stats(u->bp).fullSorts : 0;
+  for (long k = 0; k < updates; ++k) {
+    world_step(&u->w);
+    double t0 = bench_wall_now();
+    int count;
+    if (u->method == 0) {
+      if (!pd_broad_phase_update(u->bp, u->w.boxes)) abort();
+      count = pd_broad_phase_pairs(u->bp, u->out, u->capacity);
+    } else {
+      count = brute_pairs(n, u->w.boxes, u->out, u->capacity);
+    }
+    t += bench_wall_now() - t0;
+    if (count > u->capacity) {
+      fprintf(stderr, "pd_bench_broad_phase: %d pairs overflow the buffer of %d\n", count, u->capacity);
+      return false;
+    }
+    u->sum[r][0] += count;
+    if (u->method == 0) {
+      pdBroadPhaseStats st = pd_broad_phase_stats(u->bp);
+      u->sum[r][1] += (double)st.swaps;
+      u->sum[r][2] += (double)st.overlapEvents;
+      u->sum[r][3] += (double)st.pairChanges;
+    }
+    if (k == updates - 1 && u->method == 0) {  // checked once per repeat, outside the timing
+      if (!same_as_fresh(n, u->w.boxes, u->out, count, u->check, u->capacity)) {
+        fprintf(stderr, "pd_bench_broad_phase: incremental SAP and a fresh rebuild disagree at n = %d\n", n);
+        return false;
+      }
+      if (n <= bruteMax) {
+        int bruteCount = brute_pairs(n, u->w.boxes, u->check, u->capacity);
+        if (bruteCount != count || memcmp(u->check, u->out, (size_t)count * sizeof *u->out) != 0) {
+          fprintf(stderr, "pd_bench_broad_phase: SAP and brute force disagree at n = %d\n", n);
+          return false;
+        }
+      }
+    }
+  }
+  u->times[r] = 1e6 * t / (double)updates;
+  u->fullSorts[r] = u->bp ? pd_broad_phase_stats(u->bp).fullSorts - fullSorts0 : 0;
+  return true;
+}
 
 // Least-squares slope of log y against log x.
 static double loglog_slope(const double* x, const double* y, int n) {
@@ -116,11 +184,11 @@ static double loglog_slope(const double* x, const double* y, int n) {
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
-// Least squares, relative: t ≈ alpha·n + beta·tests, minimising Σ ((alpha·n + beta·tests − t) / t)².
-static void cost_model(const double* n, const double* tests, const double* t, int count, double* alpha, double* beta) {
+// Least squares, relative: t ≈ alpha·n + beta·swaps, minimising Σ ((alpha·n + beta·swaps − t) / t)².
+static void cost_model(const double* n, const double* swaps, const double* t, int count, double* alpha, double* beta) {
   double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
   for (int i = 0; i < count; ++i) {
-    double x1 = n[i] / t[i], x2 = tests[i] / t[i];
+    double x1 = n[i] / t[i], x2 = swaps[i] / t[i];
     a11 += x1 * x1;
     a12 += x1 * x2;
     a22 += x2 * x2;
@@ -167,90 +235,93 @@ int main(int argc, char** argv) {
     }
   }
 
-  printf("method,bodies,repeat,us_per_update,pairs_per_update,axis_tests_per_update,full_sorts\n");
-  double xs[2][MAX_SIZES], ys[2][MAX_SIZES], axisTests[MAX_SIZES];
-  int fits[2] = {0, 0};
-  for (int s = 0; s < sizeCount; ++s) {
-    int n = sizes[s];
-    bool brute = n <= bruteMax;
-    for (int method = 0; method < (brute ? 2 : 1); ++method) {
-      const char* name = method == 0 ? "sap" : "brute";
-      world w;
-      world_init(&w, n, (uint64_t)seed);
-      world_step(&w);
-      int capacity = 16 * n;
-      pdPair* out = malloc((size_t)capacity * sizeof *out);
-      pdPair* check = malloc((size_t)capacity * sizeof *check);
-      pdBroadPhase* bp = pd_broad_phase_create(n, NULL, 0.0);
-      if (!out || !check || !bp) abort();
-      pd_broad_phase_update(bp, w.boxes);  // the first (full) sort is not part of the per-step cost
-      double times[MAX_REPEATS], allPairs = 0.0, allTests = 0.0;
-      for (long r = 0; r < repeats; ++r) {
-        double t = 0.0, pairs = 0.0, tests = 0.0;
-        long long fullSorts0 = pd_broad_phase_stats(bp).fullSorts;
-        for (long u = 0; u < updates; ++u) {
-          world_step(&w);
-          double t0 = bench_wall_now();
-          int count;
-          if (method == 0) {
-            pd_broad_phase_update(bp, w.boxes);
-            count = pd_broad_phase_pairs(bp, out, capacity);
-          } else {
-            count = brute_pairs(n, w.boxes, out, capacity);
-          }
-          t += bench_wall_now() - t0;
-          if (count > capacity) {
-            fprintf(stderr, "pd_bench_broad_phase: %d pairs overflow the buffer of %d\n", count, capacity);
-            return 1;
-          }
-          pairs += count;
-          tests += method == 0 ? (double)pd_broad_phase_stats(bp).axisTests : 0.5 * n * (n - 1.0);
-          if (method == 1 && u == updates - 1) {  // the two methods agree (checked once per repeat)
-            pd_broad_phase_update(bp, w.boxes);
-            int sapCount = pd_broad_phase_pairs(bp, check, capacity);
-            if (sapCount != count || memcmp(check, out, (size_t)count * sizeof *out) != 0) {
-              fprintf(stderr, "pd_bench_broad_phase: SAP and brute force disagree at n = %d\n", n);
-              return 1;
-            }
-          }
-        }
-        times[r] = 1e6 * t / (double)updates;
-        allPairs += pairs;
-        allTests += tests;
-        printf("%s,%d,%ld,%.6g,%.6g,%.6g,", name, n, r + 1, times[r], pairs / (double)updates, tests / (double)updates);
-        if (method == 0) printf("%lld", pd_broad_phase_stats(bp).fullSorts - fullSorts0);  // SAP only
-        printf("\n");
-        if (r == repeats - 1) {
-          double med = bench_median(times, (int)repeats);
-          printf("%s,%d,median,%.6g,%.6g,%.6g,\n", name, n, med, allPairs / (double)(updates * repeats),
-                 allTests / (double)(updates * repeats));
-          if (method == 0) axisTests[fits[0]] = allTests / (double)(updates * repeats);
-          xs[method][fits[method]] = n;
-          ys[method][fits[method]++] = med;
-          fprintf(stderr, "%-5s n = %6d: %10.2f us per update (median of %ld x %ld updates), %.0f pairs, %.0f tests\n",
-                  name, n, med, repeats, updates, allPairs / (double)(updates * repeats),
-                  allTests / (double)(updates * repeats));
-        }
-        fflush(stdout);
+  // One run per size and method, each with its own world; the repeats go round-robin over the runs so
+  // that a slow spell of the (shared) machine hits every size alike rather than one size's block.
+  int runCount = 0;
+  run* runs = calloc(2 * MAX_SIZES, sizeof *runs);
+  if (!runs) abort();
+  for (int s = 0; s < sizeCount; ++s)
+    for (int method = 0; method < (sizes[s] <= bruteMax ? 2 : 1); ++method) {
+      run* u = &runs[runCount++];
+      u->n = sizes[s];
+      u->method = method;
+      world_init(&u->w, u->n, (uint64_t)seed);
+      world_step(&u->w);
+      u->capacity = 16 * u->n;
+      u->out = malloc((size_t)u->capacity * sizeof *u->out);
+      u->check = malloc((size_t)u->capacity * sizeof *u->check);
+      if (!u->out || !u->check) abort();
+      if (method == 0) {
+        u->bp = pd_broad_phase_create(u->n, NULL, 0.0);
+        // the first update (a full sort and rebuild sweep) is not part of the per-step cost
+        if (!u->bp || !pd_broad_phase_update(u->bp, u->w.boxes)) abort();
       }
-      pd_broad_phase_free(bp);
-      free(out);
-      free(check);
-      free(w.m);
-      free(w.boxes);
     }
+  for (long r = 0; r < repeats; ++r)
+    for (int i = 0; i < runCount; ++i)
+      if (!repeat_run(&runs[i], r, updates, bruteMax)) return 1;
+
+  printf("method,bodies,repeat,us_per_update,pairs_per_update,swaps_per_update,events_per_update,"
+         "pair_changes_per_update,full_sorts\n");
+  double xs[2][MAX_SIZES], ys[2][MAX_SIZES], swapsOf[MAX_SIZES];
+  int fits[2] = {0, 0};
+  for (int i = 0; i < runCount; ++i) {
+    run* u = &runs[i];
+    const char* name = u->method == 0 ? "sap" : "brute";
+    double all[4] = {0, 0, 0, 0};  // pairs, swaps, events, pair changes: means over all repeats
+    for (long r = 0; r < repeats; ++r) {
+      for (int c = 0; c < 4; ++c) all[c] += u->sum[r][c];
+      printf("%s,%d,%ld,%.6g,%.6g,", name, u->n, r + 1, u->times[r], u->sum[r][0] / (double)updates);
+      if (u->method == 0)  // SAP only
+        printf("%.6g,%.6g,%.6g,%lld\n", u->sum[r][1] / (double)updates, u->sum[r][2] / (double)updates,
+               u->sum[r][3] / (double)updates, u->fullSorts[r]);
+      else
+        printf(",,,\n");
+    }
+    double med = bench_median(u->times, (int)repeats), per = (double)(updates * repeats);
+    printf("%s,%d,median,%.6g,%.6g,", name, u->n, med, all[0] / per);
+    if (u->method == 0)
+      printf("%.6g,%.6g,%.6g,\n", all[1] / per, all[2] / per, all[3] / per);
+    else
+      printf(",,,\n");
+    if (u->method == 0) swapsOf[fits[0]] = all[1] / per;
+    xs[u->method][fits[u->method]] = u->n;
+    ys[u->method][fits[u->method]++] = med;
+    fprintf(stderr, "%-5s n = %6d: %10.2f us per update (median of %ld x %ld updates), %.0f pairs", name, u->n, med,
+            repeats, updates, all[0] / per);
+    if (u->method == 0) fprintf(stderr, ", %.0f swaps, %.0f overlap events", all[1] / per, all[2] / per);
+    fprintf(stderr, "\n");
+    pd_broad_phase_free(u->bp);
+    free(u->out);
+    free(u->check);
+    free(u->w.m);
+    free(u->w.boxes);
   }
+  free(runs);
   for (int method = 0; method < 2; ++method)
     if (fits[method] >= 2)
       fprintf(stderr, "fitted exponent (log-log slope of time vs n), %s, n = %g..%g: %.3f\n",
               method == 0 ? "sap" : "brute", xs[method][0], xs[method][fits[method] - 1],
               loglog_slope(xs[method], ys[method], fits[method]));
   if (fits[0] >= 2) {
+    double nlogn[MAX_SIZES];
+    for (int i = 0; i < fits[0]; ++i) nlogn[i] = xs[0][i] * log2(xs[0][i]);
+    fprintf(stderr, "reference: n log n has a fitted exponent of %.3f over the same sizes\n",
+            loglog_slope(xs[0], nlogn, fits[0]));
+    fprintf(stderr, "local exponents of sap time (slope between consecutive sizes):");
+    for (int i = 1; i < fits[0]; ++i)
+      fprintf(stderr, " %g-%g: %.2f%s", xs[0][i - 1], xs[0][i], loglog_slope(xs[0] + i - 1, ys[0] + i - 1, 2),
+              i + 1 < fits[0] ? "," : "\n");
+    bool anySwapless = false;  // log 0: no slope (tiny n, or no motion)
+    for (int i = 0; i < fits[0]; ++i) anySwapless = anySwapless || !(swapsOf[i] > 0.0);
+    if (!anySwapless)
+      fprintf(stderr, "fitted exponent (log-log slope of insertion-sort swaps vs n), sap, n = %g..%g: %.3f\n",
+              xs[0][0], xs[0][fits[0] - 1], loglog_slope(xs[0], swapsOf, fits[0]));
     double alpha, beta;
-    cost_model(xs[0], axisTests, ys[0], fits[0], &alpha, &beta);
+    cost_model(xs[0], swapsOf, ys[0], fits[0], &alpha, &beta);
     fprintf(stderr,
-            "sap cost model: time per update ~ %.3g ns x bodies + %.3g ns x axis tests (pairs overlapping "
-            "along the sweep axis, each tested on the other two)\n",
+            "sap cost model: time per update ~ %.3g ns x bodies + %.3g ns x swaps (of neighbouring endpoints, "
+            "three axes)\n",
             1e3 * alpha, 1e3 * beta);
   }
   return 0;

@@ -1,5 +1,5 @@
 // polydyn (internal) — broad phase: which body pairs have overlapping axis-aligned boxes
-// (sweep and prune, DESIGN §3.2 and §3.6).
+// (incremental sweep and prune on all three axes, DESIGN §3.2 and §3.6; Baraff 1992, Cohen et al. 1995).
 //
 // Conventions
 // - A box is closed: [lo, hi] on each world axis. Two boxes overlap when, on every axis,
@@ -7,17 +7,22 @@
 //   The margin (m, >= 0) is fixed at creation; 0 gives the plain closed-box test.
 // - Pairs are (a, b) with a < b, never both fixed, listed sorted by (a, b) — a deterministic order
 //   that does not depend on the history of updates.
-// - Sweep axis: the world axis along which the box centres have the largest variance, chosen at the
-//   first update and switched (with a full re-sort) only when another axis's variance exceeds the
-//   current one's by the factor PD_BROAD_PHASE_AXIS_SWITCH; ties go to the lowest axis (x first).
-//   The choice changes the cost, never the result.
 //
-// Cost: endpoints along the sweep axis stay sorted between updates and are re-sorted by insertion
-// sort, ~n when motion is coherent; a merge sort (n log n) takes over on the first update, on an
-// axis switch, or when insertion sort exceeds its move budget (incoherent motion). The sweep then
-// costs ~n + (pairs overlapping along the sweep axis), each such pair tested on the other two axes.
+// Cost: the endpoints of the boxes along each of the three axes stay sorted between updates, and a
+// persistent set holds the pairs overlapping on all three. An update re-sorts each axis by insertion
+// sort, ~n + s for s swaps of neighbouring endpoints (coherent motion: few per endpoint), and touches
+// the set only when a swap starts or ends a pair's overlap along one axis. A merge sort of the three
+// axes (n log n) and a rebuild of the set by one sweep (~n + pairs overlapping along the sweep axis)
+// take over on the first update and when insertion sort exceeds its swap budget (incoherent motion).
+// pd_broad_phase_pairs sorts the set, k log k for k pairs, and only when it changed.
+// Caveat: s ~ n × (endpoints per metre along an axis) × (distance moved per update, relative to the
+// others). For bodies scattered at constant density in a cube, that density grows as n^(2/3), so s
+// grows as n^(5/3) × speed and dominates large clouds (reports/bench/broad_phase.md); only a spatial
+// subdivision (a grid, or sweep and prune within regions) would keep it ~n.
 //
-// Memory: pd_broad_phase_create allocates everything; update and pairs never allocate.
+// Memory: pd_broad_phase_create allocates everything, the pair set sized for
+// PD_BROAD_PHASE_PAIRS_PER_BODY pairs per body. An update that needs more doubles the set (counted in
+// the stats); nothing else allocates after creation, and pd_broad_phase_pairs never does.
 #pragma once
 
 #include <stdbool.h>
@@ -35,17 +40,25 @@ typedef struct pdPair {
   int a, b;
 } pdPair;
 
-// Hysteresis of the sweep-axis choice: switch only when another axis's centre variance is this many
-// times larger, so that bodies milling about in a roughly isotropic cloud do not re-sort every step.
-#define PD_BROAD_PHASE_AXIS_SWITCH 2.0
+// Pairs per body the pair set holds without growing (at most half its slots in use). A resting pile
+// gives each body a handful of neighbours; scattered bodies far fewer. Denser scenes double the set.
+#define PD_BROAD_PHASE_PAIRS_PER_BODY 4
 
-// Work counters of the last update and pairs call (for benchmarks and warnings; they change no result).
+// Work counters (for benchmarks and warnings; they change no result). The "last update" ones are reset
+// by each pd_broad_phase_update.
 typedef struct pdBroadPhaseStats {
-  int axis;             // current sweep axis (0 = x, 1 = y, 2 = z; -1 before the first update)
-  long long sortMoves;  // endpoint moves by insertion sort in the last update
-  bool fullSort;        // the last update used the merge sort
-  long long fullSorts;  // merge sorts since creation
-  long long axisTests;  // pairs overlapping along the sweep axis in the last pairs call (tested on the others)
+  long long swaps;          // swaps of neighbouring endpoints by insertion sort in the last update, 3 axes
+  long long overlapEvents;  // of those, a minimum passing another body's maximum: that pair's overlap
+                            // along one axis begins or ends, and the other two axes are checked
+  long long pairChanges;    // of those events, the ones that added a pair to the set or removed one
+  bool fullSort;            // the last update merge-sorted (some of) the axes and rebuilt the set
+  long long fullSorts;      // such updates since creation
+  int sweepAxis;            // axis of the last rebuild sweep, the one with the fewest overlapping pairs
+                            // (0 = x, 1 = y, 2 = z; -1 before the first update)
+  long long sweepTests;     // pairs overlapping along sweepAxis in that sweep (each tested on the others)
+  int pairs;                // pairs in the set: overlapping on all three axes, not both fixed
+  int setCapacity;          // pairs the set holds before it must grow
+  int setGrowths;           // times an update doubled the set since creation
 } pdBroadPhaseStats;
 
 typedef struct pdBroadPhase pdBroadPhase;
@@ -56,8 +69,10 @@ pdBroadPhase* pd_broad_phase_create(int bodyCount, const bool* fixed, double mar
 void pd_broad_phase_free(pdBroadPhase* bp);
 
 // Takes this step's boxes (bodyCount of them, finite, lo <= hi; fixed bodies included, their boxes
-// unchanged) and re-sorts the endpoints. The boxes are copied. No allocation.
-void pd_broad_phase_update(pdBroadPhase* bp, const pdAabb* boxes);
+// unchanged), re-sorts the endpoints and updates the pair set. The boxes are copied. Allocates only to
+// grow the pair set. Returns false only when that allocation fails: the pairs are then unknown
+// (pd_broad_phase_pairs must not be called) until an update returns true (it rebuilds the set).
+bool pd_broad_phase_update(pdBroadPhase* bp, const pdAabb* boxes);
 
 // Writes the overlapping pairs of the last update into out[0 .. min(count, capacity)) sorted by (a, b),
 // and returns count, the number of overlapping pairs. When count > capacity only `capacity` of them

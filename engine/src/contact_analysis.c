@@ -129,13 +129,44 @@ static bool line_closest(pdVec3 P, pdVec3 u, pdVec3 Q, pdVec3 v, double* s, doub
   return true;
 }
 
-// Gauss-map test: do the arcs (a, b) and (c, d) on the unit sphere cross? a, b are the face normals
-// around an edge of one body; c, d the negated face normals around an edge of the other
-// (D. Gregorius, "The Separating Axis Test between Convex Polyhedra", GDC 2013).
-static bool arcs_cross(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d) {
+// Gauss-map test: do the arcs (a, b) and (c, d) on the unit sphere meet? a, b are the face normals
+// around an edge of one body; c, d the negated face normals around an edge of the other (D. Gregorius,
+// "The Separating Axis Test between Convex Polyhedra", GDC 2013). Closed arcs, within ARC_TOUCH_TOL:
+// arcs that only touch — an endpoint shared (two faces parallel and in contact, such as a cube turned
+// 45° on another) or lying on the other arc (an edge lying on a face) — meet too, because the crossings
+// of the edges bounding those faces are real contact points (the corners of the overlap polygon).
+// Strict crossing (the SAT's Minkowski-face test) would miss them.
+// A touching pair is a contact only where those faces press on each other: its depth (the gap of the two
+// face planes) must not exceed the bodies' overlap along the faces around the two edges; otherwise the
+// faces are far apart across an overlap that is shallow along another axis (see edge_contact_is_shallow).
+#define ARC_TOUCH_TOL 1e-9
+typedef enum arcMeeting { arcsApart = 0, arcsCross, arcsTouch } arcMeeting;
+static arcMeeting arcs_meet(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d, double slack) {
   pdVec3 bxa = pd_v3_cross(b, a), dxc = pd_v3_cross(d, c);
   double cba = pd_v3_dot(c, bxa), dba = pd_v3_dot(d, bxa), adc = pd_v3_dot(a, dxc), bdc = pd_v3_dot(b, dxc);
-  return cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0;
+  if (cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0) return arcsCross;
+  pdVec3 n1 = pd_v3_normalize(pd_v3_cross(a, b)), n2 = pd_v3_normalize(pd_v3_cross(c, d));
+  pdVec3 line = pd_v3_cross(n1, n2);
+  double len = pd_v3_norm(line);
+  if (len <= ARC_TOUCH_TOL) return arcsApart;  // one great circle: parallel edges
+  pdVec3 p = pd_v3_scale(line, 1.0 / len);
+  for (int sign = 0; sign < 2; ++sign, p = pd_v3_scale(p, -1.0)) {
+    // p on arc (a, b) when it lies between a and b along their great circle (arcs are shorter than π);
+    // each test is the sine of p's angle past an end of the arc, allowed down to −slack
+    bool on1 = pd_v3_dot(pd_v3_cross(a, p), n1) >= -slack && pd_v3_dot(pd_v3_cross(p, b), n1) >= -slack;
+    bool on2 = pd_v3_dot(pd_v3_cross(c, p), n2) >= -slack && pd_v3_dot(pd_v3_cross(p, d), n2) >= -slack;
+    if (on1 && on2) return arcsTouch;
+  }
+  return arcsApart;
+}
+
+// Overlap of A and B along unit u (A's frame, pointing from A to B), m; B's pose in A's frame (rel, off).
+static double overlap_along(const pdPolyhedron* sa, const pdPolyhedron* sb, const pdMat3* rel, pdVec3 off, pdVec3 u) {
+  double maxA = -INFINITY, minB = INFINITY;
+  for (int i = 0; i < sa->vertexCount; ++i) maxA = fmax(maxA, pd_v3_dot(u, sa->vertices[i]));
+  pdVec3 uB = pd_mat3_tmulv(rel, u);  // u in B's frame
+  for (int i = 0; i < sb->vertexCount; ++i) minB = fmin(minB, pd_v3_dot(uB, sb->vertices[i]));
+  return maxA - (minB + pd_v3_dot(u, off));
 }
 
 // Edge-edge geometry in body A's frame: B's edge given in A's frame. Fills depth, point (A frame) and
@@ -182,9 +213,17 @@ static int find_ee(const pdModel* m, int ia, const pdPose* pa, int ib, const pdP
     pdVec3 d = pd_v3_scale(pd_mat3_mulv(&rel, sb->faces[eb->f[1]].normal), -1.0);
     for (int i = 0; i < sa->edgeCount; ++i) {
       const pdEdge* ea = &sa->edges[i];
-      if (!arcs_cross(sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal, c, d)) continue;
+      arcMeeting meet = arcs_meet(sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal, c, d, ARC_TOUCH_TOL);
+      if (meet == arcsApart) continue;
       edgeGeom g;
       if (!edge_pair_geometry(sa, i, b0, b1, true, &g) || !(g.depth > 0.0)) continue;
+      if (meet == arcsTouch) {
+        // the faces around the two edges, as axes from A to B: A's normals, B's reversed (c, d)
+        const pdVec3 axes[4] = {sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal, c, d};
+        double shallowest = INFINITY;
+        for (int k = 0; k < 4; ++k) shallowest = fmin(shallowest, overlap_along(sa, sb, &rel, off, axes[k]));
+        if (g.depth > shallowest + tolA + tolB) continue;
+      }
       // a crossing, not an antipodal Minkowski face: each edge's closest point is inside the other body
       pdVec3 onA = pd_v3_sub(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on A's edge
       pdVec3 onB = pd_v3_add(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on B's edge
@@ -264,6 +303,38 @@ static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPo
   return true;
 }
 
+// A tracked EE contact keeps its edges while their Gauss-map arcs meet within this angle (rad): bodies
+// resting face on face (a 45° stack) rock by far less, so their edge crossings, whose arcs only touch,
+// persist; an edge pair that slid past a corner (arcs apart by the angle between faces) breaks.
+#define EE_TRACK_ARC_SLACK 1e-2
+// A tracked contact keeps its features while its vertex (VF) or each edge's closest point (EE) lies inside the other body, to this
+// fraction of that body's δ_max (deflection × size): a crossing that ends with the springs still loaded
+// (elastic contacts end where they began, up to the onset interpolation's error) stays; an edge pair whose
+// lines pass each other outside the bodies (it slid past a corner) does not press anywhere and breaks.
+#define TRACK_INSIDE_TOL_REL 0.1
+static bool edge_points_inside(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                               const pdContactGeom* g) {
+  pdVec3 on1 = pd_v3_muladd(g->point, -0.5 * g->depth, g->normal);  // on body 1's edge
+  pdVec3 on2 = pd_v3_muladd(g->point, 0.5 * g->depth, g->normal);   // on body 2's edge
+  const pdBody* b1 = &model->bodies[id->body1];
+  const pdBody* b2 = &model->bodies[id->body2];
+  double tol1 = TRACK_INSIDE_TOL_REL * model->settings.deflection * b1->size;
+  double tol2 = TRACK_INSIDE_TOL_REL * model->settings.deflection * b2->size;
+  return inside_body(&b1->shape, to_local(p1, on2), tol1) && inside_body(&b2->shape, to_local(p2, on1), tol2);
+}
+
+// Do the Gauss-map arcs of a known edge pair meet at the given poses (see arcs_meet)?
+static bool edge_arcs_meet(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2) {
+  const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
+  const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
+  const pdEdge* e1 = &s1->edges[id->feat1];
+  const pdEdge* e2 = &s2->edges[id->feat2];
+  pdVec3 a = pd_mat3_mulv(&p1->R, s1->faces[e1->f[0]].normal), b = pd_mat3_mulv(&p1->R, s1->faces[e1->f[1]].normal);
+  pdVec3 c = pd_v3_scale(pd_mat3_mulv(&p2->R, s2->faces[e2->f[0]].normal), -1.0);
+  pdVec3 d = pd_v3_scale(pd_mat3_mulv(&p2->R, s2->faces[e2->f[1]].normal), -1.0);
+  return arcs_meet(a, b, c, d, EE_TRACK_ARC_SLACK) != arcsApart;
+}
+
 bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                       pdContactGeom* out) {
   const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
@@ -276,9 +347,25 @@ bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose*
     out->point = p;
     out->normal = pd_mat3_mulv(&p2->R, s2->faces[id->feat2].normal);
     out->depth = face_depth(s2, id->feat2, q);
-    return projects_inside(s2, id->feat2, q, BOUNDARY_TOL_REL * model->bodies[id->body2].size);
+    // still over its face, and not outside the body across another face (it slid past an edge that is
+    // not its face's: near a corner the face plane alone can read deep while the vertex is outside)
+    double outside = TRACK_INSIDE_TOL_REL * model->settings.deflection * model->bodies[id->body2].size;
+    return projects_inside(s2, id->feat2, q, BOUNDARY_TOL_REL * model->bodies[id->body2].size) &&
+           inside_body(s2, q, outside);
   }
-  return edge_contact(model, id, p1, p2, true, out);
+  // an edge pair stays a contact while it spans a face of the Minkowski difference (its Gauss-map arcs
+  // still meet): past that, other features carry the contact and the lines' distance means nothing
+  if (edge_contact(model, id, p1, p2, true, out) && edge_arcs_meet(model, id, p1, p2) &&
+      edge_points_inside(model, id, p1, p2, out))
+    return true;
+  // broken: still report where the edge lines are closest (the caller may integrate on to the end of the
+  // step before it drops the contact); parallel lines have no closest points: normal 0 says so
+  if (!edge_contact(model, id, p1, p2, false, out)) {
+    out->point = p1->x;
+    out->normal = (pdVec3){0, 0, 0};
+    out->depth = 0.0;
+  }
+  return false;
 }
 
 // Smallest root of a t² + b t + c = 0 in [0, 1], or -1.

@@ -54,7 +54,8 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
 // Geometry of one known contact at the given poses (tracking, §4.4.2): VF by (18), EE by the
 // closest points of the two edge lines. Returns false when the contact must break for geometric
 // reasons: the vertex projected onto the face plane leaves the face polygon, or an EE closest point
-// leaves its edge.
+// leaves its edge. `out` is filled either way: when an EE contact breaks it holds the closest points of
+// the two edge lines, or, for parallel lines, a zero normal (no geometry exists).
 bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                       pdContactGeom* out);
 

@@ -1,10 +1,28 @@
-// polydyn — the state derivative of free rigid bodies (paper §2): Newton–Euler with the gyroscopic
-// term, quaternion kinematics, gravity. Contact forces join here with the contact model.
+// polydyn — the state derivative (paper §2): Newton–Euler with the gyroscopic term, quaternion
+// kinematics, gravity, and the contact forces with their spring rates (contact_set.c).
+#include <time.h>
+
+#include "contact_set.h"
 #include "polydyn/state.h"
 #include "state_layout.h"
 
-void pd_state_derivative(const pdModel* model, double t, const double* y, double* dydt) {
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt) {
   (void)t;
+  double t0 = now_seconds();
+  pdContactSet* set = state->contacts;
+  pd_contact_forces(model, set, y, dydt);
+  const pdPose* poses = pd_contact_set_poses(set);
+  const pdVec3* contactForce = pd_contact_set_force(set);
+  const pdVec3* contactTorque = pd_contact_set_torque(set);
+  double t1 = now_seconds();
+  state->stageSeconds[pd_stageForces] += t1 - t0;
+
   const pdVec3 g = model->settings.gravity;
   for (int k = 0; k < model->movingCount; ++k) {
     const pdBody* b = &model->bodies[model->movingBodies[k]];
@@ -13,21 +31,22 @@ void pd_state_derivative(const pdModel* model, double t, const double* y, double
     pdVec3 v = pd_layout_v(yb), w = pd_layout_w(yb);
     pdQuat q = pd_layout_q(yb);
     // inside a Runge–Kutta stage q drifts off unit length; the rotation uses its direction only
-    pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(q));
+    const pdMat3* r = &poses[model->movingBodies[k]].R;
 
-    pdVec3 force = pd_v3_scale(g, b->mass);
-    pdVec3 torque = {0, 0, 0};
+    pdVec3 force = pd_v3_add(pd_v3_scale(g, b->mass), contactForce[k]);
+    pdVec3 torque = contactTorque[k];
 
     // Euler's equations in the body frame: I ω̇ = τ − ω × I ω
-    pdVec3 wb = pd_mat3_tmulv(&r, w);
-    pdVec3 tb = pd_mat3_tmulv(&r, torque);
+    pdVec3 wb = pd_mat3_tmulv(r, w);
+    pdVec3 tb = pd_mat3_tmulv(r, torque);
     pdVec3 gyro = pd_v3_cross(wb, pd_mat3_mulv(&b->inertia, wb));
     pdVec3 alphaB = pd_mat3_mulv(&b->invInertia, pd_v3_sub(tb, gyro));
-    pdVec3 alpha = pd_mat3_mulv(&r, alphaB);
+    pdVec3 alpha = pd_mat3_mulv(r, alphaB);
     pdVec3 a = pd_v3_scale(force, b->invMass);
 
     // q̇ = ½ (0, ω) ⊗ q with ω in the world frame
     pdQuat dq = pd_quat_mul((pdQuat){0.0, w.x, w.y, w.z}, q);
     pd_layout_store(d, a, alpha, v, (pdQuat){0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z});
   }
+  state->stageSeconds[pd_stageDerivative] += now_seconds() - t1;
 }

@@ -26,6 +26,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "contact_set.h"
 #include "polydyn/state.h"
 #include "state_layout.h"
 
@@ -36,10 +37,13 @@ static double now_seconds(void) {
 }
 
 static void derivative(const pdModel* model, pdState* s, double t, const double* y, double* dydt) {
-  double t0 = now_seconds();
-  pd_state_derivative(model, t, y, dydt);
-  s->stageSeconds[pd_stageDerivative] += now_seconds() - t0;
+  pd_state_derivative(model, s, t, y, dydt);  // times its own stages
   ++s->count.derivatives;
+}
+
+// Seconds spent inside derivative evaluations so far (subtracted from the integration stage).
+static double derivative_seconds(const pdState* s) {
+  return s->stageSeconds[pd_stageForces] + s->stageSeconds[pd_stageDerivative];
 }
 
 // Scratch vectors inside state->work.
@@ -49,7 +53,7 @@ typedef struct stepperWork {
 
 static stepperWork work_of(pdState* s) {
   double* w = s->work;
-  size_t n = (size_t)s->n;
+  size_t n = (size_t)s->capacity;
   return (stepperWork){w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n};
 }
 
@@ -111,7 +115,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
     double h = cut ? hMax : s->h;
     bool atMinimum = h <= set->dtmin;
     double t0 = now_seconds();
-    double tDerivative = s->stageSeconds[pd_stageDerivative];
+    double tDerivative = derivative_seconds(s);
 
     rk4(model, s, &w, s->t, s->y, w.k1, h, w.full);
     rk4(model, s, &w, s->t, s->y, w.k1, 0.5 * h, w.half);
@@ -121,7 +125,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
     double norm = 0.0;
     for (int i = 0; i < n; ++i) norm = fmax(norm, fabs(w.trial[i] - w.full[i]) / (15.0 * s->weight[i]));
     bool finite = isfinite(norm) && all_finite(w.trial, n);
-    s->stageSeconds[pd_stageIntegrate] += (now_seconds() - t0) - (s->stageSeconds[pd_stageDerivative] - tDerivative);
+    s->stageSeconds[pd_stageIntegrate] += (now_seconds() - t0) - (derivative_seconds(s) - tDerivative);
 
     if (!finite) {
       ++s->warnings[pd_warnNonFinite];
@@ -139,8 +143,22 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
       s->h = fmax(set->dtmin, shrink * h);
       continue;
     }
+    // contact events (Fig. 8): a new contact's onset or a reversal inside the step may shorten it; a
+    // virtual contact restarts it with the contact list grown
+    double hRetry = h;
+    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry);
+    if (verdict == pd_eventRetry) {
+      hMax = hRetry;
+      continue;
+    }
+    if (verdict == pd_eventRestart) {
+      w = work_of(s);
+      n = s->n;
+      derivative(model, s, s->t, s->y, w.k1);
+      continue;
+    }
     if (norm > set->tol) ++s->warnings[pd_warnStepAtMinimum];
-    memcpy(s->y, w.trial, (size_t)n * sizeof *s->y);
+    pd_contact_events_commit(model, s, w.trial);
     renormalise_quaternions(model, s->y);
     ++s->count.accepted;
     if (!cut) {
@@ -156,16 +174,27 @@ static double fixed_step(const pdModel* model, pdState* s, double hMax) {
   stepperWork w = work_of(s);
   double h = fmin(model->settings.dt, hMax);
   derivative(model, s, s->t, s->y, w.k1);
-  double t0 = now_seconds();
-  double tDerivative = s->stageSeconds[pd_stageDerivative];
-  rk4(model, s, &w, s->t, s->y, w.k1, h, w.trial);
-  s->stageSeconds[pd_stageIntegrate] += (now_seconds() - t0) - (s->stageSeconds[pd_stageDerivative] - tDerivative);
-  if (!all_finite(w.trial, s->n)) {
-    ++s->warnings[pd_warnNonFinite];
-    s->failed = true;
-    return 0.0;
+  for (;;) {
+    double t0 = now_seconds();
+    double tDerivative = derivative_seconds(s);
+    rk4(model, s, &w, s->t, s->y, w.k1, h, w.trial);
+    s->stageSeconds[pd_stageIntegrate] += (now_seconds() - t0) - (derivative_seconds(s) - tDerivative);
+    if (!all_finite(w.trial, s->n)) {
+      ++s->warnings[pd_warnNonFinite];
+      s->failed = true;
+      return 0.0;
+    }
+    double hRetry = h;
+    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry);
+    if (verdict == pd_eventAccept) break;
+    if (verdict == pd_eventRestart) {
+      w = work_of(s);
+      derivative(model, s, s->t, s->y, w.k1);
+    } else {
+      h = hRetry;
+    }
   }
-  memcpy(s->y, w.trial, (size_t)s->n * sizeof *s->y);
+  pd_contact_events_commit(model, s, w.trial);
   renormalise_quaternions(model, s->y);
   ++s->count.accepted;
   return h;

@@ -1,4 +1,4 @@
-// polydyn — run directories: trajectory.csv and summary.json, written atomically.
+// polydyn — run directories: trajectory.csv, contacts.csv and summary.json, written atomically.
 #include "polydyn/output.h"
 
 #include <errno.h>
@@ -9,10 +9,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "model_contact.h"
+
 struct pdRunWriter {
   char* dir;         // final name
   char* tmp;         // temporary directory being written
   FILE* trajectory;  // tmp/trajectory.csv
+  FILE* contacts;    // tmp/contacts.csv
   bool ioError;      // a write failed
 };
 
@@ -59,6 +62,30 @@ static void write_csv_text(FILE* out, const char* s) {
     fputc(*s, out);
   }
   fputc('"', out);
+}
+
+void pd_write_contacts_header(FILE* out) {
+  fputs("t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode\n", out);
+}
+
+void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state) {
+  int count = pd_state_contact_count(state);
+  for (int i = 0; i < count; ++i) {
+    pdContactReport c = pd_state_contact(state, i);
+    write_number(out, state->t);
+    fputc(',', out);
+    write_csv_text(out, model->bodies[c.bodyA].name);
+    fputc(',', out);
+    write_csv_text(out, model->bodies[c.bodyB].name);
+    fprintf(out, ",%s,%d,%d", c.edgeEdge ? "EE" : "VF", c.featureA, c.featureB);
+    const double row[10] = {c.point.x, c.point.y, c.point.z, c.normal.x, c.normal.y, c.normal.z,
+                            c.fn, c.ft.x, c.ft.y, c.ft.z};
+    for (int k = 0; k < 10; ++k) {
+      fputc(',', out);
+      write_number(out, row[k]);
+    }
+    fputs(c.slip ? ",slip\n" : ",stick\n", out);
+  }
 }
 
 void pd_write_trajectory_header(FILE* out) { fputs("t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", out); }
@@ -109,21 +136,28 @@ pdRunWriter* pd_run_open(const char* dir, pdError* err) {
   char* path = join(run->tmp, "trajectory.csv");
   run->trajectory = fopen(path, "w");
   free(path);
-  if (!run->trajectory) {
-    pd_error_set(err, dir, 0, 0, "cannot write trajectory.csv: %s", strerror(errno));
+  path = join(run->tmp, "contacts.csv");
+  run->contacts = fopen(path, "w");
+  free(path);
+  if (!run->trajectory || !run->contacts) {
+    pd_error_set(err, dir, 0, 0, "cannot write %s: %s", run->trajectory ? "contacts.csv" : "trajectory.csv",
+                 strerror(errno));
     pd_run_abort(run);
     return NULL;
   }
-  // a large buffer: the trajectory is the bulk of the output
+  // large buffers: trajectory and contacts are the bulk of the output
   setvbuf(run->trajectory, NULL, _IOFBF, 1 << 20);
+  setvbuf(run->contacts, NULL, _IOFBF, 1 << 20);
   pd_write_trajectory_header(run->trajectory);
+  pd_write_contacts_header(run->contacts);
   return run;
 }
 
 bool pd_run_observe(const pdModel* model, const pdState* state, void* user) {
   pdRunWriter* run = user;
   pd_write_trajectory_rows(run->trajectory, model, state);
-  if (ferror(run->trajectory)) run->ioError = true;
+  pd_write_contact_rows(run->contacts, model, state);
+  if (ferror(run->trajectory) || ferror(run->contacts)) run->ioError = true;
   return !run->ioError;
 }
 
@@ -159,23 +193,50 @@ static void write_mat(FILE* out, const pdMat3* m) {
   fputc(']', out);
 }
 
-static void write_material(FILE* out, const pdMaterial* m) {
-  fputs("{\"mu\": ", out);
-  write_number(out, m->mu);
-  fputs(", \"kn\": ", out);
-  write_number(out, m->kn);
-  fputs(", \"kt\": ", out);
-  write_number(out, m->kt);
-  fputs(", \"cn\": ", out);
-  write_number(out, m->cn);
-  fputs(", \"ct\": ", out);
-  write_number(out, m->ct);
-  fputs(", \"restitution\": ", out);
-  if (m->restitution >= 0.0)
-    write_number(out, m->restitution);
+// A number, or null when it is negative (a value not set or not applicable) or not finite.
+static void write_optional(FILE* out, double x) {
+  if (x >= 0.0)
+    write_number(out, x);
   else
     fputs("null", out);
+}
+
+// The material as the scene asked for it: null for what it did not set.
+static void write_requested(FILE* out, const pdMaterial* m) {
+  const struct {
+    const char* name;
+    double value;
+  } fields[] = {{"mu", m->mu}, {"kn", m->kn}, {"kt", m->kt},
+                {"cn", m->cn}, {"ct", m->ct}, {"restitution", m->restitution}};
+  for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i) {
+    fprintf(out, "%s\"%s\": ", i ? ", " : "{", fields[i].name);
+    write_optional(out, fields[i].value);
+  }
   fputc('}', out);
+}
+
+// The material as used (per-body constants after §3.3.1), what sized it, and its time constants
+// (null for a damper that is 0).
+static void write_used(FILE* out, const pdMaterial* m, const pdBodyContactInfo* info) {
+  const struct {
+    const char* name;
+    double value;
+  } fields[] = {{"mu", m->mu},       {"kn", m->kn},          {"kt", m->kt},
+                {"cn", m->cn},       {"ct", m->ct},          {"restitution", m->restitution},
+                {"zeta", info->zeta}, {"sizing_mass", info->mass}, {"m_min", info->mMin}};
+  for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i) {
+    fprintf(out, "%s\"%s\": ", i ? ", " : "{", fields[i].name);
+    write_optional(out, fields[i].value);
+  }
+  fputs(", \"time_constants\": {\"kn\": ", out);
+  write_number(out, info->tauKn);
+  fputs(", \"kt\": ", out);
+  write_number(out, info->tauKt);
+  fputs(", \"cn\": ", out);
+  write_number(out, info->tauCn);
+  fputs(", \"ct\": ", out);
+  write_number(out, info->tauCt);
+  fputs("}}", out);
 }
 
 static const char* primitive_name(pdPrimitiveKind kind) {
@@ -189,7 +250,9 @@ static const char* primitive_name(pdPrimitiveKind kind) {
   return "?";
 }
 
-static void write_body(FILE* out, const pdBody* b) {
+static void write_body(FILE* out, const pdModel* model, int index) {
+  const pdBody* b = &model->bodies[index];
+  pdBodyContactInfo info = pd_model_body_contact_info(model, index);
   fputs("    {\"name\": ", out);
   write_json_string(out, b->name);
   fputs(", \"color\": ", out);
@@ -222,10 +285,10 @@ static void write_body(FILE* out, const pdBody* b) {
   fputs(", \"w\": ", out);
   write_vec(out, b->w0);
   fputs("},\n     \"material\": {\"requested\": ", out);
-  write_material(out, &b->requested);
-  fputs(", \"used\": ", out);
-  write_material(out, &b->used);
-  fputs(", \"adjustments\": []},\n", out);
+  write_requested(out, &b->requested);
+  fputs(",\n                  \"used\": ", out);
+  write_used(out, &b->used, &info);
+  fputs("},\n", out);
   // the shape in the body frame (origin at the centre of mass), for viewers and other engines
   fprintf(out, "     \"shape\": {\"V\": %d, \"E\": %d, \"F\": %d, \"vertices\": [", b->shape.vertexCount,
           b->shape.edgeCount, b->shape.faceCount);
@@ -264,14 +327,32 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   fprintf(out, ", \"vmax_estimated\": %s},\n", s->vmaxEstimated ? "true" : "false");
   fputs("  \"bodies\": [\n", out);
   for (int i = 0; i < model->bodyCount; ++i) {
-    write_body(out, &model->bodies[i]);
+    write_body(out, model, i);
     fputs(i + 1 < model->bodyCount ? ",\n" : "\n", out);
   }
   fputs("  ],\n", out);
+  // the contact model's constants per pair of material classes are derived from the bodies' above; what
+  // the §3.3 time-constant checks changed is listed here, one line each, never silently
+  fprintf(out, "  \"material_classes\": %d, \"contact_period_min\": ", pd_model_material_class_count(model));
+  write_number(out, pd_model_contact_period_min(model));
+  fputs(",\n  \"adjustments\": [", out);
+  char line[1024];
+  for (int i = 0, count = pd_model_adjustment_count(model); i < count; ++i) {
+    pd_model_adjustment_describe(model, i, line, sizeof line);
+    fputs(i ? ",\n    " : "\n    ", out);
+    write_json_string(out, line);
+  }
+  fprintf(out, "%s],\n  \"adjustments_dropped\": %d,\n", pd_model_adjustment_count(model) ? "\n  " : "",
+          pd_model_adjustments_dropped(model));
   fprintf(out,
           "  \"counts\": {\"accepted_steps\": %ld, \"rejected_steps\": %ld, \"derivative_evaluations\": %ld, "
-          "\"samples\": %ld, \"contact_events\": 0},\n",
-          state->count.accepted, state->count.rejected, state->count.derivatives, state->count.samples);
+          "\"samples\": %ld, \"travel_retries\": %ld, \"onset_retries\": %ld, \"refinements\": %ld, \"contacts_made\": %ld, "
+          "\"contacts_virtual\": %ld, \"contacts_transferred\": %ld, \"breaks_force\": %ld, "
+          "\"breaks_geometry\": %ld, \"contacts_at_end\": %d},\n",
+          state->count.accepted, state->count.rejected, state->count.derivatives, state->count.samples,
+          state->count.travelRetries, state->count.eventRetries, state->count.refinements, state->count.contactsMade,
+          state->count.contactsVirtual, state->count.contactsTransferred, state->count.breaksForce,
+          state->count.breaksGeometry, pd_state_contact_count(state));
   fputs("  \"warnings\": {", out);
   for (int w = 0; w < pd_warnCount; ++w) fprintf(out, "%s\"%s\": %ld", w ? ", " : "", pdWarningNames[w], state->warnings[w]);
   fputs("},\n  \"t_reached\": ", out);
@@ -292,9 +373,11 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
 }
 
 bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state, const pdRunInfo* info, pdError* err) {
-  bool ok = !run->ioError && !ferror(run->trajectory);
+  bool ok = !run->ioError && !ferror(run->trajectory) && !ferror(run->contacts);
   ok = (fclose(run->trajectory) == 0) && ok;
+  ok = (fclose(run->contacts) == 0) && ok;
   run->trajectory = NULL;
+  run->contacts = NULL;
   char* path = join(run->tmp, "summary.json");
   FILE* out = ok ? fopen(path, "w") : NULL;
   free(path);
@@ -333,6 +416,7 @@ bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state,
 void pd_run_abort(pdRunWriter* run) {
   if (!run) return;
   if (run->trajectory) fclose(run->trajectory);
+  if (run->contacts) fclose(run->contacts);
   remove_tree(run->tmp);
   free(run->dir);
   free(run->tmp);

@@ -4,20 +4,18 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "contact_set.h"
 #include "state_layout.h"
 
-const char* const pdStageNames[pd_stageCount] = {"derivative", "integrate", "observe"};
-const char* const pdWarningNames[pd_warnCount] = {"step_at_minimum", "non_finite_step"};
+const char* const pdStageNames[pd_stageCount] = {"broad_phase", "interference", "contact_analysis", "forces",
+                                                 "derivative",  "integrate",    "observe"};
+const char* const pdWarningNames[pd_warnCount] = {"step_at_minimum", "non_finite_step", "late_onset"};
 
 pdState* pd_state_create(const pdModel* model) {
   pdState* s = calloc(1, sizeof *s);
   PD_ASSERT(s != NULL);
-  s->n = PD_BODY_STATE_SIZE * model->movingCount;
-  size_t n = (size_t)(s->n > 0 ? s->n : 1);
-  s->y = calloc(n, sizeof *s->y);
-  s->weight = calloc(n, sizeof *s->weight);
-  s->work = calloc(n * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
-  PD_ASSERT(s->y && s->weight && s->work);
+  s->contacts = pd_contact_set_create(model);
+  pd_state_reserve_contacts(model, s, 4 * model->movingCount + 16);
   pd_state_reset(model, s);
   return s;
 }
@@ -26,6 +24,8 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   const pdSettings* set = &model->settings;
   s->t = 0.0;
   s->h = set->dt;
+  s->n = PD_BODY_STATE_SIZE * model->movingCount;
+  pd_contact_set_clear(s->contacts);
   s->stepper = pd_stepperRK4Adaptive;
   s->nextSample = 0;
   s->failed = false;
@@ -55,6 +55,7 @@ void pd_state_free(pdState* s) {
   free(s->y);
   free(s->weight);
   free(s->work);
+  pd_contact_set_free(s->contacts);
   free(s);
 }
 
@@ -74,5 +75,5 @@ double pd_state_energy(const pdModel* model, const pdState* s) {
     pdBodyState bs = pd_state_body(model, s, i);
     e += pd_body_kinetic_energy(b, bs.v, bs.w, bs.q) - b->mass * pd_v3_dot(model->settings.gravity, bs.x);
   }
-  return e;
+  return e + pd_contact_spring_energy(s->contacts, s->y, PD_BODY_STATE_SIZE * model->movingCount);
 }

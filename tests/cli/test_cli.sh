@@ -89,13 +89,15 @@ check "demo run exits 0" '[ $rc -eq 0 ]'
 check "demo run has trajectory.csv" '[ -f "$RUN1/trajectory.csv" ]'
 check "demo run has summary.json" '[ -f "$RUN1/summary.json" ]'
 check "trajectory header is exact" '[ "$(head -n 1 "$RUN1/trajectory.csv")" = "$HEADER" ]'
-# demo: tend 1, sample 100 -> 101 samples; 3 moving bodies (the floor is fixed)
-check "trajectory has samples x moving bodies rows" '[ "$(line_count "$RUN1/trajectory.csv")" -eq $((1 + 101 * 3)) ]'
+# demo: tend T (a whole number of seconds), sample 100 -> 100 T + 1 samples; 3 moving bodies (the floor is fixed)
+DEMO_TEND=$(awk '$1 == "tend" { t = $2 } END { printf "%d", t }' "$DEMO")
+DEMO_SAMPLES=$((100 * DEMO_TEND + 1))
+check "trajectory has samples x moving bodies rows" '[ "$(line_count "$RUN1/trajectory.csv")" -eq $((1 + DEMO_SAMPLES * 3)) ]'
 check "trajectory rows have 15 fields" \
   '[ "$(tail -n +2 "$RUN1/trajectory.csv" | awk -F, "NF != 15" | wc -l)" -eq 0 ]'
 check "trajectory lists bodies in scene order" \
   '[ "$(sed -n "2,4p" "$RUN1/trajectory.csv" | cut -d, -f2 | tr "\n" " ")" = "box cone ball " ]'
-check "last sample is at t = 1" '[ "$(tail -n 1 "$RUN1/trajectory.csv" | cut -d, -f1)" = "1" ]'
+check "last sample is at t = tend" '[ "$(tail -n 1 "$RUN1/trajectory.csv" | cut -d, -f1)" = "$DEMO_TEND" ]'
 check "summary.json is valid JSON" 'python3 -m json.tool "$RUN1/summary.json" >/dev/null'
 check "no leftover partial directory" 'no_partial "$RUN1"'
 
@@ -130,6 +132,10 @@ printf 'loc 0 0 0\ncube a red 1 1 1\n' >"$BAD/property_before_object.scene"
 printf 'cube a red 1 1 1\ncube a blue 1 1 1\nloc 3 0 0\n' >"$BAD/duplicate_name.scene"
 printf 'hull h red 0 0 0  1 0 0  0 1 0  1 1 0\n' >"$BAD/coplanar_hull.scene"
 printf '# nothing here\n' >"$BAD/no_object.scene"
+# two cubes of side 0.1 m with centres 0.09 m apart: 1 cm of overlap at t = 0 (DESIGN §4.1)
+printf 'cube a red 0.1 0.1 0.1\ncube b red 0.1 0.1 0.1\nloc 0.09 0 0\n' >"$BAD/overlapping_bodies.scene"
+# below e^-2 no contact spring and damper reproduce the restitution (paper §3.2.2)
+printf 'cube a red 1 1 1\nrestitution 0.1\n' >"$BAD/unreachable_restitution.scene"
 head -c 4096 "$PD" >"$BAD/binary.scene"
 mkdir "$BAD/directory.scene"
 
@@ -181,7 +187,7 @@ check "existing file as --out is refused with 2" '[ $rc -eq 2 ] && [ "$(cat "$SC
 touch "$RUN3/stale-marker"
 run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN3"
 check "existing run directory is replaced (exit 0)" '[ $rc -eq 0 ]'
-check "replaced run directory holds the new run" '[ "$(line_count "$RUN3/trajectory.csv")" -eq $((1 + 101 * 3)) ]'
+check "replaced run directory holds the new run" '[ "$(line_count "$RUN3/trajectory.csv")" -eq $((1 + DEMO_SAMPLES * 3)) ]'
 check "replaced run directory lost the old contents" '[ ! -e "$RUN3/stale-marker" ]'
 check "replaced run directory: no partial or old copy left" 'no_partial "$RUN3"'
 
@@ -211,6 +217,45 @@ check "check names every body" \
   'grep -q "^  floor: " "$OUT" && grep -q "^  box: " "$OUT" && grep -q "^  cone: " "$OUT" && grep -q "^  ball: " "$OUT"'
 run_pd "$OUT" "$ERR" check "$BAD/coplanar_hull.scene"
 check "check on a bad scene exits 2" '[ $rc -eq 2 ]'
+
+# --- contact material parameters (paper §3.2, §3.3) ------------------------------------------------
+run_pd "$OUT" "$ERR" check "$DEMO"
+check "check prints the used kn of every body" '[ "$(grep -c "^    material used   mu .*, kn [0-9.e+]* N/m" "$OUT")" -eq 4 ]'
+check "check prints the time constants" '[ "$(grep -c "^    time constants  kn " "$OUT")" -eq 4 ]'
+# a cube resting exactly on a floor (touching is not overlapping), default dtmin: nothing adjusted
+REST=$SCRATCH/resting.scene
+printf 'cube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\ncube box red 0.2 0.2 0.2\nloc 0 0 0.1\nrestitution 0.5\n' >"$REST"
+run_pd "$OUT" "$ERR" check "$REST"
+check "check accepts a cube resting on a floor" '[ $rc -eq 0 ]'
+check "check says when nothing was adjusted" 'grep -q "^adjustments: none$" "$OUT"'
+run_pd "$OUT" "$ERR" check "$BAD/overlapping_bodies.scene"
+check "check on overlapping bodies exits 2" '[ $rc -eq 2 ]'
+check "overlap message names both bodies at the later one's line" \
+  'grep -q "overlapping_bodies.scene:2:1: bodies .a. and .b. overlap by 0.01 m at t = 0" "$ERR"'
+run_pd "$OUT" "$ERR" check "$BAD/unreachable_restitution.scene"
+check "check on restitution 0.1 exits 2" '[ $rc -eq 2 ]'
+check "restitution 0.1 is refused for being below e^-2" 'grep -q ":1:1: .*restitution 0.1 is below e^-2" "$ERR"'
+# a resting cube and dtmin above its contact time constants: kn, kt, cn, ct lowered (§3.3.1) and
+# listed, with the pair's normal dampers switched off (§3.3.2)
+ADJ=$SCRATCH/adjusted.scene
+printf 'dt 1e-3\ndtmin 1e-3\ntend 0.01\nvmax 10\n%s\nfixed\nloc 0 0 -0.1\n%s\nloc 0 0 0.1\nrestitution 0.5\n' \
+  'cube floor grey 2 2 0.2' 'cube box red 0.2 0.2 0.2' >"$ADJ"
+run_pd "$OUT" "$ERR" check "$ADJ"
+check "check on an adjusted scene exits 0" '[ $rc -eq 0 ]'
+check "check lists the body adjustments (§3.3.1)" '[ "$(grep -c "^  box: .* (§3.3.1: " "$OUT")" -eq 4 ]'
+check "check lists the pair adjustments (§3.3.2)" 'grep -q "^  box: cn .* -> 0 N·s/m in contacts with floor (§3.3.2" "$OUT"'
+RUNADJ=$SCRATCH/run_adjusted
+run_pd "$OUT" "$ERR" run "$ADJ" --out "$RUNADJ"
+summary_field() {
+  python3 -c 'import json, sys
+d = json.load(open(sys.argv[1]))
+print(eval(sys.argv[2], {"d": d}))' "$1" "$2"
+}
+check "summary.json lists the adjustments" \
+  '[ "$(summary_field "$RUNADJ/summary.json" "sum(\"§3.3\" in a for a in d[\"adjustments\"])")" -ge 5 ]'
+check "summary.json has the used kn and the damping ratio" \
+  '[ "$(summary_field "$RUNADJ/summary.json" "d[\"bodies\"][1][\"material\"][\"used\"][\"kn\"] > 0 and abs(d[\"bodies\"][1][\"material\"][\"used\"][\"zeta\"] - 0.2553) < 1e-4")" = True ]'
+check "summary.json keeps timing last" '[ "$(summary_field "$RUNADJ/summary.json" "list(d)[-1]")" = timing ]'
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -20,7 +20,21 @@
 #define SIDE 0.1
 #define PI 3.14159265358979323846
 
-static pdModel* compile(const char* text) {
+// The scenes name the bodies only; every test sets the poses itself. Each object is placed 10 m from
+// the previous one so that the scene passes the overlap check of pd_model_compile.
+static pdModel* compile(const char* shapes) {
+  char text[2048];
+  size_t used = 0;
+  int objects = 0;
+  for (const char* line = shapes; *line;) {
+    const char* end = strchr(line, '\n');
+    size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
+    used += (size_t)snprintf(text + used, sizeof text - used, "%.*s", (int)len, line);
+    if (!strncmp(line, "cube ", 5) || !strncmp(line, "hull ", 5) || !strncmp(line, "prism ", 6))
+      used += (size_t)snprintf(text + used, sizeof text - used, "loc %d 0 0\n", 10 * objects++);
+    assert_true(used < sizeof text);
+    line += len;
+  }
   pdError err = {0};
   pdScene* scene = pd_scene_parse_buffer("test.scene", text, strlen(text), &err);
   if (!scene) fail_msg("parse: %s:%d:%d: %s", err.file, err.line, err.col, err.message);
@@ -242,6 +256,35 @@ static void test_vertex_on_vertex_and_parallel_edges_give_finite_contacts(void**
   pd_model_free(m);
 }
 
+// A cube turned 45° about the vertical on an equal cube: no vertex of either is inside the other; the
+// contact is the octagon where the two square faces overlap, whose 8 corners are crossings of a top edge
+// of the lower cube with a bottom edge of the upper one. Their Gauss-map arcs only touch (the two faces
+// are parallel), yet each crossing is a contact with the faces' overlap as depth and the vertical normal.
+static void test_cube_turned_45_degrees_on_a_cube_gives_eight_edge_crossings(void** state) {
+  (void)state;
+  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  pdPose b = pose(0, 0, SIDE - DEPTH, 45, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 8);
+  double half = SIDE / 2, offset = half * (sqrt(2.0) - 1.0);  // octagon corner: (±half, ±half(√2 − 1))
+  for (int i = 0; i < n; ++i) {
+    assert_int_equal(c[i].id.kind, pd_contactEE);
+    expect_near(c[i].depth, DEPTH, GEOM_TOL, "depth");
+    expect_near(c[i].normal.z, -1.0, GEOM_TOL, "normal from b into a");
+    double u = fmax(fabs(c[i].point.x), fabs(c[i].point.y)), v = fmin(fabs(c[i].point.x), fabs(c[i].point.y));
+    expect_near(u, half, GEOM_TOL, "corner on a's edge");
+    expect_near(v, offset, GEOM_TOL, "corner on b's edge");
+  }
+  // two cubes side by side sharing an edge line: their front faces are parallel too, but 0.1 m apart
+  // across an overlap that is only DEPTH deep sideways: no edge crossing there may count as a contact
+  pdPose side = pose(SIDE - DEPTH, 0, SIDE - DEPTH, 0, pd_v3(0, 0, 1));
+  n = pd_contacts_find(m, 0, &a, 1, &side, NULL, 0, c, CAPACITY);
+  for (int i = 0; i < n; ++i) assert_true(c[i].depth <= DEPTH * (1 + 1e-9));
+  pd_model_free(m);
+}
+
 static void test_small_capacity_reports_the_needed_count(void** state) {
   (void)state;
   pdModel* m = compile(cubeOnFloor);
@@ -263,6 +306,7 @@ int main(void) {
       cmocka_unit_test(test_vf_onset_with_a_turning_face_solves_the_quadratic),
       cmocka_unit_test(test_ee_onset_interpolates_the_line_distance),
       cmocka_unit_test(test_vertex_on_vertex_and_parallel_edges_give_finite_contacts),
+      cmocka_unit_test(test_cube_turned_45_degrees_on_a_cube_gives_eight_edge_crossings),
       cmocka_unit_test(test_small_capacity_reports_the_needed_count),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -14,12 +14,15 @@
 #include "polydyn/scene.h"
 #include "polydyn/vecmath.h"
 
-// Material of a body: as requested by the scene, and as finally used.
+// Material of a body: as requested by the scene, and as finally used (README "Contact material
+// parameters"). In `requested`, a value the scene did not set is -1 (mu always has a value: its default).
+// In `used`, kn, kt, cn, ct are the per-body constants after the §3.3.1 time-constant adjustments; the
+// constants of a contact pair (with the §3.3.2 adjustments) come from the contact model.
 typedef struct pdMaterial {
   double mu;           // base friction coefficient (pair value: √(μ₁μ₂))
-  double kn, kt;       // spring constants, N/m (0 until the contact model derives them)
+  double kn, kt;       // spring constants, N/m
   double cn, ct;       // damper constants, N·s/m
-  double restitution;  // requested e, or -1 when not requested
+  double restitution;  // requested e, or -1 when not requested (in `used` too: it derives cn and ct)
 } pdMaterial;
 
 typedef struct pdBody {
@@ -45,8 +48,8 @@ typedef struct pdBody {
   pdQuat q0;              // initial orientation (body → world)
   pdVec3 v0;              // initial linear velocity, world, m/s
   pdVec3 w0;              // initial angular velocity, world, rad/s
-  pdMaterial requested;   // what the scene said (defaults filled in)
-  pdMaterial used;        // what the engine uses
+  pdMaterial requested;   // what the scene said (mu's default filled in; -1 for what it did not set)
+  pdMaterial used;        // what the engine uses (per body; pair constants: engine/src/model_contact.h)
   pdSourceLoc where;      // the object command in the scene file
 } pdBody;
 
@@ -69,14 +72,44 @@ typedef struct pdModel {
   int movingCount;       // bodies that carry state
   int* movingBodies;     // (movingCount) body index of each moving body, scene order
   double lengthScale;    // m: the largest body size, used where a scene-wide length is needed
+  struct pdMaterialTable* materials;  // contact parameters per body and per material-class pair (internal)
 } pdModel;
 
 // Compiles a parsed scene into a model: builds and validates every polyhedron, computes exact mass
-// properties, shifts each body's frame to its centre of mass, sets initial states and settings.
-// Returns NULL and fills err (at the object's line) on a degenerate polyhedron or an empty scene.
+// properties, shifts each body's frame to its centre of mass, sets initial states and settings, derives
+// the contact model's material parameters (paper §3.2, §3.3) and checks that no two bodies overlap.
+// Returns NULL and fills err (at the object's line) on a degenerate polyhedron, an empty scene, an
+// unreachable restitution (below e^-2) or bodies interpenetrating at t = 0 (DESIGN §4.1).
 pdModel* pd_model_compile(const pdScene* scene, pdError* err);
 
 void pd_model_free(pdModel* model);
 
 // Total mechanical energy contributions of one moving body in a given state (J).
 double pd_body_kinetic_energy(const pdBody* body, pdVec3 v, pdVec3 w, pdQuat q);
+
+// ---------------------------------------------------------------- contact material (paper §3.2, §3.3)
+
+// What the contact model derived for one body, beside body->used.
+typedef struct pdBodyContactInfo {
+  double mass;          // kg: the mass that sized k and c (a fixed body: the heaviest moving body's)
+  double mMin;          // kg: minimum effective mass of the §3.3.1 checks (a fixed body: the lightest
+                        // moving body's)
+  double zeta;          // damping ratio derived from the requested restitution, or -1 when none
+  double tauKn, tauKt;  // s: undamped periods 2π√(m_min/k) with the used kn, kt
+  double tauCn, tauCt;  // s: decay times 2 m_min/c with the used cn, ct; INFINITY when c = 0
+} pdBodyContactInfo;
+
+pdBodyContactInfo pd_model_body_contact_info(const pdModel* model, int body);
+
+// Bodies whose used material (constants, sizing mass, minimum effective mass) is identical share a
+// material class; contact-pair constants are derived once per pair of classes.
+int pd_model_material_class_count(const pdModel* model);
+
+// The time-constant adjustments of §3.3.1 (per body) and §3.3.2 (per pair of material classes) made at
+// compile time. Identical §3.3.1 adjustments of several bodies are listed once, naming the first body
+// and how many more share it; a §3.3.2 adjustment names the first body of each class. Adjustments past
+// the list's capacity are not listed but counted (pd_model_adjustments_dropped).
+int pd_model_adjustment_count(const pdModel* model);
+int pd_model_adjustments_dropped(const pdModel* model);
+// One line describing adjustment i (0 <= i < count) into buf (UTF-8, no newline); returns snprintf's count.
+int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int size);

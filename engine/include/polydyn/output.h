@@ -1,5 +1,7 @@
 // polydyn — run directories (DESIGN §4.2): trajectory.csv and summary.json.
 //
+// contacts.csv: see pd_write_contact_rows.
+//
 // A run directory is written under a temporary name beside the target (`DIR.partial-PID`) and
 // renamed to DIR only when complete, so an interrupted run never leaves a directory that looks
 // complete. An existing DIR is replaced only if it is a previous run directory (has summary.json).
@@ -26,6 +28,12 @@ bool pd_run_observe(const pdModel* model, const pdState* state, void* user);
 // Writes one trajectory row per moving body at the state's time.
 void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state);
 void pd_write_trajectory_header(FILE* out);
+// contacts.csv (DESIGN §4.2): header `t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode`;
+// one row per active contact per sample, in contact-id order; kind VF or EE; body_a carries the vertex
+// (VF) or the first edge (EE); n points from body_b into body_a; (fn, ft) is the force on body_a, N;
+// mode stick or slip.
+void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state);
+void pd_write_contacts_header(FILE* out);
 
 typedef struct pdRunInfo {
   const char* engine;     // e.g. "polydyn-soft"

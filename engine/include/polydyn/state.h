@@ -1,7 +1,14 @@
 // polydyn — the mutable state of a simulation, and stepping it.
 //
 // State vector layout (paper §2): per moving body, in scene order, 13 numbers
-//   v (3, world, m/s), ω (3, world, rad/s), x (3, centre of mass, world, m), q (4, w x y z, body → world).
+//   v (3, world, m/s), ω (3, world, rad/s), x (3, centre of mass, world, m), q (4, w x y z, body → world),
+// then per active contact, in contact-id order (paper §4.4), its 8 spring deflections (m):
+//   s1n, s2n (along the contact normal), s1t (3), s2t (3) (world vectors in the tangent plane).
+// The contact list changes only between steps; the vector's length n changes with it.
+//
+// Contact conventions (engine/src/contact_analysis.h, contact_force.h): body A (body 1) carries the vertex
+// of a vertex–face (VF) contact or the first edge of an edge–edge (EE) contact; the normal points from
+// body B into body A; the force reported is the one B applies to A; penetration depth > 0 when overlapping.
 // One model can drive many states (sweeps, threads): the model is never written to.
 //
 // Memory: pd_state_create allocates everything the step needs; pd_advance allocates nothing.
@@ -16,9 +23,13 @@ enum { PD_BODY_STATE_SIZE = 13 };
 
 // Named, timed stages of a step (seconds accumulate in pdState.stageSeconds).
 typedef enum pdStage {
-  pd_stageDerivative,  // state derivative: Newton–Euler, quaternion kinematics
-  pd_stageIntegrate,   // Runge–Kutta combination, error estimate, step control
-  pd_stageObserve,     // calls to the observer (output)
+  pd_stageBroadPhase,       // boxes of the moving bodies, sweep and prune
+  pd_stageInterference,     // separating-axis test of each box-overlapping pair
+  pd_stageContactAnalysis,  // VF/EE contacts of interfering pairs, tracking, onsets, breaks, the contact list
+  pd_stageForces,           // contact forces and spring rates inside the state derivative
+  pd_stageDerivative,       // the rest of the state derivative: Newton–Euler, quaternion kinematics
+  pd_stageIntegrate,        // Runge–Kutta combination, error estimate, step control
+  pd_stageObserve,          // calls to the observer (output)
   pd_stageCount
 } pdStage;
 extern const char* const pdStageNames[pd_stageCount];
@@ -27,6 +38,8 @@ extern const char* const pdStageNames[pd_stageCount];
 typedef enum pdWarning {
   pd_warnStepAtMinimum,  // a step at dtmin still exceeded the tolerance and was accepted anyway
   pd_warnNonFinite,      // a trial step produced a non-finite number and was retried smaller
+  pd_warnLateOnset,      // a contact onset could not be located within the retries: the contact was
+                         // added deeper than the onset tolerance (its springs start at 0 there)
   pd_warnCount
 } pdWarning;
 extern const char* const pdWarningNames[pd_warnCount];
@@ -42,16 +55,26 @@ typedef struct pdCounters {
   long rejected;     // rejected trial steps
   long derivatives;  // evaluations of the state derivative
   long samples;      // output samples delivered to the observer
+  long eventRetries;      // trial steps cut short to land on a contact onset (App. C)
+  long travelRetries;     // trial steps cut short because two bodies that may meet moved too far (tunnelling)
+  long refinements;       // trial steps halved around a reversal or a stick/slip change (§3.4)
+  long contactsMade;      // contacts added at the end of a step (found, approaching)
+  long contactsVirtual;   // contacts added at the start of a step (onset within the first dt_min)
+  long contactsTransferred;  // VF contacts whose sliding vertex moved on to an adjacent face (§4.4.3)
+  long breaksForce;       // contacts dropped because the normal springs would pull
+  long breaksGeometry;    // contacts dropped because a feature left the other (vertex off its face, EE off an edge)
 } pdCounters;
 
 typedef struct pdState {
   double t;          // s
   double h;          // next step to try, s
   pdStepper stepper;
-  int n;             // length of y
+  int n;             // length of y: 13 per moving body + 8 per active contact
+  int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)
   double* y;         // (n) the state vector
   double* weight;    // (n) error weight of each component (its characteristic scale)
   double* work;      // scratch for the stepper (owned)
+  struct pdContactSet* contacts;  // the contact list and the contact search's scratch (internal)
   long nextSample;   // index k of the next output sample, at t = k / sampleRate
   bool failed;       // the run could not continue (see warnings); pd_advance returns false
   bool stopped;      // the observer asked to stop; pd_advance returns false
@@ -75,8 +98,25 @@ void pd_state_free(pdState* state);
 
 pdBodyState pd_state_body(const pdModel* model, const pdState* state, int bodyIndex);
 
-// Kinetic + gravitational potential energy of all moving bodies, J (potential zero at the origin).
+// Kinetic + gravitational potential energy of all moving bodies plus the energy stored in the contact
+// springs (½ k s² each), J (gravitational potential zero at the origin).
 double pd_state_energy(const pdModel* model, const pdState* state);
+
+// One active contact at the state's time, for output (DESIGN §4.2 contacts.csv).
+typedef struct pdContactReport {
+  int bodyA, bodyB;     // body indices: A carries the vertex (VF) or the first edge (EE)
+  bool edgeEdge;        // false: VF, true: EE
+  int featureA, featureB;  // VF: vertex of A, face of B; EE: edge of A, edge of B
+  pdVec3 point;         // world, m: the vertex (VF) or the midpoint of the edges' closest points (EE)
+  pdVec3 normal;        // unit, from B into A
+  double depth;         // m, > 0 when overlapping (geometric, not the springs' deflection)
+  double fn;            // N, normal force on A (>= 0)
+  pdVec3 ft;            // N, friction force on A
+  bool slip;            // the friction limit is active
+} pdContactReport;
+
+int pd_state_contact_count(const pdState* state);
+pdContactReport pd_state_contact(const pdState* state, int i);
 
 // Called at every output sample, with state->t exactly k / sampleRate. Returning false asks
 // pd_advance to stop after this sample (state->stopped is set).
@@ -88,5 +128,6 @@ typedef bool pdObserverFcn(const pdModel* model, const pdState* state, void* use
 // observer asked to stop (state->stopped).
 bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
 
-// The state derivative dy/dt at (t, y). Exposed for tests and alternative steppers.
-void pd_state_derivative(const pdModel* model, double t, const double* y, double* dydt);
+// The state derivative dy/dt at (t, y), y laid out for the state's current contact list (its length is
+// state->n). Uses the state's scratch and stage timers. Exposed for tests and alternative steppers.
+void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt);

@@ -1,0 +1,59 @@
+// polydyn (internal) — the contact list of a state and the work around it: contact forces inside the
+// state derivative, and the contact events between steps (paper Fig. 8, §3.4, §4.2–§4.4).
+//
+// The contact list holds the active contacts sorted by id (pd_contact_id_compare); contact i's 8 spring
+// numbers sit at y[springBase + 8 i] (state_layout.h). Everything here is sized at creation and grown only
+// between steps (pd_contact_set_reserve); nothing allocates inside a derivative evaluation.
+#pragma once
+
+#include <stdbool.h>
+
+#include "contact_analysis.h"
+#include "contact_force.h"
+#include "polydyn/state.h"
+
+enum { PD_CONTACT_STATE_SIZE = 8 };
+
+typedef struct pdContactSet pdContactSet;
+
+pdContactSet* pd_contact_set_create(const pdModel* model);
+void pd_contact_set_free(pdContactSet* set);
+// Empties the list and clears the contact search's caches (state reset).
+void pd_contact_set_clear(pdContactSet* set);
+int pd_contact_set_count(const pdContactSet* set);
+
+// Inside the derivative: poses of every body from y (fixed bodies keep theirs), then for every contact
+// its force and moment on both bodies (summed per moving body, world: pd_contact_set_force/_torque) and
+// its spring rates (written into dydt's contact part). A normal force that would pull is not applied
+// (normal springs are never in tension); the contact is dropped after the step.
+void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y, double* dydt);
+// Results of the last pd_contact_forces call: poses indexed by body; force and torque (N, N·m, about the
+// centre of mass) indexed by moving body (stateIndex).
+const pdPose* pd_contact_set_poses(const pdContactSet* set);
+const pdVec3* pd_contact_set_force(const pdContactSet* set);
+const pdVec3* pd_contact_set_torque(const pdContactSet* set);
+
+typedef enum pdEventVerdict {
+  pd_eventAccept,   // take the step: call pd_contact_events_commit
+  pd_eventRetry,    // take a shorter step from the same start (*hRetry), the contact list unchanged
+  pd_eventRestart,  // contacts were added at the start of the step (virtual contacts): y0 was re-laid
+                    // (state->n changed), re-evaluate the derivative at the start and try again
+} pdEventVerdict;
+
+// After a trial step from (t0, y0 = state->y) to y1 (length state->n) of size h that the error control
+// accepted: analyses the contacts at y1 (broad phase, interference, contact search, tracking) and decides
+// whether a contact onset or a reversal inside the step asks for a shorter step (Retry), whether
+// contacts must be added at the start (Restart: state->y and state->n are updated), or whether the step
+// stands (Accept). Onset retries are bounded per step, refinements by the refinement step. May grow the
+// state's vectors (Restart only: pointers into the stepper's scratch are then stale).
+pdEventVerdict pd_contact_events(const pdModel* model, pdState* state, double h, const double* y1, double* hRetry);
+// Accepts the step analysed by the last pd_contact_events: copies y1 into state->y with the new contact
+// list (breaks, transfers, new contacts with springs at 0), realigns the springs of continuing contacts
+// (§3.4) and records each contact's force for output. Grows the state's vectors if needed.
+void pd_contact_events_commit(const pdModel* model, pdState* state, const double* y1);
+
+// Grows the state's y, weight and work to hold `contacts` contacts (between steps only).
+void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contacts);
+
+// Spring energy ½ Σ k s² of the contacts whose springs are in y (J).
+double pd_contact_spring_energy(const pdContactSet* set, const double* y, int springBase);

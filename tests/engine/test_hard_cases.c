@@ -1,0 +1,231 @@
+// The hard cases (cases/hard/*.scene, issue item 8): thin plate, mass ratio 10⁴, a fast cube onto a thin
+// slab, crossed bars edge on edge, vertex on vertex, equal cubes face on face, a 10-box stack, a grazing
+// impact. Each scene runs through pd_advance to its tend; at every output sample the observer checks:
+// - every number is finite (body states, energy, every contact report);
+// - the deepest penetration of two bodies in contact stays below PENETRATION_LIMIT × δ_max of the pair
+//   (δ_max of a body = settings.deflection × body.size; a pair's = the smaller of its two). Penetration is
+//   the bodies' overlap: the shortest translation that separates them (the separating-axis minimum depth,
+//   interference.h), not a contact's own depth, which is measured along that contact's normal and for an
+//   edge pair nearly parallel can span a long, thin overlap;
+// - the energy (pd_state_energy: kinetic + gravitational + contact springs) never rises above its initial
+//   value by more than ENERGY_GAIN_REL_TOL (below);
+// and the run completes (pd_advance returns true, no non-finite warning). fast_cube_thin_slab also checks
+// that the cube does not tunnel: its centre stays above the slab's top face at every sample.
+// The checks see the output samples only (1000 Hz in most scenes, a few samples per impact): an excursion
+// between two samples goes unseen. Each scene prints its wall time, steps, derivative evaluations, deepest
+// penetration / δ_max and energy gain.
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <cmocka.h>
+
+#include "interference.h"
+#include "polydyn/model.h"
+#include "polydyn/scene.h"
+#include "polydyn/state.h"
+
+#define CASES_DIR PD_SOURCE_DIR "/cases/hard/"
+
+// The springs are sized so that an impact at vmax deflects them by δ_max (README: kn = m vmax²/δ_max²);
+// several contacts share a load and the geometric depth is not the springs' deflection (a late onset
+// starts the springs at 0 below the surface), so a margin is allowed, but a depth of several δ_max means
+// the contact model is not holding the bodies apart.
+#define PENETRATION_LIMIT 3.0
+// Every scene dissipates (restitution 0.5 on every body, friction): the energy can only rise through
+// integration error. The runs use tol 1e-7 (weighted local error per accepted step: positions over the
+// body size, velocities over vmax), i.e. an energy error per step of order 1e-7 of the scene's energy
+// scale, and they take a few hundred to a few thousand steps whose errors do not all add in one
+// direction; 1e-6 of the initial energy bounds that sum. Every scene puts its support's top at z ≥ 0,
+// so E(0) (potential zero at the origin) is positive and at least the energy that can be released.
+#define ENERGY_GAIN_REL_TOL 1e-6
+
+typedef struct hardCase {
+  const char* file;
+  const char* tunnelBody;  // fast_cube_thin_slab: the body that must stay above...
+  const char* slabBody;    // ...this fixed body's top face
+} hardCase;
+
+static const hardCase hardCases[] = {
+    {"thin_plate.scene", NULL, NULL},
+    {"mass_ratio.scene", NULL, NULL},
+    {"fast_cube_thin_slab.scene", "bullet", "slab"},
+    {"crossed_bars.scene", NULL, NULL},
+    {"vertex_on_vertex.scene", NULL, NULL},
+    {"cubes_face_on_face.scene", NULL, NULL},
+    {"stack_10.scene", NULL, NULL},
+    {"grazing.scene", NULL, NULL},
+};
+
+// What the observer saw over all samples.
+typedef struct watch {
+  long samples;
+  bool finite;
+  double firstNonFiniteT;
+  double energy0;
+  double energyMaxExcess;     // max over samples of E(t) − E(0), J
+  double energyMaxRise;       // max over samples of E(t) − min E(earlier), J (informative)
+  double energyLowest;
+  double worstDepthRatio;     // max over samples and contacts of depth / δ_max
+  double worstDepthT;
+  int maxContacts;
+  int tunnelBody, slabBody;   // body indices, -1 when not checked
+  double slabTop;             // m, world z of the slab's top face
+  double lowestClearance;     // m, min over samples of (tunnel body centre z − slab top)
+} watch;
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static bool body_finite(pdBodyState b) {
+  return pd_v3_isfinite(b.x) && pd_v3_isfinite(b.v) && pd_v3_isfinite(b.w) && isfinite(b.q.w) && isfinite(b.q.x) &&
+         isfinite(b.q.y) && isfinite(b.q.z);
+}
+
+static double contact_delta_max(const pdModel* m, int a, int b) {
+  return m->settings.deflection * fmin(m->bodies[a].size, m->bodies[b].size);
+}
+
+static bool watch_sample(const pdModel* model, const pdState* state, void* user) {
+  watch* w = user;
+  bool finite = true;
+  for (int j = 0; j < model->movingCount; ++j) finite = finite && body_finite(pd_state_body(model, state, model->movingBodies[j]));
+  double e = pd_state_energy(model, state);
+  finite = finite && isfinite(e);
+  int nc = pd_state_contact_count(state);
+  if (nc > w->maxContacts) w->maxContacts = nc;
+  for (int i = 0; i < nc; ++i) {
+    pdContactReport c = pd_state_contact(state, i);
+    finite = finite && pd_v3_isfinite(c.point) && pd_v3_isfinite(c.normal) && isfinite(c.depth) && isfinite(c.fn) &&
+             pd_v3_isfinite(c.ft);
+    pdBodyState a = pd_state_body(model, state, c.bodyA), b = pd_state_body(model, state, c.bodyB);
+    pdMat3 ra = pd_quat_to_mat3(a.q), rb = pd_quat_to_mat3(b.q);
+    pdSatResult sat;
+    pd_interference(&model->bodies[c.bodyA].shape, a.x, &ra, &model->bodies[c.bodyB].shape, b.x, &rb, PD_SAT_MIN_DEPTH,
+                    NULL, &sat);
+    double ratio = sat.depth / contact_delta_max(model, c.bodyA, c.bodyB);
+    if (ratio > w->worstDepthRatio) {
+      w->worstDepthRatio = ratio;
+      w->worstDepthT = state->t;
+    }
+  }
+  if (!finite) {
+    if (w->finite) w->firstNonFiniteT = state->t;
+    w->finite = false;
+    return false;  // nothing after a non-finite sample means anything
+  }
+  if (w->samples == 0) {
+    w->energy0 = e;
+    w->energyLowest = e;
+  }
+  w->energyMaxExcess = fmax(w->energyMaxExcess, e - w->energy0);
+  w->energyMaxRise = fmax(w->energyMaxRise, e - w->energyLowest);
+  w->energyLowest = fmin(w->energyLowest, e);
+  if (w->tunnelBody >= 0) {
+    double clearance = pd_state_body(model, state, w->tunnelBody).x.z - w->slabTop;
+    w->lowestClearance = fmin(w->lowestClearance, clearance);
+  }
+  ++w->samples;
+  return true;
+}
+
+static int body_index(const pdModel* m, const char* name) {
+  for (int i = 0; i < m->bodyCount; ++i)
+    if (!strcmp(m->bodies[i].name, name)) return i;
+  fail_msg("no body %s", name);
+  return -1;
+}
+
+static void test_hard_case(void** state) {
+  const hardCase* hc = *state;
+  char path[1024];
+  snprintf(path, sizeof path, "%s%s", CASES_DIR, hc->file);
+  pdError err;
+  memset(&err, 0, sizeof err);
+  pdScene* scene = pd_scene_parse_file(path, &err);
+  if (!scene) fail_msg("%s: parse: %d:%d: %s", path, err.line, err.col, err.message);
+  pdModel* m = pd_model_compile(scene, &err);
+  pd_scene_free(scene);
+  if (!m) fail_msg("%s: compile: %d:%d: %s", path, err.line, err.col, err.message);
+
+  watch w = {.finite = true, .tunnelBody = -1, .slabBody = -1, .lowestClearance = INFINITY};
+  if (hc->tunnelBody) {
+    w.tunnelBody = body_index(m, hc->tunnelBody);
+    w.slabBody = body_index(m, hc->slabBody);
+    const pdBody* slab = &m->bodies[w.slabBody];
+    assert_true(slab->fixed);
+    // an axis-aligned slab: its top face is at the centre plus the body-frame half extent along z
+    w.slabTop = slab->x0.z + slab->halfExtents.z;
+    assert_true(m->bodies[w.tunnelBody].x0.z > w.slabTop);  // the scene drops it from above
+  }
+
+  pdState* s = pd_state_create(m);
+  double t0 = now_seconds();
+  bool completed = pd_advance(m, s, m->settings.tend, watch_sample, &w);
+  double wall = now_seconds() - t0;
+
+  double scale = fabs(w.energy0);
+  print_message("%-26s wall %7.3f s  steps %6ld acc %5ld rej  derivs %7ld  samples %4ld  t %.4g/%.4g  "
+                "contacts max %3d made %ld virtual %ld  warnings min-step %ld non-finite %ld late-onset %ld  "
+                "depth/δmax %.3f (t %.4g)  energy excess %+.2e rise %.2e (rel. E0 = %.4g J)%s\n",
+                hc->file, wall, s->count.accepted, s->count.rejected, s->count.derivatives, w.samples, s->t,
+                m->settings.tend, w.maxContacts, s->count.contactsMade, s->count.contactsVirtual,
+                s->warnings[pd_warnStepAtMinimum], s->warnings[pd_warnNonFinite], s->warnings[pd_warnLateOnset],
+                w.worstDepthRatio, w.worstDepthT, w.energyMaxExcess / scale, w.energyMaxRise / scale, w.energy0,
+                w.finite ? "" : "  NON-FINITE SAMPLE");
+  if (w.tunnelBody >= 0)
+    print_message("%-26s lowest clearance of %s's centre above %s's top: %.4g m\n", hc->file, hc->tunnelBody,
+                  hc->slabBody, w.lowestClearance);
+
+  bool ok = true;
+  if (!w.finite) {
+    print_error("%s: a non-finite number at t = %.6g\n", hc->file, w.firstNonFiniteT);
+    ok = false;
+  }
+  if (!completed || s->failed || s->stopped || s->t != m->settings.tend) {
+    print_error("%s: the run did not complete: stopped at t = %.9g of %.9g (failed %d)\n", hc->file, s->t,
+                m->settings.tend, s->failed);
+    ok = false;
+  }
+  if (s->warnings[pd_warnNonFinite] != 0) {
+    print_error("%s: %ld non-finite trial steps\n", hc->file, s->warnings[pd_warnNonFinite]);
+    ok = false;
+  }
+  if (!(w.worstDepthRatio < PENETRATION_LIMIT)) {
+    print_error("%s: penetration %.3g δ_max at t = %.6g (limit %g)\n", hc->file, w.worstDepthRatio, w.worstDepthT,
+                PENETRATION_LIMIT);
+    ok = false;
+  }
+  if (!(w.energyMaxExcess <= ENERGY_GAIN_REL_TOL * scale)) {
+    print_error("%s: energy rose %.3g J above E(0) = %.6g J (limit %g relative)\n", hc->file, w.energyMaxExcess,
+                w.energy0, ENERGY_GAIN_REL_TOL);
+    ok = false;
+  }
+  if (w.tunnelBody >= 0 && !(w.lowestClearance > 0.0)) {
+    print_error("%s: %s tunnelled: its centre went %.4g m below %s's top face\n", hc->file, hc->tunnelBody,
+                -w.lowestClearance, hc->slabBody);
+    ok = false;
+  }
+  pd_state_free(s);
+  pd_model_free(m);
+  assert_true(ok);
+}
+
+int main(void) {
+  enum { N = sizeof hardCases / sizeof hardCases[0] };
+  struct CMUnitTest tests[N];
+  for (int i = 0; i < N; ++i) {
+    tests[i] = (struct CMUnitTest)cmocka_unit_test_prestate(test_hard_case, (void*)&hardCases[i]);
+    tests[i].name = hardCases[i].file;
+  }
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
