@@ -20,11 +20,11 @@
 //   not move while one axis is sorted, so the result is the same, the hot loop has no unpredictable
 //   branch, and the events' scattered reads of `boxes` overlap in the memory system.
 // - Incoherent motion (the first update, teleports) would make insertion sort quadratic: past a swap
-//   budget the remaining axes are merge-sorted and the set is rebuilt by one single-axis sweep along
+//   budget the remaining axes are re-sorted (qsort) and the set is rebuilt by one single-axis sweep along
 //   the axis with the fewest overlapping pairs (counted in O(n) per axis on the sorted arrays).
 // - The set: open addressing with linear probing keyed by (a, b), at most half full, deletion by
 //   backward shift (no tombstones, so probes stay short); the slots point into a dense list of keys,
-//   so that pd_broad_phase_pairs costs k log k (copy and merge-sort the list), not a scan of the
+//   so that pd_broad_phase_pairs costs k log k (copy and sort the list), not a scan of the
 //   table. The sorted copy is kept until the set changes.
 #include "broad_phase.h"
 
@@ -36,8 +36,8 @@
 
 #include "polydyn/error.h"
 
-// Insertion-sort budget per endpoint and axis before the merge sort takes over. Coherent motion moves
-// an endpoint past a few neighbours per update. The fallback costs ~log2(2n) merge moves per endpoint
+// Insertion-sort budget per endpoint and axis before a full sort (qsort) takes over. Coherent motion moves
+// an endpoint past a few neighbours per update. The fallback costs ~log2(2n) comparisons per endpoint
 // and axis (~15 for 10⁴ bodies) plus a rebuild sweep; past 32 swaps per endpoint the insertion sort
 // is no cheaper, and the work thrown away before giving up stays comparable to the fallback's.
 #define INSERTION_SWAPS_PER_ENDPOINT 32
@@ -78,7 +78,6 @@ struct pdBroadPhase {
   bool* fixed;        // (n)
   pdAabb* boxes;      // (n) per axis, the values that axis is sorted by (see the design note)
   endpoint* ends[3];  // (2n) per axis, sorted
-  endpoint* scratch;  // (2n) merge-sort buffer
   swapEvent* events;  // (EVENT_BATCH)
   // the rebuild sweep's open boxes: their bodies, the other two axes' intervals (hi with the margin;
   // contiguous reads in the inner loop), and each body's place among them
@@ -89,7 +88,7 @@ struct pdBroadPhase {
   size_t slotCount;
   int slotShift;               // 64 - log2(slotCount), for Fibonacci hashing
   uint64_t* list;              // (slotCount / 2) the keys, unordered
-  uint64_t *sorted, *sortTmp;  // (slotCount / 2) the keys sorted by pd_broad_phase_pairs
+  uint64_t* sorted;  // (slotCount / 2) the keys sorted by pd_broad_phase_pairs
   int count;                   // pairs in the set
   bool sortedValid;            // `sorted` holds the current set
   bool valid;       // the set matches the arrays (false before the first update, after a failed one)
@@ -108,28 +107,24 @@ static inline size_t slot_of(const pdBroadPhase* bp, uint64_t key) {
 }
 
 // Allocates a set of `slotCount` slots (a power of two); false when out of memory.
-static bool set_alloc(size_t slotCount, slot** slots, uint64_t** list, uint64_t** sorted, uint64_t** tmp) {
+static bool set_alloc(size_t slotCount, slot** slots, uint64_t** list, uint64_t** sorted) {
   *slots = malloc(slotCount * sizeof **slots);
   *list = malloc(slotCount / 2 * sizeof **list);
   *sorted = malloc(slotCount / 2 * sizeof **sorted);
-  *tmp = malloc(slotCount / 2 * sizeof **tmp);
-  if (!*slots || !*list || !*sorted || !*tmp) {
+  if (!*slots || !*list || !*sorted) {
     free(*slots);
     free(*list);
     free(*sorted);
-    free(*tmp);
     return false;
   }
   for (size_t i = 0; i < slotCount; ++i) (*slots)[i] = (slot){EMPTY_KEY, -1};
   return true;
 }
 
-static void set_use(pdBroadPhase* bp, size_t slotCount, slot* slots, uint64_t* list, uint64_t* sorted,
-                    uint64_t* tmp) {
+static void set_use(pdBroadPhase* bp, size_t slotCount, slot* slots, uint64_t* list, uint64_t* sorted) {
   bp->slots = slots;
   bp->list = list;
   bp->sorted = sorted;
-  bp->sortTmp = tmp;
   bp->slotCount = slotCount;
   int bits = 0;
   while (((size_t)1 << bits) < slotCount) ++bits;
@@ -141,7 +136,6 @@ static void set_free(pdBroadPhase* bp) {
   free(bp->slots);
   free(bp->list);
   free(bp->sorted);
-  free(bp->sortTmp);
 }
 
 // Places key (absent) in the table, pointing at list[index].
@@ -165,11 +159,11 @@ static bool set_grow(pdBroadPhase* bp) {
   if (bp->slotCount >= SET_MAX_SLOTS) return false;
   size_t slotCount = 2 * bp->slotCount;
   slot* slots;
-  uint64_t *list, *sorted, *tmp;
-  if (!set_alloc(slotCount, &slots, &list, &sorted, &tmp)) return false;
+  uint64_t *list, *sorted;
+  if (!set_alloc(slotCount, &slots, &list, &sorted)) return false;
   memcpy(list, bp->list, (size_t)bp->count * sizeof *list);
   set_free(bp);
-  set_use(bp, slotCount, slots, list, sorted, tmp);
+  set_use(bp, slotCount, slots, list, sorted);
   for (int i = 0; i < bp->count; ++i) set_place(bp, bp->list[i], i);
   bp->sortedValid = false;
   bp->stats.setGrowths++;
@@ -226,7 +220,6 @@ pdBroadPhase* pd_broad_phase_create(int bodyCount, const bool* fixed, double mar
   bp->boxes = calloc(m, sizeof *bp->boxes);
   bool ok = bp->fixed && bp->boxes;
   for (int k = 0; k < 3; ++k) ok = (bp->ends[k] = calloc(2 * m, sizeof *bp->ends[k])) && ok;
-  bp->scratch = calloc(2 * m, sizeof *bp->scratch);
   bp->events = malloc(EVENT_BATCH * sizeof *bp->events);
   bp->activeBody = calloc(m, sizeof *bp->activeBody);
   bp->activeAt = calloc(m, sizeof *bp->activeAt);
@@ -234,18 +227,18 @@ pdBroadPhase* pd_broad_phase_create(int bodyCount, const bool* fixed, double mar
   bp->hi1 = calloc(m, sizeof *bp->hi1);
   bp->lo2 = calloc(m, sizeof *bp->lo2);
   bp->hi2 = calloc(m, sizeof *bp->hi2);
-  ok = ok && bp->scratch && bp->events && bp->activeBody && bp->activeAt && bp->lo1 && bp->hi1 && bp->lo2 &&
+  ok = ok && bp->events && bp->activeBody && bp->activeAt && bp->lo1 && bp->hi1 && bp->lo2 &&
        bp->hi2;
   // slots: a power of two, at least twice the reserved pairs
   size_t slotCount = SET_MIN_SLOTS;
   while (slotCount < SET_MAX_SLOTS && slotCount / 2 < (size_t)PD_BROAD_PHASE_PAIRS_PER_BODY * n) slotCount *= 2;
   slot* slots;
-  uint64_t *list, *sorted, *tmp;
-  if (!ok || !set_alloc(slotCount, &slots, &list, &sorted, &tmp)) {
+  uint64_t *list, *sorted;
+  if (!ok || !set_alloc(slotCount, &slots, &list, &sorted)) {
     pd_broad_phase_free(bp);
     return NULL;
   }
-  set_use(bp, slotCount, slots, list, sorted, tmp);
+  set_use(bp, slotCount, slots, list, sorted);
   if (fixed) memcpy(bp->fixed, fixed, n * sizeof *fixed);
   for (int k = 0; k < 3; ++k)
     for (int i = 0; i < bodyCount; ++i) {
@@ -261,7 +254,6 @@ void pd_broad_phase_free(pdBroadPhase* bp) {
   free(bp->fixed);
   free(bp->boxes);
   for (int k = 0; k < 3; ++k) free(bp->ends[k]);
-  free(bp->scratch);
   free(bp->events);
   free(bp->activeBody);
   free(bp->activeAt);
@@ -287,22 +279,9 @@ static inline double endpoint_value(const pdAabb* boxes, double margin, uint32_t
   return v[key >> KEY_HI_SHIFT];
 }
 
-static void merge_sort(endpoint* a, endpoint* tmp, int count) {
-  endpoint *src = a, *dst = tmp;
-  for (int width = 1; width < count; width *= 2) {
-    for (int lo = 0; lo < count; lo += 2 * width) {
-      int mid = lo + width < count ? lo + width : count;
-      int hi = lo + 2 * width < count ? lo + 2 * width : count;
-      int i = lo, j = mid, k = lo;
-      while (i < mid && j < hi) dst[k++] = endpoint_less(src[j], src[i]) ? src[j++] : src[i++];
-      while (i < mid) dst[k++] = src[i++];
-      while (j < hi) dst[k++] = src[j++];
-    }
-    endpoint* t = src;
-    src = dst;
-    dst = t;
-  }
-  if (src != a) memcpy(a, src, (size_t)count * sizeof *a);
+static int compare_endpoints(const void* pa, const void* pb) {
+  endpoint a = *(const endpoint*)pa, b = *(const endpoint*)pb;
+  return endpoint_less(a, b) ? -1 : endpoint_less(b, a) ? 1 : 0;
 }
 
 // Applies the buffered swaps of `axis`, in order. A minimum passing a maximum leftwards begins that
@@ -456,7 +435,7 @@ bool pd_broad_phase_update(pdBroadPhase* bp, const pdAabb* boxes) {
   bp->growFailed = false;
   int count = 2 * bp->n;
   long long budget = (long long)INSERTION_SWAPS_PER_ENDPOINT * count;
-  // Axes from `unsorted` on are merge-sorted: all three on the first update (no order to keep), else
+  // Axes from `unsorted` on are fully sorted: all three on the first update (no order to keep), else
   // from the first axis whose insertion sort runs over its budget (sort_axis refreshed its values).
   int unsorted = bp->stats.sweepAxis < 0 ? 0 : 3;
   for (int k = 0; k < unsorted; ++k)
@@ -466,7 +445,7 @@ bool pd_broad_phase_update(pdBroadPhase* bp, const pdAabb* boxes) {
     endpoint* e = bp->ends[k];
     if (k > unsorted || bp->stats.sweepAxis < 0)
       for (int i = 0; i < count; ++i) e[i].value = endpoint_value(boxes, bp->margin, e[i].key, k);
-    merge_sort(e, bp->scratch, count);
+    qsort(e, (size_t)count, sizeof *e, compare_endpoints);  // a total order: the result is unique
   }
   if (full) {
     if (bp->n > 0) memcpy(bp->boxes, boxes, (size_t)bp->n * sizeof *boxes);
@@ -482,24 +461,10 @@ bool pd_broad_phase_update(pdBroadPhase* bp, const pdAabb* boxes) {
   return bp->valid;
 }
 
-// Bottom-up merge sort of packed pair keys (their unsigned order is the (a, b) order); returns the
-// buffer that holds the result.
-static uint64_t* sort_keys(uint64_t* a, uint64_t* tmp, int count) {
-  uint64_t *src = a, *dst = tmp;
-  for (int width = 1; width < count; width *= 2) {
-    for (int lo = 0; lo < count; lo += 2 * width) {
-      int mid = lo + width < count ? lo + width : count;
-      int hi = lo + 2 * width < count ? lo + 2 * width : count;
-      int i = lo, j = mid, k = lo;
-      while (i < mid && j < hi) dst[k++] = src[j] < src[i] ? src[j++] : src[i++];
-      while (i < mid) dst[k++] = src[i++];
-      while (j < hi) dst[k++] = src[j++];
-    }
-    uint64_t* t = src;
-    src = dst;
-    dst = t;
-  }
-  return src;
+// Packed pair keys: their unsigned order is the (a, b) order.
+static int compare_keys(const void* pa, const void* pb) {
+  uint64_t a = *(const uint64_t*)pa, b = *(const uint64_t*)pb;
+  return (a > b) - (a < b);
 }
 
 int pd_broad_phase_pairs(pdBroadPhase* bp, pdPair* out, int capacity) {
@@ -509,11 +474,7 @@ int pd_broad_phase_pairs(pdBroadPhase* bp, pdPair* out, int capacity) {
   int count = bp->count;
   if (!bp->sortedValid) {
     memcpy(bp->sorted, bp->list, (size_t)count * sizeof *bp->sorted);
-    uint64_t* s = sort_keys(bp->sorted, bp->sortTmp, count);
-    if (s != bp->sorted) {  // swap the buffers rather than copy back
-      bp->sortTmp = bp->sorted;
-      bp->sorted = s;
-    }
+    qsort(bp->sorted, (size_t)count, sizeof *bp->sorted, compare_keys);
     bp->sortedValid = true;
   }
   int written = count < capacity ? count : capacity;

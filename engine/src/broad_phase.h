@@ -11,7 +11,7 @@
 // Cost: the endpoints of the boxes along each of the three axes stay sorted between updates, and a
 // persistent set holds the pairs overlapping on all three. An update re-sorts each axis by insertion
 // sort, ~n + s for s swaps of neighbouring endpoints (coherent motion: few per endpoint), and touches
-// the set only when a swap starts or ends a pair's overlap along one axis. A merge sort of the three
+// the set only when a swap starts or ends a pair's overlap along one axis. A full sort (qsort) of the three
 // axes (n log n) and a rebuild of the set by one sweep (~n + pairs overlapping along the sweep axis)
 // take over on the first update and when insertion sort exceeds its swap budget (incoherent motion).
 // pd_broad_phase_pairs sorts the set, k log k for k pairs, and only when it changed.
@@ -51,7 +51,7 @@ typedef struct pdBroadPhaseStats {
   long long overlapEvents;  // of those, a minimum passing another body's maximum: that pair's overlap
                             // along one axis begins or ends, and the other two axes are checked
   long long pairChanges;    // of those events, the ones that added a pair to the set or removed one
-  bool fullSort;            // the last update merge-sorted (some of) the axes and rebuilt the set
+  bool fullSort;            // the last update fully sorted (some of) the axes and rebuilt the set
   long long fullSorts;      // such updates since creation
   int sweepAxis;            // axis of the last rebuild sweep, the one with the fewest overlapping pairs
                             // (0 = x, 1 = y, 2 = z; -1 before the first update)

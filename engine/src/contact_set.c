@@ -25,9 +25,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "broad_phase.h"
+#include "clock.h"
 #include "interference.h"
 #include "model_contact.h"
 #include "state_layout.h"
@@ -109,14 +109,9 @@ struct pdContactSet {
   double refineSpeed;      // m/s, see PD_REFINE_SPEED_REL
   pdVec3 *force, *torque;  // (movingCount) contact force and moment on each moving body, world
   double* width;           // (bodyCount) smallest width of each body across its face planes, m
+  double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
   int onsetRetries;        // onset retries of the step under way
 };
-
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static void* grow(void* p, int count, size_t size) {
   void* q = realloc(p, (size_t)(count > 0 ? count : 1) * size);
@@ -144,6 +139,8 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   set->bodyCount = n;
   set->force = grow(NULL, model->movingCount, sizeof *set->force);
   set->width = grow(NULL, n, sizeof *set->width);
+  set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
+  PD_ASSERT(set->travel != NULL);
   for (int i = 0; i < n; ++i) {
     // width across each face plane: the face's offset minus the lowest vertex along its normal
     const pdPolyhedron* p = &model->bodies[i].shape;
@@ -199,6 +196,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->found);
   free(set->force);
   free(set->width);
+  free(set->travel);
   free(set->torque);
   free(set->poses);
   free(set->poses0);
@@ -348,15 +346,18 @@ static void install(const pdModel* model, pdState* s, int count) {
   s->n = base + PD_CONTACT_STATE_SIZE * count;
 }
 
+// δ_max of a contact: the smaller design deflection of its two bodies (deflection × size), m.
+static double pair_delta_max(const pdModel* model, int body1, int body2) {
+  return model->settings.deflection * fmin(model->bodies[body1].size, model->bodies[body2].size);
+}
+
 // A slot for a new contact between the bodies of g.id, springs at 0.
 static contactSlot new_slot(const pdModel* model, const pdContactGeom* g) {
   contactSlot c;
   memset(&c, 0, sizeof c);
   c.id = g->id;
   c.params = pd_model_contact_params(model, g->id.body1, g->id.body2);
-  const pdBody* b1 = &model->bodies[g->id.body1];
-  const pdBody* b2 = &model->bodies[g->id.body2];
-  c.deltaMax = model->settings.deflection * fmin(b1->size, b2->size);
+  c.deltaMax = pair_delta_max(model, g->id.body1, g->id.body2);
   c.normal = g->normal;
   c.point = g->point;
   c.depth = g->depth;
@@ -395,7 +396,7 @@ static void add_candidate(pdContactSet* set, const candidate* c) {
 // that met and parted (or tunnelled) inside the step is listed too. Returns the number of pairs.
 static int broad_phase(const pdModel* model, pdState* s, const pdPose* poses0, const pdPose* poses1) {
   pdContactSet* set = s->contacts;
-  double t0 = now_seconds();
+  double t0 = pd_clock_seconds();
   for (int k = 0; k < model->movingCount; ++k) {
     int i = model->movingBodies[k];
     pdAabb a = pd_aabb_of(&model->bodies[i].shape, poses0[i].x, &poses0[i].R);
@@ -417,15 +418,13 @@ static int broad_phase(const pdModel* model, pdState* s, const pdPose* poses0, c
     set->cache = grow(set->cache, set->cacheCapacity, sizeof *set->cache);
     set->cacheNext = grow(set->cacheNext, set->cacheCapacity, sizeof *set->cacheNext);
   }
-  s->stageSeconds[pd_stageBroadPhase] += now_seconds() - t0;
+  s->stageSeconds[pd_stageBroadPhase] += pd_clock_seconds() - t0;
   return pairCount;
 }
 
 // How far body i's points move at most between two poses, m: the centre's displacement plus the largest
 // vertex radius times the rotation angle.
-static double travel(const pdModel* model, int i, const pdPose* p0, const pdPose* p1) {
-  const pdBody* b = &model->bodies[i];
-  if (b->fixed) return 0.0;
+static double travel(const pdBody* b, const pdPose* p0, const pdPose* p1) {
   pdMat3 r0t = pd_mat3_transpose(&p0->R);
   pdMat3 d = pd_mat3_mul(&p1->R, &r0t);  // the rotation over the step
   double cosAngle = fmax(-1.0, fmin(1.0, 0.5 * (d.m[0][0] + d.m[1][1] + d.m[2][2] - 1.0)));
@@ -434,15 +433,26 @@ static double travel(const pdModel* model, int i, const pdPose* p0, const pdPose
 
 // The longest step (as a fraction of the step just taken) that keeps every listed pair's relative travel
 // within PD_TRAVEL_WIDTH_FRACTION of the thinner body's width; 1 when the step is short enough.
-static double travel_limit(const pdModel* model, const pdContactSet* set, int pairCount) {
+static double travel_limit(const pdModel* model, pdContactSet* set, int pairCount) {
+  for (int k = 0; k < model->movingCount; ++k) {
+    int i = model->movingBodies[k];
+    set->travel[i] = travel(&model->bodies[i], &set->poses0[i], &set->poses1[i]);
+  }
   double limit = 1.0;
   for (int p = 0; p < pairCount; ++p) {
     int a = set->pairs[p].a, b = set->pairs[p].b;
-    double moved = travel(model, a, &set->poses0[a], &set->poses1[a]) + travel(model, b, &set->poses0[b], &set->poses1[b]);
+    double moved = set->travel[a] + set->travel[b];
     double allowed = PD_TRAVEL_WIDTH_FRACTION * fmin(set->width[a], set->width[b]);
     if (moved > allowed) limit = fmin(limit, allowed / moved);
   }
   return limit;
+}
+
+// A contact's unordered body pair against the pair (a, b), a < b: −1 before it, 0 the same, 1 after.
+static int compare_to_pair(const pdContactId* id, int a, int b) {
+  int lo = id->body1 < id->body2 ? id->body1 : id->body2, hi = id->body1 < id->body2 ? id->body2 : id->body1;
+  if (lo != a) return lo < a ? -1 : 1;
+  return hi < b ? -1 : hi > b;
 }
 
 // Interference of the pairs at poses1 (cache of the last separating feature per pair, merged by the sorted
@@ -450,7 +460,7 @@ static double travel_limit(const pdModel* model, const pdContactSet* set, int pa
 static void search(const pdModel* model, pdState* s, const double* y1, int pairCount, const pdPose* poses0,
                    const pdPose* poses1) {
   pdContactSet* set = s->contacts;
-  double t1 = now_seconds();
+  double t1 = pd_clock_seconds();
   set->candidateCount = 0;
   int cached = 0, listed = 0;
   double tInterference = 0.0;
@@ -462,28 +472,18 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
     pairCache entry = {a, b, {PD_SAT_NONE, -1, -1}};
     if (cached < set->cacheCount && set->cache[cached].a == a && set->cache[cached].b == b)
       entry.sat = set->cache[cached].sat;
-    double ti = now_seconds();
+    double ti = pd_clock_seconds();
     pdSatResult sat;
     const pdBody *A = &model->bodies[a], *B = &model->bodies[b];
     bool touching = pd_interference(&A->shape, poses1[a].x, &poses1[a].R, &B->shape, poses1[b].x, &poses1[b].R,
                                     PD_SAT_FIRST_SEPARATING, &entry.sat, &sat);
-    tInterference += now_seconds() - ti;
+    tInterference += pd_clock_seconds() - ti;
     set->cacheNext[p] = entry;
     // this pair's contacts in C0 (the list is sorted by the unordered body pair first)
-    while (listed < set->count) {
-      const pdContactId* id = &set->items[listed].id;
-      int lo = id->body1 < id->body2 ? id->body1 : id->body2, hi = id->body1 < id->body2 ? id->body2 : id->body1;
-      if (lo > a || (lo == a && hi >= b)) break;
-      ++listed;
-    }
+    while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) < 0) ++listed;
     int first = listed, previousCount = 0;
-    while (listed < set->count) {
-      const pdContactId* id = &set->items[listed].id;
-      int lo = id->body1 < id->body2 ? id->body1 : id->body2, hi = id->body1 < id->body2 ? id->body2 : id->body1;
-      if (lo != a || hi != b) break;
-      set->previous[previousCount++] = *id;
-      ++listed;
-    }
+    while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) == 0)
+      set->previous[previousCount++] = set->items[listed++].id;
     if (!touching) continue;
     int n = pd_contacts_find(model, a, &poses1[a], b, &poses1[b], set->previous, previousCount, set->found,
                              set->foundCapacity);
@@ -524,7 +524,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
   set->cacheNext = t;
   set->cacheCount = pairCount;
   s->stageSeconds[pd_stageInterference] += tInterference;
-  s->stageSeconds[pd_stageContactAnalysis] += (now_seconds() - t1) - tInterference;
+  s->stageSeconds[pd_stageContactAnalysis] += (pd_clock_seconds() - t1) - tInterference;
 }
 
 // Did anything reverse or change mode inside the step (§3.4)?
@@ -553,7 +553,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   }
 
   // 1. C0 at y1: tracking, forces, reversals
-  double t0c = now_seconds();
+  double t0c = pd_clock_seconds();
   bool refine = false;
   for (int i = 0; i < set->count; ++i) {
     contactSlot* c = &set->items[i];
@@ -564,7 +564,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     e->transferred = false;
     refine = refine || reverses(c, &e->force, du, e->geom.normal, set->refineSpeed);
   }
-  s->stageSeconds[pd_stageContactAnalysis] += now_seconds() - t0c;
+  s->stageSeconds[pd_stageContactAnalysis] += pd_clock_seconds() - t0c;
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
   if (refine && s->stepper == pd_stepperRK4Adaptive && 0.5 * h >= set->refineStep) {
     ++s->count.refinements;
@@ -576,14 +576,12 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   search(model, s, y1, pairCount, set->poses0, set->poses1);
 
   // 3. onsets: the earliest new contact that began inside the step and went deeper than its tolerance
-  double t2 = now_seconds();
+  double t2 = pd_clock_seconds();
   double earliest = 2.0;
   for (int k = 0; k < set->candidateCount; ++k) {
     const candidate* c = &set->candidates[k];
     if (!c->approaching || c->inherit >= 0) continue;
-    const pdBody* b1 = &model->bodies[c->geom.id.body1];
-    const pdBody* b2 = &model->bodies[c->geom.id.body2];
-    double tol = PD_ONSET_DEPTH_TOL_REL * model->settings.deflection * fmin(b1->size, b2->size);
+    double tol = PD_ONSET_DEPTH_TOL_REL * pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
     if (c->geom.depth > tol) earliest = fmin(earliest, c->onset);
   }
   pdEventVerdict verdict = pd_eventAccept;
@@ -627,13 +625,13 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     }
   }
   if (verdict == pd_eventAccept && earliest <= 1.0) ++s->warnings[pd_warnLateOnset];
-  s->stageSeconds[pd_stageContactAnalysis] += now_seconds() - t2;
+  s->stageSeconds[pd_stageContactAnalysis] += pd_clock_seconds() - t2;
   return verdict;
 }
 
 void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1) {
   pdContactSet* set = s->contacts;
-  double t0 = now_seconds();
+  double t0 = pd_clock_seconds();
   int base = spring_base(model);
   reserve_list(set, set->count + set->candidateCount);
   int count = 0;
@@ -675,7 +673,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
   install(model, s, count);
   poses_from(model, s->y, set->poses1);
   record(model, set, s->y, set->poses1);
-  s->stageSeconds[pd_stageContactAnalysis] += now_seconds() - t0;
+  s->stageSeconds[pd_stageContactAnalysis] += pd_clock_seconds() - t0;
 }
 
 // ---------------------------------------------------------------- read-out

@@ -1,26 +1,20 @@
 // polydyn — the state derivative (paper §2): Newton–Euler with the gyroscopic term, quaternion
 // kinematics, gravity, and the contact forces with their spring rates (contact_set.c).
-#include <time.h>
 
+#include "clock.h"
 #include "contact_set.h"
 #include "polydyn/state.h"
 #include "state_layout.h"
 
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt) {
   (void)t;
-  double t0 = now_seconds();
+  double t0 = pd_clock_seconds();
   pdContactSet* set = state->contacts;
   pd_contact_forces(model, set, y, dydt);
   const pdPose* poses = pd_contact_set_poses(set);
   const pdVec3* contactForce = pd_contact_set_force(set);
   const pdVec3* contactTorque = pd_contact_set_torque(set);
-  double t1 = now_seconds();
+  double t1 = pd_clock_seconds();
   state->stageSeconds[pd_stageForces] += t1 - t0;
 
   const pdVec3 g = model->settings.gravity;
@@ -48,5 +42,5 @@ void pd_state_derivative(const pdModel* model, pdState* state, double t, const d
     pdQuat dq = pd_quat_mul((pdQuat){0.0, w.x, w.y, w.z}, q);
     pd_layout_store(d, a, alpha, v, (pdQuat){0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z});
   }
-  state->stageSeconds[pd_stageDerivative] += now_seconds() - t1;
+  state->stageSeconds[pd_stageDerivative] += pd_clock_seconds() - t1;
 }

@@ -24,17 +24,11 @@
 #include <float.h>
 #include <math.h>
 #include <string.h>
-#include <time.h>
 
+#include "clock.h"
 #include "contact_set.h"
 #include "polydyn/state.h"
 #include "state_layout.h"
-
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static void derivative(const pdModel* model, pdState* s, double t, const double* y, double* dydt) {
   pd_state_derivative(model, s, t, y, dydt);  // times its own stages
@@ -114,7 +108,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
     bool cut = hMax < s->h;
     double h = cut ? hMax : s->h;
     bool atMinimum = h <= set->dtmin;
-    double t0 = now_seconds();
+    double t0 = pd_clock_seconds();
     double tDerivative = derivative_seconds(s);
 
     rk4(model, s, &w, s->t, s->y, w.k1, h, w.full);
@@ -125,7 +119,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
     double norm = 0.0;
     for (int i = 0; i < n; ++i) norm = fmax(norm, fabs(w.trial[i] - w.full[i]) / (15.0 * s->weight[i]));
     bool finite = isfinite(norm) && all_finite(w.trial, n);
-    s->stageSeconds[pd_stageIntegrate] += (now_seconds() - t0) - (derivative_seconds(s) - tDerivative);
+    s->stageSeconds[pd_stageIntegrate] += (pd_clock_seconds() - t0) - (derivative_seconds(s) - tDerivative);
 
     if (!finite) {
       ++s->warnings[pd_warnNonFinite];
@@ -175,10 +169,10 @@ static double fixed_step(const pdModel* model, pdState* s, double hMax) {
   double h = fmin(model->settings.dt, hMax);
   derivative(model, s, s->t, s->y, w.k1);
   for (;;) {
-    double t0 = now_seconds();
+    double t0 = pd_clock_seconds();
     double tDerivative = derivative_seconds(s);
     rk4(model, s, &w, s->t, s->y, w.k1, h, w.trial);
-    s->stageSeconds[pd_stageIntegrate] += (now_seconds() - t0) - (derivative_seconds(s) - tDerivative);
+    s->stageSeconds[pd_stageIntegrate] += (pd_clock_seconds() - t0) - (derivative_seconds(s) - tDerivative);
     if (!all_finite(w.trial, s->n)) {
       ++s->warnings[pd_warnNonFinite];
       s->failed = true;
@@ -203,11 +197,11 @@ static double fixed_step(const pdModel* model, pdState* s, double hMax) {
 static double sample_time(const pdModel* model, long k) { return (double)k / model->settings.sampleRate; }
 
 static void observe(const pdModel* model, pdState* s, pdObserverFcn* observer, void* user) {
-  double t0 = now_seconds();
+  double t0 = pd_clock_seconds();
   if (observer && !observer(model, s, user)) s->stopped = true;
   ++s->count.samples;
   ++s->nextSample;
-  s->stageSeconds[pd_stageObserve] += now_seconds() - t0;
+  s->stageSeconds[pd_stageObserve] += pd_clock_seconds() - t0;
 }
 
 bool pd_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
