@@ -9,21 +9,28 @@
 
 #include "cli.h"
 #include "polydyn/output.h"
+#include "polydyn/refcheck.h"
 #include "polydyn/state.h"
 
 static const char* const help =
-    "usage: polydyn run SCENE [--out DIR] [--engine soft] [--tend T] [--sample HZ]\n"
-    "                         [--stepper adaptive|fixed]\n"
+    "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
+    "                         [--stepper adaptive|fixed] [--variant native|matched] [--step H]\n"
+    "                         [--ode-friction pyramid|aligned]\n"
     "\n"
     "Simulates SCENE and writes DIR/trajectory.csv and DIR/summary.json. DIR is written under a\n"
     "temporary name and renamed when complete; an existing run directory DIR is replaced.\n"
     "\n"
     "  --out DIR        run directory (default: out/NAME, NAME = scene file name without extension)\n"
-    "  --engine soft    the engine (only polydyn's own soft-contact engine in this version)\n"
+    "  --engine NAME    soft: polydyn's soft-contact engine (default); ode, bullet: the same model in\n"
+    "                   a reference engine (README \"Reference engines\")\n"
     "  --tend T         simulated seconds, overrides the scene's tend\n"
     "  --sample HZ      output samples per second, overrides the scene's sample\n"
     "  --stepper NAME   adaptive: RK4 with step-doubling error control (default);\n"
-    "                   fixed: RK4 with the scene's dt, no error control\n"
+    "                   fixed: RK4 with the scene's dt, no error control (soft engine)\n"
+    "  --variant NAME   ode, bullet: native (the engine's own hard contact, default) or matched (its\n"
+    "                   soft contact set to polydyn's k and c)\n"
+    "  --step H         ode, bullet: the fixed step, s (default 1e-3)\n"
+    "  --ode-friction F ode: pyramid (ODE's Approx1 box, default) or aligned (fdir1 along the slip)\n"
     "\n"
     "Progress goes to stderr when it is a terminal. Exit status: 0 ok, 1 the run failed numerically\n"
     "(the run directory is written, marked incomplete), 2 bad input, 130 interrupted (nothing written).\n";
@@ -46,9 +53,10 @@ typedef struct runObserver {
   double lastPrint;
 } runObserver;
 
-static bool observe(const pdModel* model, const pdState* state, void* user) {
+// Progress on a terminal and the interrupt flag; used alone by the reference engines, whose driver
+// writes the samples itself.
+static bool observe_progress(const pdModel* model, const pdState* state, void* user) {
   runObserver* o = user;
-  if (!pd_run_observe(model, state, o->writer)) return false;
   if (o->progress) {
     double now = wall_now();
     if (now - o->lastPrint > 0.5) {
@@ -57,6 +65,12 @@ static bool observe(const pdModel* model, const pdState* state, void* user) {
     }
   }
   return !interrupted;
+}
+
+static bool observe(const pdModel* model, const pdState* state, void* user) {
+  runObserver* o = user;
+  if (!pd_run_observe(model, state, o->writer)) return false;
+  return observe_progress(model, state, user);
 }
 
 // mkdir -p of the directories above `path`; a real failure shows when the run directory is made
@@ -87,8 +101,11 @@ static char* default_out_dir(const char* scene) {
 int pd_cmd_run(int argc, char** argv) {
   const char* scene = NULL;
   const char* out = NULL;
+  const char* engine = "soft";
   pdCliOverrides overrides = {0};
   pdStepper stepper = pd_stepperRK4Adaptive;
+  pdRefOptions ref = {pd_refNative, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid};
+  bool refOptionGiven = false, stepperGiven = false;
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     bool hasValue = i + 1 < argc;
@@ -96,22 +113,41 @@ int pd_cmd_run(int argc, char** argv) {
       fputs(help, stdout);
       return PD_EXIT_OK;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--engine") == 0 || strcmp(a, "--tend") == 0 ||
-               strcmp(a, "--sample") == 0 || strcmp(a, "--stepper") == 0) {
+               strcmp(a, "--sample") == 0 || strcmp(a, "--stepper") == 0 || strcmp(a, "--variant") == 0 ||
+               strcmp(a, "--step") == 0 || strcmp(a, "--ode-friction") == 0) {
       if (!hasValue) return pd_cli_usage_error("run", "%s needs a value", a);
       const char* v = argv[++i];
       if (strcmp(a, "--out") == 0) {
         if (v[0] == '\0') return pd_cli_usage_error("run", "--out needs a directory name");
         out = v;
       } else if (strcmp(a, "--engine") == 0) {
-        if (strcmp(v, "soft") != 0)
-          return pd_cli_usage_error("run", "--engine '%s' is not available in this version (soft only)", v);
+        if (strcmp(v, "soft") != 0 && strcmp(v, "ode") != 0 && strcmp(v, "bullet") != 0)
+          return pd_cli_usage_error("run", "--engine must be soft, ode or bullet, not '%s'", v);
+        if (strcmp(v, "soft") != 0 && !pd_ref_adapter(v))
+          return pd_cli_usage_error("run", "--engine %s: this build of polydyn has no %s adapter", v, v);
+        engine = v;
       } else if (strcmp(a, "--tend") == 0) {
         if (!pd_cli_positive(v, &overrides.tend)) return pd_cli_usage_error("run", "--tend needs a number > 0");
       } else if (strcmp(a, "--sample") == 0) {
         if (!pd_cli_positive(v, &overrides.sample)) return pd_cli_usage_error("run", "--sample needs a number > 0");
+      } else if (strcmp(a, "--variant") == 0) {
+        refOptionGiven = true;
+        if (strcmp(v, "native") == 0) ref.variant = pd_refNative;
+        else if (strcmp(v, "matched") == 0) ref.variant = pd_refMatched;
+        else return pd_cli_usage_error("run", "--variant must be native or matched");
+      } else if (strcmp(a, "--step") == 0) {
+        refOptionGiven = true;
+        if (!pd_cli_positive(v, &ref.step)) return pd_cli_usage_error("run", "--step needs a number > 0");
+      } else if (strcmp(a, "--ode-friction") == 0) {
+        refOptionGiven = true;
+        if (strcmp(v, "pyramid") == 0) ref.odeFriction = pd_odeFrictionPyramid;
+        else if (strcmp(v, "aligned") == 0) ref.odeFriction = pd_odeFrictionAligned;
+        else return pd_cli_usage_error("run", "--ode-friction must be pyramid or aligned");
       } else if (strcmp(v, "adaptive") == 0) {
+        stepperGiven = true;
         stepper = pd_stepperRK4Adaptive;
       } else if (strcmp(v, "fixed") == 0) {
+        stepperGiven = true;
         stepper = pd_stepperRK4Fixed;
       } else {
         return pd_cli_usage_error("run", "--stepper must be adaptive or fixed");
@@ -125,6 +161,12 @@ int pd_cmd_run(int argc, char** argv) {
     }
   }
   if (!scene) return pd_cli_usage_error("run", "no scene given");
+  bool soft = strcmp(engine, "soft") == 0;
+  if (soft && refOptionGiven)
+    return pd_cli_usage_error("run", "--variant, --step and --ode-friction are for --engine ode or bullet");
+  if (!soft && stepperGiven) return pd_cli_usage_error("run", "--stepper is for the soft engine");
+  if (strcmp(engine, "bullet") == 0 && ref.odeFriction != pd_odeFrictionPyramid)
+    return pd_cli_usage_error("run", "--ode-friction is for --engine ode");
 
   pdModel* model = pd_cli_load_model(scene, &overrides, NULL);
   if (!model) return PD_EXIT_BAD_INPUT;
@@ -150,6 +192,29 @@ int pd_cmd_run(int argc, char** argv) {
     return PD_EXIT_BAD_INPUT;
   }
 
+  if (!soft) {
+    runObserver observer = {NULL, isatty(STDERR_FILENO) == 1, wall_now()};
+    pdRefRunStats stats;
+    bool ok = pd_ref_run(model, pd_ref_adapter(engine), &ref, writer, observe_progress, &observer, &stats, &err);
+    if (observer.progress) fputs("\r\033[K", stderr);
+    int status = PD_EXIT_OK;
+    if (interrupted) {
+      fprintf(stderr, "polydyn run: interrupted; nothing written\n");
+      status = 130;
+    } else if (!ok) {
+      pd_error_print(&err, stderr);
+      // a scene the engine cannot represent is bad input for that engine; a write failure is a failure
+      status = stats.refused ? PD_EXIT_BAD_INPUT : PD_EXIT_FAILURE;
+    } else if (!stats.completed) {
+      fprintf(stderr, "polydyn run: %s stopped with a non-finite state after %ld steps; see %s/summary.json\n",
+              engine, stats.steps, out);
+      status = PD_EXIT_FAILURE;
+    }
+    pd_model_free(model);
+    free(defaultOut);
+    return status;
+  }
+
   pdState* state = pd_state_create(model);
   state->stepper = stepper;
   runObserver observer = {writer, isatty(STDERR_FILENO) == 1, wall_now()};
@@ -165,7 +230,7 @@ int pd_cmd_run(int argc, char** argv) {
     fprintf(stderr, "polydyn run: interrupted at t = %.6g s; nothing written\n", state->t);
     status = 130;
   } else {
-    pdRunInfo info = {"polydyn-soft", energyStart, pd_state_energy(model, state), wall, completed};
+    pdRunInfo info = {.engine = "polydyn-soft", .energyStart = energyStart, .energyEnd = pd_state_energy(model, state), .wallSeconds = wall, .completed = completed};
     if (!pd_run_finish(writer, model, state, &info, &err)) {
       pd_error_print(&err, stderr);
       status = PD_EXIT_FAILURE;

@@ -450,3 +450,32 @@ int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int siz
   int extra = snprintf(buf ? buf + done : NULL, (size_t)(size - done), "%s", more);
   return len + extra;
 }
+
+static double series(double a, double b) { return (a > 0.0 && b > 0.0) ? a * b / (a + b) : 0.0; }
+
+pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b) {
+  pdContactParams p = pd_model_contact_params(model, a, b);
+  pdPairContact pair = {.mu = p.mu,
+                        .kn = series(p.k1n, p.k2n),
+                        .kt = series(p.k1t, p.k2t),
+                        .cn = series(p.c1n, p.c2n),
+                        .ct = series(p.c1t, p.c2t)};
+  double ea = model->bodies[a].requested.restitution, eb = model->bodies[b].requested.restitution;
+  if (ea >= 0.0 && eb >= 0.0) {
+    pair.restitution = sqrt(ea * eb);
+    pair.restitutionSource = "requested";
+  } else if (ea >= 0.0 || eb >= 0.0) {
+    pair.restitution = ea >= 0.0 ? ea : eb;
+    pair.restitutionSource = "one side requested";
+  } else {
+    // the lighter moving side decides how much of the damping it feels (eq. (15) with its sizing mass)
+    const struct pdMaterialTable* t = model->materials;
+    double m = INFINITY;
+    if (!model->bodies[a].fixed) m = fmin(m, t->info[a].mass);
+    if (!model->bodies[b].fixed) m = fmin(m, t->info[b].mass);
+    double zeta = pair.kn > 0.0 ? pair.cn / (2.0 * sqrt(pair.kn * m)) : 0.0;
+    pair.restitution = zeta >= 1.0 ? 0.0 : pd_restitution_from_damping_ratio(zeta);
+    pair.restitutionSource = "predicted by eq. (15)";
+  }
+  return pair;
+}

@@ -312,7 +312,11 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   write_json_string(out, info->engine);
   fputs(",\n  \"version\": \"" PD_VERSION "\",\n  \"scene\": ", out);
   write_json_string(out, model->scenePath);
-  fprintf(out, ",\n  \"stepper\": \"%s\",\n", state->stepper == pd_stepperRK4Fixed ? "rk4-fixed" : "rk4-adaptive");
+  fputs(",\n  \"stepper\": ", out);
+  write_json_string(out, info->stepper ? info->stepper
+                                       : state->stepper == pd_stepperRK4Fixed ? "rk4-fixed" : "rk4-adaptive");
+  fputs(",\n", out);
+  if (info->engineSettingsJson) fprintf(out, "  \"engine_settings\": %s,\n", info->engineSettingsJson);
   fputs("  \"settings\": {\"gravity\": ", out);
   write_vec(out, s->gravity);
   const struct {

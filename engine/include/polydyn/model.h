@@ -113,3 +113,20 @@ int pd_model_adjustment_count(const pdModel* model);
 int pd_model_adjustments_dropped(const pdModel* model);
 // One line describing adjustment i (0 <= i < count) into buf (UTF-8, no newline); returns snprintf's count.
 int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int size);
+
+// ---------------------------------------------------------------- one pair, as a reference engine sees it
+// A reference engine (refcheck: ODE, Bullet) takes one spring, one damper, one μ and one e per contact.
+// Our contact has each side's spring ∥ damper in series (paper Fig. 3); the single equivalent element is
+// k = k1 k2/(k1 + k2) and c = c1 c2/(c1 + c2), exact when both sides have the same c/k (every pair of one
+// material, and every pair whose dampers come from one restitution) and an approximation otherwise.
+typedef struct pdPairContact {
+  double mu;           // √(μ₁μ₂)
+  double kn, kt;       // N/m, per contact (one vertex–face or edge–edge contact)
+  double cn, ct;       // N·s/m, per contact; 0 when either side has no damper
+  double restitution;  // the pair's e: √(e₁e₂) when both bodies request one, the requested one when one
+                       // does, else e of eq. (15) with the pair's ζ for the lighter body's sizing mass
+  const char* restitutionSource;  // "requested", "one side requested" or "predicted by eq. (15)"
+} pdPairContact;
+
+// The pair constants of bodies a and b (model body indices, a != b, not both fixed), as used.
+pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b);

@@ -41,6 +41,8 @@ typedef struct pdRunInfo {
   double energyEnd;       // J
   double wallSeconds;     // wall time of pd_advance
   bool completed;         // reached tend
+  const char* stepper;    // nullable: the stepper's name when it is not the state's (reference engines)
+  const char* engineSettingsJson;  // nullable: one JSON object written as "engine_settings" (refcheck)
 } pdRunInfo;
 
 // Writes summary.json, closes every file and renames the directory into place. Returns false and
