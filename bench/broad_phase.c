@@ -105,17 +105,20 @@ static int brute_pairs(int n, const pdAabb* b, pdPair* out, int capacity) {
 
 // The pairs of a fresh broad phase given `boxes` (a full sort and rebuild sweep) equal `pairs`.
 static bool same_as_fresh(int n, const pdAabb* boxes, const pdPair* pairs, int count, pdPair* buf, int capacity) {
-  pdBroadPhase* fresh = pd_broad_phase_create(n, NULL, 0.0);
+  pdBroadPhase* fresh = pd_broad_phase_create_with(n, NULL, 0.0, pd_broadPhaseSweep);
   if (!fresh || !pd_broad_phase_update(fresh, boxes)) abort();
   int freshCount = pd_broad_phase_pairs(fresh, buf, capacity);
   pd_broad_phase_free(fresh);
   return freshCount == count && memcmp(buf, pairs, (size_t)(count < capacity ? count : capacity) * sizeof *buf) == 0;
 }
 
+enum { METHOD_SAP, METHOD_BRUTE, METHOD_GRID, METHOD_COUNT };
+static const char* const methodNames[METHOD_COUNT] = {"sap", "brute", "grid"};
+
 // One size and method: its world, buffers and broad phase (SAP only), and per repeat the time and the
 // sums over its updates.
 typedef struct run {
-  int n, method;  // method 0: sweep and prune, 1: brute force
+  int n, method;  // METHOD_SAP, METHOD_BRUTE, METHOD_GRID
   world w;
   int capacity;
   pdPair *out, *check;
@@ -134,7 +137,7 @@ static bool repeat_run(run* u, long r, long updates, long bruteMax) {
     world_step(&u->w);
     double t0 = bench_wall_now();
     int count;
-    if (u->method == 0) {
+    if (u->method != METHOD_BRUTE) {
       if (!pd_broad_phase_update(u->bp, u->w.boxes)) abort();
       count = pd_broad_phase_pairs(u->bp, u->out, u->capacity);
     } else {
@@ -146,21 +149,21 @@ static bool repeat_run(run* u, long r, long updates, long bruteMax) {
       return false;
     }
     u->sum[r][0] += count;
-    if (u->method == 0) {
+    if (u->method == METHOD_SAP) {
       pdBroadPhaseStats st = pd_broad_phase_stats(u->bp);
       u->sum[r][1] += (double)st.swaps;
       u->sum[r][2] += (double)st.overlapEvents;
       u->sum[r][3] += (double)st.pairChanges;
     }
-    if (k == updates - 1 && u->method == 0) {  // checked once per repeat, outside the timing
+    if (k == updates - 1 && u->method != METHOD_BRUTE) {  // checked once per repeat, outside the timing
       if (!same_as_fresh(n, u->w.boxes, u->out, count, u->check, u->capacity)) {
-        fprintf(stderr, "pd_bench_broad_phase: incremental SAP and a fresh rebuild disagree at n = %d\n", n);
+        fprintf(stderr, "pd_bench_broad_phase: %s and a fresh SAP rebuild disagree at n = %d\n", methodNames[u->method], n);
         return false;
       }
       if (n <= bruteMax) {
         int bruteCount = brute_pairs(n, u->w.boxes, u->check, u->capacity);
         if (bruteCount != count || memcmp(u->check, u->out, (size_t)count * sizeof *u->out) != 0) {
-          fprintf(stderr, "pd_bench_broad_phase: SAP and brute force disagree at n = %d\n", n);
+          fprintf(stderr, "pd_bench_broad_phase: %s and brute force disagree at n = %d\n", methodNames[u->method], n);
           return false;
         }
       }
@@ -238,10 +241,11 @@ int main(int argc, char** argv) {
   // One run per size and method, each with its own world; the repeats go round-robin over the runs so
   // that a slow spell of the (shared) machine hits every size alike rather than one size's block.
   int runCount = 0;
-  run* runs = calloc(2 * MAX_SIZES, sizeof *runs);
+  run* runs = calloc(METHOD_COUNT * MAX_SIZES, sizeof *runs);
   if (!runs) abort();
   for (int s = 0; s < sizeCount; ++s)
-    for (int method = 0; method < (sizes[s] <= bruteMax ? 2 : 1); ++method) {
+    for (int method = 0; method < METHOD_COUNT; ++method) {
+      if (method == METHOD_BRUTE && sizes[s] > bruteMax) continue;
       run* u = &runs[runCount++];
       u->n = sizes[s];
       u->method = method;
@@ -251,8 +255,9 @@ int main(int argc, char** argv) {
       u->out = malloc((size_t)u->capacity * sizeof *u->out);
       u->check = malloc((size_t)u->capacity * sizeof *u->check);
       if (!u->out || !u->check) abort();
-      if (method == 0) {
-        u->bp = pd_broad_phase_create(u->n, NULL, 0.0);
+      if (method != METHOD_BRUTE) {
+        u->bp = pd_broad_phase_create_with(u->n, NULL, 0.0,
+                                           method == METHOD_SAP ? pd_broadPhaseSweep : pd_broadPhaseGrid);
         // the first update (a full sort and rebuild sweep) is not part of the per-step cost
         if (!u->bp || !pd_broad_phase_update(u->bp, u->w.boxes)) abort();
       }
@@ -263,16 +268,16 @@ int main(int argc, char** argv) {
 
   printf("method,bodies,repeat,us_per_update,pairs_per_update,swaps_per_update,events_per_update,"
          "pair_changes_per_update,full_sorts\n");
-  double xs[2][MAX_SIZES], ys[2][MAX_SIZES], swapsOf[MAX_SIZES];
-  int fits[2] = {0, 0};
+  double xs[METHOD_COUNT][MAX_SIZES], ys[METHOD_COUNT][MAX_SIZES], swapsOf[MAX_SIZES];
+  int fits[METHOD_COUNT] = {0, 0, 0};
   for (int i = 0; i < runCount; ++i) {
     run* u = &runs[i];
-    const char* name = u->method == 0 ? "sap" : "brute";
+    const char* name = methodNames[u->method];
     double all[4] = {0, 0, 0, 0};  // pairs, swaps, events, pair changes: means over all repeats
     for (long r = 0; r < repeats; ++r) {
       for (int c = 0; c < 4; ++c) all[c] += u->sum[r][c];
       printf("%s,%d,%ld,%.6g,%.6g,", name, u->n, r + 1, u->times[r], u->sum[r][0] / (double)updates);
-      if (u->method == 0)  // SAP only
+      if (u->method == METHOD_SAP)  // SAP only
         printf("%.6g,%.6g,%.6g,%lld\n", u->sum[r][1] / (double)updates, u->sum[r][2] / (double)updates,
                u->sum[r][3] / (double)updates, u->fullSorts[r]);
       else
@@ -280,16 +285,16 @@ int main(int argc, char** argv) {
     }
     double med = bench_median(u->times, (int)repeats), per = (double)(updates * repeats);
     printf("%s,%d,median,%.6g,%.6g,", name, u->n, med, all[0] / per);
-    if (u->method == 0)
+    if (u->method == METHOD_SAP)
       printf("%.6g,%.6g,%.6g,\n", all[1] / per, all[2] / per, all[3] / per);
     else
       printf(",,,\n");
-    if (u->method == 0) swapsOf[fits[0]] = all[1] / per;
+    if (u->method == METHOD_SAP) swapsOf[fits[0]] = all[1] / per;
     xs[u->method][fits[u->method]] = u->n;
     ys[u->method][fits[u->method]++] = med;
     fprintf(stderr, "%-5s n = %6d: %10.2f us per update (median of %ld x %ld updates), %.0f pairs", name, u->n, med,
             repeats, updates, all[0] / per);
-    if (u->method == 0) fprintf(stderr, ", %.0f swaps, %.0f overlap events", all[1] / per, all[2] / per);
+    if (u->method == METHOD_SAP) fprintf(stderr, ", %.0f swaps, %.0f overlap events", all[1] / per, all[2] / per);
     fprintf(stderr, "\n");
     pd_broad_phase_free(u->bp);
     free(u->out);
@@ -298,11 +303,24 @@ int main(int argc, char** argv) {
     free(u->w.boxes);
   }
   free(runs);
-  for (int method = 0; method < 2; ++method)
+  for (int method = 0; method < METHOD_COUNT; ++method)
     if (fits[method] >= 2)
       fprintf(stderr, "fitted exponent (log-log slope of time vs n), %s, n = %g..%g: %.3f\n",
-              method == 0 ? "sap" : "brute", xs[method][0], xs[method][fits[method] - 1],
+              methodNames[method], xs[method][0], xs[method][fits[method] - 1],
               loglog_slope(xs[method], ys[method], fits[method]));
+  // the engine's default (pd_broadPhaseAuto): sweep and prune below the threshold, the grid from it on
+  if (fits[METHOD_SAP] == fits[METHOD_GRID] && fits[METHOD_SAP] >= 2) {
+    double autoTime[MAX_SIZES];
+    for (int i = 0; i < fits[METHOD_SAP]; ++i)
+      autoTime[i] = xs[METHOD_SAP][i] >= PD_BROAD_PHASE_GRID_MIN_BODIES ? ys[METHOD_GRID][i] : ys[METHOD_SAP][i];
+    fprintf(stderr, "fitted exponent (log-log slope of time vs n), auto (grid from %d bodies), n = %g..%g: %.3f\n",
+            PD_BROAD_PHASE_GRID_MIN_BODIES, xs[METHOD_SAP][0], xs[METHOD_SAP][fits[METHOD_SAP] - 1],
+            loglog_slope(xs[METHOD_SAP], autoTime, fits[METHOD_SAP]));
+    fprintf(stderr, "local exponents of grid time (slope between consecutive sizes):");
+    for (int i = 1; i < fits[METHOD_GRID]; ++i)
+      fprintf(stderr, " %g-%g: %.2f%s", xs[METHOD_GRID][i - 1], xs[METHOD_GRID][i],
+              loglog_slope(xs[METHOD_GRID] + i - 1, ys[METHOD_GRID] + i - 1, 2), i + 1 < fits[METHOD_GRID] ? "," : "\n");
+  }
   if (fits[0] >= 2) {
     double nlogn[MAX_SIZES];
     for (int i = 0; i < fits[0]; ++i) nlogn[i] = xs[0][i] * log2(xs[0][i]);

@@ -28,6 +28,8 @@
 //   table. The sorted copy is kept until the set changes.
 #include "broad_phase.h"
 
+#include "broad_grid.h"
+
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
@@ -94,6 +96,7 @@ struct pdBroadPhase {
   bool valid;       // the set matches the arrays (false before the first update, after a failed one)
   bool growFailed;  // this update could not grow the set
   pdBroadPhaseStats stats;
+  pdBroadGrid* grid;  // non-NULL: the grid method does the work (none of the arrays above are used)
 };
 
 // ---------------------------------------------------------------- the pair set
@@ -209,10 +212,29 @@ static void set_clear(pdBroadPhase* bp) {
 // ---------------------------------------------------------------- creation
 
 pdBroadPhase* pd_broad_phase_create(int bodyCount, const bool* fixed, double margin) {
+  return pd_broad_phase_create_with(bodyCount, fixed, margin, pd_broadPhaseAuto);
+}
+
+pdBroadPhase* pd_broad_phase_create_with(int bodyCount, const bool* fixed, double margin,
+                                         pdBroadPhaseMethod method) {
   PD_ASSERT(bodyCount >= 0 && bodyCount <= INT_MAX / 2 - 1);
   PD_ASSERT(margin >= 0.0 && isfinite(margin));
+  if (method == pd_broadPhaseAuto)
+    method = bodyCount >= PD_BROAD_PHASE_GRID_MIN_BODIES ? pd_broadPhaseGrid : pd_broadPhaseSweep;
   pdBroadPhase* bp = calloc(1, sizeof *bp);
   if (!bp) return NULL;
+  if (method == pd_broadPhaseGrid) {
+    bp->n = bodyCount;
+    bp->margin = margin;
+    bp->grid = pd_broad_grid_create(bodyCount, fixed, margin);
+    bp->stats.sweepAxis = -1;
+    bp->stats.grid = true;
+    if (!bp->grid) {
+      free(bp);
+      return NULL;
+    }
+    return bp;
+  }
   size_t n = (size_t)bodyCount, m = n > 0 ? n : 1;
   bp->n = bodyCount;
   bp->margin = margin;
@@ -251,6 +273,7 @@ pdBroadPhase* pd_broad_phase_create(int bodyCount, const bool* fixed, double mar
 
 void pd_broad_phase_free(pdBroadPhase* bp) {
   if (!bp) return;
+  pd_broad_grid_free(bp->grid);
   free(bp->fixed);
   free(bp->boxes);
   for (int k = 0; k < 3; ++k) free(bp->ends[k]);
@@ -429,6 +452,19 @@ bool pd_broad_phase_update(pdBroadPhase* bp, const pdAabb* boxes) {
     const pdAabb* b = &boxes[i];
     for (int k = 0; k < 3; ++k) PD_ASSERT(isfinite(b->lo[k]) && isfinite(b->hi[k]) && b->lo[k] <= b->hi[k]);
   }
+  if (bp->grid) {
+    bp->valid = pd_broad_grid_update(bp->grid, boxes);
+    pdBroadGridStats g = pd_broad_grid_stats(bp->grid);
+    int count = 0;
+    pd_broad_grid_pairs(bp->grid, &count);
+    bp->stats.pairs = bp->valid ? count : 0;
+    bp->stats.cell = g.cell;
+    bp->stats.cellEntries = g.entries;
+    bp->stats.largeBoxes = g.large;
+    bp->stats.boxTests = g.tests;
+    bp->stats.sweepAxis = 0;  // "updated at least once"
+    return bp->valid;
+  }
   bp->stats.swaps = 0;
   bp->stats.overlapEvents = 0;
   bp->stats.pairChanges = 0;
@@ -471,6 +507,12 @@ int pd_broad_phase_pairs(pdBroadPhase* bp, pdPair* out, int capacity) {
   PD_ASSERT(bp != NULL && capacity >= 0 && (out != NULL || capacity == 0));
   PD_ASSERT(bp->valid || bp->stats.sweepAxis < 0);  // not after a failed update
   if (!bp->valid) return 0;                         // no update yet: no boxes
+  if (bp->grid) {
+    int count = 0;
+    const pdPair* pairs = pd_broad_grid_pairs(bp->grid, &count);
+    memcpy(out, pairs, (size_t)(count < capacity ? count : capacity) * sizeof *out);
+    return count;
+  }
   int count = bp->count;
   if (!bp->sortedValid) {
     memcpy(bp->sorted, bp->list, (size_t)count * sizeof *bp->sorted);

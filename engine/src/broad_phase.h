@@ -18,7 +18,8 @@
 // Caveat: s ~ n × (endpoints per metre along an axis) × (distance moved per update, relative to the
 // others). For bodies scattered at constant density in a cube, that density grows as n^(2/3), so s
 // grows as n^(5/3) × speed and dominates large clouds (reports/bench/broad_phase.md); only a spatial
-// subdivision (a grid, or sweep and prune within regions) would keep it ~n.
+// subdivision keeps it ~n: from PD_BROAD_PHASE_GRID_MIN_BODIES bodies on, the broad phase is a hashed
+// uniform grid rebuilt at every update (broad_grid.h), ~n + k log k whatever the motion.
 //
 // Memory: pd_broad_phase_create allocates everything, the pair set sized for
 // PD_BROAD_PHASE_PAIRS_PER_BODY pairs per body. An update that needs more doubles the set (counted in
@@ -59,13 +60,26 @@ typedef struct pdBroadPhaseStats {
   int pairs;                // pairs in the set: overlapping on all three axes, not both fixed
   int setCapacity;          // pairs the set holds before it must grow
   int setGrowths;           // times an update doubled the set since creation
+  // the grid method (stats.grid): its last update
+  bool grid;                // the grid method is in use (the counters above stay 0)
+  double cell;              // m: edge of a grid cell
+  long long cellEntries;    // (box, cell) entries
+  int largeBoxes;           // boxes too large for the grid, tested against every box
+  long long boxTests;       // box–box overlap tests
 } pdBroadPhaseStats;
+
+// Which method finds the pairs. Auto: sweep and prune below PD_BROAD_PHASE_GRID_MIN_BODIES bodies, the
+// grid from there on (reports/bench/broad_phase.md measures both; the crossover sets the constant).
+typedef enum pdBroadPhaseMethod { pd_broadPhaseAuto, pd_broadPhaseSweep, pd_broadPhaseGrid } pdBroadPhaseMethod;
+#define PD_BROAD_PHASE_GRID_MIN_BODIES 1000
 
 typedef struct pdBroadPhase pdBroadPhase;
 
 // `fixed` (bodyCount flags, or NULL when no body is fixed) is copied. bodyCount >= 0, margin >= 0 (m).
 // Returns NULL only when memory runs out.
-pdBroadPhase* pd_broad_phase_create(int bodyCount, const bool* fixed, double margin);
+pdBroadPhase* pd_broad_phase_create(int bodyCount, const bool* fixed, double margin);  // method auto
+pdBroadPhase* pd_broad_phase_create_with(int bodyCount, const bool* fixed, double margin,
+                                         pdBroadPhaseMethod method);
 void pd_broad_phase_free(pdBroadPhase* bp);
 
 // Takes this step's boxes (bodyCount of them, finite, lo <= hi; fixed bodies included, their boxes

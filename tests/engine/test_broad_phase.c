@@ -98,6 +98,13 @@ static void random_movers(lcg* g, mover* m, int n, double side) {
     }
 }
 
+// The method under test: the sweep-and-prune tests run as written; the grid variants below set this and
+// re-run the tests that check results (not sweep-and-prune internals) against brute force.
+static pdBroadPhaseMethod testMethod = pd_broadPhaseSweep;
+static pdBroadPhase* create_bp(int n, const bool* fixed, double margin) {
+  return pd_broad_phase_create_with(n, fixed, margin, testMethod);
+}
+
 // One coherent step: drift, small random accelerations, half extents breathing (a rotating body's box).
 static void move(lcg* g, mover* m, int n, const bool* fixed) {
   for (int i = 0; i < n; ++i) {
@@ -123,7 +130,7 @@ static void run_against_brute_force(int n, double side, int moves, double fixedF
   int wantCap = 1 << 16, capacity = 16;
   pdPair* want = malloc((size_t)wantCap * sizeof *want);
   pdPair* got = malloc((size_t)capacity * sizeof *got);
-  pdBroadPhase* bp = pd_broad_phase_create(n, fixed, margin);
+  pdBroadPhase* bp = create_bp(n, fixed, margin);
   assert_true(want && got && bp);
   for (int step = 0; step <= moves; ++step) {
     if (step > 0) move(&g, m, n, fixed);
@@ -139,7 +146,8 @@ static void run_against_brute_force(int n, double side, int moves, double fixedF
     *pairsChecked += gotCount;
     *fixedFixedExcluded += brute_pairs(n, boxes, NULL, margin, NULL, 0) - wantCount;
     // coherent motion: after the first update, insertion sort alone
-    if (step > 0) assert_false(pd_broad_phase_stats(bp).fullSort);
+    if (step > 0 && testMethod == pd_broadPhaseSweep) assert_false(pd_broad_phase_stats(bp).fullSort);
+    if (testMethod == pd_broadPhaseGrid) assert_true(pd_broad_phase_stats(bp).grid);
   }
   pd_broad_phase_free(bp);
   free(want);
@@ -155,7 +163,7 @@ static void test_pairs_equal_brute_force_for_2000_random_boxes_over_50_coherent_
   (void)state;
   long long checked = 0, excluded = 0;
   run_against_brute_force(2000, 10.0, 50, 0.0, 0.0, 0x5a9e11ull, &checked, &excluded);
-  print_message("SAP = brute force over 51 updates of 2000 boxes: %lld pairs checked\n", checked);
+  print_message("%s = brute force over 51 updates of 2000 boxes: %lld pairs checked\n", testMethod == pd_broadPhaseGrid ? "grid" : "SAP", checked);
   assert_int_equal(excluded, 0);
   assert_true(checked > 51 * 2000);  // a meaningful number of overlaps (~1.3 per body)
 }
@@ -188,7 +196,7 @@ static void test_boxes_touching_exactly_count_as_overlapping(void** state) {
       {{1, 1, 1}, {3, 3, 3}},
       {{nextafter(1.0, 2.0), 0, 0}, {1.5, 1, 1}},
   };
-  pdBroadPhase* bp = pd_broad_phase_create(5, NULL, 0.0);
+  pdBroadPhase* bp = create_bp(5, NULL, 0.0);
   pd_broad_phase_update(bp, boxes);
   pdPair out[16];
   int count = pd_broad_phase_pairs(bp, out, 16);
@@ -210,9 +218,9 @@ static void test_boxes_touching_exactly_count_as_overlapping(void** state) {
         row[i].lo[k] = k == axis ? (double)i : 0.0;
         row[i].hi[k] = k == axis ? (double)(i + 1) : 1.0;
       }
-    bp = pd_broad_phase_create(4, NULL, 0.0);
+    bp = create_bp(4, NULL, 0.0);
     pd_broad_phase_update(bp, row);
-    assert_int_equal(pd_broad_phase_stats(bp).sweepAxis, axis);
+    if (testMethod == pd_broadPhaseSweep) assert_int_equal(pd_broad_phase_stats(bp).sweepAxis, axis);
     count = pd_broad_phase_pairs(bp, out, 16);
     const pdPair chain[] = {{0, 1}, {1, 2}, {2, 3}};
     assert_same_pairs(out, count, chain, 3, "row");
@@ -222,7 +230,7 @@ static void test_boxes_touching_exactly_count_as_overlapping(void** state) {
   // with a margin: gap == margin overlaps, a gap one ulp wider does not (per the header's formula)
   double margin = 0.25;
   pdAabb gap[3] = {{{0, 0, 0}, {1, 1, 1}}, {{1.25, 0, 0}, {2, 1, 1}}, {{0, 0, nextafter(1.25, 2.0)}, {1, 1, 2}}};
-  bp = pd_broad_phase_create(3, NULL, margin);
+  bp = create_bp(3, NULL, margin);
   pd_broad_phase_update(bp, gap);
   count = pd_broad_phase_pairs(bp, out, 16);
   const pdPair withMargin[] = {{0, 1}};  // (0,2) is one ulp too far apart along z, (1,2) 0.25 + ulp
@@ -240,7 +248,7 @@ static void test_capacity_overflow_returns_the_needed_count_and_writes_at_most_c
       boxes[i].lo[k] = lcg_range(&g, 0, 1);
       boxes[i].hi[k] = boxes[i].lo[k] + 1.0;  // all overlap: 780 pairs
     }
-  pdBroadPhase* bp = pd_broad_phase_create(N, NULL, 0.0);
+  pdBroadPhase* bp = create_bp(N, NULL, 0.0);
   pd_broad_phase_update(bp, boxes);
   assert_int_equal(pd_broad_phase_pairs(bp, NULL, 0), N * (N - 1) / 2);
   enum { CAP = 100, GUARD = 8 };
@@ -264,14 +272,14 @@ static void test_order_is_sorted_and_independent_of_history(void** state) {
   mover m[N];
   random_movers(&g, m, N, 6.0);
   pdAabb boxes[N], jumbled[N];
-  pdBroadPhase* coherent = pd_broad_phase_create(N, NULL, 0.0);
+  pdBroadPhase* coherent = create_bp(N, NULL, 0.0);
   for (int s = 0; s < STEPS; ++s) {
     move(&g, m, N, NULL);
     for (int i = 0; i < N; ++i) boxes[i] = box_of(&m[i]);
     pd_broad_phase_update(coherent, boxes);
   }
   // another instance: first fed unrelated boxes (teleports), then the same final boxes
-  pdBroadPhase* other = pd_broad_phase_create(N, NULL, 0.0);
+  pdBroadPhase* other = create_bp(N, NULL, 0.0);
   for (int i = 0; i < N; ++i)
     for (int k = 0; k < 3; ++k) {
       jumbled[i].lo[k] = lcg_range(&g, -50, 50);
@@ -307,7 +315,7 @@ static void test_teleports_and_reshaping_fall_back_to_a_full_sort_and_stay_exact
   int capacity = 16;
   random_movers(&g, m, N, 8.0);
   for (int i = 0; i < N; ++i) m[i].c[0] *= 3.0;  // spread along x
-  pdBroadPhase* bp = pd_broad_phase_create(N, NULL, 0.0);
+  pdBroadPhase* bp = create_bp(N, NULL, 0.0);
   for (int step = 0; step < 40; ++step) {
     if (step == 10)  // every body teleports: insertion sort would be quadratic
       for (int i = 0; i < N; ++i) m[i].c[0] = lcg_range(&g, 0, 24);
@@ -368,7 +376,7 @@ static void test_pairs_equal_brute_force_over_200_updates_with_crossings_on_ever
   for (int i = 0; i < N; ++i) fixed[i] = i % 5 == 0;  // fixed bodies stay put; the others cross them
   int capacity = 16;
   pdPair* got = malloc((size_t)capacity * sizeof *got);
-  pdBroadPhase* bp = pd_broad_phase_create(N, fixed, margin);
+  pdBroadPhase* bp = create_bp(N, fixed, margin);
   assert_true(got && bp);
   long long changed[3] = {0, 0, 0}, events = 0, pairChanges = 0, checked = 0;
   for (int step = 0; step <= STEPS; ++step) {
@@ -418,7 +426,7 @@ static void test_a_teleported_body_is_tracked_without_a_full_sort(void** state) 
   pdPair* got = malloc((size_t)capacity * sizeof *got);
   assert_true(m && boxes && got);
   random_movers(&g, m, N, 10.0);
-  pdBroadPhase* bp = pd_broad_phase_create(N, NULL, 0.0);
+  pdBroadPhase* bp = create_bp(N, NULL, 0.0);
   const int body = 417;
   for (int step = 0; step < 24; ++step) {
     move(&g, m, N, NULL);
@@ -461,7 +469,7 @@ static void test_identical_boxes_moving_together_and_one_sliding_through_them(vo
   for (int i = 0; i < N; ++i) fixed[i] = i % 4 == 1;
   int capacity = 16;
   pdPair* got = malloc((size_t)capacity * sizeof *got);
-  pdBroadPhase* bp = pd_broad_phase_create(N, fixed, margin);
+  pdBroadPhase* bp = create_bp(N, fixed, margin);
   assert_true(got && bp);
   int fixedCount = N / 4, all = N * (N - 1) / 2 - fixedCount * (fixedCount - 1) / 2;
   for (int step = 0; step < 8; ++step) {  // all together, by exact steps of 1/4
@@ -508,7 +516,7 @@ static void test_touching_reached_by_motion_on_a_lattice_is_exact(void** state) 
       for (int k = 0; k < 3; ++k) v[i][k] = 0.125 * (double)((int)(lcg_uniform(&g) * 5) - 2);
     int capacity = 16;
     pdPair* got = malloc((size_t)capacity * sizeof *got);
-    pdBroadPhase* bp = pd_broad_phase_create(N, NULL, margin);
+    pdBroadPhase* bp = create_bp(N, NULL, margin);
     assert_true(got && bp);
     long long exactTouches = 0;
     for (int step = 0; step <= STEPS; ++step) {
@@ -523,7 +531,8 @@ static void test_touching_reached_by_motion_on_a_lattice_is_exact(void** state) 
       char label[64];
       snprintf(label, sizeof label, "lattice, margin %g, step %d", margin, step);
       update_and_check(bp, N, boxes, NULL, margin, &got, &capacity, label);
-      if (step > 0) assert_false(pd_broad_phase_stats(bp).fullSort);
+      if (step > 0 && testMethod == pd_broadPhaseSweep) assert_false(pd_broad_phase_stats(bp).fullSort);
+      if (testMethod == pd_broadPhaseGrid) assert_true(pd_broad_phase_stats(bp).grid);
       for (int a = 0; a < N; ++a)
         for (int b = 0; b < N; ++b)
           for (int k = 0; k < 3; ++k) exactTouches += a != b && boxes[a].lo[k] == boxes[b].hi[k] + margin;
@@ -545,7 +554,7 @@ static void test_the_set_grows_inside_an_update_as_a_cloud_contracts(void** stat
   random_movers(&g, m, N, 20.0);
   int capacity = 16;
   pdPair* got = malloc((size_t)capacity * sizeof *got);
-  pdBroadPhase* bp = pd_broad_phase_create(N, NULL, 0.0);
+  pdBroadPhase* bp = create_bp(N, NULL, 0.0);
   assert_true(got && bp);
   int initialCapacity = pd_broad_phase_stats(bp).setCapacity, growthsWhileIncremental = 0, count = 0;
   assert_true(initialCapacity >= PD_BROAD_PHASE_PAIRS_PER_BODY * N);
@@ -583,7 +592,7 @@ static void test_a_full_sort_sweeps_along_the_axis_with_fewest_overlaps_and_cohe
   }
   int capacity = 16;
   pdPair* got = malloc((size_t)capacity * sizeof *got);
-  pdBroadPhase* bp = pd_broad_phase_create(N, NULL, 0.0);
+  pdBroadPhase* bp = create_bp(N, NULL, 0.0);
   assert_true(got && bp);
   for (int step = 0; step < 40; ++step) {
     move(&g, m, N, NULL);
@@ -612,13 +621,13 @@ static void test_a_full_sort_sweeps_along_the_axis_with_fewest_overlaps_and_cohe
 
 static void test_zero_one_and_coincident_bodies(void** state) {
   (void)state;
-  pdBroadPhase* bp = pd_broad_phase_create(0, NULL, 0.0);
+  pdBroadPhase* bp = create_bp(0, NULL, 0.0);
   pd_broad_phase_update(bp, NULL);
   assert_int_equal(pd_broad_phase_pairs(bp, NULL, 0), 0);
   pd_broad_phase_free(bp);
 
   pdAabb one = {{0, 0, 0}, {1, 1, 1}};
-  bp = pd_broad_phase_create(1, NULL, 0.0);
+  bp = create_bp(1, NULL, 0.0);
   assert_int_equal(pd_broad_phase_pairs(bp, NULL, 0), 0);  // before any update: nothing
   pd_broad_phase_update(bp, &one);
   assert_int_equal(pd_broad_phase_pairs(bp, NULL, 0), 0);
@@ -633,13 +642,13 @@ static void test_zero_one_and_coincident_bodies(void** state) {
     fixed[i] = i < 5;
   }
   pdPair out[64], want[64];
-  bp = pd_broad_phase_create(N, NULL, 0.0);
+  bp = create_bp(N, NULL, 0.0);
   pd_broad_phase_update(bp, same);
   int count = pd_broad_phase_pairs(bp, out, 64);
   assert_same_pairs(out, count, want, brute_pairs(N, same, NULL, 0.0, want, 64), "identical");
   assert_int_equal(count, 45);
   pd_broad_phase_free(bp);
-  bp = pd_broad_phase_create(N, fixed, 0.0);
+  bp = create_bp(N, fixed, 0.0);
   pd_broad_phase_update(bp, same);
   count = pd_broad_phase_pairs(bp, out, 64);
   assert_same_pairs(out, count, want, brute_pairs(N, same, fixed, 0.0, want, 64), "identical, half fixed");
@@ -685,6 +694,72 @@ static void test_aabb_of_is_the_exact_box_of_the_rotated_vertices(void** state) 
   pd_polyhedron_free(&s);
 }
 
+// ---------------------------------------------------------------- the grid method
+
+#define GRID_VARIANT(name, test)          \
+  static void name(void** state) {        \
+    testMethod = pd_broadPhaseGrid;       \
+    test(state);                          \
+    testMethod = pd_broadPhaseSweep;      \
+  }
+GRID_VARIANT(test_grid_pairs_equal_brute_force_for_2000_random_boxes_over_50_moves,
+             test_pairs_equal_brute_force_for_2000_random_boxes_over_50_coherent_moves)
+GRID_VARIANT(test_grid_pairs_equal_brute_force_with_fixed_bodies_and_no_fixed_fixed_pair,
+             test_pairs_equal_brute_force_with_fixed_bodies_and_no_fixed_fixed_pair)
+GRID_VARIANT(test_grid_pairs_equal_brute_force_with_a_margin, test_pairs_equal_brute_force_with_a_margin)
+GRID_VARIANT(test_grid_boxes_touching_exactly_count_as_overlapping, test_boxes_touching_exactly_count_as_overlapping)
+GRID_VARIANT(test_grid_capacity_overflow_returns_the_needed_count,
+             test_capacity_overflow_returns_the_needed_count_and_writes_at_most_capacity)
+GRID_VARIANT(test_grid_zero_one_and_coincident_bodies, test_zero_one_and_coincident_bodies)
+GRID_VARIANT(test_grid_touching_reached_by_motion_on_a_lattice_is_exact, test_touching_reached_by_motion_on_a_lattice_is_exact)
+
+// Floors, walls and long bars span many cells: they are tested directly, and the pairs still equal brute
+// force's, including the small boxes touching them exactly.
+static void test_grid_with_boxes_much_larger_than_the_cell_equals_brute_force(void** state) {
+  (void)state;
+  enum { N = 600, BIG = 6 };
+  lcg g = {0xb16b0e5ull};
+  pdAabb boxes[N];
+  bool fixed[N];
+  for (int i = 0; i < N; ++i) {
+    fixed[i] = i < BIG / 2;
+    for (int k = 0; k < 3; ++k) {
+      double c = lcg_range(&g, 0, 8), h = lcg_range(&g, 0.05, 0.3);
+      boxes[i].lo[k] = c - h;
+      boxes[i].hi[k] = c + h;
+    }
+  }
+  // a floor (z top at exactly 1, touched by box BIG), two walls, three long bars
+  boxes[0] = (pdAabb){{-1, -1, 0}, {9, 9, 1}};
+  boxes[1] = (pdAabb){{-1, -1, 0}, {0, 9, 9}};
+  boxes[2] = (pdAabb){{8, -1, 0}, {9, 9, 9}};
+  for (int i = 3; i < BIG; ++i) boxes[i] = (pdAabb){{0, 2.0 * i - 4, 3}, {8, 2.0 * i - 3.8, 3.2}};
+  boxes[BIG] = (pdAabb){{4, 4, 1}, {4.2, 4.2, 1.2}};
+  pdBroadPhase* bp = pd_broad_phase_create_with(N, fixed, 0.0, pd_broadPhaseGrid);
+  assert_true(pd_broad_phase_update(bp, boxes));
+  pdBroadPhaseStats st = pd_broad_phase_stats(bp);
+  assert_true(st.grid && st.largeBoxes >= BIG);
+  static pdPair got[N * 8], want[N * 8];
+  int count = pd_broad_phase_pairs(bp, got, N * 8), wantCount = brute_pairs(N, boxes, fixed, 0.0, want, N * 8);
+  assert_same_pairs(got, count, want, wantCount, "large boxes");
+  bool touching = false;
+  for (int i = 0; i < count; ++i) touching = touching || (got[i].a == 0 && got[i].b == BIG);
+  assert_true(touching);
+  print_message("grid with %d large boxes: %d pairs, cell %.3g m, %lld entries, %lld box tests\n", st.largeBoxes,
+                count, st.cell, st.cellEntries, st.boxTests);
+  pd_broad_phase_free(bp);
+}
+
+static void test_auto_method_uses_the_grid_from_the_threshold_on(void** state) {
+  (void)state;
+  pdBroadPhase* small = pd_broad_phase_create(PD_BROAD_PHASE_GRID_MIN_BODIES - 1, NULL, 0.0);
+  pdBroadPhase* large = pd_broad_phase_create(PD_BROAD_PHASE_GRID_MIN_BODIES, NULL, 0.0);
+  assert_false(pd_broad_phase_stats(small).grid);
+  assert_true(pd_broad_phase_stats(large).grid);
+  pd_broad_phase_free(small);
+  pd_broad_phase_free(large);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_pairs_equal_brute_force_for_2000_random_boxes_over_50_coherent_moves),
@@ -702,6 +777,15 @@ int main(void) {
       cmocka_unit_test(test_a_full_sort_sweeps_along_the_axis_with_fewest_overlaps_and_coherent_updates_follow),
       cmocka_unit_test(test_zero_one_and_coincident_bodies),
       cmocka_unit_test(test_aabb_of_is_the_exact_box_of_the_rotated_vertices),
+      cmocka_unit_test(test_grid_pairs_equal_brute_force_for_2000_random_boxes_over_50_moves),
+      cmocka_unit_test(test_grid_pairs_equal_brute_force_with_fixed_bodies_and_no_fixed_fixed_pair),
+      cmocka_unit_test(test_grid_pairs_equal_brute_force_with_a_margin),
+      cmocka_unit_test(test_grid_boxes_touching_exactly_count_as_overlapping),
+      cmocka_unit_test(test_grid_capacity_overflow_returns_the_needed_count),
+      cmocka_unit_test(test_grid_zero_one_and_coincident_bodies),
+      cmocka_unit_test(test_grid_touching_reached_by_motion_on_a_lattice_is_exact),
+      cmocka_unit_test(test_grid_with_boxes_much_larger_than_the_cell_equals_brute_force),
+      cmocka_unit_test(test_auto_method_uses_the_grid_from_the_threshold_on),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
