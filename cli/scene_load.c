@@ -12,6 +12,7 @@ pdModel* pd_cli_load_model(const char* path, const pdCliOverrides* overrides, pd
   }
   if (overrides && overrides->tend > 0.0) scene->settings.tend = overrides->tend;
   if (overrides && overrides->sample > 0.0) scene->settings.sample = overrides->sample;
+  if (overrides && overrides->tolScale > 0.0) scene->settings.tol *= overrides->tolScale;
   if (scene->settings.tend * scene->settings.sample > 1e8) {
     pd_error_set(&err, path, 0, 0, "too many output samples (tend × sample > 1e8)");
     pd_error_print(&err, stderr);
