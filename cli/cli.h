@@ -12,6 +12,7 @@ enum { PD_EXIT_OK = 0, PD_EXIT_FAILURE = 1, PD_EXIT_BAD_INPUT = 2 };
 int pd_cmd_run(int argc, char** argv);
 int pd_cmd_check(int argc, char** argv);
 int pd_cmd_compare(int argc, char** argv);
+int pd_cmd_sweep(int argc, char** argv);
 
 // Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr; returns 2.
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -27,6 +28,8 @@ typedef struct pdCliOverrides {
   double tend;
   double sample;
   double tolScale;  // > 0: multiplies the scene's tol (compare's tighter reference run)
+  double tol;       // > 0: replaces the scene's tol (sweeps)
+  double dt;        // > 0: replaces the scene's dt, the fixed stepper's step (sweeps)
 } pdCliOverrides;
 
 // Parses and compiles a scene, applying the overrides. On bad input prints `FILE:LINE:COL: message`

@@ -73,14 +73,14 @@ static sampling plan_sampling(double requestedStep, double sampleRate) {
 
 bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOptions* options,
                 pdRunWriter* writer, pdObserverFcn* observer, void* user, pdRefRunStats* stats, pdError* err) {
-  PD_ASSERT(model && adapter && options && writer && stats && options->step > 0.0);
+  PD_ASSERT(model && adapter && options && stats && options->step > 0.0);
   memset(stats, 0, sizeof *stats);
   sampling plan = plan_sampling(options->step, model->settings.sampleRate);
   double wall0 = wall_seconds();
   pdRefWorld* world = adapter->create(model, options, err);
   if (!world) {
     stats->refused = true;
-    pd_run_abort(writer);
+    if (writer) pd_run_abort(writer);
     return false;
   }
   pdState* state = pd_state_create(model);
@@ -108,7 +108,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
       break;
     }
     ++state->count.samples;
-    if (!pd_run_observe(model, state, writer)) stopped = true;
+    if (writer && !pd_run_observe(model, state, writer)) stopped = true;
     if (observer && !observer(model, state, user)) stopped = true;
   }
   stats->wallSeconds = wall_seconds() - wall0;
@@ -119,7 +119,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
     double t = state->t;
     adapter->destroy(world);
     pd_state_free(state);
-    pd_run_abort(writer);
+    if (writer) pd_run_abort(writer);
     pd_error_set(err, model->scenePath, 0, 0, "stopped at t = %.6g s; nothing written", t);
     return false;
   }
@@ -149,7 +149,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
                     .stepper = stepper,
                     .engineSettingsJson = settings};
   if (!ok) state->failed = true;
-  bool written = pd_run_finish(writer, model, state, &info, err);
+  bool written = writer ? pd_run_finish(writer, model, state, &info, err) : true;
   free(settings);
   pd_state_free(state);
   return written;

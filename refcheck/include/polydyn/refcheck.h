@@ -78,6 +78,7 @@ typedef struct pdRefRunStats {
 // recorded in the summary). Finishes the writer (pd_run_finish) — also when the engine produced a
 // non-finite state (then the summary says completed false and stats->completed is false). Aborts the
 // writer, fills err and returns false when create fails, the observer asks to stop (nothing is
-// written), or the directory cannot be written. `observer` (nullable) sees every sample too.
+// written), or the directory cannot be written. `observer` (nullable) sees every sample too. `writer` may
+// be NULL (sweeps: the samples go to the observer only).
 bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOptions* options,
                 pdRunWriter* writer, pdObserverFcn* observer, void* user, pdRefRunStats* stats, pdError* err);
