@@ -4,9 +4,12 @@
 //   pair's per-contact k_n), through 4 contacts on a floor plane;
 // - a cube sliding to rest stops at v²/(2 μ g): ODE's pyramid along a pyramid axis, the aligned friction in
 //   any direction, both variants; the pyramid along its diagonal stops short at v²/(2 √2 μ g) (the trap);
+// - a cube on an incline steeper than the friction angle slides at g (sin θ − μ cos θ) with the aligned
+//   friction whatever the slope's direction; ODE's pyramid holds it when the slope runs along the pyramid's
+//   diagonal (the trap, again);
 // - native: a cube dropped flat bounces with the requested e;
 // - a floor plane that stops being exact (a body slides off the slab's face) becomes the slab's convex;
-// - two runs give identical bytes;
+// - two runs give identical bytes, and two worlds stepped in turn give what each gives alone;
 // - every scene in cases/ (examples, hard) finishes with finite numbers or is refused with a message.
 #include <dirent.h>
 #include <math.h>
@@ -41,6 +44,12 @@
 // start, exact up to the push-out of the penetration (ERP 0.2 of at most one step's travel, well below
 // e v); a flat landing spreads it over 4 contacts that the Dantzig solver treats exactly. 0.5 % of e.
 #define BOUNCE_REL_TOL 0.005
+// Incline: the distance slid in 1 s against ½ a t², a = g (sin θ − μ cos θ); the cube starts touching and
+// falls freely for its first step (1 ms), far below 1 % of the second it slides.
+#define INCLINE_REL_TOL 0.01
+// A cube held by the pyramid on the incline moves only by the first step's free fall and the settling into
+// contact: micrometres, against the 0.33 m it would slide.
+#define INCLINE_HELD_DISTANCE 1e-4  // m
 // q at t = 0: ODE normalises the quaternion it is given; a unit quaternion changes by rounding only.
 #define INITIAL_POSE_TOL 1e-15
 
@@ -254,6 +263,44 @@ static void test_pyramid_friction_is_stronger_along_its_diagonal(void** state) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// incline: a fixed floor slab turned by θ about a horizontal axis at azimuth φ, a cube resting on it
+
+static double incline_slide(pdRefVariant variant, pdOdeFriction friction, double phiDeg, double* expected) {
+  const double theta = 30.0, mu = 0.5, pi = 3.14159265358979323846;
+  pdVec3 axis = {cos(phiDeg * pi / 180.0), sin(phiDeg * pi / 180.0), 0.0};
+  pdVec3 centre = pd_quat_rotate(pd_quat_from_axis_angle(axis, theta * pi / 180.0), (pdVec3){0, 0, 0.2});
+  char text[1024];
+  snprintf(text, sizeof text,
+           "tend 1\ncube floor grey 4 4 0.2\nfixed\nloc 0 0 0  %g %.17g %.17g 0\nmu %g\nrestitution 0.5\n"
+           "cube box red 0.2 0.2 0.2\nloc %.17g %.17g %.17g  %g %.17g %.17g 0\nmu %g\nrestitution 0.5\n",
+           theta, axis.x, axis.y, mu, centre.x, centre.y, centre.z, theta, axis.x, axis.y, mu);
+  pdModel* m = compile_text(text);
+  pdRefWorld* w = create(m, variant, friction);
+  advance(w, 1.0);
+  double d = pd_v3_norm(pd_v3_sub(ode()->body(w, 0).x, centre));
+  *expected = 0.5 * G * (sin(theta * pi / 180.0) - mu * cos(theta * pi / 180.0));
+  print_message("incline 30° (friction angle %.2f°), tilt axis at azimuth %g°, %s %s: slid %.6f m, ½ a t² = %.6f m\n",
+                atan(mu) * 180.0 / pi, phiDeg, variant_name(variant), friction_name(friction), d, *expected);
+  ode()->destroy(w);
+  pd_model_free(m);
+  return d;
+}
+
+static void test_incline_slides_at_the_coulomb_rate_with_aligned_friction(void** state) {
+  (void)state;
+  const pdRefVariant variants[] = {pd_refNative, pd_refMatched};
+  for (int i = 0; i < 2; ++i) {
+    double expected;
+    for (double phi = 20.0; phi <= 45.0; phi += 25.0) {
+      double d = incline_slide(variants[i], pd_odeFrictionAligned, phi, &expected);
+      assert_true(fabs(d / expected - 1.0) <= INCLINE_REL_TOL);
+    }
+    // tan 30° = 0.577 lies between μ = 0.5 and √2 μ = 0.707: along its diagonal the pyramid holds the cube
+    assert_true(incline_slide(variants[i], pd_odeFrictionPyramid, 45.0, &expected) < INCLINE_HELD_DISTANCE);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // native bounce: a cube dropped flat leaves the floor at e times its landing speed
 
 static void test_native_flat_drop_bounces_with_the_requested_restitution(void** state) {
@@ -381,6 +428,28 @@ static void test_two_runs_give_identical_bytes(void** state) {
   pd_model_free(m);
 }
 
+// Each world has its own dWorld, dSpace and contact group: stepping two in turn changes neither.
+static void test_two_worlds_stepped_in_turn_match_one_alone(void** state) {
+  (void)state;
+  pdModel* m = compile_file(PD_SOURCE_DIR "/cases/examples/demo.scene");
+  pdRefWorld* alone = create(m, pd_refMatched, pd_odeFrictionAligned);
+  advance(alone, 1.0);
+  pdRefWorld* a = create(m, pd_refMatched, pd_odeFrictionAligned);
+  pdRefWorld* b = create(m, pd_refNative, pd_odeFrictionPyramid);
+  for (int k = 0; k < 1000; ++k) {
+    assert_true(ode()->step(a, PD_REF_DEFAULT_STEP));
+    assert_true(ode()->step(b, PD_REF_DEFAULT_STEP));
+  }
+  for (int i = 0; i < m->movingCount; ++i) {
+    pdBodyState x = ode()->body(alone, i), y = ode()->body(a, i);
+    assert_memory_equal(&x, &y, sizeof x);
+  }
+  ode()->destroy(b);
+  ode()->destroy(a);
+  ode()->destroy(alone);
+  pd_model_free(m);
+}
+
 // ---------------------------------------------------------------------------------------------
 // every scene of cases/
 
@@ -463,9 +532,11 @@ int main(void) {
       cmocka_unit_test(test_matched_cube_rests_at_the_static_sinkage),
       cmocka_unit_test(test_sliding_cube_stops_at_the_coulomb_distance),
       cmocka_unit_test(test_pyramid_friction_is_stronger_along_its_diagonal),
+      cmocka_unit_test(test_incline_slides_at_the_coulomb_rate_with_aligned_friction),
       cmocka_unit_test(test_native_flat_drop_bounces_with_the_requested_restitution),
       cmocka_unit_test(test_floor_plane_becomes_convex_when_a_body_leaves_its_face),
       cmocka_unit_test(test_two_runs_give_identical_bytes),
+      cmocka_unit_test(test_two_worlds_stepped_in_turn_match_one_alone),
       cmocka_unit_test(test_every_case_scene_finishes_or_is_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
