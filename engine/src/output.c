@@ -174,6 +174,8 @@ static void write_json_string(FILE* out, const char* s) {
   fputc('"', out);
 }
 
+void pd_write_json_string(FILE* out, const char* s) { write_json_string(out, s); }
+
 static void write_vec(FILE* out, pdVec3 v) {
   fputc('[', out);
   write_number(out, v.x);

@@ -53,5 +53,8 @@ bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state,
 // Removes the temporary directory and frees the writer.
 void pd_run_abort(pdRunWriter* run);
 
+// Writes `s` (UTF-8) as a JSON string: quoted, with the quote, the backslash and control characters escaped.
+void pd_write_json_string(FILE* out, const char* s);
+
 // Writes the summary JSON object to `out` (also used by `polydyn check --json` later).
 void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state, const pdRunInfo* info);
