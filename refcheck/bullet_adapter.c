@@ -28,11 +28,17 @@
 enum { LISTED_PAIRS_MAX = 64 };
 
 // Solver settings of each variant (bullet_shim.h; every one is written into the summary).
-// native: Bullet's rigid contact with Newton restitution. Contact points act only once the hulls overlap
-// (processing threshold 0: Bullet's speculative points at a positive distance brake a body before it
-// touches and destroy its bounce, reference-engines.md §2.5), and every penetration is recovered by the
-// split impulse (threshold 0 instead of −0.04 m), so the push-out never adds to the bounce velocity.
-// Restitution applies above Bullet's default approach speed of 0.2 m/s.
+// Both: 100 solver iterations instead of 10, so a flat landing's four contact points converge to the same
+// impulse (with 10, a 0.1 m cube dropped flat from 0.5 m leaves with a spurious 0.07 rad/s spin and tumbles
+// on its second bounce). Contact points act only once the hulls overlap (processing threshold 0: Bullet's
+// speculative points at a positive distance brake a body before it touches, reference-engines.md §2.5).
+// The hull–hull normal comes from GJK/EPA (Bullet's default), not from its separating-axis test: in Bullet
+// 3.24 that test adds an edge–edge contact at the edges' witness points when an edge pair's axis ties with
+// the face normal to round-off, far from the real contact (measured: an elastic octahedron landing vertex
+// first on a cube rebounds with e = 1.22 and spins).
+// native: Bullet's rigid contact with Newton restitution (above Bullet's default approach speed of
+// 0.2 m/s); every penetration is recovered by the split impulse (threshold 0 instead of −0.04 m), so the
+// push-out never adds to the bounce velocity (with −0.04: e 0.545 for 0.5).
 static const btsSolverSettings nativeSettings = {
     .iterations = 100,
     .splitImpulse = true,
@@ -41,7 +47,7 @@ static const btsSolverSettings nativeSettings = {
     .restitutionVelocityThreshold = 0.2,
     .warmstartingFactor = 0.85,
     .contactProcessingThreshold = 0.0,
-    .satConvex = true,
+    .satConvex = false,
 };
 // matched: each contact point is a spring-damper (erp = h k/(h k + c), cfm = 1/(h k + c)); its position
 // term must act through the velocity, as the spring does, so the split impulse is off.
@@ -53,15 +59,15 @@ static const btsSolverSettings matchedSettings = {
     .restitutionVelocityThreshold = 0.2,
     .warmstartingFactor = 0.85,
     .contactProcessingThreshold = 0.0,
-    .satConvex = true,
+    .satConvex = false,
 };
 
 struct pdRefWorld {
   const pdModel* model;
   pdRefVariant variant;
-  double step;              // s, the step create() was told
   btsSolverSettings solver;
   btsWorld* bullet;
+  int fixedCount;           // Bullet numbers the fixed bodies first
   pdQuat* principal;        // (movingCount) q_P of each moving body
   pdQuat* last;             // (movingCount) last orientation reported: the next keeps its sign
 };
@@ -81,15 +87,37 @@ static void pair_material(void* user, int a, int b, btsContactMaterial* out) {
   }
 }
 
-// Hull vertices of body b in its principal frame, packed xyz.
-static double* principal_vertices(const pdBody* b) {
-  double* xyz = malloc(sizeof(double) * 3 * (size_t)b->shape.vertexCount);
-  if (!xyz) abort();
-  for (int i = 0; i < b->shape.vertexCount; ++i) {
-    pdVec3 p = pd_mat3_tmulv(&b->principalAxes, b->shape.vertices[i]);
-    xyz[3 * i] = p.x, xyz[3 * i + 1] = p.y, xyz[3 * i + 2] = p.z;
+// Body b's polyhedron in its principal frame: vertices Pᵀ x, face normals Pᵀ n (offsets unchanged: the
+// rotation is about the centre of mass). Free with free_hull.
+static btsHull principal_hull(const pdBody* b) {
+  const pdPolyhedron* p = &b->shape;
+  int indexCount = 0;
+  for (int f = 0; f < p->faceCount; ++f) indexCount += p->faces[f].count;
+  double* vertices = malloc(sizeof(double) * 3 * (size_t)p->vertexCount);
+  double* planes = malloc(sizeof(double) * 4 * (size_t)p->faceCount);
+  int* sizes = malloc(sizeof(int) * (size_t)p->faceCount);
+  int* indices = malloc(sizeof(int) * (size_t)indexCount);
+  if (!vertices || !planes || !sizes || !indices) abort();
+  for (int i = 0; i < p->vertexCount; ++i) {
+    pdVec3 x = pd_mat3_tmulv(&b->principalAxes, p->vertices[i]);
+    vertices[3 * i] = x.x, vertices[3 * i + 1] = x.y, vertices[3 * i + 2] = x.z;
   }
-  return xyz;
+  for (int f = 0, at = 0; f < p->faceCount; ++f) {
+    const pdFace* face = &p->faces[f];
+    pdVec3 n = pd_mat3_tmulv(&b->principalAxes, face->normal);
+    planes[4 * f] = n.x, planes[4 * f + 1] = n.y, planes[4 * f + 2] = n.z, planes[4 * f + 3] = face->offset;
+    sizes[f] = face->count;
+    for (int k = 0; k < face->count; ++k) indices[at++] = p->faceVertices[face->first + k];
+  }
+  return (btsHull){.vertexCount = p->vertexCount, .vertices = vertices, .faceCount = p->faceCount, .faceSizes = sizes,
+                   .faceVertices = indices, .facePlanes = planes};
+}
+
+static void free_hull(btsHull* h) {
+  free((void*)h->vertices);
+  free((void*)h->facePlanes);
+  free((void*)h->faceSizes);
+  free((void*)h->faceVertices);
 }
 
 static double mat3_det(const pdMat3* m) {
@@ -124,7 +152,6 @@ static pdRefWorld* bullet_create(const pdModel* model, const pdRefOptions* optio
   if (!w) abort();
   w->model = model;
   w->variant = options->variant;
-  w->step = options->step;
   w->solver = options->variant == pd_refMatched ? matchedSettings : nativeSettings;
   w->principal = calloc((size_t)model->movingCount + 1, sizeof *w->principal);
   w->last = calloc((size_t)model->movingCount + 1, sizeof *w->last);
@@ -132,20 +159,24 @@ static pdRefWorld* bullet_create(const pdModel* model, const pdRefOptions* optio
   const double gravity[3] = {model->settings.gravity.x, model->settings.gravity.y, model->settings.gravity.z};
   w->bullet = bts_world_create(gravity, &w->solver, pair_material, w);
 
-  // moving bodies first, in scene order, so Bullet's body number is the moving index
+  // Fixed bodies first: Bullet's hull–hull clipping takes the first-added body's face as the reference
+  // face, and a vertex landing on a fixed face is placed right only when that face is the reference (see
+  // the README: with the order reversed, an octahedron dropped vertex first gets its contact point off the
+  // vertex and spins). Then the moving bodies in scene order: Bullet body fixedCount + moving index.
+  w->fixedCount = model->bodyCount - model->movingCount;
   for (int pass = 0; pass < 2; ++pass) {
     for (int i = 0; i < model->bodyCount; ++i) {
       const pdBody* b = &model->bodies[i];
-      if (b->fixed != (pass == 1)) continue;
+      if (b->fixed != (pass == 0)) continue;
       PD_ASSERT(mat3_det(&b->principalAxes) > 0.0);
       pdQuat qP = pd_quat_from_mat3(&b->principalAxes);
       pdQuat q = pd_quat_mul(b->q0, qP);
-      double* xyz = principal_vertices(b);
+      btsHull hull = principal_hull(b);
       const double x[3] = {b->x0.x, b->x0.y, b->x0.z}, quat[4] = {q.w, q.x, q.y, q.z};
       const double v[3] = {b->v0.x, b->v0.y, b->v0.z}, omega[3] = {b->w0.x, b->w0.y, b->w0.z};
-      bts_add_hull(w->bullet, i, xyz, b->shape.vertexCount, b->fixed ? 0.0 : b->mass, b->principal, x, quat, v,
-                   omega);
-      free(xyz);
+      const double none[3] = {0.0, 0.0, 0.0};
+      bts_add_hull(w->bullet, i, &hull, b->fixed ? 0.0 : b->mass, b->fixed ? none : b->principal, x, quat, v, omega);
+      free_hull(&hull);
       if (!b->fixed) {
         w->principal[b->stateIndex] = qP;
         w->last[b->stateIndex] = b->q0;
@@ -159,7 +190,7 @@ static bool bullet_step(pdRefWorld* w, double h) {
   bts_step(w->bullet, h);
   for (int i = 0; i < w->model->movingCount; ++i) {
     double x[3], q[4], v[3], omega[3];
-    bts_body_state(w->bullet, i, x, q, v, omega);
+    bts_body_state(w->bullet, w->fixedCount + i, x, q, v, omega);
     for (int k = 0; k < 3; ++k)
       if (!isfinite(x[k]) || !isfinite(v[k]) || !isfinite(omega[k]) || !isfinite(q[k + 1])) return false;
     if (!isfinite(q[0])) return false;
@@ -170,7 +201,7 @@ static bool bullet_step(pdRefWorld* w, double h) {
 static pdBodyState bullet_body(const pdRefWorld* w, int movingIndex) {
   PD_ASSERT(movingIndex >= 0 && movingIndex < w->model->movingCount);
   double x[3], q[4], v[3], omega[3];
-  bts_body_state(w->bullet, movingIndex, x, q, v, omega);
+  bts_body_state(w->bullet, w->fixedCount + movingIndex, x, q, v, omega);
   pdQuat ours = pd_quat_mul((pdQuat){q[0], q[1], q[2], q[3]}, quat_conjugate(w->principal[movingIndex]));
   // q and −q are the same rotation; Bullet keeps a matrix and may return either, so keep the trajectory's sign
   pdQuat prev = w->last[movingIndex];
@@ -225,9 +256,11 @@ static void bullet_settings_json(const pdRefWorld* w, FILE* out) {
           "btDefaultCollisionConfiguration\", \"step_call\": \"stepSimulation(h, 0): one internal step of h\", "
           "\"integrator\": \"semi-implicit Euler; gyroscopic term implicit (Bullet default)\", "
           "\"gravity\": [%.17g, %.17g, %.17g], "
-          "\"shape\": \"btConvexHullShape of the model's vertices in the principal frame, recalcLocalAabb, "
-          "initializePolyhedralFeatures: hull-hull contacts by clipping, up to 4 points\", \"margin\": 0, "
-          "\"sat_convex\": %s, \"manifold_points_max\": 4, "
+          "\"shape\": \"btConvexHullShape of the model's vertices in the principal frame, recalcLocalAabb; "
+          "polyhedral features from the model's exact faces (setPolyhedralFeatures, not "
+          "initializePolyhedralFeatures): hull-hull contacts by clipping, up to 4 points\", \"margin\": 0, "
+          "\"sat_convex\": %s, \"body_order\": \"fixed bodies first (the clipping's reference face), then "
+          "moving bodies in scene order\", \"manifold_points_max\": 4, "
           "\"inertia\": \"exact principal moments of the model (not calculateLocalInertia)\", "
           "\"fixed_bodies\": \"static btRigidBody, mass 0\", \"deactivation\": false, \"ccd\": false, "
           "\"linear_damping\": 0, \"angular_damping\": 0, \"angular_motion_per_step_max\": %.17g, "

@@ -1,10 +1,11 @@
 // polydyn refcheck — the extern "C" shim over Bullet (see bullet_shim.h). Kept small: a world, hull bodies,
 // one step, read-back, a contact count. Traps of Debian's Bullet 3.24 that it handles
-// (shared/reference/reference-engines.md §2): margin 0 with recalcLocalAabb, polyhedral features for a
-// 4-point hull–hull manifold, exact principal inertia (never calculateLocalInertia), gravity set,
+// (shared/reference/reference-engines.md §2): margin 0 with recalcLocalAabb, polyhedral features (from the
+// model's exact faces) for a 4-point hull–hull manifold, exact principal inertia (never calculateLocalInertia), gravity set,
 // stepSimulation(h, 0), deactivation off, the pair material set per contact point.
 #include "bullet_shim.h"
 
+#include <BulletCollision/CollisionShapes/btConvexPolyhedron.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <memory>
@@ -87,15 +88,29 @@ extern "C" void bts_solver_info(const btsWorld* w, btsSolverInfo* out) {
   out->contactBreakingThreshold = gContactBreakingThreshold;
 }
 
-extern "C" void bts_add_hull(btsWorld* w, int id, const double* points, int count, double mass,
-                             const double inertia[3], const double position[3], const double quaternion[4],
-                             const double velocity[3], const double angularVelocity[3]) {
+extern "C" void bts_add_hull(btsWorld* w, int id, const btsHull* hull, double mass, const double inertia[3],
+                             const double position[3], const double quaternion[4], const double velocity[3],
+                             const double angularVelocity[3]) {
   auto shape = std::make_unique<btConvexHullShape>();
-  for (int i = 0; i < count; ++i)
-    shape->addPoint(btVector3(points[3 * i], points[3 * i + 1], points[3 * i + 2]), i == count - 1);
-  shape->setMargin(0);        // the default 0.04 m inflates a hull
-  shape->recalcLocalAabb();   // setMargin does not refresh the cached box
-  shape->initializePolyhedralFeatures();  // hull–hull by clipping: up to 4 points on the un-inflated hulls
+  const double* v = hull->vertices;
+  for (int i = 0; i < hull->vertexCount; ++i)
+    shape->addPoint(btVector3(v[3 * i], v[3 * i + 1], v[3 * i + 2]), i == hull->vertexCount - 1);
+  shape->setMargin(0);       // the default 0.04 m inflates a hull
+  shape->recalcLocalAabb();  // setMargin does not refresh the cached box
+  // the polyhedral features (hull–hull contacts by clipping, up to 4 points) from the exact faces
+  btConvexPolyhedron polyhedron;
+  for (int i = 0; i < hull->vertexCount; ++i) polyhedron.m_vertices.push_back(btVector3(v[3 * i], v[3 * i + 1], v[3 * i + 2]));
+  const int* index = hull->faceVertices;
+  for (int f = 0; f < hull->faceCount; ++f) {
+    btFace face;
+    for (int k = 0; k < hull->faceSizes[f]; ++k) face.m_indices.push_back(*index++);
+    const double* plane = hull->facePlanes + 4 * f;
+    face.m_plane[0] = plane[0], face.m_plane[1] = plane[1], face.m_plane[2] = plane[2];
+    face.m_plane[3] = -plane[3];  // Bullet's plane: n · x + m_plane[3] = 0
+    polyhedron.m_faces.push_back(face);
+  }
+  polyhedron.initialize();  // unique edge directions, centre, extents
+  shape->setPolyhedralFeatures(polyhedron);
 
   btTransform start;
   start.setOrigin(btVector3(position[0], position[1], position[2]));
