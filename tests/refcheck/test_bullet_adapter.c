@@ -235,13 +235,15 @@ static void test_native_flat_landing_bounces_with_the_pair_restitution(void** st
 
 // A1, matched: a regular octahedron falls vertex first at 1 m/s onto a fixed cube, gravity off,
 // frictionless: one contact spring-damper; with a step small against the contact time Bullet's implicit
-// spring-damper bounces with e = exp(−2ζ arccos ζ/√(1−ζ²)), ζ = c/(2√(k m)) of the pair.
+// spring-damper bounces with e = exp(−2ζ arccos ζ/√(1−ζ²)), ζ = c/(2√(k m)) of the pair. The vertex starts
+// 0.12345678 mm above the face so that it does not reach it exactly at the end of a step: at an exact touch
+// Bullet's GJK/EPA returns an arbitrary normal and the point made with it stays in the manifold (README).
 
 static void test_matched_single_contact_bounces_with_eq_15(void** state) {
   (void)state;
   pdModel* m = compile_text("gravity 0 0 0\ncube plate grey 0.2 0.2 0.2\nfixed\nloc 0 0 -0.1\nmu 0\nrestitution 0.5\n"
                             "hull oct red 0.1 0 0  -0.1 0 0  0 0.1 0  0 -0.1 0  0 0 0.1  0 0 -0.1\n"
-                            "loc 0 0 0.1001\nvel 0 0 -1\nmu 0\nrestitution 0.5\n");
+                            "loc 0 0 0.10012345678\nvel 0 0 -1\nmu 0\nrestitution 0.5\n");
   int oct = body_index(m, "oct");
   pdPairContact pair = pd_model_pair_contact(m, body_index(m, "plate"), oct);
   double zeta = pair.cn / (2.0 * sqrt(pair.kn * m->bodies[oct].mass));
