@@ -208,7 +208,8 @@ static pdBodyState bullet_body(const pdRefWorld* w, int movingIndex) {
   if (ours.w * prev.w + ours.x * prev.x + ours.y * prev.y + ours.z * prev.z < 0.0)
     ours = (pdQuat){-ours.w, -ours.x, -ours.y, -ours.z};
   w->last[movingIndex] = ours;
-  return (pdBodyState){.x = {x[0], x[1], x[2]}, .q = ours, .v = {v[0], v[1], v[2]}, .w = {omega[0], omega[1], omega[2]}};
+  return (pdBodyState){
+      .x = {x[0], x[1], x[2]}, .q = ours, .v = {v[0], v[1], v[2]}, .w = {omega[0], omega[1], omega[2]}};
 }
 
 static int bullet_contact_count(const pdRefWorld* w) { return bts_contact_count(w->bullet); }
@@ -243,7 +244,8 @@ static void write_pairs(const pdRefWorld* w, FILE* out) {
         fprintf(out, ", \"restitution\": %.17g, \"restitution_source\": \"%s\"}", p.restitution, p.restitutionSource);
     }
   }
-  fprintf(out, "], \"pairs_total\": %ld, \"pairs_listed\": %ld", total, total < LISTED_PAIRS_MAX ? total : (long)LISTED_PAIRS_MAX);
+  fprintf(out, "], \"pairs_total\": %ld, \"pairs_listed\": %ld", total,
+          total < LISTED_PAIRS_MAX ? total : (long)LISTED_PAIRS_MAX);
 }
 
 static void bullet_settings_json(const pdRefWorld* w, FILE* out) {

@@ -1,8 +1,9 @@
 // polydyn refcheck — the extern "C" shim over Bullet (see bullet_shim.h). Kept small: a world, hull bodies,
 // one step, read-back, a contact count. Traps of Debian's Bullet 3.24 that it handles
 // (shared/reference/reference-engines.md §2): margin 0 with recalcLocalAabb, polyhedral features (from the
-// model's exact faces) for a 4-point hull–hull manifold, exact principal inertia (never calculateLocalInertia), gravity set,
-// stepSimulation(h, 0), deactivation off, the pair material set per contact point.
+// model's exact faces) for a 4-point hull–hull manifold, exact principal inertia (never
+// calculateLocalInertia), gravity set, stepSimulation(h, 0), deactivation off, the pair material set per
+// contact point.
 #include "bullet_shim.h"
 
 #include <BulletCollision/CollisionShapes/btConvexPolyhedron.h>
@@ -92,14 +93,14 @@ extern "C" void bts_add_hull(btsWorld* w, int id, const btsHull* hull, double ma
                              const double position[3], const double quaternion[4], const double velocity[3],
                              const double angularVelocity[3]) {
   auto shape = std::make_unique<btConvexHullShape>();
-  const double* v = hull->vertices;
-  for (int i = 0; i < hull->vertexCount; ++i)
-    shape->addPoint(btVector3(v[3 * i], v[3 * i + 1], v[3 * i + 2]), i == hull->vertexCount - 1);
+  btConvexPolyhedron polyhedron;  // the polyhedral features (hull–hull contacts by clipping, up to 4 points)
+  for (int i = 0; i < hull->vertexCount; ++i) {
+    const double* x = hull->vertices + 3 * i;
+    shape->addPoint(btVector3(x[0], x[1], x[2]), i == hull->vertexCount - 1);
+    polyhedron.m_vertices.push_back(btVector3(x[0], x[1], x[2]));
+  }
   shape->setMargin(0);       // the default 0.04 m inflates a hull
   shape->recalcLocalAabb();  // setMargin does not refresh the cached box
-  // the polyhedral features (hull–hull contacts by clipping, up to 4 points) from the exact faces
-  btConvexPolyhedron polyhedron;
-  for (int i = 0; i < hull->vertexCount; ++i) polyhedron.m_vertices.push_back(btVector3(v[3 * i], v[3 * i + 1], v[3 * i + 2]));
   const int* index = hull->faceVertices;
   for (int f = 0; f < hull->faceCount; ++f) {
     btFace face;
@@ -115,7 +116,8 @@ extern "C" void bts_add_hull(btsWorld* w, int id, const btsHull* hull, double ma
   btTransform start;
   start.setOrigin(btVector3(position[0], position[1], position[2]));
   start.setRotation(btQuaternion(quaternion[1], quaternion[2], quaternion[3], quaternion[0]));
-  btRigidBody::btRigidBodyConstructionInfo ci(mass, nullptr, shape.get(), btVector3(inertia[0], inertia[1], inertia[2]));
+  btRigidBody::btRigidBodyConstructionInfo ci(mass, nullptr, shape.get(),
+                                              btVector3(inertia[0], inertia[1], inertia[2]));
   ci.m_startWorldTransform = start;
   auto body = std::make_unique<btRigidBody>(ci);
   body->setUserPointer(w);

@@ -95,7 +95,8 @@ static void test_initial_pose_is_the_scene_pose(void** state) {
   for (int v = pd_refNative; v <= pd_refMatched; ++v) {
     pdRefWorld* w = create(m, (pdRefVariant)v, 1e-3);
     pdBodyState s = bullet()->body(w, 0);
-    double dq = fmax(fmax(fabs(s.q.w - b->q0.w), fabs(s.q.x - b->q0.x)), fmax(fabs(s.q.y - b->q0.y), fabs(s.q.z - b->q0.z)));
+    double dq = fmax(fmax(fabs(s.q.w - b->q0.w), fabs(s.q.x - b->q0.x)),
+                     fmax(fabs(s.q.y - b->q0.y), fabs(s.q.z - b->q0.z)));
     double dx = pd_v3_norm(pd_v3_sub(s.x, b->x0)), dv = pd_v3_norm(pd_v3_sub(s.v, b->v0)),
            dw = pd_v3_norm(pd_v3_sub(s.w, b->w0));
     print_message("%s: |dx| %.1e m, |dq| %.1e, |dv| %.1e m/s, |dw| %.1e rad/s\n", variant_name((pdRefVariant)v), dx, dq,
@@ -249,7 +250,8 @@ static void test_matched_single_contact_bounces_with_eq_15(void** state) {
   double zeta = pair.cn / (2.0 * sqrt(pair.kn * m->bodies[oct].mass));
   double predicted = pd_restitution_from_damping_ratio(zeta);
   double e = first_impact_restitution(m, pd_refMatched, 1e-5, 0.05);
-  print_message("A1 matched vertex contact, h = 1e-5 s: zeta %.5f, predicted e %.6f, measured %.6f\n", zeta, predicted, e);
+  print_message("A1 matched vertex contact, h = 1e-5 s: zeta %.5f, predicted e %.6f, measured %.6f\n", zeta,
+                predicted, e);
   assert_true(fabs(e - predicted) <= RESTITUTION_TOL);
   pd_model_free(m);
 }
@@ -360,7 +362,8 @@ static void run_every_scene_in(const char* folder) {
       bool finite;
       bool ok = run_to(m, (pdRefVariant)v, "bullet_case", &stats, &err, &finite);
       print_message("%s/%s %s: %s, %ld steps, at most %ld contacts, %.3f s wall%s%s\n", folder, e->d_name,
-                    variant_name((pdRefVariant)v), stats.completed ? "completed" : (stats.refused ? "refused" : "FAILED"),
+                    variant_name((pdRefVariant)v),
+                    stats.completed ? "completed" : (stats.refused ? "refused" : "FAILED"),
                     stats.steps, stats.maxContacts, stats.wallSeconds, stats.refused ? ": " : "",
                     stats.refused ? err.message : "");
       if (stats.refused) {
