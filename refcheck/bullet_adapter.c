@@ -35,7 +35,8 @@ enum { LISTED_PAIRS_MAX = 64 };
 // The hull–hull normal comes from GJK/EPA (Bullet's default), not from its separating-axis test: in Bullet
 // 3.24 that test adds an edge–edge contact at the edges' witness points when an edge pair's axis ties with
 // the face normal to round-off, far from the real contact (measured: an elastic octahedron landing vertex
-// first on a cube rebounds with e = 1.22 and spins).
+// first on a cube rebounds with e = 1.22 and spins). The GJK path has its own flaw, smaller: its EPA point
+// joins the manifold and can displace a corner of a flat face contact (README "Reference engines: Bullet").
 // native: Bullet's rigid contact with Newton restitution (above Bullet's default approach speed of
 // 0.2 m/s); every penetration is recovered by the split impulse (threshold 0 instead of −0.04 m), so the
 // push-out never adds to the bounce velocity (with −0.04: e 0.545 for 0.5).
