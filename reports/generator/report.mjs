@@ -175,6 +175,7 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
     const out = s.build(ctx);
     if (out) built.push({ section: s, ...out });
   }
+  if (!built.length) throw new InputError(dir, 0, 'nothing to report: the inputs there give no section (results.csv, series/*.csv, sweep.csv or metrics.csv with rows)');
   const json = {
     format: 'polydyn-report/1',
     directory: dir,

@@ -1,7 +1,9 @@
 // Browser smoke test of a generated report, in Debian's Chromium (never a downloaded browser) through
 // playwright-core: the page loads from file:// without a single network request or console error,
 // every chart has drawn (a non-empty SVG with marks), and every embedded replay mounts.
-// usage: node browser_check.mjs REPORT.html... [--screenshot PNG (of the first page)] [--width W] [--height H]
+// usage: node browser_check.mjs REPORT.html... [--screenshot PNG [--until SECTION_ID]] [--width W] [--height H]
+//   --screenshot: a full-page screenshot of the first page, or down to the end of section SECTION_ID
+//   (reports/report-fixture.png is `--screenshot reports/report-fixture.png --until cost`)
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
@@ -72,7 +74,13 @@ try {
     check(requests.length === 0, `no network request${requests.length ? ': ' + requests.join(', ') : ''}`);
     if (shot && k === 0) {
       await page.evaluate(() => document.querySelectorAll('details.replay').forEach((d) => { d.open = false; }));
-      await page.screenshot({ path: shot, fullPage: true });
+      const until = opt('--until', null);
+      const bottom = until ? await page.evaluate((id) => {
+        const el = document.getElementById(id);
+        return el ? Math.ceil(el.getBoundingClientRect().bottom + window.scrollY) + 16 : null;
+      }, until) : null;
+      if (until && bottom === null) check(false, `section ${until} for the screenshot`);
+      await page.screenshot({ path: shot, fullPage: true, ...(bottom ? { clip: { x: 0, y: 0, width: page.viewportSize().width, height: bottom } } : {}) });
     }
     await page.close();
   }

@@ -63,6 +63,15 @@ sections=$(python3 -c 'import json,sys; print(",".join(json.load(open(sys.argv[1
 [[ $sections == "verdict,work-precision,cost" ]] && ok "only sweep.csv: sections verdict, work-precision, cost" || bad "sweep-only sections: $sections"
 grep -q 'PASS/FAIL matrix' "$work/s/report.html" && bad "the sweep-only page has a matrix" || ok "the sweep-only page has no matrix"
 
+# a compare directory (metrics.csv only) gets the comparison table only
+"$polydyn" report "$src/tests/reports/fixtures/compare" -o "$work/o/cmp.html" --no-viewer 2>/dev/null
+sections=$(python3 -c 'import json,sys; print(",".join(json.load(open(sys.argv[1]))["sections"]))' "$work/o/cmp.json")
+[[ $sections == "compare" ]] && ok "only metrics.csv: section compare" || bad "compare-only sections: $sections"
+mkdir "$work/e"
+cp "$fixture/experiments.json" "$work/e/"
+[[ $("$polydyn" report "$work/e" --no-viewer 2>"$work/err"; echo $?) == 2 ]] && grep -q "nothing to report" "$work/err" &&
+  ok "experiments.json alone (no results, no series): nothing to report, exit 2" || bad "experiments.json alone: $(cat "$work/err")"
+
 # --- malformed inputs: FILE:LINE, exit 2, nothing written
 fresh; sed -i '5s/,[^,]*$//' "$work/d/results.csv"
 expect_bad "a row one field short" "$work/d/results.csv:5: 16 fields expected, 15 found"

@@ -273,5 +273,26 @@ class FixtureReport(unittest.TestCase):
                          + sum(len(p["materials"]) + len(p["adjustments"]) for p in self.json["parameters"]))
 
 
+class CompareReport(unittest.TestCase):
+    def test_comparison_metrics_equal_metrics_csv(self):
+        fixture = os.path.join(SOURCE, "tests", "reports", "fixtures", "compare")
+        with tempfile.TemporaryDirectory() as d:
+            subprocess.run([POLYDYN, "report", fixture, "-o", os.path.join(d, "r.html"), "--no-viewer"], check=True, stderr=subprocess.DEVNULL)
+            with open(os.path.join(d, "r.json"), encoding="utf-8") as f:
+                rows = json.load(f)["compare"]
+            with open(os.path.join(d, "r.html"), encoding="utf-8") as f:
+                page = f.read()
+        with open(os.path.join(fixture, "metrics.csv"), newline="", encoding="utf-8") as f:
+            want = list(csv.DictReader(f))
+        self.assertEqual(len(rows), len(want))
+        for j, r in zip(rows, want):
+            for k, v in r.items():
+                if k in ("scene", "engine", "variant", "reference", "restitution_impacts"):
+                    self.assertEqual(j[k], v)
+                else:
+                    self.assertTrue(same(from_json(j[k]), num(v)), f"{k}: {j[k]} vs {v}")
+            self.assertIn(r["restitution_impacts"], page)
+
+
 if __name__ == "__main__":
     unittest.main(argv=sys.argv[:1], verbosity=2)

@@ -19,6 +19,11 @@ test('csv: an unclosed quote is reported at the line where it opened', () => {
   assert.throws(() => parseCsv('a,b\n1,2\n3,"never\nclosed\n', 'f.csv'), { message: 'f.csv:3: quoted field is never closed' });
 });
 
+test('csv: an unbalanced quote that swallows lines is reported where it opens', () => {
+  assert.throws(() => parseCsv('a,b\n1,"x\n2,y\n3,"z",\n', 'f.csv'),
+    { message: 'f.csv:2: the quoted field that opens here runs to line 4 and is followed by text there (an unbalanced quote?)' });
+});
+
 test('csv: a quote inside an unquoted field and text after a closing quote are errors with their line', () => {
   assert.throws(() => parseCsv('a,b\n1,x"y\n', 'f.csv'), /^Error: f\.csv:2: quote inside an unquoted field/);
   assert.throws(() => parseCsv('a,b\n\n"q"x,1\n', 'f.csv'), /^Error: f\.csv:3: text after a closing quote/);

@@ -22,7 +22,7 @@ export default {
       const rows = m.rows.filter((r) => r.scene === scene);
       html += `<h3>${esc(scene)}</h3>`;
       html += table(['engine variant', 'reference', ...cols.map((c) => esc(LABELS[c])), 'restitution per impact'],
-        rows.map((r) => [esc(r.ev), esc(r.reference), ...cols.map((c) => ({ html: num(r[c]), cls: 'n', title: String(r[c] ?? '') })),
+        rows.map((r) => [esc(r.ev), { html: esc(r.reference), cls: 'nowrap' }, ...cols.map((c) => ({ html: c === 'steps' && r[c] !== null ? String(r[c]) : num(r[c]), cls: 'n', title: String(r[c] ?? '') })),
           esc(r.restitution_impacts)]), 'metrics');
     }
     return { html, data: m.rows, csv: [] };
