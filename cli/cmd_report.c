@@ -156,7 +156,7 @@ int pd_cmd_report(int argc, char** argv) {
   sigaction(SIGQUIT, &oldQuit, NULL);
 
   if (rc != 0) {
-    fprintf(stderr, "polydyn report: cannot run %s (%s): the report needs Node.js 18 or later (scripts/install-deps)\n",
+    fprintf(stderr, "polydyn report: cannot run %s (%s): the report needs Node.js 20 or later (scripts/install-deps)\n",
             node, strerror(rc));
     return PD_EXIT_FAILURE;
   }
