@@ -1,0 +1,170 @@
+// polydyn report — one self-contained HTML report of a gedanken / sweep / compare directory.
+//
+// The report is made by a Node.js script, reports/generator/report.mjs (it inlines Apache ECharts
+// from its node_modules, installed by `npm ci --prefix reports/generator`). This command checks its
+// arguments, finds the script and runs it with posix_spawnp — an argument vector, no shell, so any
+// file name is passed as it is. The script reads and checks every input (a malformed file is
+// `polydyn report: FILE:LINE: message` and exit status 2, before anything is written) and writes
+// the page, report.json and report-*.csv, each under a temporary name renamed when complete.
+//
+// Where the script is: $PD_REPORT_GENERATOR when set, else PD_SOURCE_DIR/reports/generator/report.mjs
+// (PD_SOURCE_DIR is the source tree this binary was built from, a compile definition). Which node:
+// $PD_NODE when set, else `node` on the PATH.
+#include <errno.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+extern char** environ;
+
+#ifndef PD_SOURCE_DIR
+#error "PD_SOURCE_DIR (the source tree, where reports/generator/report.mjs is) must be defined"
+#endif
+
+static const char* const help =
+    "usage: polydyn report DIR [-o FILE] [--viewer FILE | --no-viewer]\n"
+    "\n"
+    "Writes one self-contained HTML report of DIR (what polydyn gedanken, sweep and compare wrote\n"
+    "there: no network needed to view it), with the numbers it shows as JSON and CSV beside it.\n"
+    "Each section appears when its inputs are in DIR:\n"
+    "  results.csv, experiments.json  verdict, PASS/FAIL matrix, restitution table, friction cone,\n"
+    "                                 cost, one block per experiment\n"
+    "  series/EXPERIMENT.csv          each experiment's quantity over time against the analytic line\n"
+    "  runs/*/*/summary.json          the parameters every engine actually used\n"
+    "  sweep.csv                      work-precision diagrams, cost to reach error 1e-3\n"
+    "  metrics.csv                    comparison metrics of polydyn compare\n"
+    "\n"
+    "  -o FILE         the page (default DIR/report.html); FILE.json (FILE without .html) and\n"
+    "                  FILE-TABLE.csv are written beside it\n"
+    "  --viewer FILE   inline this replay bundle once and add a 3-D replay of each run (default:\n"
+    "                  viewer/dist/viewer.js of the source tree, when it exists)\n"
+    "  --no-viewer     no replays\n"
+    "\n"
+    "Needs Node.js and `npm ci --prefix reports/generator` (scripts/setup does it). Exit status:\n"
+    "0 written, 1 failure, 2 bad input (`FILE:LINE: message`, nothing written), 130 interrupted.\n";
+
+// the generator script: $PD_REPORT_GENERATOR or the one in the source tree
+static const char* generator_path(void) {
+  const char* env = getenv("PD_REPORT_GENERATOR");
+  if (env && *env) return env;
+  return PD_SOURCE_DIR "/reports/generator/report.mjs";
+}
+
+int pd_cmd_report(int argc, char** argv) {
+  const char* dir = NULL;
+  const char* out = NULL;
+  const char* viewer = NULL;
+  bool noViewer = false;
+  for (int i = 1; i < argc; ++i) {
+    const char* a = argv[i];
+    if (pd_cli_is_help(a)) {
+      fputs(help, stdout);
+      return PD_EXIT_OK;
+    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--out") == 0 || strcmp(a, "--viewer") == 0) {
+      if (i + 1 >= argc) return pd_cli_usage_error("report", "%s needs a value", a);
+      if (strcmp(a, "--viewer") == 0) viewer = argv[++i];
+      else out = argv[++i];
+    } else if (strcmp(a, "--no-viewer") == 0) {
+      noViewer = true;
+    } else if (a[0] == '-' && a[1] != '\0') {
+      return pd_cli_usage_error("report", "unknown option '%s'", a);
+    } else if (!dir) {
+      dir = a;
+    } else {
+      return pd_cli_usage_error("report", "one directory expected, got '%s' and '%s'", dir, a);
+    }
+  }
+  if (!dir) return pd_cli_usage_error("report", "DIR is missing");
+  if (viewer && noViewer) return pd_cli_usage_error("report", "--viewer and --no-viewer exclude each other");
+
+  // the directory: checked here too, so that a typo does not wait for node to start
+  struct stat st;
+  if (stat(dir, &st) != 0) {
+    fprintf(stderr, "polydyn report: %s: no such directory\n", dir);
+    return PD_EXIT_BAD_INPUT;
+  }
+  if (!S_ISDIR(st.st_mode)) {
+    fprintf(stderr, "polydyn report: %s: not a directory\n", dir);
+    return PD_EXIT_BAD_INPUT;
+  }
+
+  const char* script = generator_path();
+  if (access(script, R_OK) != 0) {
+    fprintf(stderr,
+            "polydyn report: the report generator %s is not there (%s); set PD_REPORT_GENERATOR to "
+            "reports/generator/report.mjs of a polydyn source tree\n",
+            script, strerror(errno));
+    return PD_EXIT_FAILURE;
+  }
+  const char* node = getenv("PD_NODE");
+  if (!node || !*node) node = "node";
+
+  // node SCRIPT DIR [-o FILE] [--viewer FILE | --no-viewer]
+  char* args[9];
+  int n = 0;
+  args[n++] = (char*)node;
+  args[n++] = (char*)script;
+  args[n++] = (char*)dir;
+  if (out) {
+    args[n++] = "-o";
+    args[n++] = (char*)out;
+  }
+  if (viewer) {
+    args[n++] = "--viewer";
+    args[n++] = (char*)viewer;
+  } else if (noViewer) {
+    args[n++] = "--no-viewer";
+  }
+  args[n] = NULL;
+
+  // like system(): the child gets Ctrl-C (same process group) and cleans up its temporary files;
+  // this process waits for it instead of dying first
+  struct sigaction ignore = {0}, oldInt, oldQuit;
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGINT, &ignore, &oldInt);
+  sigaction(SIGQUIT, &ignore, &oldQuit);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGINT);
+  sigaddset(&defaults, SIGQUIT);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
+
+  pid_t pid;
+  int rc = posix_spawnp(&pid, node, NULL, &attr, args, environ);
+  posix_spawnattr_destroy(&attr);
+  int status = 0;
+  if (rc == 0) {
+    while (waitpid(pid, &status, 0) < 0) {
+      if (errno != EINTR) {
+        rc = errno;
+        break;
+      }
+    }
+  }
+  sigaction(SIGINT, &oldInt, NULL);
+  sigaction(SIGQUIT, &oldQuit, NULL);
+
+  if (rc != 0) {
+    fprintf(stderr, "polydyn report: cannot run %s (%s): the report needs Node.js 20 or later (scripts/install-deps)\n",
+            node, strerror(rc));
+    return PD_EXIT_FAILURE;
+  }
+  if (WIFSIGNALED(status)) return WTERMSIG(status) == SIGINT ? 130 : PD_EXIT_FAILURE;
+  if (!WIFEXITED(status)) return PD_EXIT_FAILURE;
+  int code = WEXITSTATUS(status);
+  // the generator's own statuses pass through; anything else (node itself failing) is a failure
+  if (code == PD_EXIT_OK || code == PD_EXIT_FAILURE || code == PD_EXIT_BAD_INPUT || code == 130) return code;
+  fprintf(stderr, "polydyn report: %s exited with status %d\n", node, code);
+  return PD_EXIT_FAILURE;
+}

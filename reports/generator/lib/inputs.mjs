@@ -1,0 +1,248 @@
+// The inputs of a report directory, read and checked against the schemas of DESIGN / the gedanken,
+// sweep and compare commands. Every reader returns null when its file does not exist (a section then
+// does not appear) and throws InputError(FILE, LINE, message) when the file is there but malformed.
+import fs from 'node:fs';
+import path from 'node:path';
+import { parseCsv } from './csv.mjs';
+import { parseJson, lineOf } from './json.mjs';
+import { InputError } from './errors.mjs';
+
+export const RESULTS_HEADER = ['experiment', 'group', 'title', 'engine', 'variant', 'quantity', 'unit', 'input',
+  'measured', 'expected', 'error', 'tolerance', 'status', 'wall_seconds', 'run_dir', 'note'];
+export const SERIES_HEADER = ['t', 'engine', 'variant', 'input', 'value', 'analytic'];
+export const SWEEP_HEADER = ['scene', 'engine', 'variant', 'setting', 'value', 'error', 'error_kind', 'wall_seconds',
+  'wall_per_sim_second', 'steps', 'repeats', 'reference'];
+export const METRICS_HEADER = ['scene', 'engine', 'variant', 'reference', 'pos_err_final', 'pos_err_rms',
+  'rot_err_final_rad', 'rot_err_rms_rad', 'energy_drift_rel', 'momentum_drift_rel', 'max_penetration_over_size',
+  'wall_per_sim_second', 'steps', 'restitution_impacts'];
+export const STATUSES = ['PASS', 'FAIL', 'REFUSED', 'NOT_BUILT', 'ERROR'];
+
+const NUMBER = /^[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?$/;
+const NONFINITE = { nan: NaN, '-nan': NaN, inf: Infinity, '+inf': Infinity, '-inf': -Infinity, infinity: Infinity,
+  '-infinity': -Infinity };
+const WORD = /^[A-Za-z0-9_.+-]+$/;
+
+// Reads a file of the report directory; null when it does not exist. `shown` is the path as printed.
+export function readText(dir, name) {
+  const file = path.join(dir, name);
+  let text;
+  try {
+    text = fs.readFileSync(file);
+  } catch (e) {
+    if (e.code === 'ENOENT') return null;
+    if (e.code === 'EISDIR') throw new InputError(file, 0, 'is a directory, not a file');
+    throw new InputError(file, 0, `cannot read: ${e.message}`);
+  }
+  if (text.includes(0)) throw new InputError(file, 0, 'not a text file (contains NUL bytes)');
+  return { file, text: text.toString('utf8') };
+}
+
+// A number field: null when empty; nan/inf as C prints them are accepted; anything else is an error.
+function number(value, column, file, line, { required = false, positive = false, integer = false } = {}) {
+  const v = value.trim();
+  if (v === '') {
+    if (required) throw new InputError(file, line, `${column}: empty (a number is required)`);
+    return null;
+  }
+  let x;
+  if (NUMBER.test(v)) x = Number(v);
+  else if (Object.prototype.hasOwnProperty.call(NONFINITE, v.toLowerCase())) x = NONFINITE[v.toLowerCase()];
+  else throw new InputError(file, line, `${column}: not a number: '${value}'`);
+  if (positive && !(x > 0 && Number.isFinite(x))) throw new InputError(file, line, `${column}: must be a finite number > 0, not '${value}'`);
+  if (integer && !(Number.isInteger(x) && x >= 0)) throw new InputError(file, line, `${column}: must be a whole number ≥ 0, not '${value}'`);
+  return x;
+}
+
+// Records of a CSV file with an exact header; blank lines and repeated header lines (several files
+// concatenated) are skipped. Returns [{line, f: {column: text}}].
+function table(src, header) {
+  const records = parseCsv(src.text, src.file);
+  if (records.length === 0) throw new InputError(src.file, 1, `empty file (expected the header ${header.join(',')})`);
+  const first = records[0];
+  if (first.fields.join(',') !== header.join(','))
+    throw new InputError(src.file, first.line, `header must be exactly '${header.join(',')}', found '${first.fields.join(',')}'`);
+  const out = [];
+  for (const r of records.slice(1)) {
+    if (r.fields.length === 1 && r.fields[0].trim() === '') continue;
+    if (r.fields.join(',') === header.join(',')) continue;
+    if (r.fields.length !== header.length)
+      throw new InputError(src.file, r.line, `${header.length} fields expected, ${r.fields.length} found`);
+    const f = {};
+    header.forEach((h, k) => { f[h] = r.fields[k]; });
+    out.push({ line: r.line, f });
+  }
+  return out;
+}
+
+function word(value, column, file, line) {
+  if (!WORD.test(value)) throw new InputError(file, line, `${column}: expected a name (letters, digits, _ . + -), found '${value}'`);
+  return value;
+}
+
+// input `name=value` → {inputName, inputValue (number or null when not numeric)}
+function parseInput(value, file, line) {
+  if (value === '') return { inputName: '', inputValue: null };
+  const m = /^([A-Za-z_][A-Za-z0-9_]*)=(.+)$/.exec(value);
+  if (!m) throw new InputError(file, line, `input: expected name=value or empty, found '${value}'`);
+  const x = NUMBER.test(m[2]) ? Number(m[2]) : null;
+  return { inputName: m[1], inputValue: x };
+}
+
+// A run directory named in a CSV: relative, inside DIR.
+function runDir(value, file, line) {
+  if (value === '') return '';
+  const parts = value.split('/');
+  if (value.startsWith('/') || parts.includes('..'))
+    throw new InputError(file, line, `run_dir: must be a path inside the report directory, found '${value}'`);
+  return parts.filter((p) => p !== '' && p !== '.').join('/');
+}
+
+export function readResults(dir) {
+  const src = readText(dir, 'results.csv');
+  if (!src) return null;
+  const rows = [];
+  const seen = new Map();
+  for (const { line, f } of table(src, RESULTS_HEADER)) {
+    const file = src.file;
+    if (f.experiment === '') throw new InputError(file, line, 'experiment: empty');
+    if (!/^[A-Z]$/.test(f.group)) throw new InputError(file, line, `group: expected one capital letter (A..G), found '${f.group}'`);
+    if (!STATUSES.includes(f.status))
+      throw new InputError(file, line, `status: expected one of ${STATUSES.join(', ')}, found '${f.status}'`);
+    const row = {
+      line,
+      experiment: f.experiment,
+      group: f.group,
+      title: f.title,
+      engine: word(f.engine, 'engine', file, line),
+      variant: word(f.variant, 'variant', file, line),
+      quantity: f.quantity,
+      unit: f.unit,
+      input: f.input,
+      ...parseInput(f.input, file, line),
+      measured: number(f.measured, 'measured', file, line),
+      expected: number(f.expected, 'expected', file, line),
+      error: number(f.error, 'error', file, line),
+      tolerance: number(f.tolerance, 'tolerance', file, line),
+      status: f.status,
+      wall_seconds: number(f.wall_seconds, 'wall_seconds', file, line),
+      run_dir: runDir(f.run_dir, file, line),
+      note: f.note,
+    };
+    row.ev = `${row.engine} ${row.variant}`;
+    row.relative = /\brelative\b/i.test(row.note);
+    const key = [row.experiment, row.engine, row.variant, row.input].join('\u0000');
+    if (seen.has(key))
+      throw new InputError(file, line, `duplicate row: same experiment, engine, variant and input as line ${seen.get(key)}`);
+    seen.set(key, line);
+    rows.push(row);
+  }
+  return { file: src.file, rows };
+}
+
+const EXPERIMENT_FIELDS = { name: 'string', group: 'string', title: 'string', quantity: 'string', unit: 'string',
+  formula: 'string', tolerance_reason: 'string', qualitative: 'boolean', scene: 'string', series_label: 'string' };
+
+export function readExperiments(dir) {
+  const src = readText(dir, 'experiments.json');
+  if (!src) return null;
+  const list = parseJson(src.text, src.file);
+  if (!Array.isArray(list)) throw new InputError(src.file, lineOf(list) || 1, 'expected an array of experiments');
+  const names = new Map();
+  for (const e of list) {
+    const line = lineOf(e) || lineOf(list);
+    if (!e || typeof e !== 'object' || Array.isArray(e)) throw new InputError(src.file, line, 'expected an object for each experiment');
+    for (const [k, type] of Object.entries(EXPERIMENT_FIELDS)) {
+      if (!(k in e)) throw new InputError(src.file, line, `experiment${typeof e.name === 'string' ? ` "${e.name}"` : ''}: missing "${k}"`);
+      if (typeof e[k] !== type) throw new InputError(src.file, line, `"${k}" must be a ${type}`);
+    }
+    if (names.has(e.name)) throw new InputError(src.file, line, `duplicate experiment "${e.name}" (first at line ${names.get(e.name)})`);
+    names.set(e.name, line);
+  }
+  return { file: src.file, list };
+}
+
+// DIR/series/*.csv → Map(experiment → {file, points: [{line, t, engine, variant, input, value, analytic}]})
+export function readSeries(dir) {
+  let names;
+  try {
+    names = fs.readdirSync(path.join(dir, 'series')).filter((n) => n.endsWith('.csv')).sort();
+  } catch (e) {
+    if (e.code === 'ENOENT' || e.code === 'ENOTDIR') return null;
+    throw e;
+  }
+  const out = new Map();
+  for (const name of names) {
+    const src = readText(dir, path.join('series', name));
+    if (!src) continue;
+    const points = [];
+    for (const { line, f } of table(src, SERIES_HEADER)) {
+      points.push({
+        t: number(f.t, 't', src.file, line, { required: true }),
+        engine: word(f.engine, 'engine', src.file, line),
+        variant: word(f.variant, 'variant', src.file, line),
+        input: f.input,
+        value: number(f.value, 'value', src.file, line),
+        analytic: number(f.analytic, 'analytic', src.file, line),
+      });
+      parseInput(f.input, src.file, line);
+    }
+    out.set(name.slice(0, -4), { file: src.file, points });
+  }
+  return out.size ? out : null;
+}
+
+export function readSweep(dir) {
+  const src = readText(dir, 'sweep.csv');
+  if (!src) return null;
+  const rows = [];
+  for (const { line, f } of table(src, SWEEP_HEADER)) {
+    if (f.scene === '') throw new InputError(src.file, line, 'scene: empty');
+    if (f.setting !== 'tol' && f.setting !== 'step')
+      throw new InputError(src.file, line, `setting: expected tol or step, found '${f.setting}'`);
+    const row = {
+      line,
+      scene: f.scene,
+      engine: word(f.engine, 'engine', src.file, line),
+      variant: word(f.variant, 'variant', src.file, line),
+      setting: f.setting,
+      value: number(f.value, 'value', src.file, line, { required: true, positive: true }),
+      error: number(f.error, 'error', src.file, line),
+      error_kind: f.error_kind,
+      wall_seconds: number(f.wall_seconds, 'wall_seconds', src.file, line),
+      wall_per_sim_second: number(f.wall_per_sim_second, 'wall_per_sim_second', src.file, line),
+      steps: number(f.steps, 'steps', src.file, line, { integer: true }),
+      repeats: number(f.repeats, 'repeats', src.file, line, { integer: true }),
+      reference: f.reference,
+    };
+    row.ev = `${row.engine} ${row.variant}`;
+    rows.push(row);
+  }
+  return { file: src.file, rows };
+}
+
+export function readMetrics(dir) {
+  const src = readText(dir, 'metrics.csv');
+  if (!src) return null;
+  const rows = [];
+  for (const { line, f } of table(src, METRICS_HEADER)) {
+    const row = { line, scene: f.scene, engine: word(f.engine, 'engine', src.file, line),
+      variant: word(f.variant, 'variant', src.file, line), reference: f.reference };
+    for (const h of METRICS_HEADER.slice(4, 13)) row[h] = number(f[h], h, src.file, line, { integer: h === 'steps' });
+    row.restitution_impacts = f.restitution_impacts;
+    row.ev = `${row.engine} ${row.variant}`;
+    rows.push(row);
+  }
+  return { file: src.file, rows };
+}
+
+// summary.json of a run directory (relative to DIR): the parsed object, or null when absent.
+export function readSummary(dir, run) {
+  const src = readText(dir, path.join(run, 'summary.json'));
+  if (!src) return null;
+  const v = parseJson(src.text, src.file);
+  if (!v || typeof v !== 'object' || Array.isArray(v)) throw new InputError(src.file, 1, 'expected a JSON object');
+  if ('engine_settings' in v && (!v.engine_settings || typeof v.engine_settings !== 'object' || Array.isArray(v.engine_settings)))
+    throw new InputError(src.file, lineOf(v), '"engine_settings" must be an object');
+  if ('bodies' in v && !Array.isArray(v.bodies)) throw new InputError(src.file, lineOf(v), '"bodies" must be an array');
+  return { file: src.file, summary: v };
+}

@@ -1,0 +1,77 @@
+// polydyn report: draws the charts (Apache ECharts, inlined above) from the JSON specifications the
+// generator wrote into #pd-charts, and mounts the 3-D replays when a viewer bundle is inlined.
+(function () {
+  'use strict';
+  // a number for axis labels and tooltips: 3 significant digits, scientific outside [1e-3, 1e5)
+  function num(x) {
+    if (typeof x !== 'number' || !isFinite(x)) return String(x);
+    if (x === 0) return '0';
+    var a = Math.abs(x);
+    if (a >= 1e-3 && a < 1e5) return String(Number(x.toPrecision(3)));
+    var p = x.toExponential(2).split('e');
+    return p[0].replace(/\.?0+$/, '') + 'e' + Number(p[1]);
+  }
+  // log axes: powers of ten as 1e-3, others as numbers
+  function sci(x) {
+    var l = Math.log10(Math.abs(x));
+    return Math.abs(l - Math.round(l)) < 1e-9 && (x < 1e-2 || x >= 1e4) ? '1e' + Math.round(l) : num(x);
+  }
+  var FORMATTERS = {
+    num: num,
+    sci: sci,
+    deg: function (x) { return x + '°'; },
+    // tooltip of a point [x, y, label]
+    point3: function (p) {
+      var d = p.data || p.value;
+      return p.marker + p.seriesName + (d[2] !== undefined ? ' · ' + d[2] : '') + '<br>' + num(d[0]) + ', ' + num(d[1]);
+    },
+    // tooltip of a polar point [radius, angle]
+    polar: function (p) {
+      var d = p.data || p.value;
+      return p.marker + p.seriesName + '<br>' + num(d[1]) + '°: ' + num(d[0]);
+    }
+  };
+  // replaces formatter names by the functions above
+  function decorate(o) {
+    if (Array.isArray(o)) return o.map(decorate);
+    if (o && typeof o === 'object') {
+      var out = {};
+      for (var k in o) {
+        var v = o[k];
+        if ((k === 'formatter' || k === 'valueFormatter') && typeof v === 'string' && FORMATTERS[v]) out[k] = FORMATTERS[v];
+        else out[k] = decorate(v);
+      }
+      return out;
+    }
+    return o;
+  }
+  var specs = JSON.parse(document.getElementById('pd-charts').textContent);
+  var charts = [];
+  specs.forEach(function (s) {
+    var el = document.getElementById(s.id);
+    var chart = echarts.init(el, null, { renderer: 'svg' });
+    var option = decorate(s.option);
+    option.animation = false;
+    option.textStyle = { fontFamily: 'system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans", sans-serif' };
+    chart.setOption(option);
+    charts.push(chart);
+  });
+  window.addEventListener('resize', function () { charts.forEach(function (c) { c.resize(); }); });
+  window.polydynReport = { charts: charts };
+
+  // replays: the inlined viewer bundle defines PolydynViewer.mount(element, run); each run is
+  // mounted when its <details> is first opened (one WebGL context per open replay)
+  var viewer = window.PolydynViewer;
+  Array.prototype.forEach.call(document.querySelectorAll('details.replay'), function (d) {
+    d.addEventListener('toggle', function () {
+      if (!d.open || d.dataset.mounted) return;
+      d.dataset.mounted = '1';
+      var target = d.querySelector('.pd-replay');
+      if (!viewer || typeof viewer.mount !== 'function') {
+        target.textContent = 'The inlined viewer bundle does not define PolydynViewer.mount.';
+        return;
+      }
+      viewer.mount(target, JSON.parse(d.querySelector('script.pd-run').textContent));
+    });
+  });
+})();

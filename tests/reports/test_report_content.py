@@ -1,0 +1,298 @@
+#!/usr/bin/env python3
+"""What the fixture report shows, checked with parsers independent of the generator's (Python's csv,
+json and html.parser): the page is self-contained; the PASS/FAIL matrix has one cell per
+(experiment, engine-variant) of results.csv, each showing its error; the numbers in report.json and
+report-*.csv equal those in the input CSVs and summaries; the cost to reach 1e-3 follows the
+log-log interpolation.
+
+usage: test_report_content.py POLYDYN SOURCE_DIR
+"""
+import csv
+import html.parser
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+POLYDYN, SOURCE = sys.argv[1], sys.argv[2]
+FIXTURE = os.path.join(SOURCE, "tests", "reports", "fixtures", "gedanken")
+
+
+def num(text):
+    """A CSV number as the schema writes it (%.17g, nan, inf); None when empty."""
+    return None if text == "" else float(text)
+
+
+def from_json(v):
+    """A number of report.json: non-finite ones are the strings nan, inf, -inf."""
+    return float(v) if isinstance(v, str) else v
+
+
+def same(a, b):
+    if a is None or b is None:
+        return a is None and b is None
+    return (math.isnan(a) and math.isnan(b)) or a == b
+
+
+class Page(html.parser.HTMLParser):
+    """Collects the tags, the matrix cells (with their text) and the scripts of the page."""
+
+    def __init__(self):
+        super().__init__()
+        self.tags = []
+        self.cells = []
+        self.cell = None
+        self.scripts = []
+        self.in_script = None
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        self.tags.append((tag, a))
+        if tag == "td" and "data-experiment" in a:
+            self.cell = {**a, "text": ""}
+        if tag == "script":
+            self.in_script = {"attrs": a, "text": ""}
+
+    def handle_endtag(self, tag):
+        if tag == "td" and self.cell is not None:
+            self.cells.append(self.cell)
+            self.cell = None
+        if tag == "script" and self.in_script is not None:
+            self.scripts.append(self.in_script)
+            self.in_script = None
+
+    def handle_data(self, data):
+        if self.cell is not None:
+            self.cell["text"] += data
+        if self.in_script is not None:
+            self.in_script["text"] += data
+
+
+class FixtureReport(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp()
+        cls.out = os.path.join(cls.dir, "report.html")
+        subprocess.run([POLYDYN, "report", FIXTURE, "-o", cls.out, "--no-viewer"], check=True, stderr=subprocess.DEVNULL,
+                       env={**os.environ, "PD_REPORT_GENERATOR": os.path.join(SOURCE, "reports", "generator", "report.mjs")})
+        with open(cls.out, encoding="utf-8") as f:
+            cls.html = f.read()
+        with open(os.path.join(cls.dir, "report.json"), encoding="utf-8") as f:
+            cls.json = json.load(f)
+        with open(os.path.join(FIXTURE, "results.csv"), newline="", encoding="utf-8") as f:
+            cls.results = list(csv.DictReader(f))
+        with open(os.path.join(FIXTURE, "sweep.csv"), newline="", encoding="utf-8") as f:
+            cls.sweep = [r for r in csv.DictReader(f) if r["scene"] != "scene"]  # two sweeps, header repeated
+        cls.page = Page()
+        cls.page.feed(cls.html)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.dir)
+
+    def table(self, name):
+        with open(os.path.join(self.dir, f"report-{name}.csv"), newline="", encoding="utf-8") as f:
+            return list(csv.DictReader(f))
+
+    # --- self-contained
+    def test_page_loads_nothing_from_outside(self):
+        for tag, a in self.page.tags:
+            self.assertNotIn("src", a, f"<{tag} src=…>: everything must be inlined")
+            if tag == "link":
+                self.fail(f"<link {a}>: no external stylesheet or resource")
+            for attr in ("href", "action", "poster", "data"):
+                self.assertFalse(re.match(r"\s*(https?:)?//", a.get(attr) or ""), f"<{tag} {attr}={a.get(attr)}>")
+        self.assertNotRegex(self.html, r"@import|url\(\s*['\"]?(https?:)?//", "no CSS import or url() from outside")
+        self.assertNotRegex(self.html, r"<iframe|<embed|<object", "no embedded documents")
+
+    def test_charting_library_and_page_script_are_inlined(self):
+        code = [s for s in self.page.scripts if s["attrs"].get("type") != "application/json"]
+        self.assertEqual(len(code), 2, "ECharts and the page script, nothing else")
+        self.assertIn("Apache ECharts", code[0]["text"][:200])
+        self.assertGreater(len(code[0]["text"]), 500_000, "the whole minified library is there")
+        charts = json.loads(next(s for s in self.page.scripts if s["attrs"].get("id") == "pd-charts")["text"])
+        self.assertEqual(len(charts), len(re.findall(r'<div class="chart" id="chart-\d+"', self.html)))
+
+    def test_charts_include_the_polar_friction_cone_and_log_log_work_precision(self):
+        charts = json.loads(next(s for s in self.page.scripts if s["attrs"].get("id") == "pd-charts")["text"])
+        polar = [c for c in charts if "polar" in c["option"]]
+        self.assertEqual(len(polar), 1)
+        self.assertTrue(all(s["coordinateSystem"] == "polar" for s in polar[0]["option"]["series"]))
+        loglog = [c for c in charts if c["option"].get("xAxis", {}).get("type") == "log" and c["option"]["yAxis"]["type"] == "log"]
+        self.assertEqual(len(loglog), len({r["scene"] for r in self.sweep}), "one work-precision diagram per scene")
+        # one curve per engine-variant (and setting) of each scene
+        for c, scene in zip(loglog, dict.fromkeys(r["scene"] for r in self.sweep)):
+            curves = {(r["engine"], r["variant"], r["setting"]) for r in self.sweep if r["scene"] == scene}
+            self.assertEqual(len(c["option"]["series"]), len(curves))
+
+    # --- PASS/FAIL matrix
+    def test_matrix_has_one_cell_per_experiment_and_engine_variant(self):
+        pairs = {(r["experiment"], f'{r["engine"]} {r["variant"]}') for r in self.results}
+        cells = [(c["data-experiment"], c["data-ev"]) for c in self.page.cells]
+        self.assertEqual(len(cells), len(set(cells)), "no cell twice")
+        self.assertEqual(set(cells), pairs)
+
+    def test_each_matrix_cell_shows_its_status_and_largest_error(self):
+        for c in self.page.cells:
+            rows = [r for r in self.results if r["experiment"] == c["data-experiment"] and f'{r["engine"]} {r["variant"]}' == c["data-ev"]]
+            errors = [num(r["error"]) for r in rows if r["error"] not in ("", "nan")]
+            statuses = {r["status"] for r in rows}
+            self.assertIn(c["data-status"], statuses)
+            self.assertIn(c["data-status"], c["text"])
+            if statuses == {"PASS"}:
+                self.assertEqual(c["data-status"], "PASS")
+            if "FAIL" in statuses and "ERROR" not in statuses:
+                self.assertEqual(c["data-status"], "FAIL", "a cell with a failing input is not PASS")
+            if errors:
+                self.assertEqual(float(c["data-error"]), max(errors))
+                self.assertRegex(c["text"], r"error [-0-9.e]+( %)?", "the error is shown in the cell")
+            else:
+                self.assertEqual(c["data-error"], "")
+
+    # --- numbers: report.json and the CSV tables against the inputs
+    def test_report_json_results_equal_results_csv(self):
+        rows = self.json["results"]
+        self.assertEqual(len(rows), len(self.results))
+        for csv_row, j in zip(self.results, rows):
+            for k in ("experiment", "engine", "variant", "input", "status", "note", "run_dir"):
+                self.assertEqual(j[k], csv_row[k], k)
+            for k in ("measured", "expected", "error", "tolerance", "wall_seconds"):
+                self.assertTrue(same(from_json(j[k]), num(csv_row[k])), f'{csv_row["experiment"]} {k}: {j[k]} vs {csv_row[k]}')
+
+    def test_matrix_numbers_equal_results_csv(self):
+        cells = self.json["matrix"]["cells"]
+        table = self.table("matrix")
+        self.assertEqual(len(table), len(cells))
+        for c, t in zip(cells, table):
+            rows = [r for r in self.results if r["experiment"] == c["experiment"] and r["engine"] == c["engine"] and r["variant"] == c["variant"]]
+            errors = [num(r["error"]) for r in rows if r["error"] not in ("", "nan")]
+            self.assertEqual(c["error"], max(errors) if errors else None)
+            self.assertEqual(c["passed"], sum(r["status"] == "PASS" for r in rows))
+            self.assertEqual(c["inputs"], len(rows))
+            walls = [num(r["wall_seconds"]) for r in rows if r["wall_seconds"]]
+            self.assertAlmostEqual(c["wall_seconds"] or 0, sum(walls), delta=1e-12)
+            self.assertTrue(same(num(t["error"]), c["error"]))
+            self.assertEqual(t["status"], c["status"])
+
+    def test_restitution_table_equals_results_csv(self):
+        rows = [r for r in self.results if r["quantity"] == "restitution"]
+        self.assertTrue(rows)
+        table = self.table("restitution")
+        self.assertEqual(len(table), len(rows))
+        for r in rows:
+            t = next(t for t in table if (t["experiment"], t["input"], t["engine"], t["variant"]) == (r["experiment"], r["input"], r["engine"], r["variant"]))
+            self.assertEqual(num(t["measured"]), num(r["measured"]))
+            self.assertEqual(num(t["predicted"]), num(r["expected"]))
+            self.assertEqual(num(t["requested"]), float(r["input"].split("=")[1]))
+            g = next(g for g in self.json["restitution"]["rows"] if (g["experiment"], g["input"]) == (r["experiment"], r["input"]))
+            self.assertEqual(g["measured"][f'{r["engine"]} {r["variant"]}'], num(r["measured"]))
+
+    def test_friction_cone_equals_results_csv(self):
+        rows = [r for r in self.results if r["quantity"] == "stopping_distance" and r["input"].startswith("push_deg=") and r["measured"]]
+        self.assertEqual(len(rows), 20)
+        traces = {t["ev"]: t for c in self.json["friction-cone"] for t in c["traces"]}
+        for r in rows:
+            pts = traces[f'{r["engine"]} {r["variant"]}']["points"]
+            p = next(p for p in pts if p["push_deg"] == float(r["input"].split("=")[1]))
+            self.assertEqual(p["distance"], num(r["measured"]))
+        # the isotropy spread of a trace: (max − min) / mean
+        d = [num(r["measured"]) for r in rows if r["engine"] == "ode" and r["variant"] == "native"]
+        self.assertAlmostEqual(traces["ode native"]["spread"], (max(d) - min(d)) / (sum(d) / len(d)), places=14)
+
+    def test_work_precision_points_equal_sweep_csv(self):
+        points = {(s["scene"], c["engine"], c["variant"], c["setting"], p["value"]): p
+                  for s in self.json["work-precision"] for c in s["curves"] for p in c["points"]}
+        self.assertEqual(len(points), len(self.sweep))
+        for r in self.sweep:
+            p = points[(r["scene"], r["engine"], r["variant"], r["setting"], num(r["value"]))]
+            self.assertTrue(same(p["error"], num(r["error"])))
+            self.assertEqual(p["wall_per_sim_second"], num(r["wall_per_sim_second"]))
+            self.assertEqual(p["wall_seconds"], num(r["wall_seconds"]))
+
+    def test_cost_to_reach_1e_3_is_the_log_log_interpolation_on_the_curve(self):
+        target = 1e-3
+        cost = {r["ev"]: r for r in self.json["cost"]["rows"]}
+        for scene in {r["scene"] for r in self.sweep}:
+            for ev in {f'{r["engine"]} {r["variant"]}' for r in self.sweep if r["scene"] == scene}:
+                best = None
+                for setting in ("tol", "step"):
+                    pts = sorted(([num(r["value"]), num(r["error"]), num(r["wall_per_sim_second"])] for r in self.sweep
+                                  if r["scene"] == scene and f'{r["engine"]} {r["variant"]}' == ev and r["setting"] == setting
+                                  and r["error"] not in ("", "nan")), reverse=True)
+                    for k, (_, e, w) in enumerate(pts):
+                        if e <= target:
+                            if k == 0:
+                                c = w
+                            else:
+                                e0, w0 = pts[k - 1][1], pts[k - 1][2]
+                                s = (math.log(target) - math.log(e0)) / (math.log(e) - math.log(e0))
+                                c = math.exp(math.log(w0) + s * (math.log(w) - math.log(w0)))
+                            best = c if best is None else min(best, c)
+                            break
+                got = cost[ev]["to_target"][scene]
+                if best is None:
+                    self.assertEqual(got["kind"], "never", f"{scene} {ev}")
+                else:
+                    self.assertAlmostEqual(got["wall_per_sim_second"], best, delta=1e-12 * best, msg=f"{scene} {ev}")
+        self.assertEqual(cost["ode native"]["to_target"]["cases/gedanken/slide.scene"]["kind"], "never")
+
+    def test_cost_table_wall_times_equal_results_csv(self):
+        for r in self.json["cost"]["rows"]:
+            walls = {}
+            for x in self.results:
+                if f'{x["engine"]} {x["variant"]}' == r["ev"] and x["wall_seconds"]:
+                    walls[x["experiment"]] = walls.get(x["experiment"], 0) + num(x["wall_seconds"])
+            if not walls:
+                continue
+            self.assertAlmostEqual(r["total_wall_seconds"], sum(walls.values()), delta=1e-12)
+            w = sorted(walls.values())
+            mid = len(w) // 2
+            self.assertAlmostEqual(r["median_wall_seconds_per_experiment"], w[mid] if len(w) % 2 else (w[mid - 1] + w[mid]) / 2, delta=1e-12)
+
+    def test_parameters_list_every_engine_setting_of_every_run(self):
+        params = {p["ev"]: p for p in self.json["parameters"]}
+        runs = {(r["run_dir"], f'{r["engine"]} {r["variant"]}') for r in self.results if r["run_dir"]}
+        for run_dir, ev in runs:
+            with open(os.path.join(FIXTURE, run_dir, "summary.json"), encoding="utf-8") as f:
+                s = json.load(f)
+            # values are kept as JSON text (strings as they are)
+            settings = {x["key"]: [v["value"] if v["value"] and v["value"][0] not in '-0123456789[{tfn' else json.loads(v["value"])
+                                   for v in x["values"]] for x in params[ev]["settings"]}
+            source = s.get("engine_settings") or s["settings"]
+            for k, v in source.items():
+                self.assertIn(v, settings[k], f"{run_dir}: {k}")
+            for b in s.get("bodies", []):
+                used = b["material"]["used"]
+                self.assertTrue(any(m["used"]["kn"] == used["kn"] and m["used"]["cn"] == used["cn"] for m in params[ev]["materials"]))
+        self.assertEqual(len(self.table("parameters")), sum(len(x["values"]) for p in self.json["parameters"] for x in p["settings"])
+                         + sum(len(p["materials"]) + len(p["adjustments"]) for p in self.json["parameters"]))
+
+
+class CompareReport(unittest.TestCase):
+    def test_comparison_metrics_equal_metrics_csv(self):
+        fixture = os.path.join(SOURCE, "tests", "reports", "fixtures", "compare")
+        with tempfile.TemporaryDirectory() as d:
+            subprocess.run([POLYDYN, "report", fixture, "-o", os.path.join(d, "r.html"), "--no-viewer"], check=True, stderr=subprocess.DEVNULL)
+            with open(os.path.join(d, "r.json"), encoding="utf-8") as f:
+                rows = json.load(f)["compare"]
+            with open(os.path.join(d, "r.html"), encoding="utf-8") as f:
+                page = f.read()
+        with open(os.path.join(fixture, "metrics.csv"), newline="", encoding="utf-8") as f:
+            want = list(csv.DictReader(f))
+        self.assertEqual(len(rows), len(want))
+        for j, r in zip(rows, want):
+            for k, v in r.items():
+                if k in ("scene", "engine", "variant", "reference", "restitution_impacts"):
+                    self.assertEqual(j[k], v)
+                else:
+                    self.assertTrue(same(from_json(j[k]), num(v)), f"{k}: {j[k]} vs {v}")
+            self.assertIn(r["restitution_impacts"], page)
+
+
+if __name__ == "__main__":
+    unittest.main(argv=sys.argv[:1], verbosity=2)

@@ -1,0 +1,112 @@
+// Unit tests of the report generator's parts (node --test): the CSV and JSON readers keep line
+// numbers, the cost-to-target interpolation, the matrix aggregation, the number formatting.
+import test from 'node:test';
+import assert from 'node:assert/strict';
+import { parseCsv, writeCsv } from '../../reports/generator/lib/csv.mjs';
+import { parseJson, lineOf } from '../../reports/generator/lib/json.mjs';
+import { costToReach, matrix, orderEngineVariants, median } from '../../reports/generator/lib/derive.mjs';
+import { num } from '../../reports/generator/lib/html.mjs';
+import { parseArgs, outputPaths } from '../../reports/generator/report.mjs';
+
+test('csv: quoted fields keep commas, quotes and line breaks, and records keep their first line', () => {
+  const recs = parseCsv('a,b\n1,"x, ""y""\nz"\r\n2,\n', 'f.csv');
+  assert.deepEqual(recs.map((r) => r.line), [1, 2, 4]);
+  assert.deepEqual(recs[1].fields, ['1', 'x, "y"\nz']);
+  assert.deepEqual(recs[2].fields, ['2', '']);
+});
+
+test('csv: an unclosed quote is reported at the line where it opened', () => {
+  assert.throws(() => parseCsv('a,b\n1,2\n3,"never\nclosed\n', 'f.csv'), { message: 'f.csv:3: quoted field is never closed' });
+});
+
+test('csv: an unbalanced quote that swallows lines is reported where it opens', () => {
+  assert.throws(() => parseCsv('a,b\n1,"x\n2,y\n3,"z",\n', 'f.csv'),
+    { message: 'f.csv:2: the quoted field that opens here runs to line 4 and is followed by text there (an unbalanced quote?)' });
+});
+
+test('csv: a quote inside an unquoted field and text after a closing quote are errors with their line', () => {
+  assert.throws(() => parseCsv('a,b\n1,x"y\n', 'f.csv'), /^Error: f\.csv:2: quote inside an unquoted field/);
+  assert.throws(() => parseCsv('a,b\n\n"q"x,1\n', 'f.csv'), /^Error: f\.csv:3: text after a closing quote/);
+});
+
+test('csv: what writeCsv writes reads back to the same fields', () => {
+  const rows = [['plain', 'with, comma', 'with "quote"', 'two\nlines', ' lead', 1.5e-300, -0]];
+  const back = parseCsv(writeCsv(['a', 'b', 'c', 'd', 'e', 'f', 'g'], rows), 'x');
+  assert.deepEqual(back[1].fields, ['plain', 'with, comma', 'with "quote"', 'two\nlines', ' lead', '1.5e-300', '0']);
+});
+
+test('json: objects and arrays remember their line; errors give the line', () => {
+  const v = parseJson('[\n  {"a": 1},\n\n  {"b": [\n 2]}\n]\n', 'e.json');
+  assert.equal(lineOf(v), 1);
+  assert.equal(lineOf(v[0]), 2);
+  assert.equal(lineOf(v[1]), 4);
+  assert.equal(lineOf(v[1].b), 4);
+  assert.throws(() => parseJson('{\n "a": 1,\n "b": tru\n}', 'e.json'), /^Error: e\.json:3: malformed JSON/);
+  assert.throws(() => parseJson('{"a": 1, "a": 2}', 'e.json'), /e\.json:1: duplicate member "a"/);
+});
+
+test('json: numbers and strings decode exactly as JSON.parse does', () => {
+  const text = '{"x": 0.29999999999999993, "y": -1.5e-310, "s": "\\u00e9\\n\\"", "big": 1e308}';
+  assert.deepEqual(parseJson(text, 'f'), JSON.parse(text));
+});
+
+test('costToReach: interpolates linearly in log error and log cost between the points around the target', () => {
+  const pts = [{ value: 1e-2, error: 1e-1, wall_per_sim_second: 1e-3 }, { value: 1e-3, error: 1e-4, wall_per_sim_second: 1e-1 }];
+  const c = costToReach(pts, 1e-3);
+  assert.equal(c.kind, 'interpolated');
+  // error falls 3 decades over 2 decades of cost: 1e-3 is 2/3 of the way: cost 10^(-3 + 4/3)
+  assert.ok(Math.abs(Math.log10(c.wall_per_sim_second) - (-3 + 4 / 3)) < 1e-12);
+});
+
+test('costToReach: "at_most" when the loosest usable point is already there, "never" when none is, failed points skipped', () => {
+  assert.deepEqual(costToReach([{ value: 1, error: null, wall_per_sim_second: 1 }, { value: 0.1, error: 1e-4, wall_per_sim_second: 2 }], 1e-3),
+    { kind: 'at_most', wall_per_sim_second: 2, setting_value: 0.1 });
+  assert.equal(costToReach([{ value: 1, error: 0.1, wall_per_sim_second: 1 }, { value: 0.1, error: 0.01, wall_per_sim_second: 2 }], 1e-3).kind, 'never');
+  assert.equal(costToReach([], 1e-3).kind, 'never');
+});
+
+test('matrix: a cell over several inputs has the worst status, the passing count and the largest error', () => {
+  const row = (input, status, error, tolerance) => ({ experiment: 'A1', engine: 'ode', variant: 'native', ev: 'ode native', input,
+    inputValue: Number(input.split('=')[1]), status, error, tolerance, relative: false, wall_seconds: 1, line: 2 });
+  const m = matrix({ rows: [row('e=0.3', 'PASS', 0.001, 0.005), row('e=0.5', 'FAIL', 0.02, 0.005), row('e=0.8', 'ERROR', null, 0.005)] }, null);
+  assert.equal(m.cells.length, 1);
+  const c = m.cells[0];
+  assert.equal(c.status, 'ERROR');
+  assert.equal(c.passed, 1);
+  assert.equal(c.inputs, 3);
+  assert.equal(c.error, 0.02);
+  assert.equal(c.error_over_tolerance, 4);
+  assert.equal(c.worst_input, 'e=0.5');
+  assert.equal(c.wall_seconds, 3);
+});
+
+test('engine-variants are ordered soft, ode, bullet, then others; adaptive, native, matched within one', () => {
+  const evs = [['bullet', 'matched'], ['zeta', 'native'], ['ode', 'native'], ['bullet', 'native'], ['soft', 'adaptive'], ['ode', 'matched']]
+    .map(([engine, variant]) => ({ engine, variant, ev: `${engine} ${variant}` }));
+  assert.deepEqual(orderEngineVariants(evs).map((x) => x.ev),
+    ['soft adaptive', 'ode native', 'ode matched', 'bullet native', 'bullet matched', 'zeta native']);
+});
+
+test('median of an even count is the mean of the middle two; non-finite values are left out', () => {
+  assert.equal(median([4, 1, NaN, 3, 2]), 2.5);
+  assert.equal(median([]), null);
+});
+
+test('numbers read with 3 significant digits, scientific outside [1e-3, 1e5)', () => {
+  assert.equal(num(0.50968), '0.51');
+  assert.equal(num(0.5097, 4), '0.5097');
+  assert.equal(num(1.23456e-7), '1.23e-7');
+  assert.equal(num(2e6), '2e6');
+  assert.equal(num(0), '0');
+  assert.equal(num(null), '—');
+  assert.equal(num(NaN), 'nan');
+});
+
+test('arguments: DIR, -o, --viewer, --no-viewer; outputs beside the page', () => {
+  assert.deepEqual(parseArgs(['d', '-o', 'x/r.html', '--no-viewer']), { dir: 'd', out: 'x/r.html', viewer: null });
+  assert.throws(() => parseArgs([]), /DIR is missing/);
+  assert.throws(() => parseArgs(['a', 'b']), /one directory expected/);
+  assert.throws(() => parseArgs(['a', '--bogus']), /unknown option/);
+  assert.deepEqual(outputPaths('d', null, ['matrix']), { page: 'd/report.html', json: 'd/report.json', csv: { matrix: 'd/report-matrix.csv' } });
+  assert.equal(outputPaths('d', 'out/x.html', []).json, 'out/x.json');
+});
