@@ -275,6 +275,7 @@ export class Replay {
 
   setMovieMode(on) {
     this.ui.classList.toggle('pdv-movie', on);
+    if (on) this.selectBody(-1);
     this.pause();
     this.resize();
   }
