@@ -10,6 +10,7 @@
 //   pdViewer.open(id)       opens a replay of a report; returns it
 //   pdViewer.setTime(t)     the main replay at time t, drawn before it returns
 //   pdViewer.loadMs         ms from navigation start to the main replay's first frame
+//   pdViewer.main.timings   ms: start (document parsed), decode (base64 → arrays), build (geometry, UI)
 import css from './style.css';
 import { readReplay } from './data.js';
 import { Replay } from './replay.js';
@@ -35,10 +36,13 @@ window.pdViewer = api;
 function open(id) {
   if (api.replays[id]) return api.replays[id];
   const section = document.getElementById(`pd-replay-${id}`);
+  const t0 = performance.now();
   const data = readReplay(id);
+  const t1 = performance.now();
   const holder = section.querySelector('.pdv-holder') || section;
   section.querySelector('.pdv-open')?.remove();
   const replay = new Replay(holder, data);
+  replay.timings = { start: t0, decode: t1 - t0, build: performance.now() - t1 };
   api.replays[id] = replay;
   opened.push(id);
   while (opened.length > MAX_OPEN) close(opened[0]);

@@ -246,8 +246,34 @@ export class Replay {
 
   // --- the animation loop
 
+  // While playing, the resolution follows the frame rate: below ~50 frames/s (a software renderer, a
+  // weak GPU) fewer pixels are drawn, down to a third of the device's; a paused frame is drawn in full.
+  adaptQuality(now) {
+    const gaps = this.gaps || (this.gaps = []);
+    if (!this.playing || this.movie) {
+      gaps.length = 0;
+      if (this.scene.quality !== 1) { this.scene.setQuality(1); this.dirty = true; }
+      return;
+    }
+    if (this.last != null) gaps.push(now - this.last);
+    if (gaps.length < 12) return;
+    gaps.sort((a, b) => a - b);
+    const typical = gaps[6];
+    gaps.length = 0;
+    const q = this.scene.quality;
+    // a level found too slow is not tried again (no back and forth between two resolutions)
+    if (typical > 20 && q > 0.34) {
+      this.ceiling = q;
+      // the pixels drawn go as quality²: aim at 60 frames/s in one step
+      this.scene.setQuality(Math.max(0.34, Math.min(0.85 * q, 0.9 * q * Math.sqrt(16.7 / typical))));
+    } else if (typical < 17.5 && q / 0.85 < (this.ceiling ?? 1.01)) {
+      this.scene.setQuality(Math.min(1, q / 0.85));
+    }
+  }
+
   frame(now) {
     this.raf = requestAnimationFrame(this.frame);
+    this.adaptQuality(now);
     if (this.playing) {
       const dt = this.last == null ? 0 : (now - this.last) / 1000;
       let t = this.t + dt * this.speed;
@@ -274,6 +300,8 @@ export class Replay {
   }
 
   setMovieMode(on) {
+    this.movie = on;
+    this.scene.setQuality(1);
     this.ui.classList.toggle('pdv-movie', on);
     if (on) this.selectBody(-1);
     this.pause();

@@ -212,7 +212,9 @@ export class SceneView {
     const bodies = runs[0].bodies;
     this.bodies = bodies;
     this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: false });
-    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+    this.basePixelRatio = Math.min(window.devicePixelRatio || 1, 2);
+    this.quality = 1;  // fraction of the base pixel ratio rendered (lowered while playing when frames are slow)
+    this.renderer.setPixelRatio(this.basePixelRatio);
     this.renderer.setClearColor(0x20242b);
     container.appendChild(this.renderer.domElement);
     this.canvas = this.renderer.domElement;
@@ -327,7 +329,16 @@ export class SceneView {
     this.follow = -1;
   }
 
+  // Renders at `quality` × the device's pixel ratio (fewer pixels when a software renderer is slow).
+  setQuality(quality) {
+    if (quality === this.quality) return;
+    this.quality = quality;
+    this.renderer.setPixelRatio(this.basePixelRatio * quality);
+    if (this.size) this.renderer.setSize(this.size[0], this.size[1], false);
+  }
+
   resize(width, height) {
+    this.size = [width, height];
     this.renderer.setSize(width, height, false);
     this.canvas.style.width = `${width}px`;
     this.canvas.style.height = `${height}px`;
