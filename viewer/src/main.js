@@ -7,7 +7,7 @@
 //   pdViewer.ready          Promise of the standalone replay, resolved after its first frame
 //   pdViewer.main           that Replay (see replay.js: setTime, play, pause, bodyMatrix, runs, ...)
 //   pdViewer.replays        every open Replay by id
-//   pdViewer.open(id)       opens a replay of a report; returns it
+//   pdViewer.open(id)       opens a replay of a report; a Promise of it
 //   pdViewer.setTime(t)     the main replay at time t, drawn before it returns
 //   pdViewer.loadMs         ms from navigation start to the main replay's first frame
 //   pdViewer.main.timings   ms: start (document parsed), decode (base64 → arrays), build (geometry, UI)
@@ -33,11 +33,17 @@ let resolveReady, rejectReady;
 api.ready = new Promise((res, rej) => { resolveReady = res; rejectReady = rej; });
 window.pdViewer = api;
 
+const pending = {};
 function open(id) {
-  if (api.replays[id]) return api.replays[id];
+  if (api.replays[id]) return Promise.resolve(api.replays[id]);
+  pending[id] ??= mount(id).finally(() => { delete pending[id]; });
+  return pending[id];
+}
+
+async function mount(id) {
   const section = document.getElementById(`pd-replay-${id}`);
   const t0 = performance.now();
-  const data = readReplay(id);
+  const data = await readReplay(id);
   const t1 = performance.now();
   const holder = section.querySelector('.pdv-holder') || section;
   section.querySelector('.pdv-open')?.remove();
@@ -66,7 +72,8 @@ function addOpenButton(section, id) {
   button.className = 'pdv-open';
   button.textContent = `▶ Open the 3-D replay (${r.bodies.length} bodies, ${r.samples} samples; ${engines})`;
   button.addEventListener('click', () => {
-    try { open(id); } catch (e) { showError(section, e); }
+    button.disabled = true;
+    open(id).catch((e) => showError(section, e));
   });
   section.append(button);
 }
@@ -91,17 +98,17 @@ function start() {
     if (section.dataset.standalone) {
       standalone = true;
       document.body.classList.add('pdv-standalone');
-      try {
-        api.main = open(id);
-        api.main.renderNow();
+      open(id).then((replay) => {
+        api.main = replay;
+        replay.renderNow();
         requestAnimationFrame(() => {
           api.loadMs = performance.now();
-          resolveReady(api.main);
+          resolveReady(replay);
         });
-      } catch (e) {
+      }).catch((e) => {
         showError(section, e);
         rejectReady(e);
-      }
+      });
     } else {
       addOpenButton(section, id);
     }

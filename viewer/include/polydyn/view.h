@@ -14,7 +14,7 @@
 // once, anywhere (the bundle mounts every replay element when the document has loaded). Replays in a
 // page with several of them open on a click, so a long report does not hold a WebGL context per replay.
 //
-// Data in the page: per run a JSON block (bodies, geometry, settings) and a base64 block of
+// Data in the page: per run a JSON block (bodies, geometry, settings) and a base64 block of zlib-compressed
 // little-endian arrays: sample times and poses as float64 (exact: what the page draws at a sample time
 // is the trajectory.csv value, to float32 GPU precision), velocities and contacts as float32.
 #pragma once
