@@ -5,8 +5,7 @@
 
 #include "polydyn/view.h"
 
-// Columns of the data block (all little-endian; each array starts at a multiple of 8 bytes). In the page
-// the block is zlib-compressed (RFC 1950), then base64.
+// Columns of the data block (all little-endian; each array starts at a multiple of 8 bytes).
 enum {
   PD_VIEW_POSE = 7,     // float64 per body per sample: x, y, z, qw, qx, qy, qz
   PD_VIEW_VEL = 6,      // float32 per body per sample: vx, vy, vz, wx, wy, wz

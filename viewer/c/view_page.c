@@ -6,7 +6,6 @@
 #include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include "view_internal.h"
 
@@ -102,36 +101,11 @@ static void base64_finish(base64Writer* w) {
   w->carried = 0;
 }
 
-// The data block goes through zlib (level 1: fast; float64 poses shrink to about 60 %, velocities and
-// contacts of bodies at rest much more), then base64: the page inflates it with DecompressionStream.
-typedef struct zlibWriter {
-  z_stream z;
-  base64Writer* out;
-  unsigned char buf[1 << 16];
-} zlibWriter;
-
-static void zlib_feed(zlibWriter* w, const void* data, size_t bytes, int flush) {
-  w->z.next_in = (Bytef*)data;
-  w->z.avail_in = (uInt)bytes;
-  do {
-    w->z.next_out = w->buf;
-    w->z.avail_out = sizeof w->buf;
-    int rc = deflate(&w->z, flush);
-    PD_ASSERT(rc != Z_STREAM_ERROR);
-    base64_write(w->out, w->buf, sizeof w->buf - w->z.avail_out);
-  } while (w->z.avail_out == 0);
-}
-
-// An array of the data block, padded to its layout size (multiples of 8 bytes), in pieces zlib can take.
-static void write_block(zlibWriter* w, const void* data, size_t bytes) {
+// An array of the data block, padded to its layout size (multiples of 8 bytes).
+static void write_block(base64Writer* w, const void* data, size_t bytes) {
   static const unsigned char zeros[8] = {0};
-  const unsigned char* p = data;
-  for (size_t done = 0; done < bytes;) {
-    size_t n = bytes - done < (1u << 30) ? bytes - done : (1u << 30);
-    zlib_feed(w, p + done, n, Z_NO_FLUSH);
-    done += n;
-  }
-  zlib_feed(w, zeros, (8 - bytes % 8) % 8, Z_NO_FLUSH);
+  base64_write(w, data, bytes);
+  base64_write(w, zeros, (8 - bytes % 8) % 8);
 }
 
 static void write_run_data(FILE* out, const pdViewRun* run) {
@@ -139,17 +113,11 @@ static void write_run_data(FILE* out, const pdViewRun* run) {
   const uint16_t one = 1;
   PD_ASSERT(*(const unsigned char*)&one == 1);
   pdViewLayout l = pd_view_layout(run);
-  base64Writer b = {.out = out};
-  zlibWriter* w = calloc(1, sizeof *w);
-  PD_ASSERT(w != NULL && deflateInit(&w->z, 1) == Z_OK);
-  w->out = &b;
+  base64Writer w = {.out = out};
   const void* arrays[PD_VIEW_BLOCKS] = {run->t, run->pose, run->vel, run->contactStart, run->contactFloat,
                                         run->contactInt};
-  for (int i = 0; i < PD_VIEW_BLOCKS; ++i) write_block(w, arrays[i], l.bytes[i]);
-  zlib_feed(w, NULL, 0, Z_FINISH);
-  deflateEnd(&w->z);
-  free(w);
-  base64_finish(&b);
+  for (int i = 0; i < PD_VIEW_BLOCKS; ++i) write_block(&w, arrays[i], l.bytes[i]);
+  base64_finish(&w);
 }
 
 static bool valid_id(const char* id) {

@@ -3,6 +3,7 @@
 // opened and played in headless Chromium. Appends one row to reports/viewer/scale.csv.
 //
 // usage: node viewer/scripts/scale.mjs POLYDYN_BINARY [--bodies N] [--tend T] [--repeats R] [--csv FILE]
+//                                      [--keep DIR]
 //
 // Measured: the time of polydyn view (reading the CSV, writing the page), the page's size, the load time
 // (navigation start → first frame drawn, pdViewer.loadMs; median of R fresh pages), and, while playing
@@ -21,12 +22,13 @@ const args = process.argv.slice(2);
 const option = (name, fallback) => { const i = args.indexOf(name); return i >= 0 ? args.splice(i, 2)[1] : fallback; };
 const bodies = Number(option('--bodies', 1000)), tend = Number(option('--tend', 10));
 const repeats = Number(option('--repeats', 3));
+const keep = option('--keep', null);  // a directory to keep the run and the page in
 const csv = resolve(option('--csv', join(root, 'reports/viewer/scale.csv')));
 const polydyn = resolve(args[0] ?? join(root, 'build/cli/polydyn'));
 const median = (xs) => [...xs].sort((a, b) => a - b)[Math.floor(xs.length / 2)];
 const pct = (xs, p) => [...xs].sort((a, b) => a - b)[Math.min(xs.length - 1, Math.floor(p * xs.length))];
 
-const scratch = mkdtempSync(join(tmpdir(), 'pd_viewer_scale.'));
+const scratch = keep ? resolve(keep) : mkdtempSync(join(tmpdir(), 'pd_viewer_scale.'));
 try {
   // N cubes 0.1 m on a grid 0.5 m apart, thrown up at 49 m/s (back down at 10 s), each spinning
   let scene = `tend ${tend}\nsample 100\n`;
@@ -97,5 +99,5 @@ try {
   appendFileSync(csv, `${Object.values(row).join(',')}\n`);
   console.log(row);
 } finally {
-  rmSync(scratch, { recursive: true, force: true });
+  if (!keep) rmSync(scratch, { recursive: true, force: true });
 }

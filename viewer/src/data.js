@@ -1,6 +1,5 @@
 // Run data of a replay element: the JSON block written by polydyn view and one base64 block per run
-// (zlib-compressed; layout in viewer/c/view_internal.h: float64 times and poses, float32 velocities and
-// contacts).
+// (layout in viewer/c/view_internal.h: float64 times and poses, float32 velocities and contacts).
 
 function decodeBase64(text) {
   if (typeof Uint8Array.fromBase64 === 'function') return Uint8Array.fromBase64(text.trim());
@@ -61,21 +60,16 @@ export class Run {
   }
 }
 
-async function inflate(bytes) {
-  const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
-  return new Uint8Array(await new Response(stream).arrayBuffer());
-}
-
 // Reads the runs of replay element `id` (section#pd-replay-ID).
-export async function readReplay(id) {
+export function readReplay(id) {
   const metaEl = document.getElementById(`pd-replay-${id}-meta`);
   if (!metaEl) throw new Error(`replay ${id}: no data block`);
   const meta = JSON.parse(metaEl.textContent);
-  const runs = await Promise.all(meta.runs.map(async (m, i) => {
+  const runs = meta.runs.map((m, i) => {
     const el = document.getElementById(`pd-replay-${id}-run-${i}`);
-    const bytes = await inflate(decodeBase64(el.textContent));
+    const bytes = decodeBase64(el.textContent);
     if (bytes.byteLength !== m.bytes) throw new Error(`replay ${id}, run ${i}: ${bytes.byteLength} bytes, expected ${m.bytes}`);
     return new Run(m, bytes);
-  }));
+  });
   return { title: meta.title, runs };
 }
