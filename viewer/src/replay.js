@@ -69,7 +69,8 @@ export class Replay {
     this.view.append(this.caption, this.legend);
     this.plotCanvas = el('canvas', { class: 'pdv-plot' });
     this.ui = el('div', { class: 'pdv' },
-      el('div', { class: 'pdv-top' }, el('span', { class: 'pdv-title' }, title), el('span', { class: 'pdv-runs' }, ...runToggles)),
+      el('div', { class: 'pdv-top' }, el('span', { class: 'pdv-title' }, title), el('span', { class: 'pdv-runs' }, ...runToggles),
+        el('span', { class: 'pdv-info' }, this.describe())),
       this.view,
       this.plotCanvas,
       el('div', { class: 'pdv-bar' },
@@ -131,6 +132,14 @@ export class Replay {
     this.last = null;
     this.frame = this.frame.bind(this);
     this.raf = requestAnimationFrame(this.frame);
+  }
+
+  // One line about what is replayed: bodies, time span, samples, contacts.
+  describe() {
+    const r = this.runs[0], fixed = r.bodies.filter((b) => b.fixed).length;
+    const rate = r.t.length > 1 ? Math.round((r.t.length - 1) / (r.t1 - r.t0)) : 0;
+    const contacts = r.hasContacts ? `${r.contacts.toLocaleString('en')} contact rows` : 'no contacts.csv';
+    return `${r.bodies.length} bodies (${fixed} fixed) · t = ${r.t0}…${r.t1} s · ${r.t.length} samples (${rate}/s) · ${contacts}`;
   }
 
   onKey(e) {

@@ -318,7 +318,7 @@ export class SceneView {
 
   fit() {
     const c = this.bounds.getCenter(new THREE.Vector3());
-    const d = 0.8 * this.sceneSize / (2 * Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2)));
+    const d = 0.65 * this.sceneSize / (2 * Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2)));
     const dir = new THREE.Vector3(0.55, -1, 0.55).normalize();
     this.camera.position.copy(c).addScaledVector(dir, d);
     this.camera.near = d / 1000;
