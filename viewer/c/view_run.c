@@ -115,6 +115,19 @@ static bool csv_number(csvReader* r, const char* field, double* value, pdError* 
   return true;
 }
 
+// Reads `count` number fields that follow `before` fields of a row of `total` fields.
+static bool csv_numbers(csvReader* r, double* out, int count, int before, int total, pdError* err) {
+  for (int c = 0; c < count; ++c) {
+    const char* field = csv_field(r);
+    if (!field) {
+      pd_error_set(err, r->path, r->lineNo, (int)strlen(r->line) + 1, "expected %d fields, found %d", total, before + c);
+      return false;
+    }
+    if (!csv_number(r, field, &out[c], err)) return false;
+  }
+  return true;
+}
+
 // Opens a CSV file and checks its header line.
 static bool csv_open(csvReader* r, const char* path, const char* header, pdError* err) {
   memset(r, 0, sizeof *r);
@@ -369,15 +382,7 @@ static bool read_trajectory(pdViewRun* run, pdError* err) {
     }
     size_t base = (size_t)(run->sampleCount - 1) * (size_t)m + (size_t)row;
     double values[13];
-    for (int c = 0; ok && c < 13; ++c) {
-      field = csv_field(&r);
-      if (!field) {
-        pd_error_set(err, path, r.lineNo, (int)strlen(r.line) + 1, "expected 15 fields, found %d", c + 2);
-        ok = false;
-      } else {
-        ok = csv_number(&r, field, &values[c], err);
-      }
-    }
+    ok = csv_numbers(&r, values, 13, 2, 15, err);
     if (ok && r.pos) {
       pd_error_set(err, path, r.lineNo, (int)(r.pos - r.line), "more than 15 fields");
       ok = false;
@@ -481,16 +486,7 @@ static bool read_contacts(pdViewRun* run, pdError* err) {
       break;
     }
     double v[12];  // feat_a, feat_b, p, n, fn, ft
-    for (int c = 0; ok && c < 12; ++c) {
-      field = csv_field(&r);
-      if (!field) {
-        pd_error_set(err, path, r.lineNo, (int)strlen(r.line) + 1, "expected 17 fields, found %d", c + 4);
-        ok = false;
-      } else {
-        ok = csv_number(&r, field, &v[c], err);
-      }
-    }
-    if (!ok) break;
+    if (!(ok = csv_numbers(&r, v, 12, 4, 17, err))) break;
     field = csv_field(&r);
     if (field && strcmp(field, "slip") == 0)
       flags |= PD_VIEW_SLIP;

@@ -77,6 +77,19 @@ export function interpolatePose(run, slot, k, a, p) {
   return p;
 }
 
+// Outward normal (not unit) of face f (vertex indices, counter-clockwise from outside) by Newell's
+// method, robust for any planar polygon; V: flat vertex coordinates.
+function faceNormal(V, f) {
+  let nx = 0, ny = 0, nz = 0;
+  for (let i = 0; i < f.length; ++i) {
+    const p = f[i] * 3, q = f[(i + 1) % f.length] * 3;
+    nx += (V[p + 1] - V[q + 1]) * (V[p + 2] + V[q + 2]);
+    ny += (V[p + 2] - V[q + 2]) * (V[p] + V[q]);
+    nz += (V[p] - V[q]) * (V[p + 1] + V[q + 1]);
+  }
+  return [nx, ny, nz];
+}
+
 // A float texture of 3×4 poses, one per body.
 class PoseTexture {
   constructor(bodyCount) {
@@ -116,14 +129,7 @@ function buildGeometry(bodies, colors) {
     const seen = new Set();
     const start = e;
     for (const f of b.faces) {
-      // face normal by Newell's method (robust for any planar polygon)
-      let nx = 0, ny = 0, nz = 0;
-      for (let i = 0; i < f.length; ++i) {
-        const p = f[i] * 3, q = f[(i + 1) % f.length] * 3;
-        nx += (V[p + 1] - V[q + 1]) * (V[p + 2] + V[q + 2]);
-        ny += (V[p + 2] - V[q + 2]) * (V[p] + V[q]);
-        nz += (V[p] - V[q]) * (V[p + 1] + V[q + 1]);
-      }
+      const [nx, ny, nz] = faceNormal(V, f);
       const nl = Math.hypot(nx, ny, nz) || 1;
       for (let i = 1; i + 1 < f.length; ++i) {
         for (const vi of [f[0], f[i], f[i + 1]]) {
@@ -417,14 +423,8 @@ export class SceneView {
       let t0 = 0, t1 = bestT;
       const V = b.vertices;
       for (const f of b.faces) {
-        // outward plane n·p = c of the face (Newell normal, any vertex)
-        let nx = 0, ny = 0, nz = 0;
-        for (let i = 0; i < f.length; ++i) {
-          const p = f[i] * 3, q = f[(i + 1) % f.length] * 3;
-          nx += (V[p + 1] - V[q + 1]) * (V[p + 2] + V[q + 2]);
-          ny += (V[p + 2] - V[q + 2]) * (V[p] + V[q]);
-          nz += (V[p] - V[q]) * (V[p + 1] + V[q + 1]);
-        }
+        // outward plane n·p = c of the face
+        const [nx, ny, nz] = faceNormal(V, f);
         const c = nx * V[f[0] * 3] + ny * V[f[0] * 3 + 1] + nz * V[f[0] * 3 + 2];
         const num = c - (nx * lo[0] + ny * lo[1] + nz * lo[2]), den = nx * ld[0] + ny * ld[1] + nz * ld[2];
         if (den === 0) { if (num < 0) { t0 = Infinity; break; } continue; }
