@@ -71,5 +71,9 @@ export function readReplay(id) {
     if (bytes.byteLength !== m.bytes) throw new Error(`replay ${id}, run ${i}: ${bytes.byteLength} bytes, expected ${m.bytes}`);
     return new Run(m, bytes);
   });
+  // runs of one engine are told apart by their directories
+  const engines = runs.map((r) => r.engine);
+  if (new Set(engines).size < engines.length)
+    runs.forEach((r) => { r.label = `${r.engine} (${r.dir.replace(/\/+$/, '').replace(/^.*\//, '')})`; });
   return { title: meta.title, runs };
 }

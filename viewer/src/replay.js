@@ -36,7 +36,7 @@ export class Replay {
     this.frameTimes = [];
 
     const sceneName = first.scene.replace(/^.*\//, '').replace(/\.scene$/, '');
-    const title = data.title || `${sceneName}: ${runs.map((r) => r.engine).join(', ')}`;
+    const title = data.title || `${sceneName}: ${runs.map((r) => r.label).join(' vs ')}`;
 
     // controls
     this.playButton = el('button', { class: 'pdv-play', title: 'play / pause (space)', onclick: () => this.toggle() }, '▶');
@@ -60,7 +60,7 @@ export class Replay {
       const swatch = el('span', { class: i ? 'pdv-swatch' : 'pdv-swatch pdv-swatch-scene' });
       if (i) swatch.style.background = KEY_COLORS[i % KEY_COLORS.length];
       const note = r.completed ? '' : ' (stopped early)';
-      return el('label', { class: 'pdv-runlabel', title: r.dir }, box, swatch, `${r.engine}${i ? ' (ghost)' : ''}${note}`);
+      return el('label', { class: 'pdv-runlabel', title: r.dir }, box, swatch, `${r.label}${i ? ', ghost' : ''}${note}`);
     });
 
     this.view = el('div', { class: 'pdv-view' });
