@@ -1,5 +1,6 @@
 // polydyn view — a self-contained HTML replay of run directories, and movies of it.
 #include <errno.h>
+#include <signal.h>
 #include <ftw.h>
 #include <spawn.h>
 #include <stdio.h>
@@ -34,7 +35,8 @@ static const char* const help =
     "viewer/dist/viewer.js (built by scripts/setup). Movies need node ($POLYDYN_NODE, default node on\n"
     "PATH), Chromium ($POLYDYN_CHROMIUM, default /usr/bin/chromium) and ffmpeg.\n"
     "\n"
-    "Exit status: 0 ok, 1 the movie could not be made, 2 bad input (arguments, run directories).\n";
+    "Exit status: 0 ok, 1 the movie could not be made, 2 bad input (arguments, run directories),\n"
+    "130 interrupted (nothing written).\n";
 
 enum { MAX_RUNS = 16 };
 
@@ -75,15 +77,31 @@ static int run_movie_script(const char* html, const char* mp4, const char* fps, 
   if (!node || !*node) node = "node";
   char* argv[] = {(char*)node, script, "--html", (char*)html, "--out", (char*)mp4, "--fps", (char*)fps,
                   "--speed", (char*)speed, NULL};
+  // Ctrl-C stops the child (it keeps the default action) while this process waits and then cleans up
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGINT);
+  sigaddset(&defaults, SIGTERM);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
+  struct sigaction ignore = {.sa_handler = SIG_IGN}, oldInt, oldTerm;
+  sigaction(SIGINT, &ignore, &oldInt);
+  sigaction(SIGTERM, &ignore, &oldTerm);
   pid_t pid;
-  int rc = posix_spawnp(&pid, node, NULL, NULL, argv, environ);
+  int rc = posix_spawnp(&pid, node, NULL, &attr, argv, environ);
+  posix_spawnattr_destroy(&attr);
+  int status = 0;
+  if (rc == 0)
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) continue;
+  sigaction(SIGINT, &oldInt, NULL);
+  sigaction(SIGTERM, &oldTerm, NULL);
   if (rc != 0) {
     fprintf(stderr, "polydyn view: cannot start %s: %s\n", node, strerror(rc));
     return -1;
   }
-  int status;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
@@ -110,7 +128,10 @@ static int make_movie(pdViewRun* const* runs, int count, const char* title, cons
     status = PD_EXIT_FAILURE;
   } else {
     int rc = run_movie_script(html, partial, fps, speed);
-    if (rc != 0) {
+    if (rc == 128 + SIGINT || rc == 128 + SIGTERM || rc == 130) {
+      fprintf(stderr, "polydyn view: interrupted; no movie written\n");
+      status = 130;
+    } else if (rc != 0) {
       fprintf(stderr, "polydyn view: the movie could not be made (%s/scripts/movie.mjs exited with %d)\n",
               pd_view_dir(), rc);
       status = PD_EXIT_FAILURE;

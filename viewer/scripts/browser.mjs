@@ -17,7 +17,7 @@ export const chromiumArgs = [
 
 export function haveChromium() { return existsSync(chromiumPath); }
 
-// Returns { browser, close } with a fresh profile directory that close() removes.
+// Returns { context, close }: a persistent context on a fresh profile directory that close() removes.
 export async function launch() {
   const profile = mkdtempSync(join(tmpdir(), 'polydyn-chromium-'));
   const context = await chromium.launchPersistentContext(profile, {
@@ -25,12 +25,21 @@ export async function launch() {
     headless: true,
     args: chromiumArgs,
     viewport: { width: 1280, height: 720 },
+    // the scripts handle Ctrl-C themselves (movie.mjs removes its unfinished output first)
+    handleSIGINT: false, handleSIGTERM: false, handleSIGHUP: false,
   });
   return {
     context,
     async close() {
-      await context.close();
-      rmSync(profile, { recursive: true, force: true });
+      let died = false;
+      await context.close().catch(() => { died = true; });
+      // a browser that died on its own (Ctrl-C reaches it too) may still write its profile while it
+      // goes: remove the profile again once it has had time to finish
+      rmSync(profile, { recursive: true, force: true, maxRetries: 20, retryDelay: 100 });
+      if (died) {
+        await new Promise((res) => setTimeout(res, 1500));
+        rmSync(profile, { recursive: true, force: true, maxRetries: 20, retryDelay: 100 });
+      }
     },
   };
 }

@@ -5,6 +5,7 @@
 // Frame k shows simulated time t0 + k·speed/fps, for k = 0 … N−1, N = ⌊(t1 − t0)·fps/speed⌋ + 1; the
 // movie lasts N/fps seconds. H.264 (libx264) when ffmpeg has it, else MPEG-4 part 2.
 import { spawn, spawnSync } from 'node:child_process';
+import { rmSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { launch } from './browser.mjs';
@@ -34,7 +35,24 @@ const codec = /\blibx264\b/.test(encoders.stdout)
   : ['-c:v', 'mpeg4', '-q:v', '3', '-pix_fmt', 'yuv420p'];
 
 const browser = await launch();
-let encoder = null;
+let encoder = null, encoderDone = null;
+
+// Stops ffmpeg, removes the unfinished movie and the browser's profile, exits with `code`. The first
+// call wins: on Ctrl-C the browser dies too, and the failed screenshot that follows is not the news.
+let abandoning = null;
+function abandon(code, message) {
+  abandoning ??= (async () => {
+    if (message) console.error(`movie: ${message.split('\n')[0]}`);
+    if (encoder && encoder.exitCode === null) encoder.kill('SIGKILL');
+    await encoderDone;
+    rmSync(opts.out, { force: true });
+    await browser.close().catch(() => {});
+    process.exit(code);
+  })();
+  return abandoning;
+}
+for (const signal of ['SIGINT', 'SIGTERM']) process.on(signal, () => abandon(130, 'interrupted'));
+
 try {
   const page = await browser.context.newPage();
   await page.setViewportSize({ width, height });
@@ -51,7 +69,7 @@ try {
   encoder = spawn(ffmpeg, ['-hide_banner', '-loglevel', 'error', '-y', '-f', 'image2pipe', '-c:v', 'mjpeg',
     '-framerate', String(fps), '-i', '-', ...codec, '-r', String(fps), '-movflags', '+faststart', '-f', 'mp4', opts.out],
   { stdio: ['pipe', 'inherit', 'inherit'] });
-  const done = new Promise((res) => encoder.on('close', res));
+  encoderDone = new Promise((res) => encoder.on('close', res));
   const tty = process.stderr.isTTY;
   for (let k = 0; k < frames; ++k) {
     const t = Math.min(t1, t0 + (k * speed) / fps);
@@ -62,13 +80,11 @@ try {
   }
   if (tty) process.stderr.write('\r\x1b[K');
   encoder.stdin.end();
-  const code = await done;
-  if (code !== 0) fail(`ffmpeg exited with ${code}`);
-  if (errors.length) fail(`the page reported: ${errors.join('; ')}`);
+  const code = await encoderDone;
+  if (code !== 0) await abandon(1, `ffmpeg exited with ${code}`);
+  if (errors.length) await abandon(1, `the page reported: ${errors.join('; ')}`);
   console.error(`movie: ${frames} frames at ${fps} fps (${(frames / fps).toFixed(3)} s), speed ${speed}×`);
 } catch (e) {
-  encoder?.kill();
-  fail(e.message);
-} finally {
-  await browser.close();
+  await abandon(1, e.message);
 }
+await browser.close();
