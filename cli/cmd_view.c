@@ -208,12 +208,15 @@ int pd_cmd_view(int argc, char** argv) {
   if (!title) title = defaultTitle;
   char* defaultPage = NULL;
   if (status == PD_EXIT_OK && !page && !movie) page = defaultPage = default_page(dirs[0]);
-  if (status == PD_EXIT_OK && page) {
-    if (!pd_view_write_page(page, title, runs, dirCount, &err)) {
-      pd_error_print(&err, stderr);
-      // a missing bundle or an unwritable file: a failure of this installation, not of the input
-      status = PD_EXIT_FAILURE;
-    }
+  if (status == PD_EXIT_OK && access(pd_view_bundle_path(), R_OK) != 0) {
+    // a failure of this installation, not of the input
+    fprintf(stderr, "polydyn view: the viewer bundle %s is missing; build it with scripts/setup\n",
+            pd_view_bundle_path());
+    status = PD_EXIT_FAILURE;
+  }
+  if (status == PD_EXIT_OK && page && !pd_view_write_page(page, title, runs, dirCount, &err)) {
+    pd_error_print(&err, stderr);  // -o names a file that cannot be written
+    status = PD_EXIT_BAD_INPUT;
   }
   if (status == PD_EXIT_OK && movie) status = make_movie(runs, dirCount, title, movie, fps, speed);
   for (int i = 0; i < loaded; ++i) pd_view_run_free(runs[i]);

@@ -30,6 +30,8 @@ if [ -f "$SRC/viewer/dist/viewer.js" ]; then
   check "the page loads nothing from elsewhere" '! grep -qiE "<script[^>]+src=|<link[^>]+href=" "$SCRATCH/good.html"'
   run_pd view "$RUN"
   check "the default page is DIR.html" '[ $rc -eq 0 ] && [ -s "$RUN.html" ]'
+  run_pd view "$RUN" -o "$SCRATCH/no/such/dir/page.html"
+  check "an unwritable -o exits 2" '[ $rc -eq 2 ] && grep -q "page.html: cannot write" "$SCRATCH/err"'
 else
   echo "SKIP: the viewer bundle is not built (scripts/setup); page checks skipped"
 fi
