@@ -23,6 +23,7 @@ static const char* const usage =
     "                 work-precision: error against wall time over tolerances and step sizes\n"
     "  report DIR [-o FILE]\n"
     "                 one self-contained HTML report (+ JSON, CSV) of a gedanken/sweep/compare DIR\n"
+    "  view DIR...    self-contained HTML replay of run directories (or --movie OUT.mp4)\n"
     "  help           this text\n"
     "  --version      print the version\n"
     "\n"
@@ -62,6 +63,7 @@ int main(int argc, char** argv) {
   if (strcmp(cmd, "compare") == 0) return pd_cmd_compare(argc - 1, argv + 1);
   if (strcmp(cmd, "sweep") == 0) return pd_cmd_sweep(argc - 1, argv + 1);
   if (strcmp(cmd, "report") == 0) return pd_cmd_report(argc - 1, argv + 1);
+  if (strcmp(cmd, "view") == 0) return pd_cmd_view(argc - 1, argv + 1);
   if (strcmp(cmd, "help") == 0 || pd_cli_is_help(cmd)) {
     fputs(usage, stdout);
     return PD_EXIT_OK;
