@@ -21,6 +21,8 @@ static const char* const usage =
     "                 run a scene in every engine, write DIR/metrics.csv against a tighter soft run\n"
     "  sweep SCENE --out DIR [--repeats R]\n"
     "                 work-precision: error against wall time over tolerances and step sizes\n"
+    "  cubetoss [fit] --data FILE.csv --out DIR [--engines soft,ode,bullet]\n"
+    "                 real cube tosses in every engine against the record; fit each engine's parameters\n"
     "  help           this text\n"
     "  --version      print the version\n"
     "\n"
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
   if (strcmp(cmd, "check") == 0) return pd_cmd_check(argc - 1, argv + 1);
   if (strcmp(cmd, "compare") == 0) return pd_cmd_compare(argc - 1, argv + 1);
   if (strcmp(cmd, "sweep") == 0) return pd_cmd_sweep(argc - 1, argv + 1);
+  if (strcmp(cmd, "cubetoss") == 0) return pd_cmd_cubetoss(argc - 1, argv + 1);
   if (strcmp(cmd, "help") == 0 || pd_cli_is_help(cmd)) {
     fputs(usage, stdout);
     return PD_EXIT_OK;
