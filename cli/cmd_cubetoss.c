@@ -783,7 +783,7 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   for (int e = 0; e < engineCount && written; ++e) {
     if (!specs[e].built) continue;
     snprintf(path, sizeof path, "%s/fitted-%s.scene", tmp, specs[e].name);
-    char comment[1024];
+    char comment[2048];
     const pdTossFitResult* f = &fits[e];
     snprintf(comment, sizeof comment,
              "polydyn cubetoss fit: %s engine, fitted on %d training tosses of %.300s (even positions%s)\n"
