@@ -524,6 +524,62 @@ static void print_table(const engineSpec* spec, const char* label, const pdTossR
   }
 }
 
+// The results of one parameter set over a list of tosses (a cubetoss run has one, fit two).
+typedef struct resultGroup {
+  const char* label;              // the params column
+  const tossJobResult* results;   // (count) one per toss, in toss order
+  const int* indices;             // (count) set indices of the tosses
+  int count;
+  bool runs;                      // run directories were kept
+} resultGroup;
+
+// One engine's results of a group as a column of pointers (malloc'd; free it).
+static const pdTossResult** engine_column(const resultGroup* g, int e) {
+  const pdTossResult** column = malloc((size_t)(g->count > 0 ? g->count : 1) * sizeof *column);
+  if (!column) abort();
+  for (int i = 0; i < g->count; ++i) column[i] = &g->results[i].engines[e];
+  return column;
+}
+
+// DIR/per_toss.csv (group, toss, engine order) and DIR/summary.csv; false (path says which) on an I/O error.
+static bool write_result_csvs(const char* dir, const pdTossSet* set, const engineSpec* specs, int engineCount,
+                              const resultGroup* groups, int groupCount, char* path, size_t pathSize) {
+  snprintf(path, pathSize, "%s/per_toss.csv", dir);
+  FILE* out = fopen(path, "w");
+  if (!out) return false;
+  per_toss_header(out);
+  for (int k = 0; k < groupCount; ++k) {
+    const resultGroup* g = &groups[k];
+    for (int i = 0; i < g->count; ++i)
+      for (int e = 0; e < engineCount; ++e)
+        per_toss_row(out, &set->tosses[g->indices[i]], g->indices[i], &specs[e], g->label, &g->results[i].engines[e],
+                     g->runs);
+  }
+  bool written = !ferror(out);
+  if (fclose(out) != 0 || !written) return false;
+  snprintf(path, pathSize, "%s/summary.csv", dir);
+  out = fopen(path, "w");
+  if (!out) return false;
+  summary_header(out);
+  for (int k = 0; k < groupCount; ++k)
+    for (int e = 0; e < engineCount; ++e) {
+      const pdTossResult** column = engine_column(&groups[k], e);
+      summary_rows(out, &specs[e], groups[k].label, column, groups[k].indices, groups[k].count);
+      free(column);
+    }
+  written = !ferror(out);
+  return fclose(out) == 0 && written;
+}
+
+static void print_tables(const engineSpec* specs, int engineCount, const resultGroup* groups, int groupCount) {
+  for (int k = 0; k < groupCount; ++k)
+    for (int e = 0; e < engineCount; ++e) {
+      const pdTossResult** column = engine_column(&groups[k], e);
+      print_table(&specs[e], groups[k].label, column, groups[k].indices, groups[k].count, k == 0 && e == 0);
+      free(column);
+    }
+}
+
 static bool write_params_file(const char* path, const pdTossParams* p, const char* comment) {
   FILE* out = fopen(path, "w");
   if (!out) return false;
@@ -587,33 +643,8 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   // per_toss.csv in toss order, summary.csv, the parameter fragments used
   int status = PD_EXIT_OK;
   char path[4400];
-  snprintf(path, sizeof path, "%s/per_toss.csv", tmp);
-  FILE* out = fopen(path, "w");
-  bool written = out != NULL;
-  if (out) {
-    per_toss_header(out);
-    for (int i = 0; i < count; ++i) {
-      const pdToss* toss = &set->tosses[indices[i]];
-      for (int e = 0; e < engineCount; ++e)
-        per_toss_row(out, toss, indices[i], &specs[e], o->label, &results[i].engines[e], o->runs);
-    }
-    written = !ferror(out) && written;
-    written = fclose(out) == 0 && written;
-  }
-  const pdTossResult** column = malloc((size_t)count * sizeof *column);
-  if (!column) abort();
-  snprintf(path, sizeof path, "%s/summary.csv", tmp);
-  out = written ? fopen(path, "w") : NULL;
-  written = out != NULL;
-  if (out) {
-    summary_header(out);
-    for (int e = 0; e < engineCount; ++e) {
-      for (int i = 0; i < count; ++i) column[i] = &results[i].engines[e];
-      summary_rows(out, &specs[e], o->label, column, indices, count);
-    }
-    written = !ferror(out) && written;
-    written = fclose(out) == 0 && written;
-  }
+  resultGroup group = {o->label, results, indices, count, o->runs};
+  bool written = write_result_csvs(tmp, set, specs, engineCount, &group, 1, path, sizeof path);
   for (int e = 0; e < engineCount && written; ++e) {
     snprintf(path, sizeof path, "%s/params-%s.scene", tmp, specs[e].name);
     char comment[512], inertia[64] = "that of a uniform cube";
@@ -645,13 +676,9 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   } else if (!close_out("cubetoss", tmp, o->out)) {
     status = PD_EXIT_FAILURE;
   } else {
-    for (int e = 0; e < engineCount; ++e) {
-      for (int i = 0; i < count; ++i) column[i] = &results[i].engines[e];
-      print_table(&specs[e], o->label, column, indices, count, e == 0);
-    }
+    print_tables(specs, engineCount, &group, 1);
     printf("per toss: %s/per_toss.csv; statistics: %s/summary.csv\n", o->out, o->out);
   }
-  free(column);
   free(results);
   return status;
 }
@@ -797,35 +824,9 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
              specs[e].name);
     written = write_params_file(path, &f->params, comment);
   }
-  const char* labels[2] = {"default", "fitted"};
-  if (o->label) labels[0] = o->label;
-  snprintf(path, sizeof path, "%s/per_toss.csv", tmp);
-  out = written ? fopen(path, "w") : NULL;
-  written = out != NULL;
-  if (out) {
-    per_toss_header(out);
-    for (int k = 0; k < 2; ++k)
-      for (int i = 0; i < testCount; ++i)
-        for (int e = 0; e < engineCount; ++e)
-          per_toss_row(out, &set->tosses[test[i]], test[i], &specs[e], labels[k], &results[k][i].engines[e], false);
-    written = !ferror(out) && written;
-    written = fclose(out) == 0 && written;
-  }
-  const pdTossResult** column = malloc((size_t)testCount * sizeof *column);
-  if (!column) abort();
-  snprintf(path, sizeof path, "%s/summary.csv", tmp);
-  out = written ? fopen(path, "w") : NULL;
-  written = out != NULL;
-  if (out) {
-    summary_header(out);
-    for (int k = 0; k < 2; ++k)
-      for (int e = 0; e < engineCount; ++e) {
-        for (int i = 0; i < testCount; ++i) column[i] = &results[k][i].engines[e];
-        summary_rows(out, &specs[e], labels[k], column, test, testCount);
-      }
-    written = !ferror(out) && written;
-    written = fclose(out) == 0 && written;
-  }
+  resultGroup groups[2] = {{o->label ? o->label : "default", results[0], test, testCount, false},
+                           {"fitted", results[1], test, testCount, false}};
+  written = written && write_result_csvs(tmp, set, specs, engineCount, groups, 2, path, sizeof path);
   int status = PD_EXIT_OK;
   if (!written) {
     fprintf(stderr, "polydyn cubetoss fit: cannot write %s: %s\n", path, strerror(errno));
@@ -840,14 +841,9 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
              specs[e].label, fits[e].params.mu, fits[e].params.restitution, fits[e].params.kn, trainCount,
              fits[e].startObjective, fits[e].objective, fits[e].evaluations, fits[e].converged ? ", converged" : "");
     }
-    for (int k = 0; k < 2; ++k)
-      for (int e = 0; e < engineCount; ++e) {
-        for (int i = 0; i < testCount; ++i) column[i] = &results[k][i].engines[e];
-        print_table(&specs[e], labels[k], column, test, testCount, k == 0 && e == 0);
-      }
+    print_tables(specs, engineCount, groups, 2);
     printf("fitted parameters: %s/fitted-ENGINE.scene; test tosses: %s/summary.csv\n", o->out, o->out);
   }
-  free(column);
   free(results[0]);
   free(results[1]);
   free(train);
