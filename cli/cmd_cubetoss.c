@@ -425,7 +425,7 @@ static void per_toss_row(FILE* out, const pdToss* toss, int index, const engineS
   } else {
     fputs(",,,", out);
   }
-  if (runs && s->built) fprintf(out, "runs/%ld/%s", toss->id, s->label);
+  if (runs && r->runWritten) fprintf(out, "runs/%ld/%s", toss->id, s->label);
   fputc(',', out);
   write_csv_text(out, r->message);
   fputc('\n', out);
@@ -518,6 +518,10 @@ static void print_table(const engineSpec* spec, const char* label, const pdTossR
     }
     char completed[24];
     snprintf(completed, sizeof completed, "%d/%d", s.completed, s.tosses);
+    if (s.completed == 0) {  // no numbers to show (and never a NaN)
+      printf("%-15s %-8s %-6s %9s  none completed\n", name, label, splits[k], completed);
+      continue;
+    }
     printf("%-15s %-8s %-6s %9s  med %5.3f p90 %5.3f  med %5.1f p90 %5.1f  med %5.3f p90 %5.3f %8.3f s %8.3f s\n",
            name, label, splits[k], completed, s.q[0].median, s.q[0].p90, s.q[2].median * deg, s.q[2].p90 * deg,
            s.q[1].median, s.q[1].p90, s.q[4].mean, s.q[5].mean);

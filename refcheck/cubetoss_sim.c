@@ -217,6 +217,8 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
       error_text(&err, text, sizeof text);
       fail(r, pd_tossFailed, "%s", text);
       ok = false;
+    } else {
+      r->runWritten = writer != NULL;
     }
     pd_state_free(state);
   } else {
@@ -225,6 +227,7 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
     r->cpuSeconds = cpu_now() - cpu0;
     r->wallSeconds = stats.wallSeconds;
     r->steps = stats.steps;
+    r->runWritten = ok && writer != NULL;  // pd_ref_run finishes the writer unless it returns false
     if (!ok) {
       error_text(&err, text, sizeof text);
       fail(r, stats.refused ? pd_tossRefused : pd_tossFailed, "%s", text);

@@ -44,6 +44,13 @@ for args in "--jobs 0" "--jobs x" "--tol 2" "--step -1" "--variant soft" "--iner
 done
 "$PD" cubetoss fit --data "$BAD" --out "$SCRATCH/x" --no-runs >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "fit --no-runs: exit 2" '[ $rc -eq 2 ] && grep -q "^polydyn cubetoss fit: " "$SCRATCH/err"'
+# a toss whose first pose is inside the board: refused, reported with the scene's line, no run directory, exit 1
+OVERLAP=$SCRATCH/overlap.csv
+printf 'toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n1,0.000000,0,0,0.01,1,0,0,0,0,0,0,0,0,0\n1,0.006757,0,0,0.01,1,0,0,0,0,0,0,0,0,0\n' >"$OVERLAP"
+"$PD" cubetoss --data "$OVERLAP" --out "$SCRATCH/ov" --engines soft >/dev/null 2>"$SCRATCH/err"; rc=$?
+check "a refused toss: exit 1, a row saying refused and why, no run directory named" \
+  '[ $rc -eq 1 ] && grep -q "^1,train,soft,adaptive,default,refused,2,[0-9.]*,,,,,,,,,toss 1:[0-9]*:1: bodies .board. and .cube. overlap" "$SCRATCH/ov/per_toss.csv" && [ ! -e "$SCRATCH/ov/runs/1/soft" ]'
+check "a refused toss: summary says failed, with no numbers" 'grep -q "^soft,adaptive,default,all,failed,1,0,pos_err_end,cube_widths,,,$" "$SCRATCH/ov/summary.csv"'
 "$PD" cubetoss --help | grep -q "per_toss.csv"; rc=$?; check "--help documents per_toss.csv" '[ $rc -eq 0 ]'
 "$PD" help | grep -q "cubetoss"; rc=$?; check "polydyn help lists cubetoss" '[ $rc -eq 0 ]'
 

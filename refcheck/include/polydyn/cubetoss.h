@@ -144,6 +144,7 @@ typedef struct pdTossResult {
   double cpuSeconds;              // CPU time of this process over the same span (a shared machine's wall
                                   // time counts other processes too)
   long steps;                     // accepted steps
+  bool runWritten;                // the run directory asked for was written (also for a run that failed)
   char message[640];              // why, unless ok
 } pdTossResult;
 
