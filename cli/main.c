@@ -24,6 +24,8 @@ static const char* const usage =
     "  report DIR [-o FILE]\n"
     "                 one self-contained HTML report (+ JSON, CSV) of a gedanken/sweep/compare DIR\n"
     "  view DIR...    self-contained HTML replay of run directories (or --movie OUT.mp4)\n"
+    "  cubetoss [fit] --data FILE.csv --out DIR [--engines soft,ode,bullet]\n"
+    "                 real cube tosses in every engine against the record; fit each engine's parameters\n"
     "  help           this text\n"
     "  --version      print the version\n"
     "\n"
@@ -64,6 +66,7 @@ int main(int argc, char** argv) {
   if (strcmp(cmd, "sweep") == 0) return pd_cmd_sweep(argc - 1, argv + 1);
   if (strcmp(cmd, "report") == 0) return pd_cmd_report(argc - 1, argv + 1);
   if (strcmp(cmd, "view") == 0) return pd_cmd_view(argc - 1, argv + 1);
+  if (strcmp(cmd, "cubetoss") == 0) return pd_cmd_cubetoss(argc - 1, argv + 1);
   if (strcmp(cmd, "help") == 0 || pd_cli_is_help(cmd)) {
     fputs(usage, stdout);
     return PD_EXIT_OK;

@@ -1,0 +1,908 @@
+// polydyn cubetoss — real cube tosses in every engine, and fitting each engine's free parameters to them
+// (DESIGN §5 "Real data"; the library part is refcheck/include/polydyn/cubetoss.h).
+#include <errno.h>
+#include <ftw.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "polydyn/cubetoss.h"
+
+// Longest --out path: the run directories' paths below it fit the fixed buffers.
+#define CUBETOSS_PATH_MAX 3000
+enum { ENGINES_MAX = 3, PARAM_FILES_MAX = 8 };
+// Fit defaults: evaluations of the objective (each one run of every training toss) and the simplex size
+// (scaled units: log10 μ, e, log10 k_n) below which a further step cannot matter against the noise of
+// the objective across tosses.
+#define FIT_DEFAULT_MAX_EVALUATIONS 100
+#define FIT_DEFAULT_SIZE_TOL 0.01
+#define DEFAULT_JOBS 2  // the machine's two cores (DESIGN: the tosses are independent)
+
+static const char* const help =
+    "usage: polydyn cubetoss --data FILE.csv --out DIR [--engines soft,ode,bullet] [--tosses LIST]\n"
+    "                        [--params [ENGINE=]FILE]... [--label WORD] [--variant native|matched] [--step H]\n"
+    "                        [--tol T] [--inertia I|uniform] [--jobs N] [--no-runs]\n"
+    "       polydyn cubetoss fit --data FILE.csv --out DIR [--engines ...] [--tosses LIST] [--train-every K]\n"
+    "                        [--max-evals N] [--size-tol S] [--params [ENGINE=]FILE]... [--variant ...] [--step H]\n"
+    "                        [--tol T] [--inertia I|uniform] [--jobs N]\n"
+    "\n"
+    "Simulates real cube tosses (CSV `toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz` at 148 Hz, e.g.\n"
+    "shared/data/cube-toss/tosses-train.csv from the ContactNets data set) from each toss's first sample to its\n"
+    "last, sampled at 148 Hz, and compares them with the record: position error in cube widths and rotation\n"
+    "angle error, at the end and RMS over the toss. Writes DIR/per_toss.csv (one row per toss and engine),\n"
+    "DIR/summary.csv (mean, median and 90th percentile per engine, for all, training and test tosses), the\n"
+    "parameter fragments used (DIR/params-ENGINE.scene) and, unless --no-runs, DIR/runs/TOSS/record/ (the\n"
+    "record as a run directory) beside DIR/runs/TOSS/ENGINE[-VARIANT]/, for replay.\n"
+    "\n"
+    "`fit` fits each engine's free parameters (mu, restitution, kn; kn not for the native reference engines)\n"
+    "on the training tosses (even positions in the file) with GSL's Nelder-Mead simplex, minimising the mean\n"
+    "end position error (cube widths) + the mean end rotation error (rad), and runs the test tosses (odd\n"
+    "positions) with the starting and the fitted parameters. Writes DIR/fitted-ENGINE.scene (read by\n"
+    "--params), DIR/fit.csv, DIR/fit_trace.csv (every evaluation), DIR/per_toss.csv and DIR/summary.csv.\n"
+    "\n"
+    "  --engines LIST   soft, ode, bullet (default: all three; one without an adapter is reported, skipped)\n"
+    "  --tosses LIST    all (default), train, test, or toss ids and ranges: 1-20,35\n"
+    "  --params [ENGINE=]FILE  mu/restitution/kn lines over the defaults (mu 0.18, restitution 0.1354,\n"
+    "                   kn 2.1e6 N/m on the cube and the board), for ENGINE or every engine; repeatable\n"
+    "  --label WORD     the params column of the CSVs (default: default, or params with --params)\n"
+    "  --variant V      of ode and bullet: native (default: their own contact) or matched (our k, c)\n"
+    "  --step H         the reference engines' step, s (default 1e-3)\n"
+    "  --tol T          the soft engine's integration tolerance (default 1e-6)\n"
+    "  --inertia I      the cube's moment of inertia, kg m^2 (default 8.1e-4, the data's), or uniform\n"
+    "  --jobs N         worker processes (default 2)\n"
+    "  --no-runs        keep no run directories (only the CSVs)\n"
+    "  --train-every K  fit on every K-th training toss (default 1: all)\n"
+    "  --max-evals N    objective evaluations per engine (default 100); --size-tol S simplex size (0.01)\n"
+    "\n"
+    "DIR is written under a temporary name and renamed when complete. Progress on stderr when a terminal.\n"
+    "Exit status: 0 ok, 1 a soft-engine run failed (or the work could not finish), 2 bad input, 130\n"
+    "interrupted (nothing written).\n";
+
+static volatile sig_atomic_t interrupted = 0;
+static void on_signal(int sig) {
+  (void)sig;
+  interrupted = 1;
+}
+
+static double wall_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+// ---------------------------------------------------------------- options
+
+typedef struct engineSpec {
+  const char* name;     // soft, ode, bullet
+  char label[24];       // soft, ode-native, ...: run directories, messages
+  const char* variant;  // adaptive, native, matched
+  pdTossEngine engine;
+  pdTossParams params;
+  const char* paramsFile;  // nullable
+  bool built;
+} engineSpec;
+
+typedef struct options {
+  bool fit;
+  const char* data;
+  const char* out;
+  const char* engines;
+  const char* tosses;
+  const char* label;
+  pdRefVariant variant;
+  double step;
+  double tol;
+  double inertia;
+  bool inertiaGiven;
+  int jobs;
+  bool runs;
+  int trainEvery;
+  int maxEvals;
+  double sizeTol;
+  const char* paramEngine[PARAM_FILES_MAX];  // "" = every engine
+  const char* paramFile[PARAM_FILES_MAX];
+  int paramCount;
+} options;
+
+static bool positive_int(const char* text, int* value) {
+  char* end = NULL;
+  errno = 0;
+  long v = strtol(text, &end, 10);
+  if (end == text || *end != '\0' || errno == ERANGE || v < 1 || v > 1000000) return false;
+  *value = (int)v;
+  return true;
+}
+
+static bool known_engine(const char* name, size_t len) {
+  static const char* const known[] = {"soft", "ode", "bullet"};
+  for (int i = 0; i < 3; ++i)
+    if (strlen(known[i]) == len && strncmp(name, known[i], len) == 0) return true;
+  return false;
+}
+
+static bool list_has(const char* list, const char* word) {
+  size_t n = strlen(word);
+  for (const char* p = list; p && *p;) {
+    const char* comma = strchr(p, ',');
+    size_t len = comma ? (size_t)(comma - p) : strlen(p);
+    if (len == n && strncmp(p, word, n) == 0) return true;
+    p = comma ? comma + 1 : NULL;
+  }
+  return false;
+}
+
+// Parses argv into o; returns -1 to go on, else an exit status (help printed, or a usage error).
+static int parse_options(int argc, char** argv, options* o) {
+  const char* cmd = o->fit ? "cubetoss fit" : "cubetoss";
+  for (int i = 1; i < argc; ++i) {
+    const char* a = argv[i];
+    if (pd_cli_is_help(a)) {
+      fputs(help, stdout);
+      return PD_EXIT_OK;
+    }
+    if (strcmp(a, "--no-runs") == 0) {
+      if (o->fit) return pd_cli_usage_error(cmd, "--no-runs is for polydyn cubetoss (fit keeps no runs)");
+      o->runs = false;
+      continue;
+    }
+    static const char* const valued[] = {"--data",   "--out",  "--engines",     "--tosses",    "--params",
+                                         "--label",  "--variant", "--step",     "--tol",       "--inertia",
+                                         "--jobs",   "--train-every", "--max-evals", "--size-tol", NULL};
+    int which = -1;
+    for (int k = 0; valued[k]; ++k)
+      if (strcmp(a, valued[k]) == 0) which = k;
+    if (which < 0) {
+      if (a[0] == '-') return pd_cli_usage_error(cmd, "unknown option '%s'", a);
+      return pd_cli_usage_error(cmd, "unexpected argument '%s'", a);
+    }
+    if (i + 1 >= argc) return pd_cli_usage_error(cmd, "%s needs a value", a);
+    const char* v = argv[++i];
+    if (which >= 11 && !o->fit) return pd_cli_usage_error(cmd, "%s is for polydyn cubetoss fit", a);
+    switch (which) {
+      case 0:
+      case 1:
+        if (!v[0]) return pd_cli_usage_error(cmd, "%s needs a file name", a);
+        if (which == 0) o->data = v;
+        else o->out = v;
+        break;
+      case 2:
+        for (const char* p = v; p;) {
+          const char* comma = strchr(p, ',');
+          size_t len = comma ? (size_t)(comma - p) : strlen(p);
+          if (!known_engine(p, len))
+            return pd_cli_usage_error(cmd, "--engines: unknown engine '%.*s' (soft, ode, bullet)", (int)(len < 40 ? len : 40), p);
+          p = comma ? comma + 1 : NULL;
+        }
+        o->engines = v;
+        break;
+      case 3:
+        if (!v[0]) return pd_cli_usage_error(cmd, "--tosses needs a list");
+        o->tosses = v;
+        break;
+      case 4: {
+        if (o->paramCount == PARAM_FILES_MAX) return pd_cli_usage_error(cmd, "at most %d --params", PARAM_FILES_MAX);
+        const char* eq = strchr(v, '=');
+        const char* engine = "";
+        if (eq && known_engine(v, (size_t)(eq - v))) {
+          engine = v;
+          v = eq + 1;
+        }
+        if (!v[0]) return pd_cli_usage_error(cmd, "--params needs a file name");
+        o->paramEngine[o->paramCount] = engine;
+        o->paramFile[o->paramCount++] = v;
+        break;
+      }
+      case 5:
+        if (!v[0] || strpbrk(v, ",\"\n\r ")) return pd_cli_usage_error(cmd, "--label needs one word (no comma, quote, space)");
+        o->label = v;
+        break;
+      case 6:
+        if (strcmp(v, "native") == 0) o->variant = pd_refNative;
+        else if (strcmp(v, "matched") == 0) o->variant = pd_refMatched;
+        else return pd_cli_usage_error(cmd, "--variant must be native or matched");
+        break;
+      case 7:
+        if (!pd_cli_positive(v, &o->step)) return pd_cli_usage_error(cmd, "--step needs a number > 0");
+        break;
+      case 8:
+        if (!pd_cli_positive(v, &o->tol) || o->tol >= 1.0) return pd_cli_usage_error(cmd, "--tol needs a number in (0, 1)");
+        break;
+      case 9:
+        o->inertiaGiven = true;
+        if (strcmp(v, "uniform") == 0) o->inertia = 0.0;
+        else if (!pd_cli_positive(v, &o->inertia)) return pd_cli_usage_error(cmd, "--inertia needs a number > 0 (kg m^2) or uniform");
+        break;
+      case 10:
+        if (!positive_int(v, &o->jobs) || o->jobs > 64) return pd_cli_usage_error(cmd, "--jobs needs an integer in 1..64");
+        break;
+      case 11:
+        if (!positive_int(v, &o->trainEvery)) return pd_cli_usage_error(cmd, "--train-every needs an integer >= 1");
+        break;
+      case 12:
+        if (!positive_int(v, &o->maxEvals)) return pd_cli_usage_error(cmd, "--max-evals needs an integer >= 1");
+        break;
+      case 13:
+        if (!pd_cli_positive(v, &o->sizeTol)) return pd_cli_usage_error(cmd, "--size-tol needs a number > 0");
+        break;
+    }
+  }
+  if (!o->data) return pd_cli_usage_error(cmd, "--data FILE.csv is required");
+  if (!o->out) return pd_cli_usage_error(cmd, "--out DIR is required");
+  if (strlen(o->out) > CUBETOSS_PATH_MAX) return pd_cli_usage_error(cmd, "--out: path longer than %d bytes", CUBETOSS_PATH_MAX);
+  for (int k = 0; k < o->paramCount; ++k) {
+    if (!o->paramEngine[k][0]) continue;
+    size_t len = (size_t)(strchr(o->paramEngine[k], '=') - o->paramEngine[k]);
+    char name[16];
+    snprintf(name, sizeof name, "%.*s", (int)len, o->paramEngine[k]);
+    if (!list_has(o->engines, name)) return pd_cli_usage_error(cmd, "--params %s=...: %s is not among --engines", name, name);
+  }
+  return -1;
+}
+
+// The engines of --engines in the fixed order soft, ode, bullet, with their parameters.
+static int make_engines(const options* o, engineSpec* specs, char* why, size_t whySize) {
+  static const char* const order[] = {"soft", "ode", "bullet"};
+  int n = 0;
+  for (int e = 0; e < 3; ++e) {
+    if (!list_has(o->engines, order[e])) continue;
+    engineSpec* s = &specs[n++];
+    memset(s, 0, sizeof *s);
+    s->name = order[e];
+    bool soft = e == 0;
+    s->variant = soft ? "adaptive" : o->variant == pd_refMatched ? "matched" : "native";
+    snprintf(s->label, sizeof s->label, soft ? "%s" : "%s-%s", s->name, s->variant);
+    s->engine = (pdTossEngine){.name = s->name, .ref = {o->variant, o->step, pd_odeFrictionPyramid}};
+    s->built = soft || pd_ref_adapter(s->name) != NULL;
+    s->params = pd_toss_default_params();
+    s->params.tol = o->tol;
+    if (o->inertiaGiven) s->params.inertia = o->inertia;
+    // files for every engine first, then the engine's own, each in the order given
+    for (int pass = 0; pass < 2; ++pass)
+      for (int k = 0; k < o->paramCount; ++k) {
+        const char* pe = o->paramEngine[k];
+        bool mine = pe[0] && strncmp(pe, s->name, strlen(s->name)) == 0 && pe[strlen(s->name)] == '=';
+        if ((pass == 0 && pe[0]) || (pass == 1 && !mine)) continue;
+        pdError err = {0};
+        if (!pd_toss_params_read(o->paramFile[k], &s->params, &err)) {
+          if (err.line > 0)
+            snprintf(why, whySize, "%.300s:%d:%d: %.400s", err.file, err.line, err.col, err.message);
+          else
+            snprintf(why, whySize, "%.300s: %.400s", err.file, err.message);
+          return -1;
+        }
+        s->paramsFile = o->paramFile[k];
+      }
+  }
+  return n;
+}
+
+// ---------------------------------------------------------------- output directory
+
+static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw) {
+  (void)st, (void)flag, (void)ftw;
+  return remove(path);
+}
+
+static void remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
+
+// Makes DIR.partial-PID; refuses a DIR that exists and is not one of ours (no `marker` file in it).
+static bool open_out(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize) {
+  struct stat st;
+  char path[4200];
+  snprintf(path, sizeof path, "%s/%s", out, marker);
+  if (stat(out, &st) == 0 && stat(path, &st) != 0) {
+    fprintf(stderr, "polydyn %s: %s exists and is not a %s directory (no %s); not replacing it\n", cmd, out, cmd, marker);
+    return false;
+  }
+  snprintf(tmp, tmpSize, "%s.partial-%ld", out, (long)getpid());
+  if (mkdir(tmp, 0777) != 0) {
+    fprintf(stderr, "polydyn %s: cannot create %s: %s\n", cmd, tmp, strerror(errno));
+    return false;
+  }
+  return true;
+}
+
+// Moves tmp into place as out (replacing a previous one); false on failure (tmp is then removed).
+static bool close_out(const char* cmd, const char* tmp, const char* out) {
+  struct stat st;
+  char old[4200];
+  snprintf(old, sizeof old, "%s.old-%ld", out, (long)getpid());
+  bool hadOld = stat(out, &st) == 0;
+  bool ok = (!hadOld || rename(out, old) == 0) && rename(tmp, out) == 0;
+  if (ok && hadOld) remove_tree(old);
+  if (!ok) {
+    fprintf(stderr, "polydyn %s: cannot write %s: %s\n", cmd, out, strerror(errno));
+    remove_tree(tmp);
+  }
+  return ok;
+}
+
+// ---------------------------------------------------------------- CSVs
+
+// One toss in every engine: the result of one job.
+typedef struct tossJobResult {
+  pdTossResult engines[ENGINES_MAX];
+  bool recordOk;
+  char recordMessage[256];
+} tossJobResult;
+
+typedef struct runContext {
+  const pdTossSet* set;
+  const int* tosses;
+  const engineSpec* specs;
+  int engineCount;
+  const char* runsDir;  // nullable: no run directories
+  const pdTossParams* overrideParams;  // nullable: every engine runs these (fit's test runs)
+} runContext;
+
+static void toss_job(int i, void* out, void* user) {
+  const runContext* c = user;
+  tossJobResult* r = out;
+  const pdToss* toss = &c->set->tosses[c->tosses[i]];
+  char dir[4400];
+  if (c->runsDir) {
+    snprintf(dir, sizeof dir, "%s/%ld", c->runsDir, toss->id);
+    mkdir(dir, 0777);
+    snprintf(dir, sizeof dir, "%s/%ld/record", c->runsDir, toss->id);
+    pdError err = {0};
+    r->recordOk = pd_toss_write_record(toss, &c->specs[0].params, dir, c->set->path, &err);
+    if (!r->recordOk) snprintf(r->recordMessage, sizeof r->recordMessage, "%.240s", err.message);
+  }
+  for (int e = 0; e < c->engineCount; ++e) {
+    const engineSpec* s = &c->specs[e];
+    const pdTossParams* p = c->overrideParams ? &c->overrideParams[e] : &s->params;
+    if (c->runsDir) snprintf(dir, sizeof dir, "%s/%ld/%s", c->runsDir, toss->id, s->label);
+    pdTrajectory* tr = pd_toss_simulate(toss, p, &s->engine, c->runsDir && s->built ? dir : NULL, &r->engines[e]);
+    pd_trajectory_free(tr);
+  }
+}
+
+typedef struct progressState {
+  const char* what;
+  bool terminal;
+  double start, lastPrint;
+  int evaluation;  // fit: evaluations seen (a new one starts at done == 0)
+  bool fitting;
+} progressState;
+
+static bool show_progress(int done, int total, void* user) {
+  progressState* p = user;
+  if (p->fitting && done == 0) ++p->evaluation;
+  if (p->terminal) {
+    double now = wall_now();
+    if (now - p->lastPrint > 0.2 || done == total) {
+      p->lastPrint = now;
+      if (p->fitting)
+        fprintf(stderr, "\rpolydyn cubetoss fit: %s, evaluation %d, toss %d/%d, %.0f s\033[K", p->what, p->evaluation,
+                done, total, now - p->start);
+      else
+        fprintf(stderr, "\rpolydyn cubetoss: %s %d/%d tosses, %.0f s\033[K", p->what, done, total, now - p->start);
+    }
+  }
+  return !interrupted;
+}
+
+static void write_number(FILE* out, double v) {
+  if (isfinite(v)) fprintf(out, "%.9g", v);
+}
+
+static void write_csv_text(FILE* out, const char* s) {
+  if (!strpbrk(s, ",\"\r\n")) {
+    fputs(s, out);
+    return;
+  }
+  fputc('"', out);
+  for (; *s; ++s) {
+    if (*s == '"') fputc('"', out);
+    fputc(*s, out);
+  }
+  fputc('"', out);
+}
+
+static void per_toss_header(FILE* out) {
+  fputs("toss,split,engine,variant,params,status,samples,duration_s,pos_err_end,pos_err_rms,rot_err_end_rad,"
+        "rot_err_rms_rad,wall_seconds,cpu_seconds,steps,run_dir,message\n",
+        out);
+}
+
+static void per_toss_row(FILE* out, const pdToss* toss, int index, const engineSpec* s, const char* label,
+                         const pdTossResult* r, bool runs) {
+  fprintf(out, "%ld,%s,%s,%s,%s,%s,%d,%.9g,", toss->id, pd_toss_split_name(pd_toss_split(index)), s->name, s->variant,
+          label, pd_toss_status_name(r->status), r->samples, (double)(toss->sampleCount - 1) / PD_TOSS_RATE);
+  const double values[] = {r->posErrEnd, r->posErrRms, r->rotErrEnd, r->rotErrRms};
+  for (int k = 0; k < 4; ++k) {
+    write_number(out, values[k]);
+    fputc(',', out);
+  }
+  if (r->status == pd_tossOk || r->status == pd_tossFailed) {
+    fprintf(out, "%.6g,%.6g,%ld,", r->wallSeconds, r->cpuSeconds, r->steps);
+  } else {
+    fputs(",,,", out);
+  }
+  if (runs && r->runWritten) fprintf(out, "runs/%ld/%s", toss->id, s->label);
+  fputc(',', out);
+  write_csv_text(out, r->message);
+  fputc('\n', out);
+}
+
+static void summary_header(FILE* out) {
+  fputs("engine,variant,params,split,status,tosses,completed,quantity,unit,mean,median,p90\n", out);
+}
+
+enum { QUANTITIES = 6 };
+static const char* const quantityNames[QUANTITIES] = {"pos_err_end", "pos_err_rms", "rot_err_end", "rot_err_rms",
+                                                      "wall_seconds", "cpu_seconds"};
+static const char* const quantityUnits[QUANTITIES] = {"cube_widths", "cube_widths", "rad", "rad", "s", "s"};
+
+static double quantity(const pdTossResult* r, int q) {
+  const double v[QUANTITIES] = {r->posErrEnd, r->posErrRms, r->rotErrEnd, r->rotErrRms,
+                                r->status == pd_tossOk ? r->wallSeconds : NAN,
+                                r->status == pd_tossOk ? r->cpuSeconds : NAN};
+  return v[q];
+}
+
+// Statistics of one engine over the tosses of one split ("all", "train", "test"); results[i] belongs to
+// toss position indices[i]. Writes nothing when the split has no toss.
+typedef struct splitStats {
+  int tosses, completed;
+  pdTossStats q[QUANTITIES];
+} splitStats;
+
+static splitStats split_stats(const pdTossResult* const* results, const int* indices, int count, const char* split) {
+  splitStats s = {0};
+  double* v = malloc((size_t)(count > 0 ? count : 1) * sizeof *v);
+  if (!v) abort();
+  for (int q = 0; q < QUANTITIES; ++q) {
+    int n = 0;
+    s.tosses = s.completed = 0;
+    for (int i = 0; i < count; ++i) {
+      if (strcmp(split, "all") != 0 && strcmp(pd_toss_split_name(pd_toss_split(indices[i])), split) != 0) continue;
+      ++s.tosses;
+      s.completed += results[i]->status == pd_tossOk;
+      v[n++] = quantity(results[i], q);
+    }
+    s.q[q] = pd_toss_stats(v, n);
+  }
+  free(v);
+  return s;
+}
+
+static const char* summary_status(const engineSpec* spec, const splitStats* s) {
+  if (!spec->built) return "not built";
+  if (s->completed == s->tosses) return "ok";
+  return s->completed == 0 ? "failed" : "partial";
+}
+
+static void summary_rows(FILE* out, const engineSpec* spec, const char* label, const pdTossResult* const* results,
+                         const int* indices, int count) {
+  static const char* const splits[] = {"all", "train", "test"};
+  for (int k = 0; k < 3; ++k) {
+    splitStats s = split_stats(results, indices, count, splits[k]);
+    if (s.tosses == 0) continue;
+    for (int q = 0; q < QUANTITIES; ++q) {
+      fprintf(out, "%s,%s,%s,%s,%s,%d,%d,%s,%s,", spec->name, spec->variant, label, splits[k], summary_status(spec, &s),
+              s.tosses, s.completed, quantityNames[q], quantityUnits[q]);
+      write_number(out, s.q[q].mean);
+      fputc(',', out);
+      write_number(out, s.q[q].median);
+      fputc(',', out);
+      write_number(out, s.q[q].p90);
+      fputc('\n', out);
+    }
+  }
+}
+
+// The table a person reads first: per engine and split, median and 90th percentile of the end errors.
+static void print_table(const engineSpec* spec, const char* label, const pdTossResult* const* results,
+                        const int* indices, int count, bool header) {
+  if (header)
+    printf("%-15s %-8s %-6s %9s  %-19s  %-19s  %-19s %10s %10s\n", "engine", "params", "split", "completed",
+           "pos end (widths)", "rot end (deg)", "pos rms (widths)", "wall/toss", "cpu/toss");
+  static const char* const splits[] = {"all", "train", "test"};
+  const double deg = 180.0 / 3.14159265358979323846;
+  char name[40];
+  snprintf(name, sizeof name, "%s%s%s", spec->name, strcmp(spec->name, "soft") ? "-" : "",
+           strcmp(spec->name, "soft") ? spec->variant : "");
+  for (int k = 0; k < 3; ++k) {
+    splitStats s = split_stats(results, indices, count, splits[k]);
+    if (s.tosses == 0) continue;
+    if (!spec->built) {
+      printf("%-15s %-8s %-6s %9s\n", name, label, splits[k], "not built");
+      return;
+    }
+    char completed[24];
+    snprintf(completed, sizeof completed, "%d/%d", s.completed, s.tosses);
+    if (s.completed == 0) {  // no numbers to show (and never a NaN)
+      printf("%-15s %-8s %-6s %9s  none completed\n", name, label, splits[k], completed);
+      continue;
+    }
+    printf("%-15s %-8s %-6s %9s  med %5.3f p90 %5.3f  med %5.1f p90 %5.1f  med %5.3f p90 %5.3f %8.3f s %8.3f s\n",
+           name, label, splits[k], completed, s.q[0].median, s.q[0].p90, s.q[2].median * deg, s.q[2].p90 * deg,
+           s.q[1].median, s.q[1].p90, s.q[4].mean, s.q[5].mean);
+  }
+}
+
+// The results of one parameter set over a list of tosses (a cubetoss run has one, fit two).
+typedef struct resultGroup {
+  const char* label;              // the params column
+  const tossJobResult* results;   // (count) one per toss, in toss order
+  const int* indices;             // (count) set indices of the tosses
+  int count;
+  bool runs;                      // run directories were kept
+} resultGroup;
+
+// One engine's results of a group as a column of pointers (malloc'd; free it).
+static const pdTossResult** engine_column(const resultGroup* g, int e) {
+  const pdTossResult** column = malloc((size_t)(g->count > 0 ? g->count : 1) * sizeof *column);
+  if (!column) abort();
+  for (int i = 0; i < g->count; ++i) column[i] = &g->results[i].engines[e];
+  return column;
+}
+
+// DIR/per_toss.csv (group, toss, engine order) and DIR/summary.csv; false (path says which) on an I/O error.
+static bool write_result_csvs(const char* dir, const pdTossSet* set, const engineSpec* specs, int engineCount,
+                              const resultGroup* groups, int groupCount, char* path, size_t pathSize) {
+  snprintf(path, pathSize, "%s/per_toss.csv", dir);
+  FILE* out = fopen(path, "w");
+  if (!out) return false;
+  per_toss_header(out);
+  for (int k = 0; k < groupCount; ++k) {
+    const resultGroup* g = &groups[k];
+    for (int i = 0; i < g->count; ++i)
+      for (int e = 0; e < engineCount; ++e)
+        per_toss_row(out, &set->tosses[g->indices[i]], g->indices[i], &specs[e], g->label, &g->results[i].engines[e],
+                     g->runs);
+  }
+  bool written = !ferror(out);
+  if (fclose(out) != 0 || !written) return false;
+  snprintf(path, pathSize, "%s/summary.csv", dir);
+  out = fopen(path, "w");
+  if (!out) return false;
+  summary_header(out);
+  for (int k = 0; k < groupCount; ++k)
+    for (int e = 0; e < engineCount; ++e) {
+      const pdTossResult** column = engine_column(&groups[k], e);
+      summary_rows(out, &specs[e], groups[k].label, column, groups[k].indices, groups[k].count);
+      free(column);
+    }
+  written = !ferror(out);
+  return fclose(out) == 0 && written;
+}
+
+static void print_tables(const engineSpec* specs, int engineCount, const resultGroup* groups, int groupCount) {
+  for (int k = 0; k < groupCount; ++k)
+    for (int e = 0; e < engineCount; ++e) {
+      const pdTossResult** column = engine_column(&groups[k], e);
+      print_table(&specs[e], groups[k].label, column, groups[k].indices, groups[k].count, k == 0 && e == 0);
+      free(column);
+    }
+}
+
+static bool write_params_file(const char* path, const pdTossParams* p, const char* comment) {
+  FILE* out = fopen(path, "w");
+  if (!out) return false;
+  pd_toss_params_write(out, p, comment);
+  bool ok = !ferror(out);
+  return fclose(out) == 0 && ok;
+}
+
+static void catch_signals(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+}
+
+// ---------------------------------------------------------------- polydyn cubetoss
+
+static int finish_interrupted(const char* cmd, const char* tmp) {
+  if (isatty(STDERR_FILENO) == 1) fputs("\r\033[K", stderr);
+  fprintf(stderr, "polydyn %s: interrupted; nothing written\n", cmd);
+  remove_tree(tmp);
+  return 130;
+}
+
+static int run_tosses(const options* o, const pdTossSet* set, const int* indices, int count, engineSpec* specs,
+                      int engineCount) {
+  char tmp[4200], runsDir[4300];
+  if (!open_out("cubetoss", o->out, "per_toss.csv", tmp, sizeof tmp)) return PD_EXIT_BAD_INPUT;
+  snprintf(runsDir, sizeof runsDir, "%s/runs", tmp);
+  if (o->runs && mkdir(runsDir, 0777) != 0) {
+    fprintf(stderr, "polydyn cubetoss: cannot create %s: %s\n", runsDir, strerror(errno));
+    remove_tree(tmp);
+    return PD_EXIT_FAILURE;
+  }
+  for (int e = 0; e < engineCount; ++e)
+    if (!specs[e].built)
+      fprintf(stderr, "polydyn cubetoss: %s: this build of polydyn has no %s adapter; reported as not built\n",
+              specs[e].label, specs[e].name);
+
+  tossJobResult* results = calloc((size_t)count, sizeof *results);
+  if (!results) abort();
+  runContext ctx = {set, indices, specs, engineCount, o->runs ? runsDir : NULL, NULL};
+  progressState progress = {.what = "", .terminal = isatty(STDERR_FILENO) == 1, .start = wall_now()};
+  char what[128] = "";
+  for (int e = 0; e < engineCount; ++e)
+    if (specs[e].built) snprintf(what + strlen(what), sizeof what - strlen(what), "%s%s", what[0] ? "," : "", specs[e].label);
+  progress.what = what;
+  char why[256] = "";
+  bool ok = pd_toss_parallel(count, o->jobs, sizeof *results, results, toss_job, &ctx, show_progress, &progress, why,
+                             sizeof why);
+  if (progress.terminal) fputs("\r\033[K", stderr);
+  if (!ok) {
+    free(results);
+    if (interrupted) return finish_interrupted("cubetoss", tmp);
+    fprintf(stderr, "polydyn cubetoss: %s\n", why);
+    remove_tree(tmp);
+    return PD_EXIT_FAILURE;
+  }
+
+  // per_toss.csv in toss order, summary.csv, the parameter fragments used
+  int status = PD_EXIT_OK;
+  char path[4400];
+  resultGroup group = {o->label, results, indices, count, o->runs};
+  bool written = write_result_csvs(tmp, set, specs, engineCount, &group, 1, path, sizeof path);
+  for (int e = 0; e < engineCount && written; ++e) {
+    snprintf(path, sizeof path, "%s/params-%s.scene", tmp, specs[e].name);
+    char comment[512], inertia[64] = "that of a uniform cube";
+    if (specs[e].params.inertia > 0.0) snprintf(inertia, sizeof inertia, "%g kg m^2", specs[e].params.inertia);
+    snprintf(comment, sizeof comment,
+             "polydyn cubetoss: parameters of the %s engine in this run (%.300s),\n"
+             "on the cube and the board; the cube's inertia %s about every axis, tol %g",
+             specs[e].label, specs[e].paramsFile ? specs[e].paramsFile : "defaults", inertia, specs[e].params.tol);
+    written = write_params_file(path, &specs[e].params, comment);
+  }
+  for (int i = 0; i < count; ++i) {
+    if (o->runs && !results[i].recordOk) {
+      fprintf(stderr, "polydyn cubetoss: toss %ld: the record's run directory: %s\n", set->tosses[indices[i]].id,
+              results[i].recordMessage);
+      status = PD_EXIT_FAILURE;
+    }
+    for (int e = 0; e < engineCount; ++e) {
+      const pdTossResult* r = &results[i].engines[e];
+      if (r->status == pd_tossOk || r->status == pd_tossNotBuilt) continue;
+      fprintf(stderr, "polydyn cubetoss: toss %ld, %s: %s: %s\n", set->tosses[indices[i]].id, specs[e].label,
+              pd_toss_status_name(r->status), r->message);
+      if (e == 0 && strcmp(specs[e].name, "soft") == 0) status = PD_EXIT_FAILURE;
+    }
+  }
+  if (!written) {
+    fprintf(stderr, "polydyn cubetoss: cannot write %s: %s\n", path, strerror(errno));
+    remove_tree(tmp);
+    status = PD_EXIT_FAILURE;
+  } else if (!close_out("cubetoss", tmp, o->out)) {
+    status = PD_EXIT_FAILURE;
+  } else {
+    print_tables(specs, engineCount, &group, 1);
+    printf("per toss: %s/per_toss.csv; statistics: %s/summary.csv\n", o->out, o->out);
+  }
+  free(results);
+  return status;
+}
+
+// ---------------------------------------------------------------- polydyn cubetoss fit
+
+static int fit_tosses(const options* o, const pdTossSet* set, const int* indices, int count, engineSpec* specs,
+                      int engineCount) {
+  // training: selected tosses at even positions, every K-th of them; test: selected ones at odd positions
+  int* train = malloc((size_t)count * sizeof *train);
+  int* test = malloc((size_t)count * sizeof *test);
+  if (!train || !test) abort();
+  int trainCount = 0, testCount = 0, seenTrain = 0;
+  for (int i = 0; i < count; ++i) {
+    if (pd_toss_split(indices[i]) == pd_tossTest) test[testCount++] = indices[i];
+    else if (seenTrain++ % o->trainEvery == 0) train[trainCount++] = indices[i];
+  }
+  if (trainCount == 0 || testCount == 0) {
+    free(train);
+    free(test);
+    return pd_cli_usage_error("cubetoss fit", "--tosses %s selects %d training and %d test tosses; both must be > 0",
+                              o->tosses, trainCount, testCount);
+  }
+  char tmp[4200];
+  if (!open_out("cubetoss fit", o->out, "fit.csv", tmp, sizeof tmp)) {
+    free(train);
+    free(test);
+    return PD_EXIT_BAD_INPUT;
+  }
+  char path[4400];
+  snprintf(path, sizeof path, "%s/fit_trace.csv", tmp);
+  FILE* trace = fopen(path, "w");
+  if (!trace) {
+    fprintf(stderr, "polydyn cubetoss fit: cannot write %s: %s\n", path, strerror(errno));
+    remove_tree(tmp);
+    free(train);
+    free(test);
+    return PD_EXIT_FAILURE;
+  }
+  pd_toss_fit_trace_header(trace);
+
+  pdTossFitResult fits[ENGINES_MAX] = {0};
+  pdTossParams fitted[ENGINES_MAX];
+  bool ok = true;
+  char why[256] = "";
+  progressState progress = {.terminal = isatty(STDERR_FILENO) == 1, .start = wall_now(), .fitting = true};
+  for (int e = 0; e < engineCount && ok; ++e) {
+    fitted[e] = specs[e].params;
+    if (!specs[e].built) {
+      fprintf(stderr, "polydyn cubetoss fit: %s: this build of polydyn has no %s adapter; not fitted\n", specs[e].label,
+              specs[e].name);
+      continue;
+    }
+    progress.what = specs[e].label;
+    progress.evaluation = 0;
+    pdTossFitOptions fo = {.set = set,
+                           .tosses = train,
+                           .tossCount = trainCount,
+                           .engine = specs[e].engine,
+                           .start = specs[e].params,
+                           .fitStiffness = strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched,
+                           .maxEvaluations = o->maxEvals,
+                           .sizeTol = o->sizeTol,
+                           .workers = o->jobs,
+                           .progress = show_progress,
+                           .progressUser = &progress,
+                           .trace = trace};
+    ok = pd_toss_fit(&fo, &fits[e], why, sizeof why);
+    if (ok) fitted[e] = fits[e].params;
+  }
+  bool traceOk = !ferror(trace);
+  traceOk = fclose(trace) == 0 && traceOk;
+
+  // the test tosses with the starting and with the fitted parameters
+  tossJobResult* results[2] = {calloc((size_t)testCount, sizeof(tossJobResult)),
+                               calloc((size_t)testCount, sizeof(tossJobResult))};
+  if (!results[0] || !results[1]) abort();
+  pdTossParams startParams[ENGINES_MAX];
+  for (int e = 0; e < engineCount; ++e) startParams[e] = specs[e].params;
+  const pdTossParams* sets[2] = {startParams, fitted};
+  progress.fitting = false;
+  for (int k = 0; k < 2 && ok; ++k) {
+    runContext ctx = {set, test, specs, engineCount, NULL, sets[k]};
+    progress.what = k == 0 ? "test tosses, starting parameters," : "test tosses, fitted parameters,";
+    ok = pd_toss_parallel(testCount, o->jobs, sizeof(tossJobResult), results[k], toss_job, &ctx, show_progress,
+                          &progress, why, sizeof why);
+  }
+  if (progress.terminal) fputs("\r\033[K", stderr);
+  if (!ok) {
+    free(results[0]);
+    free(results[1]);
+    free(train);
+    free(test);
+    if (interrupted) return finish_interrupted("cubetoss fit", tmp);
+    fprintf(stderr, "polydyn cubetoss fit: %s\n", why);
+    remove_tree(tmp);
+    return PD_EXIT_FAILURE;
+  }
+
+  // fit.csv, the fragments, per_toss.csv and summary.csv of the test tosses
+  bool written = traceOk;
+  snprintf(path, sizeof path, "%s/fit.csv", tmp);
+  FILE* out = written ? fopen(path, "w") : NULL;
+  written = out != NULL;
+  if (out) {
+    fputs("engine,variant,status,fitted,mu,restitution,kn,objective_train,pos_err_end_mean_train,"
+          "rot_err_end_mean_train_rad,failed_train,evaluations,converged,train_tosses,train_every,test_tosses,"
+          "start_mu,start_restitution,start_kn,start_objective_train\n",
+          out);
+    for (int e = 0; e < engineCount; ++e) {
+      const pdTossFitResult* f = &fits[e];
+      const pdTossParams* s = &specs[e].params;
+      bool stiff = strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched;
+      fprintf(out, "%s,%s,%s,%s,", specs[e].name, specs[e].variant, specs[e].built ? "ok" : "not built",
+              stiff ? "mu;restitution;kn" : "mu;restitution");
+      if (specs[e].built)
+        fprintf(out, "%.10g,%.10g,%.10g,%.9g,%.9g,%.9g,%d,%d,%s,", f->params.mu, f->params.restitution, f->params.kn,
+                f->objective, f->posErrEndMean, f->rotErrEndMean, f->failed, f->evaluations,
+                f->converged ? "true" : "false");
+      else
+        fputs(",,,,,,,,,", out);
+      fprintf(out, "%d,%d,%d,%.10g,%.10g,%.10g,", trainCount, o->trainEvery, testCount, s->mu, s->restitution, s->kn);
+      if (specs[e].built) fprintf(out, "%.9g", f->startObjective);
+      fputc('\n', out);
+    }
+    written = !ferror(out) && written;
+    written = fclose(out) == 0 && written;
+  }
+  for (int e = 0; e < engineCount && written; ++e) {
+    if (!specs[e].built) continue;
+    snprintf(path, sizeof path, "%s/fitted-%s.scene", tmp, specs[e].name);
+    char comment[2048];
+    const pdTossFitResult* f = &fits[e];
+    snprintf(comment, sizeof comment,
+             "polydyn cubetoss fit: %s engine, fitted on %d training tosses of %.300s (even positions%s)\n"
+             "objective (mean end position error in cube widths + mean end rotation error in rad): %.4g at the\n"
+             "start, %.4g fitted (%d evaluations, %s); %s\n"
+             "put these lines under the cube and the board of a scene, or: polydyn cubetoss --params %s=FILE",
+             specs[e].label, trainCount, set->path, o->trainEvery > 1 ? ", every K-th" : "", f->startObjective,
+             f->objective, f->evaluations, f->converged ? "converged" : "stopped at --max-evals",
+             strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched ? "mu, restitution, kn fitted"
+                                                                               : "mu, restitution fitted; kn as given",
+             specs[e].name);
+    written = write_params_file(path, &f->params, comment);
+  }
+  resultGroup groups[2] = {{o->label ? o->label : "default", results[0], test, testCount, false},
+                           {"fitted", results[1], test, testCount, false}};
+  written = written && write_result_csvs(tmp, set, specs, engineCount, groups, 2, path, sizeof path);
+  int status = PD_EXIT_OK;
+  if (!written) {
+    fprintf(stderr, "polydyn cubetoss fit: cannot write %s: %s\n", path, strerror(errno));
+    remove_tree(tmp);
+    status = PD_EXIT_FAILURE;
+  } else if (!close_out("cubetoss fit", tmp, o->out)) {
+    status = PD_EXIT_FAILURE;
+  } else {
+    for (int e = 0; e < engineCount; ++e) {
+      if (!specs[e].built) continue;
+      printf("%s: mu %.4g, restitution %.4g, kn %.4g N/m; objective on %d training tosses %.4g -> %.4g (%d evaluations%s)\n",
+             specs[e].label, fits[e].params.mu, fits[e].params.restitution, fits[e].params.kn, trainCount,
+             fits[e].startObjective, fits[e].objective, fits[e].evaluations, fits[e].converged ? ", converged" : "");
+    }
+    print_tables(specs, engineCount, groups, 2);
+    printf("fitted parameters: %s/fitted-ENGINE.scene; test tosses: %s/summary.csv\n", o->out, o->out);
+  }
+  free(results[0]);
+  free(results[1]);
+  free(train);
+  free(test);
+  return status;
+}
+
+// ---------------------------------------------------------------- entry
+
+int pd_cmd_cubetoss(int argc, char** argv) {
+  options o = {.engines = "soft,ode,bullet",
+               .tosses = "all",
+               .variant = pd_refNative,
+               .step = PD_REF_DEFAULT_STEP,
+               .tol = pd_toss_default_params().tol,
+               .jobs = DEFAULT_JOBS,
+               .runs = true,
+               .trainEvery = 1,
+               .maxEvals = FIT_DEFAULT_MAX_EVALUATIONS,
+               .sizeTol = FIT_DEFAULT_SIZE_TOL};
+  if (argc >= 2 && strcmp(argv[1], "fit") == 0) {
+    o.fit = true;
+    --argc;
+    ++argv;
+  }
+  const char* cmd = o.fit ? "cubetoss fit" : "cubetoss";
+  int parsed = parse_options(argc, argv, &o);
+  if (parsed >= 0) return parsed;
+  if (!o.label && !o.fit) o.label = o.paramCount > 0 ? "params" : "default";
+
+  pdError err = {0};
+  pdTossSet* set = pd_toss_read(o.data, &err);
+  if (!set) {
+    pd_error_print(&err, stderr);
+    return PD_EXIT_BAD_INPUT;
+  }
+  int* indices = NULL;
+  int count = 0;
+  char why[1024];
+  if (!pd_toss_select(set, o.tosses, &indices, &count, why, sizeof why)) {
+    pd_toss_set_free(set);
+    return pd_cli_usage_error(cmd, "--tosses: %s", why);
+  }
+  engineSpec specs[ENGINES_MAX];
+  int engineCount = make_engines(&o, specs, why, sizeof why);
+  if (engineCount < 0) {
+    fprintf(stderr, "%s\n", why);
+    free(indices);
+    pd_toss_set_free(set);
+    return PD_EXIT_BAD_INPUT;
+  }
+  catch_signals();
+  int status = o.fit ? fit_tosses(&o, set, indices, count, specs, engineCount)
+                     : run_tosses(&o, set, indices, count, specs, engineCount);
+  free(indices);
+  pd_toss_set_free(set);
+  return status;
+}

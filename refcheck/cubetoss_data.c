@@ -1,0 +1,262 @@
+// polydyn refcheck — reading the cube-toss CSV, the train/test split and toss lists (cubetoss.h).
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "polydyn/cubetoss.h"
+
+#define TOSS_HEADER "toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz"
+enum { TOSS_FIELDS = 15 };
+
+static void* grow(void* p, size_t count, size_t size) {
+  void* q = realloc(p, count * size);
+  if (!q) abort();
+  return q;
+}
+
+void pd_toss_set_free(pdTossSet* set) {
+  if (!set) return;
+  for (int i = 0; i < set->count; ++i) free(set->tosses[i].samples);
+  free(set->tosses);
+  free(set->path);
+  free(set);
+}
+
+// Splits `line` at commas into at most TOSS_FIELDS fields (in place); returns the number of fields and
+// each field's 1-based column.
+static int split_fields(char* line, char** fields, int* cols) {
+  int n = 0;
+  char* p = line;
+  for (;;) {
+    if (n < TOSS_FIELDS) {
+      fields[n] = p;
+      cols[n] = (int)(p - line) + 1;
+    }
+    ++n;
+    char* comma = strchr(p, ',');
+    if (!comma) break;
+    *comma = '\0';
+    p = comma + 1;
+  }
+  return n;
+}
+
+static bool parse_number(const char* text, double* v) {
+  char* end = NULL;
+  errno = 0;
+  *v = strtod(text, &end);
+  return end != text && *end == '\0' && errno != ERANGE && isfinite(*v);
+}
+
+static bool parse_id(const char* text, long* v) {
+  char* end = NULL;
+  errno = 0;
+  *v = strtol(text, &end, 10);
+  return end != text && *end == '\0' && errno != ERANGE;
+}
+
+pdTossSet* pd_toss_read(const char* path, pdError* err) {
+  FILE* in = fopen(path, "r");
+  if (!in) {
+    pd_error_set(err, path, 0, 0, "cannot read: %s", strerror(errno));
+    return NULL;
+  }
+  pdTossSet* set = calloc(1, sizeof *set);
+  if (!set) abort();
+  set->path = strdup(path);
+  if (!set->path) abort();
+  int capacity = 0, sampleCapacity = 0;
+  char* line = NULL;
+  size_t lineSize = 0;
+  long lineNo = 0;
+  bool ok = true;
+  pdToss* cur = NULL;
+  for (ssize_t len; ok && (len = getline(&line, &lineSize, in)) >= 0;) {
+    ++lineNo;
+    while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) line[--len] = '\0';
+    if ((size_t)len != strlen(line)) {
+      pd_error_set(err, path, (int)lineNo, (int)strlen(line) + 1, "not text (a NUL byte)");
+      ok = false;
+      break;
+    }
+    if (lineNo == 1) {
+      if (strcmp(line, TOSS_HEADER) != 0) {
+        pd_error_set(err, path, 1, 1, "header is not `" TOSS_HEADER "`");
+        ok = false;
+      }
+      continue;
+    }
+    if (len == 0) continue;  // a blank line (e.g. at the end) carries nothing
+    char* fields[TOSS_FIELDS];
+    int cols[TOSS_FIELDS];
+    int n = split_fields(line, fields, cols);
+    if (n != TOSS_FIELDS) {
+      pd_error_set(err, path, (int)lineNo, 1, "%d fields, expected %d (" TOSS_HEADER ")", n, TOSS_FIELDS);
+      ok = false;
+      break;
+    }
+    long id;
+    if (!parse_id(fields[0], &id)) {
+      pd_error_set(err, path, (int)lineNo, cols[0], "toss: not an integer: '%.40s'", fields[0]);
+      ok = false;
+      break;
+    }
+    double v[TOSS_FIELDS - 1];
+    for (int f = 1; f < TOSS_FIELDS && ok; ++f) {
+      if (!parse_number(fields[f], &v[f - 1])) {
+        pd_error_set(err, path, (int)lineNo, cols[f], "not a finite number: '%.40s'", fields[f]);
+        ok = false;
+      }
+    }
+    if (!ok) break;
+    // a new toss starts where the id changes; its id must not have been seen before
+    if (!cur || cur->id != id) {
+      for (int i = 0; i < set->count; ++i)
+        if (set->tosses[i].id == id) {
+          pd_error_set(err, path, (int)lineNo, cols[0], "toss %ld continues after other tosses (line %ld): its rows must be consecutive",
+                       id, set->tosses[i].line);
+          ok = false;
+        }
+      if (cur && cur->sampleCount < 2) {
+        pd_error_set(err, path, (int)cur->line, 1, "toss %ld has one row: a toss needs at least 2", cur->id);
+        ok = false;
+      }
+      if (!ok) break;
+      if (set->count == capacity) {
+        capacity = capacity ? 2 * capacity : 64;
+        set->tosses = grow(set->tosses, (size_t)capacity, sizeof *set->tosses);
+      }
+      cur = &set->tosses[set->count++];
+      *cur = (pdToss){.id = id, .line = lineNo};
+      sampleCapacity = 0;
+    }
+    int k = cur->sampleCount;
+    double expected = (double)k / PD_TOSS_RATE;
+    if (fabs(v[0] - expected) > PD_TOSS_TIME_TOL) {
+      pd_error_set(err, path, (int)lineNo, cols[1], "t = %.9g s, expected %.9g s (sample %d of toss %ld at %g Hz)", v[0],
+                   expected, k, id, PD_TOSS_RATE);
+      ok = false;
+      break;
+    }
+    pdQuat q = {v[4], v[5], v[6], v[7]};
+    double norm = sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+    if (fabs(norm - 1.0) > PD_TOSS_QUAT_NORM_TOL) {
+      pd_error_set(err, path, (int)lineNo, cols[5], "quaternion norm %.9g, expected 1", norm);
+      ok = false;
+      break;
+    }
+    if (k == sampleCapacity) {
+      sampleCapacity = sampleCapacity ? 2 * sampleCapacity : 128;
+      cur->samples = grow(cur->samples, (size_t)sampleCapacity, sizeof *cur->samples);
+    }
+    cur->samples[k] = (pdBodyState){.x = {v[1], v[2], v[3]},
+                                    .q = {q.w / norm, q.x / norm, q.y / norm, q.z / norm},
+                                    .v = {v[8], v[9], v[10]},
+                                    .w = {v[11], v[12], v[13]}};
+    ++cur->sampleCount;
+  }
+  if (ok && ferror(in)) {
+    pd_error_set(err, path, 0, 0, "read error");
+    ok = false;
+  }
+  if (ok && lineNo == 0) {
+    pd_error_set(err, path, 0, 0, "empty file (expected the header `" TOSS_HEADER "`)");
+    ok = false;
+  }
+  if (ok && set->count == 0) {
+    pd_error_set(err, path, 2, 1, "no tosses after the header");
+    ok = false;
+  }
+  if (ok && cur && cur->sampleCount < 2) {
+    pd_error_set(err, path, (int)cur->line, 1, "toss %ld has one row: a toss needs at least 2", cur->id);
+    ok = false;
+  }
+  free(line);
+  fclose(in);
+  if (!ok) {
+    pd_toss_set_free(set);
+    return NULL;
+  }
+  return set;
+}
+
+pdTossSplit pd_toss_split(int index) {
+  PD_ASSERT(index >= 0);
+  return index % 2 == 0 ? pd_tossTrain : pd_tossTest;
+}
+
+const char* pd_toss_split_name(pdTossSplit split) { return split == pd_tossTrain ? "train" : "test"; }
+
+bool pd_toss_select(const pdTossSet* set, const char* list, int** indices, int* count, char* why, size_t whySize) {
+  PD_ASSERT(set && list && indices && count);
+  bool* chosen = calloc((size_t)set->count, sizeof *chosen);
+  if (!chosen) abort();
+  bool ok = true;
+  if (strcmp(list, "all") == 0 || strcmp(list, "train") == 0 || strcmp(list, "test") == 0) {
+    for (int i = 0; i < set->count; ++i)
+      chosen[i] = list[0] == 'a' || (list[1] == 'r') == (pd_toss_split(i) == pd_tossTrain);
+  } else if (!list[0]) {
+    snprintf(why, whySize, "empty toss list");
+    ok = false;
+  } else {
+    for (const char* p = list; ok && p;) {
+      const char* comma = strchr(p, ',');
+      size_t len = comma ? (size_t)(comma - p) : strlen(p);
+      char word[64];
+      if (len == 0 || len >= sizeof word) {
+        snprintf(why, whySize, "bad toss list entry '%.*s'", (int)(len < 40 ? len : 40), p);
+        ok = false;
+        break;
+      }
+      memcpy(word, p, len);
+      word[len] = '\0';
+      // an id, or a range FIRST-LAST of ids (ids are non-negative in the data)
+      long first, last;
+      char* dash = strchr(word + 1, '-');
+      if (dash) *dash = '\0';
+      if (!parse_id(word, &first) || (dash && !parse_id(dash + 1, &last))) {
+        if (dash) *dash = '-';
+        snprintf(why, whySize, "bad toss list entry '%s' (expected an id or a range FIRST-LAST)", word);
+        ok = false;
+        break;
+      }
+      if (!dash) last = first;
+      if (last < first) {
+        snprintf(why, whySize, "empty toss range %ld-%ld", first, last);
+        ok = false;
+        break;
+      }
+      // a single id must be in the data; a range must hold at least one (ids need not be contiguous)
+      int hits = 0;
+      for (int i = 0; i < set->count; ++i)
+        if (set->tosses[i].id >= first && set->tosses[i].id <= last) chosen[i] = true, ++hits;
+      if (hits == 0) {
+        if (dash)
+          snprintf(why, whySize, "no toss of %s has an id in %ld-%ld", set->path, first, last);
+        else
+          snprintf(why, whySize, "toss %ld is not in %s", first, set->path);
+        ok = false;
+        break;
+      }
+      p = comma ? comma + 1 : NULL;
+    }
+  }
+  int n = 0;
+  for (int i = 0; i < set->count; ++i) n += chosen[i];
+  if (ok && n == 0) {
+    snprintf(why, whySize, "no toss selected by '%s'", list);
+    ok = false;
+  }
+  *indices = NULL;
+  *count = 0;
+  if (ok) {
+    *indices = malloc((size_t)n * sizeof **indices);
+    if (!*indices) abort();
+    for (int i = 0; i < set->count; ++i)
+      if (chosen[i]) (*indices)[(*count)++] = i;
+  }
+  free(chosen);
+  return ok;
+}

@@ -1,0 +1,491 @@
+// polydyn refcheck — one cube toss: its scene, its run in an engine, its errors against the record, the
+// record as a run directory, statistics and parameter fragments (conventions in cubetoss.h).
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "polydyn/cubetoss.h"
+#include "polydyn/output.h"
+#include "polydyn/scene.h"
+
+// Default stiffness of each side, N/m: eq. (11) for the cube, m vmax²/δ_max² with δ_max = 0.01 × side
+// (the engine's default deflection): 0.37 × 2.5² / (0.01 × 0.1048)² = 2.105e6, rounded.
+#define TOSS_DEFAULT_KN 2.1e6
+// The data's authors' friction coefficient for their own model (data README).
+#define TOSS_DEFAULT_MU 0.18
+#define TOSS_DEFAULT_TOL 1e-6
+
+static const double kPi = 3.14159265358979323846;
+
+static double wall_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double cpu_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+pdTossParams pd_toss_default_params(void) {
+  return (pdTossParams){.mu = TOSS_DEFAULT_MU,
+                        .restitution = PD_TOSS_RESTITUTION_MIN,
+                        .kn = TOSS_DEFAULT_KN,
+                        .tol = TOSS_DEFAULT_TOL,
+                        .inertia = PD_TOSS_CUBE_INERTIA};
+}
+
+const char* pd_toss_status_name(pdTossStatus status) {
+  switch (status) {
+    case pd_tossOk: return "ok";
+    case pd_tossFailed: return "failed";
+    case pd_tossRefused: return "refused";
+    case pd_tossNotBuilt: return "not built";
+  }
+  return "?";
+}
+
+// ---------------------------------------------------------------- the scene
+
+// Appends to a growing string (aborts when memory runs out, as the rest of the CLI).
+typedef struct textBuf {
+  char* s;
+  size_t len, cap;
+} textBuf;
+
+static void append(textBuf* b, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+static void append(textBuf* b, const char* fmt, ...) {
+  for (;;) {
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(b->s ? b->s + b->len : NULL, b->s ? b->cap - b->len : 0, fmt, ap);
+    va_end(ap);
+    PD_ASSERT(n >= 0);
+    if (b->s && b->len + (size_t)n < b->cap) {
+      b->len += (size_t)n;
+      return;
+    }
+    b->cap = 2 * (b->cap + (size_t)n) + 256;
+    b->s = realloc(b->s, b->cap);
+    if (!b->s) abort();
+  }
+}
+
+static void append_material(textBuf* b, const pdTossParams* p) {
+  append(b, "mu %.17g\nrestitution %.17g\nkn %.17g\n", p->mu, p->restitution, p->kn);
+}
+
+char* pd_toss_scene(const pdToss* toss, const pdTossParams* p) {
+  PD_ASSERT(toss && p && toss->sampleCount >= 2);
+  const pdBodyState* s0 = &toss->samples[0];
+  textBuf b = {0};
+  append(&b, "# polydyn cubetoss: toss %ld from its first sample (generated)\n", toss->id);
+  append(&b, "tend %.17g\nsample %.17g\ntol %.17g\nvmax %.17g\n", (double)(toss->sampleCount - 1) / PD_TOSS_RATE,
+         PD_TOSS_RATE, p->tol, PD_TOSS_VMAX);
+  append(&b, "cube board grey %.17g %.17g %.17g\nfixed\nloc 0 0 %.17g\n", PD_TOSS_BOARD_WIDTH, PD_TOSS_BOARD_WIDTH,
+         PD_TOSS_BOARD_THICKNESS, PD_TOSS_BOARD_TOP - 0.5 * PD_TOSS_BOARD_THICKNESS);
+  append_material(&b, p);
+  const double side = PD_TOSS_CUBE_SIDE;
+  append(&b, "cube cube red %.17g %.17g %.17g\nspgrav %.17g\n", side, side, side,
+         PD_TOSS_CUBE_MASS / (side * side * side) / 1000.0);
+  // orientation as an angle about a world axis: q = (cos θ/2, sin θ/2 u), θ ∈ [0, 2π] keeps q's sign
+  pdVec3 qv = {s0->q.x, s0->q.y, s0->q.z};
+  double qvNorm = pd_v3_norm(qv);
+  append(&b, "loc %.17g %.17g %.17g", s0->x.x, s0->x.y, s0->x.z);
+  if (qvNorm > 0.0) {
+    double angle = 2.0 * atan2(qvNorm, s0->q.w);
+    append(&b, " %.17g %.17g %.17g %.17g", angle * 180.0 / kPi, qv.x / qvNorm, qv.y / qvNorm, qv.z / qvNorm);
+  }
+  // angular velocity: `vel` takes a spin about an axis of the object's own frame, so ω_body = Rᵀ ω
+  append(&b, "\nvel %.17g %.17g %.17g", s0->v.x, s0->v.y, s0->v.z);
+  double spin = pd_v3_norm(s0->w);
+  if (spin > 0.0) {
+    pdMat3 r = pd_quat_to_mat3(s0->q);
+    pdVec3 axis = pd_v3_scale(pd_mat3_tmulv(&r, s0->w), 1.0 / spin);
+    append(&b, " %.17g %.17g %.17g %.17g", spin * 180.0 / kPi, axis.x, axis.y, axis.z);
+  }
+  append(&b, "\n");
+  append_material(&b, p);
+  return b.s;
+}
+
+pdModel* pd_toss_model(const pdToss* toss, const pdTossParams* p, pdError* err) {
+  PD_ASSERT(p->inertia >= 0.0);
+  char* text = pd_toss_scene(toss, p);
+  char name[64];
+  snprintf(name, sizeof name, "toss %ld", toss->id);
+  pdScene* scene = pd_scene_parse_buffer(name, text, strlen(text), err);
+  free(text);
+  if (!scene) return NULL;
+  pdModel* model = pd_model_compile(scene, err);
+  pd_scene_free(scene);
+  if (!model) return NULL;
+  PD_ASSERT(model->bodyCount == 2 && model->movingCount == 1 && !model->bodies[PD_TOSS_CUBE_BODY].fixed);
+  if (p->inertia > 0.0) {
+    // isotropic: the same moment about every axis, so any frame is principal
+    pdBody* cube = &model->bodies[PD_TOSS_CUBE_BODY];
+    double inv = 1.0 / p->inertia;
+    cube->inertia = (pdMat3){{{p->inertia, 0, 0}, {0, p->inertia, 0}, {0, 0, p->inertia}}};
+    cube->invInertia = (pdMat3){{{inv, 0, 0}, {0, inv, 0}, {0, 0, inv}}};
+    for (int i = 0; i < 3; ++i) cube->principal[i] = p->inertia;
+    cube->principalAxes = pd_mat3_identity();
+  }
+  return model;
+}
+
+// ---------------------------------------------------------------- running one toss
+
+typedef struct softObserver {
+  pdRunWriter* writer;  // nullable
+  pdTrajectory* trajectory;
+} softObserver;
+
+static bool observe_soft(const pdModel* model, const pdState* state, void* user) {
+  softObserver* o = user;
+  if (o->writer && !pd_run_observe(model, state, o->writer)) return false;
+  return pd_trajectory_observe(model, state, o->trajectory);
+}
+
+static void fail(pdTossResult* r, pdTossStatus status, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+static void fail(pdTossResult* r, pdTossStatus status, const char* fmt, ...) {
+  r->status = status;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(r->message, sizeof r->message, fmt, ap);
+  va_end(ap);
+}
+
+// `FILE:LINE:COL: message` into buf (the file name cut to 150 bytes, the message to 400: they fit)
+static void error_text(const pdError* err, char* buf, size_t size) {
+  if (err->line > 0)
+    snprintf(buf, size, "%.150s:%d:%d: %.400s", err->file, err->line, err->col, err->message);
+  else
+    snprintf(buf, size, "%.150s%s%.400s", err->file, err->file[0] ? ": " : "", err->message);
+}
+
+static void clear_errors(pdTossResult* r) { r->posErrEnd = r->posErrRms = r->rotErrEnd = r->rotErrRms = NAN; }
+
+pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, const pdTossEngine* engine,
+                               const char* runDir, pdTossResult* r) {
+  PD_ASSERT(toss && params && engine && engine->name && r);
+  memset(r, 0, sizeof *r);
+  clear_errors(r);
+  r->samples = toss->sampleCount;
+  bool soft = strcmp(engine->name, "soft") == 0;
+  const pdRefAdapter* adapter = soft ? NULL : pd_ref_adapter(engine->name);
+  if (!soft && !adapter) {
+    fail(r, pd_tossNotBuilt, "this build of polydyn has no %s adapter", engine->name);
+    return NULL;
+  }
+  pdError err = {0};
+  char text[sizeof r->message];
+  pdModel* model = pd_toss_model(toss, params, &err);
+  if (!model) {
+    error_text(&err, text, sizeof text);
+    fail(r, pd_tossRefused, "%s", text);
+    return NULL;
+  }
+  pdRunWriter* writer = NULL;
+  if (runDir && !(writer = pd_run_open(runDir, &err))) {
+    error_text(&err, text, sizeof text);
+    fail(r, pd_tossFailed, "%s", text);
+    pd_model_free(model);
+    return NULL;
+  }
+  pdTrajectory* trajectory = pd_trajectory_create(model);
+  bool ok;
+  double cpu0 = cpu_now();
+  if (soft) {
+    pdState* state = pd_state_create(model);
+    softObserver o = {writer, trajectory};
+    double e0 = pd_state_energy(model, state), t0 = wall_now();
+    bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
+    r->wallSeconds = wall_now() - t0;
+    r->cpuSeconds = cpu_now() - cpu0;
+    r->steps = state->count.accepted;
+    pdRunInfo info = {.engine = "polydyn-soft", .energyStart = e0, .energyEnd = pd_state_energy(model, state),
+                      .wallSeconds = r->wallSeconds, .completed = completed};
+    ok = completed;
+    if (!completed) fail(r, pd_tossFailed, "the soft engine stopped at t = %.6g s", state->t);
+    if (writer && !pd_run_finish(writer, model, state, &info, &err)) {
+      error_text(&err, text, sizeof text);
+      fail(r, pd_tossFailed, "%s", text);
+      ok = false;
+    } else {
+      r->runWritten = writer != NULL;
+    }
+    pd_state_free(state);
+  } else {
+    pdRefRunStats stats;
+    ok = pd_ref_run(model, adapter, &engine->ref, writer, pd_trajectory_observe, trajectory, &stats, &err);
+    r->cpuSeconds = cpu_now() - cpu0;
+    r->wallSeconds = stats.wallSeconds;
+    r->steps = stats.steps;
+    r->runWritten = ok && writer != NULL;  // pd_ref_run finishes the writer unless it returns false
+    if (!ok) {
+      error_text(&err, text, sizeof text);
+      fail(r, stats.refused ? pd_tossRefused : pd_tossFailed, "%s", text);
+    } else if (!stats.completed) {
+      fail(r, pd_tossFailed, "%s: non-finite state after %ld steps", engine->name, stats.steps);
+      ok = false;
+    }
+  }
+  pd_model_free(model);
+  if (ok) pd_toss_judge(toss, trajectory, r);
+  if (r->status != pd_tossOk) {
+    clear_errors(r);
+    pd_trajectory_free(trajectory);
+    return NULL;
+  }
+  return trajectory;
+}
+
+// Angle of q_ref⁻¹ q, rad in [0, π]; atan2 of the vector part keeps small angles exact.
+static double rotation_angle(pdQuat q, pdQuat ref) {
+  pdQuat d = pd_quat_mul((pdQuat){ref.w, -ref.x, -ref.y, -ref.z}, q);
+  return 2.0 * atan2(sqrt(d.x * d.x + d.y * d.y + d.z * d.z), fabs(d.w));
+}
+
+// Sample times of a run may differ from k/148 by round-off only (both are computed as k/rate), s.
+#define TOSS_SAMPLE_TIME_TOL 1e-9
+
+void pd_toss_judge(const pdToss* toss, const pdTrajectory* run, pdTossResult* r) {
+  PD_ASSERT(toss && run && r && run->movingCount == 1);
+  clear_errors(r);
+  r->samples = toss->sampleCount;
+  if (run->samples < toss->sampleCount) {
+    fail(r, pd_tossFailed, "the run has %ld samples, the record %d", run->samples, toss->sampleCount);
+    return;
+  }
+  double pos2 = 0.0, rot2 = 0.0, pos = 0.0, rot = 0.0;
+  for (int k = 0; k < toss->sampleCount; ++k) {
+    if (fabs(run->t[k] - (double)k / PD_TOSS_RATE) > TOSS_SAMPLE_TIME_TOL) {
+      fail(r, pd_tossFailed, "sample %d of the run is at t = %.9g s, not %.9g s", k, run->t[k], (double)k / PD_TOSS_RATE);
+      return;
+    }
+    const pdBodyState *sim = &run->bodies[k], *rec = &toss->samples[k];
+    pos = pd_v3_norm(pd_v3_sub(sim->x, rec->x)) / PD_TOSS_CUBE_SIDE;
+    rot = rotation_angle(sim->q, rec->q);
+    if (!isfinite(pos) || !isfinite(rot)) {
+      fail(r, pd_tossFailed, "non-finite pose at sample %d", k);
+      return;
+    }
+    pos2 += pos * pos;
+    rot2 += rot * rot;
+  }
+  r->status = pd_tossOk;
+  r->message[0] = '\0';
+  r->posErrEnd = pos;
+  r->rotErrEnd = rot;
+  r->posErrRms = sqrt(pos2 / toss->sampleCount);
+  r->rotErrRms = sqrt(rot2 / toss->sampleCount);
+}
+
+// ---------------------------------------------------------------- the record as a run directory
+
+static void write_json_text(FILE* out, const char* s) {
+  fputc('"', out);
+  for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
+    if (*p == '"' || *p == '\\') fputc('\\', out);
+    if (*p < 0x20) fprintf(out, "\\u%04x", *p);
+    else fputc(*p, out);
+  }
+  fputc('"', out);
+}
+
+bool pd_toss_write_record(const pdToss* toss, const pdTossParams* params, const char* dir, const char* dataPath,
+                          pdError* err) {
+  pdModel* model = pd_toss_model(toss, params, err);
+  if (!model) return false;
+  pdRunWriter* writer = pd_run_open(dir, err);
+  if (!writer) {
+    pd_model_free(model);
+    return false;
+  }
+  pdState* state = pd_state_create(model);
+  double energyStart = 0.0;
+  bool ok = true;
+  for (int k = 0; k < toss->sampleCount && ok; ++k) {
+    const pdBodyState* b = &toss->samples[k];
+    const double y[PD_BODY_STATE_SIZE] = {b->v.x, b->v.y, b->v.z, b->w.x, b->w.y, b->w.z, b->x.x,
+                                          b->x.y, b->x.z, b->q.w, b->q.x, b->q.y, b->q.z};
+    memcpy(state->y, y, sizeof y);  // the cube is the only moving body: the first 13 numbers (state.h)
+    state->t = (double)k / PD_TOSS_RATE;
+    ++state->count.samples;
+    if (k == 0) energyStart = pd_state_energy(model, state);
+    ok = pd_run_observe(model, state, writer);
+  }
+  char* settings = NULL;
+  size_t settingsSize = 0;
+  FILE* mem = open_memstream(&settings, &settingsSize);
+  if (!mem) abort();
+  fputs("{\"source\": ", mem);
+  write_json_text(mem, dataPath ? dataPath : "");
+  fprintf(mem, ", \"toss\": %ld, \"first_line\": %ld, \"rate_hz\": %.17g, \"quaternions\": \"normalised on reading\"}",
+          toss->id, toss->line, PD_TOSS_RATE);
+  fclose(mem);
+  pdRunInfo info = {.engine = "record",
+                    .energyStart = energyStart,
+                    .energyEnd = pd_state_energy(model, state),
+                    .completed = true,
+                    .stepper = "record",
+                    .engineSettingsJson = settings};
+  if (ok) {
+    ok = pd_run_finish(writer, model, state, &info, err);
+  } else {
+    pd_error_set(err, dir, 0, 0, "cannot write trajectory.csv");
+    pd_run_abort(writer);
+  }
+  free(settings);
+  pd_state_free(state);
+  pd_model_free(model);
+  return ok;
+}
+
+// ---------------------------------------------------------------- statistics
+
+static int compare_doubles(const void* a, const void* b) {
+  double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+// Type-7 percentile of sorted x[0..n), p in [0, 1].
+static double percentile(const double* x, int n, double p) {
+  double h = p * (double)(n - 1);
+  int lo = (int)floor(h);
+  if (lo >= n - 1) return x[n - 1];
+  return x[lo] + (h - (double)lo) * (x[lo + 1] - x[lo]);
+}
+
+pdTossStats pd_toss_stats(const double* v, int count) {
+  PD_ASSERT(count >= 0 && (v || count == 0));
+  double* x = malloc((size_t)(count > 0 ? count : 1) * sizeof *x);
+  if (!x) abort();
+  int n = 0;
+  double sum = 0.0;
+  for (int i = 0; i < count; ++i)
+    if (isfinite(v[i])) {
+      x[n++] = v[i];
+      sum += v[i];
+    }
+  pdTossStats s = {n, NAN, NAN, NAN};
+  if (n > 0) {
+    qsort(x, (size_t)n, sizeof *x, compare_doubles);
+    s.mean = sum / n;
+    s.median = percentile(x, n, 0.5);
+    s.p90 = percentile(x, n, 0.9);
+  }
+  free(x);
+  return s;
+}
+
+// ---------------------------------------------------------------- parameter fragments
+
+// A fragment is at most this long: three numbers and comments.
+#define TOSS_FRAGMENT_MAX_BYTES 65536
+#define TOSS_FRAGMENT_PREFIX "cube fragment none 1 1 1\n"
+
+static const char* const fragmentKeys[] = {"mu", "restitution", "kn"};
+enum { FRAGMENT_KEYS = 3 };
+
+bool pd_toss_params_read(const char* path, pdTossParams* params, pdError* err) {
+  FILE* in = fopen(path, "rb");
+  if (!in) {
+    pd_error_set(err, path, 0, 0, "cannot read: %s", strerror(errno));
+    return false;
+  }
+  const size_t prefixLen = strlen(TOSS_FRAGMENT_PREFIX);
+  char* text = malloc(prefixLen + TOSS_FRAGMENT_MAX_BYTES + 2);
+  if (!text) abort();
+  memcpy(text, TOSS_FRAGMENT_PREFIX, prefixLen);
+  size_t n = fread(text + prefixLen, 1, TOSS_FRAGMENT_MAX_BYTES + 1, in);
+  bool readError = ferror(in);
+  fclose(in);
+  if (readError || n > TOSS_FRAGMENT_MAX_BYTES) {
+    pd_error_set(err, path, 0, 0, readError ? "read error" : "longer than %d bytes: not a parameter fragment",
+                 TOSS_FRAGMENT_MAX_BYTES);
+    free(text);
+    return false;
+  }
+  text[prefixLen + n] = '\0';
+  // which commands appear, line by line (the scene parser checks values, ranges and arity after this)
+  int keyLine[FRAGMENT_KEYS] = {0}, keyCol[FRAGMENT_KEYS] = {0};
+  int line = 1;
+  for (const char* p = text + prefixLen; *p; ++line) {
+    const char* end = strchr(p, '\n');
+    size_t len = end ? (size_t)(end - p) : strlen(p);
+    size_t i = 0;
+    while (i < len && (p[i] == ' ' || p[i] == '\t' || p[i] == '\r')) ++i;
+    if (i < len && p[i] != '#') {
+      size_t w = i;
+      while (w < len && p[w] != ' ' && p[w] != '\t' && p[w] != '\r' && p[w] != '#') ++w;
+      int key = -1;
+      for (int k = 0; k < FRAGMENT_KEYS; ++k)
+        if (strlen(fragmentKeys[k]) == w - i && strncmp(p + i, fragmentKeys[k], w - i) == 0) key = k;
+      if (key < 0) {
+        pd_error_set(err, path, line, (int)i + 1,
+                     "'%.*s': a cubetoss parameter fragment holds only mu, restitution and kn lines (and comments)",
+                     (int)(w - i < 40 ? w - i : 40), p + i);
+        free(text);
+        return false;
+      }
+      keyLine[key] = line;
+      keyCol[key] = (int)i + 1;
+    }
+    p = end ? end + 1 : p + len;
+  }
+  pdScene* scene = pd_scene_parse_buffer(path, text, prefixLen + n, err);
+  free(text);
+  if (!scene) {
+    if (err && err->line > 0) --err->line;  // the prefix line is ours
+    return false;
+  }
+  const pdSceneObject* o = &scene->objects[0];
+  bool ok = true;
+  if (keyLine[1] && o->restitution < 0.1353352832366127) {  // e⁻², engine/src/material.h
+    pd_error_set(err, path, keyLine[1], keyCol[1], "restitution %.10g is below e^-2 = 0.1353352832, the model's limit",
+                 o->restitution);
+    ok = false;
+  } else if (!keyLine[0] && !keyLine[1] && !keyLine[2]) {
+    pd_error_set(err, path, 0, 0, "sets none of mu, restitution, kn");
+    ok = false;
+  }
+  if (ok) {
+    if (keyLine[0]) params->mu = o->mu;
+    if (keyLine[1]) params->restitution = o->restitution;
+    if (keyLine[2]) params->kn = o->kn;
+  }
+  pd_scene_free(scene);
+  return ok;
+}
+
+// The shortest %.Ng that reads back as the same double.
+static void write_exact(FILE* out, double v) {
+  char buf[40];
+  for (int precision = 1; precision <= 17; ++precision) {
+    snprintf(buf, sizeof buf, "%.*g", precision, v);
+    if (strtod(buf, NULL) == v) break;
+  }
+  fputs(buf, out);
+}
+
+void pd_toss_params_write(FILE* out, const pdTossParams* p, const char* comment) {
+  for (const char* c = comment; c && *c;) {
+    const char* end = strchr(c, '\n');
+    int len = end ? (int)(end - c) : (int)strlen(c);
+    fprintf(out, "# %.*s\n", len, c);
+    c = end ? end + 1 : c + len;
+  }
+  const double values[FRAGMENT_KEYS] = {p->mu, p->restitution, p->kn};
+  for (int k = 0; k < FRAGMENT_KEYS; ++k) {
+    fprintf(out, "%s ", fragmentKeys[k]);
+    write_exact(out, values[k]);
+    fputc('\n', out);
+  }
+}
