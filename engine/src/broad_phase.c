@@ -510,7 +510,8 @@ int pd_broad_phase_pairs(pdBroadPhase* bp, pdPair* out, int capacity) {
   if (bp->grid) {
     int count = 0;
     const pdPair* pairs = pd_broad_grid_pairs(bp->grid, &count);
-    memcpy(out, pairs, (size_t)(count < capacity ? count : capacity) * sizeof *out);
+    int written = count < capacity ? count : capacity;
+    if (written > 0) memcpy(out, pairs, (size_t)written * sizeof *out);  // out may be NULL when capacity is 0
     return count;
   }
   int count = bp->count;
