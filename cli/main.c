@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   const char* cmd = argv[1];
   if (strcmp(cmd, "run") == 0) return pd_cmd_run(argc - 1, argv + 1);
   if (strcmp(cmd, "check") == 0) return pd_cmd_check(argc - 1, argv + 1);
+  if (strcmp(cmd, "gedanken") == 0) return pd_cmd_gedanken(argc - 1, argv + 1);
   if (strcmp(cmd, "help") == 0 || pd_cli_is_help(cmd)) {
     fputs(usage, stdout);
     return PD_EXIT_OK;
