@@ -40,7 +40,6 @@ void gk_text_floor(pdGkText* out, double sx, double sy, double sz, double cx, co
 // Per-sample values of moving body j through `get`, into a new array (free it).
 typedef double gkGetter(const pdBodyState* b);
 double* gk_column(const pdGkRecord* rec, int j, gkGetter* get);
-double gk_get_x(const pdBodyState* b);
 double gk_get_z(const pdBodyState* b);
 double gk_get_vx(const pdBodyState* b);
 double gk_get_vz(const pdBodyState* b);

@@ -181,7 +181,11 @@ static void a3_measure(const pdModel* model, const pdGkRecord* rec, double input
   int j = gk_moving(model, "box");
   pdBodyState last = pd_gk_body(rec, rec->count - 1, j);
   out->value = 0.05 - last.x.z;
-  gk_note(out, "lateral drift %.3g m; contacts at the end %d", hypot(last.x.x, last.x.y), rec->contacts[rec->count - 1]);
+  int contacts = rec->contacts[rec->count - 1];
+  if (contacts >= 0)
+    gk_note(out, "lateral drift %.3g m; contacts at the end %d", hypot(last.x.x, last.x.y), contacts);
+  else
+    gk_note(out, "lateral drift %.3g m", hypot(last.x.x, last.x.y));
 }
 
 static double a3_series(const pdModel* model, const pdGkRecord* rec, int k, double input, double* analytic) {
