@@ -109,6 +109,21 @@ double gk_get_tilt_deg(const pdBodyState* b) {
   return acos(fmax(-1.0, fmin(1.0, c))) * 180.0 / M_PI;
 }
 
+bool gk_measure_slope(const pdGkRecord* rec, int j, gkGetter* get, double from, double to, const char* what,
+                      pdGkMeasured* out) {
+  double* y = gk_column(rec, j, get);
+  double slope;
+  bool ok = pd_gk_fit_line(rec->t, y, rec->count, from, to, &slope, NULL);
+  if (ok) {
+    out->value = slope;
+    gk_note(out, "line fitted to the %s over %.3g..%.3g s", what, from, to);
+  } else {
+    gk_note(out, "too few samples in %.3g..%.3g s", from, to);
+  }
+  free(y);
+  return ok;
+}
+
 void gk_note(pdGkMeasured* out, const char* fmt, ...) {
   va_list ap;
   va_start(ap, fmt);

@@ -51,6 +51,12 @@ double gk_get_tilt_deg(const pdBodyState* b);          // angle of the body z ax
 // Positions of moving body j (new array; free it).
 pdVec3* gk_positions(const pdGkRecord* rec, int j);
 
+// The slope of a line fitted to moving body j's `get` over from <= t <= to (an acceleration from a speed, a
+// mean speed from a position) into out->value, with a note naming `what` was fitted. False (and a note)
+// when the window holds fewer than two samples.
+bool gk_measure_slope(const pdGkRecord* rec, int j, gkGetter* get, double from, double to, const char* what,
+                      pdGkMeasured* out);
+
 // Sets out->note (printf style).
 void gk_note(pdGkMeasured* out, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 

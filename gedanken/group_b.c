@@ -57,15 +57,7 @@ static double downhill_speed(const pdBodyState* b) { return pd_v3_dot(b->v, down
 
 static void b1_slide_measure(const pdModel* model, const pdGkRecord* rec, double input, pdGkMeasured* out) {
   (void)input;
-  double* v = gk_column(rec, gk_moving(model, "box"), downhill_speed);
-  double a;
-  if (pd_gk_fit_line(rec->t, v, rec->count, SLIDE_FIT_FROM, SLIDE_FIT_TO, &a, NULL)) {
-    out->value = a;
-    gk_note(out, "line fitted to the downhill speed over %g..%g s", SLIDE_FIT_FROM, SLIDE_FIT_TO);
-  } else {
-    gk_note(out, "too few samples in %g..%g s", SLIDE_FIT_FROM, SLIDE_FIT_TO);
-  }
-  free(v);
+  gk_measure_slope(rec, gk_moving(model, "box"), downhill_speed, SLIDE_FIT_FROM, SLIDE_FIT_TO, "downhill speed", out);
 }
 
 static double b1_slide_series(const pdModel* model, const pdGkRecord* rec, int k, double input, double* analytic) {
@@ -341,16 +333,12 @@ static void b4_measure(const pdModel* model, const pdGkRecord* rec, double input
   double common = b4_common(model, &tStar);
   // the slip phase without its first 20 ms (the block's springs load) and its last fifth
   double from = 0.02, to = 0.8 * tStar;
-  double* v = gk_column(rec, gk_moving(model, "block"), gk_get_vx);
-  double a;
-  if (pd_gk_fit_line(rec->t, v, rec->count, from, to, &a, NULL)) {
-    out->value = a;
-    gk_note(out, "fitted over %.3g..%.3g s; common speed at the end %.6g m/s (momentum: %.6g m/s)", from, to,
-            v[rec->count - 1], common);
-  } else {
-    gk_note(out, "too few samples in %.3g..%.3g s", from, to);
+  int j = gk_moving(model, "block");
+  if (gk_measure_slope(rec, j, gk_get_vx, from, to, "block's speed", out)) {
+    size_t n = strlen(out->note);
+    snprintf(out->note + n, sizeof out->note - n, "; common speed at the end %.6g m/s (momentum: %.6g m/s)",
+             pd_gk_body(rec, rec->count - 1, j).v.x, common);
   }
-  free(v);
 }
 
 static double b4_series(const pdModel* model, const pdGkRecord* rec, int k, double input, double* analytic) {

@@ -91,15 +91,7 @@ static double d1_position(const pdBodyState* b) { return pd_v3_dot(b->x, d1_down
 
 static void d1_measure(const pdModel* model, const pdGkRecord* rec, double input, pdGkMeasured* out) {
   (void)input;
-  double* s = gk_column(rec, gk_moving(model, "wheel"), d1_position);
-  double speed;
-  if (pd_gk_fit_line(rec->t, s, rec->count, D1_FIT_FROM, D1_TEND, &speed, NULL)) {
-    out->value = speed;
-    gk_note(out, "line fitted to the downhill position over %g..%g s", D1_FIT_FROM, D1_TEND);
-  } else {
-    gk_note(out, "too few samples in %g..%g s", D1_FIT_FROM, D1_TEND);
-  }
-  free(s);
+  gk_measure_slope(rec, gk_moving(model, "wheel"), d1_position, D1_FIT_FROM, D1_TEND, "downhill position", out);
 }
 
 static double d1_series(const pdModel* model, const pdGkRecord* rec, int k, double input, double* analytic) {

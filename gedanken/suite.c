@@ -65,36 +65,9 @@ static void make_parents(const char* path) {
   free(p);
 }
 
-// CSV field, quoted (RFC 4180) only when it holds a comma, a quote or a line break.
-static void csv_text(FILE* out, const char* s) {
-  if (!strpbrk(s, ",\"\r\n")) {
-    fputs(s, out);
-    return;
-  }
-  fputc('"', out);
-  for (; *s; ++s) {
-    if (*s == '"') fputc('"', out);
-    fputc(*s, out);
-  }
-  fputc('"', out);
-}
-
 // A number with %.17g, or nothing when it is not finite (no NaN is ever written).
 static void csv_number(FILE* out, double x) {
   if (isfinite(x)) fprintf(out, "%.17g", x);
-}
-
-static void json_string(FILE* out, const char* s) {
-  fputc('"', out);
-  for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
-    if (*p == '"' || *p == '\\')
-      fprintf(out, "\\%c", *p);
-    else if (*p < 0x20)
-      fprintf(out, "\\u%04x", *p);
-    else
-      fputc(*p, out);
-  }
-  fputc('"', out);
 }
 
 bool pd_gk_out_replaceable(const char* out, pdError* err) {
@@ -372,15 +345,15 @@ static bool write_results(const gkSuite* s, pdError* err) {
     const pdGkExperiment* e = job->c->experiment;
     bool judged = job->status == pd_gkPass || job->status == pd_gkFail;
     bool quantitative = isfinite(job->c->expected.value);
-    csv_text(out, e->name);
+    pd_write_csv_text(out, e->name);
     fprintf(out, ",%c,", e->group);
-    csv_text(out, e->title);
+    pd_write_csv_text(out, e->title);
     fprintf(out, ",%s,%s,", pdGkEngineNames[job->engine], variant_name(job));
-    csv_text(out, e->quantity);
+    pd_write_csv_text(out, e->quantity);
     fputc(',', out);
-    csv_text(out, e->unit);
+    pd_write_csv_text(out, e->unit);
     fputc(',', out);
-    csv_text(out, job->c->label);
+    pd_write_csv_text(out, job->c->label);
     fputc(',', out);
     if (judged) csv_number(out, job->measured);
     fputc(',', out);
@@ -392,9 +365,9 @@ static bool write_results(const gkSuite* s, pdError* err) {
     fprintf(out, ",%s,", pdGkStatusNames[job->status]);
     csv_number(out, job->wallSeconds);
     fputc(',', out);
-    csv_text(out, job->runDir);
+    pd_write_csv_text(out, job->runDir);
     fputc(',', out);
-    csv_text(out, job->note);
+    pd_write_csv_text(out, job->note);
     fputc('\n', out);
   }
   bool ok = !ferror(out);
@@ -427,10 +400,10 @@ static bool write_experiments(const gkSuite* s, pdError* err) {
     fputc('{', out);
     for (size_t f = 0; f < sizeof fields / sizeof fields[0]; ++f) {
       fprintf(out, "%s\"%s\": ", f ? ", " : "", fields[f].key);
-      json_string(out, fields[f].value);
+      pd_write_json_string(out, fields[f].value);
     }
     fprintf(out, ", \"qualitative\": %s, \"scene\": \"generated\", \"series_label\": ", e->qualitative ? "true" : "false");
-    json_string(out, e->seriesLabel);
+    pd_write_json_string(out, e->seriesLabel);
     fputc('}', out);
   }
   fputs("\n]\n", out);

@@ -64,6 +64,8 @@ static void write_csv_text(FILE* out, const char* s) {
   fputc('"', out);
 }
 
+void pd_write_csv_text(FILE* out, const char* s) { write_csv_text(out, s); }
+
 void pd_write_contacts_header(FILE* out) {
   fputs("t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode\n", out);
 }
@@ -173,6 +175,8 @@ static void write_json_string(FILE* out, const char* s) {
   }
   fputc('"', out);
 }
+
+void pd_write_json_string(FILE* out, const char* s) { write_json_string(out, s); }
 
 static void write_vec(FILE* out, pdVec3 v) {
   fputc('[', out);
