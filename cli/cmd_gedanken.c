@@ -141,6 +141,8 @@ int pd_cmd_gedanken(int argc, char** argv) {
     options.only = (const char* const*)onlyNames;
     options.onlyCount = count;
   }
+  if (pd_gk_selected_count(&options) == 0)
+    return pd_cli_usage_error("gedanken", "no experiment selected (--only names none of the --fast subset)");
   if (!enginesGiven)
     for (int e = 0; e < pd_gkEngineCount; ++e) options.engines[e] = true;
   pdError err = {0};

@@ -473,6 +473,12 @@ static bool selected(const pdGkOptions* o, const pdGkExperiment* e) {
   return false;
 }
 
+int pd_gk_selected_count(const pdGkOptions* options) {
+  int count = 0;
+  for (int i = 0; i < pd_gk_experiment_count(); ++i) count += selected(options, pd_gk_experiment(i));
+  return count;
+}
+
 static bool build_case(gkCase* c, const pdGkExperiment* e, double input, double toleranceScale, pdError* err) {
   c->experiment = e;
   c->input = input;

@@ -129,6 +129,7 @@ bad_args "--jobs 0" --out "$BADOUT" --jobs 0
 bad_args "--jobs not a number" --out "$BADOUT" --jobs two
 bad_args "a negative tolerance scale" --out "$BADOUT" --tolerance-scale -1
 bad_args "--out without a value" --out
+bad_args "an empty selection" --out "$BADOUT" --fast --only a4_elastic_apex
 mkdir -p "$SCRATCH/precious"
 touch "$SCRATCH/precious/keep"
 run_pd gedanken --only c2_momentum --engines soft --out "$SCRATCH/precious"

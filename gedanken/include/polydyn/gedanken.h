@@ -194,6 +194,9 @@ typedef struct pdGkSummary {
   double wallSeconds;
 } pdGkSummary;
 
+// How many experiments the options select (--only and --fast); 0 is bad input for the suite.
+int pd_gk_selected_count(const pdGkOptions* options);
+
 // True when `out` does not exist or is a previous gedanken directory (has results.csv), which the suite
 // replaces; otherwise false with err ("exists and is not a gedanken directory").
 bool pd_gk_out_replaceable(const char* out, pdError* err);
