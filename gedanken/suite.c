@@ -277,7 +277,7 @@ static void run_job(gkSuite* s, gkJob* job) {
   } else if (!written) {
     job->status = pd_gkError;
     job->runDir[0] = '\0';
-    job_note(job, "the run directory could not be written: %s", err.message);
+    job_note(job, "the run directory could not be written: %s", err.message[0] ? err.message : "a write failed");
   } else {
     pthread_mutex_lock(&s->fileLock);
     bool copied = write_scene_copy(dir, c->sceneText);
