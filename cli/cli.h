@@ -16,6 +16,7 @@ int pd_cmd_sweep(int argc, char** argv);
 int pd_cmd_report(int argc, char** argv);
 int pd_cmd_view(int argc, char** argv);
 int pd_cmd_cubetoss(int argc, char** argv);
+int pd_cmd_gedanken(int argc, char** argv);
 
 // Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr; returns 2.
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) __attribute__((format(printf, 2, 3)));

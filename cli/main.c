@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
   if (strcmp(cmd, "report") == 0) return pd_cmd_report(argc - 1, argv + 1);
   if (strcmp(cmd, "view") == 0) return pd_cmd_view(argc - 1, argv + 1);
   if (strcmp(cmd, "cubetoss") == 0) return pd_cmd_cubetoss(argc - 1, argv + 1);
+  if (strcmp(cmd, "gedanken") == 0) return pd_cmd_gedanken(argc - 1, argv + 1);
   if (strcmp(cmd, "help") == 0 || pd_cli_is_help(cmd)) {
     fputs(usage, stdout);
     return PD_EXIT_OK;

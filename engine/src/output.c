@@ -64,6 +64,8 @@ static void write_csv_text(FILE* out, const char* s) {
   fputc('"', out);
 }
 
+void pd_write_csv_text(FILE* out, const char* s) { write_csv_text(out, s); }
+
 void pd_write_contacts_header(FILE* out) {
   fputs("t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode\n", out);
 }

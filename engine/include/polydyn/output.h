@@ -34,6 +34,8 @@ void pd_write_trajectory_header(FILE* out);
 // mode stick or slip.
 void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state);
 void pd_write_contacts_header(FILE* out);
+// Writes `s` as one CSV field: as it is, or quoted (RFC 4180) when it holds a comma, a quote or a line break.
+void pd_write_csv_text(FILE* out, const char* s);
 
 typedef struct pdRunInfo {
   const char* engine;     // e.g. "polydyn-soft"

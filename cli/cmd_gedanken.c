@@ -1,0 +1,186 @@
+// polydyn gedanken — run the catalogue of Gedanken experiments on every engine (gedanken/RESULT_SCHEMAS.md).
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "polydyn/gedanken.h"
+
+static const char* const help =
+    "usage: polydyn gedanken --out DIR [--only NAME[,NAME...]] [--engines ENGINE[,ENGINE...]] [--fast]\n"
+    "                        [--jobs N] [--tolerance-scale F]\n"
+    "       polydyn gedanken --list [--fast]\n"
+    "\n"
+    "Runs the Gedanken experiments (closed-form mechanics: restitution, sinkage, friction, impacts, rolling,\n"
+    "Painleve's rod, a top, stacks) on each engine and compares every measured value with its expected value\n"
+    "and tolerance. Writes DIR/results.csv, DIR/experiments.json, DIR/series/NAME.csv and every run's\n"
+    "directory DIR/runs/NAME/ENGINE-VARIANT[-INPUT]/ (with the generated scene as scene.scene). DIR is written\n"
+    "under a temporary name and renamed when complete; an existing DIR is replaced only if it is a previous\n"
+    "gedanken directory.\n"
+    "\n"
+    "  --out DIR            output directory\n"
+    "  --list               list the experiments (name, group, title, inputs) and exit\n"
+    "  --only NAMES         only these experiments (comma-separated names from --list)\n"
+    "  --engines ENGINES    soft, ode, bullet (default: all three); ode and bullet run in their native and\n"
+    "                       matched variants; an engine this build has no adapter for gives NOT_BUILT rows\n"
+    "  --fast               only the fast subset that CI runs\n"
+    "  --jobs N             soft-engine runs in N threads (default 2); reference engines run on one thread\n"
+    "  --tolerance-scale F  multiply every tolerance by F > 0 (default 1: the catalogue's); only to check that\n"
+    "                       failures are reported, the verdicts are then not the catalogue's\n"
+    "\n"
+    "Progress goes to stderr when it is a terminal. Exit status: 0 every soft-engine experiment passed (other\n"
+    "engines may fail some: see results.csv), 1 a soft-engine experiment failed or the results could not be\n"
+    "written, 2 bad input, 130 interrupted (nothing written).\n";
+
+enum { MAX_ONLY = 64, MAX_JOBS = 64 };
+
+static volatile sig_atomic_t interrupted = 0;
+static void on_signal(int sig) {
+  (void)sig;
+  interrupted = 1;
+}
+
+static void progress(const pdGkProgress* p, void* user) {
+  (void)user;
+  fprintf(stderr, "\r\033[Kpolydyn gedanken: %d/%d %s %s%s%s", p->done, p->total, p->experiment, p->engine,
+          p->input[0] ? " " : "", p->input);
+}
+
+static void list(bool fast) {
+  for (int i = 0; i < pd_gk_experiment_count(); ++i) {
+    const pdGkExperiment* e = pd_gk_experiment(i);
+    if (fast && !e->fast) continue;
+    printf("%-24s %c  %s%s", e->name, e->group, e->title, e->fast ? "  [fast]" : "");
+    if (e->inputName) {
+      printf("  (%s:", e->inputName);
+      for (int k = 0; k < e->inputCount; ++k) printf(" %g", e->inputs[k]);
+      putchar(')');
+    }
+    putchar('\n');
+  }
+}
+
+// Splits a comma-separated list in place into `items` (at most max); false on an empty item or too many.
+static int split(char* text, char** items, int max) {
+  int count = 0;
+  for (char* item = text;; ++count) {
+    char* comma = strchr(item, ',');
+    if (comma) *comma = '\0';
+    if (item[0] == '\0' || count == max) return -1;
+    items[count] = item;
+    if (!comma) return count + 1;
+    item = comma + 1;
+  }
+}
+
+int pd_cmd_gedanken(int argc, char** argv) {
+  pdGkOptions options = {.jobs = 2, .toleranceScale = 1.0};
+  bool listOnly = false, enginesGiven = false;
+  char* onlyText = NULL;
+  char* onlyNames[MAX_ONLY];
+  for (int i = 1; i < argc; ++i) {
+    const char* a = argv[i];
+    if (pd_cli_is_help(a)) {
+      fputs(help, stdout);
+      return PD_EXIT_OK;
+    } else if (strcmp(a, "--list") == 0) {
+      listOnly = true;
+    } else if (strcmp(a, "--fast") == 0) {
+      options.fast = true;
+    } else if (strcmp(a, "--out") == 0 || strcmp(a, "--only") == 0 || strcmp(a, "--engines") == 0 ||
+               strcmp(a, "--jobs") == 0 || strcmp(a, "--tolerance-scale") == 0) {
+      if (i + 1 >= argc) return pd_cli_usage_error("gedanken", "%s needs a value", a);
+      char* v = argv[++i];
+      if (strcmp(a, "--out") == 0) {
+        if (v[0] == '\0') return pd_cli_usage_error("gedanken", "--out needs a directory name");
+        options.out = v;
+      } else if (strcmp(a, "--only") == 0) {
+        if (onlyText) return pd_cli_usage_error("gedanken", "--only once, with a comma-separated list");
+        onlyText = v;
+      } else if (strcmp(a, "--engines") == 0) {
+        if (enginesGiven) return pd_cli_usage_error("gedanken", "--engines once, with a comma-separated list");
+        enginesGiven = true;
+        char* names[pd_gkEngineCount * 2];
+        int count = split(v, names, pd_gkEngineCount * 2);
+        if (count < 0) return pd_cli_usage_error("gedanken", "--engines needs a list like soft,ode,bullet");
+        for (int k = 0; k < count; ++k) {
+          int e = 0;
+          while (e < pd_gkEngineCount && strcmp(names[k], pdGkEngineNames[e]) != 0) ++e;
+          if (e == pd_gkEngineCount)
+            return pd_cli_usage_error("gedanken", "unknown engine '%s' (soft, ode or bullet)", names[k]);
+          options.engines[e] = true;
+        }
+      } else if (strcmp(a, "--jobs") == 0) {
+        char* end = NULL;
+        errno = 0;
+        long n = strtol(v, &end, 10);
+        if (end == v || *end != '\0' || errno || n < 1 || n > MAX_JOBS)
+          return pd_cli_usage_error("gedanken", "--jobs needs a whole number from 1 to %d", MAX_JOBS);
+        options.jobs = (int)n;
+      } else if (!pd_cli_positive(v, &options.toleranceScale)) {
+        return pd_cli_usage_error("gedanken", "--tolerance-scale needs a number > 0");
+      }
+    } else {
+      return pd_cli_usage_error("gedanken", "unknown argument '%s'", a);
+    }
+  }
+  if (listOnly) {
+    list(options.fast);
+    return PD_EXIT_OK;
+  }
+  if (!options.out) return pd_cli_usage_error("gedanken", "--out DIR is required");
+  if (onlyText) {
+    int count = split(onlyText, onlyNames, MAX_ONLY);
+    if (count < 0) return pd_cli_usage_error("gedanken", "--only needs a comma-separated list of names");
+    for (int k = 0; k < count; ++k)
+      if (!pd_gk_find(onlyNames[k]))
+        return pd_cli_usage_error("gedanken", "no experiment '%s' (see --list)", onlyNames[k]);
+    options.only = (const char* const*)onlyNames;
+    options.onlyCount = count;
+  }
+  if (pd_gk_selected_count(&options) == 0)
+    return pd_cli_usage_error("gedanken", "no experiment selected (--only names none of the --fast subset)");
+  if (!enginesGiven)
+    for (int e = 0; e < pd_gkEngineCount; ++e) options.engines[e] = true;
+  pdError err = {0};
+  if (!pd_gk_out_replaceable(options.out, &err)) {
+    fprintf(stderr, "polydyn gedanken: ");
+    pd_error_print(&err, stderr);
+    return PD_EXIT_BAD_INPUT;
+  }
+
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  options.interrupt = &interrupted;
+  bool terminal = isatty(STDERR_FILENO) == 1;
+  if (terminal) options.progress = progress;
+
+  pdGkSummary summary;
+  bool ok = pd_gk_run_suite(&options, &summary, &err);
+  if (terminal) fputs("\r\033[K", stderr);
+  if (summary.interrupted) {
+    fprintf(stderr, "polydyn gedanken: interrupted; nothing written\n");
+    return 130;
+  }
+  if (!ok) {
+    fprintf(stderr, "polydyn gedanken: ");
+    pd_error_print(&err, stderr);
+    return PD_EXIT_FAILURE;
+  }
+  printf("polydyn gedanken: %d rows in %.1f s:", summary.rows, summary.wallSeconds);
+  for (int s = 0; s <= pd_gkError; ++s)
+    if (summary.count[s]) printf(" %d %s", summary.count[s], pdGkStatusNames[s]);
+  printf("; %s/results.csv\n", options.out);
+  if (summary.softFailures > 0) {
+    fprintf(stderr, "polydyn gedanken: %d soft-engine row%s failed: %s\n", summary.softFailures,
+            summary.softFailures > 1 ? "s" : "", summary.softFailed);
+    return PD_EXIT_FAILURE;
+  }
+  return PD_EXIT_OK;
+}

@@ -1,0 +1,635 @@
+// polydyn gedanken — the suite: every selected experiment on every selected engine, and its output files
+// (gedanken/RESULT_SCHEMAS.md: results.csv, experiments.json, series/NAME.csv, runs/NAME/ENGINE-VARIANT[-INPUT]).
+//
+// Order of work: the scenes are generated and compiled on the calling thread (compiling touches GSL's global
+// error handler), one model per (experiment, input), shared read-only by that case's runs. Soft-engine runs
+// then go to `jobs` threads; reference-engine runs stay on the calling thread (ODE keeps per-thread data;
+// polydyn run calls it from the main thread too). Every job owns its row, record and series text, so the
+// files are the same bytes whatever the number of threads, except wall times.
+#include <errno.h>
+#include <ftw.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "gedanken_internal.h"
+#include "polydyn/output.h"
+#include "polydyn/refcheck.h"
+
+const char* const pdGkEngineNames[pd_gkEngineCount] = {"soft", "ode", "bullet"};
+const char* const pdGkStatusNames[] = {"PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR"};
+
+enum { SERIES_MAX_ROWS = 500 };  // per run (RESULT_SCHEMAS.md: "at most ~500 rows per run")
+
+static double wall_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// files
+
+static int remove_entry(const char* path, const struct stat* sb, int flag, struct FTW* ftw) {
+  (void)sb, (void)flag, (void)ftw;
+  return remove(path);
+}
+
+static void remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
+
+static char* path_join(const char* a, const char* b) {
+  size_t n = strlen(a) + strlen(b) + 2;
+  char* s = malloc(n);
+  PD_ASSERT(s != NULL);
+  snprintf(s, n, "%s/%s", a, b);
+  return s;
+}
+
+static bool make_dir(const char* path, pdError* err) {
+  if (mkdir(path, 0777) == 0 || errno == EEXIST) return true;
+  pd_error_set(err, path, 0, 0, "cannot create the directory: %s", strerror(errno));
+  return false;
+}
+
+// mkdir -p of the directories above `path` (a real failure shows when the directory itself is made)
+static void make_parents(const char* path) {
+  char* p = strdup(path);
+  PD_ASSERT(p != NULL);
+  for (char* slash = strchr(p + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
+    *slash = '\0';
+    mkdir(p, 0777);
+    *slash = '/';
+  }
+  free(p);
+}
+
+// A number with %.17g, or nothing when it is not finite (no NaN is ever written).
+static void csv_number(FILE* out, double x) {
+  if (isfinite(x)) fprintf(out, "%.17g", x);
+}
+
+bool pd_gk_out_replaceable(const char* out, pdError* err) {
+  struct stat st;
+  if (stat(out, &st) != 0) return true;
+  char* results = path_join(out, "results.csv");
+  bool ours = S_ISDIR(st.st_mode) && access(results, F_OK) == 0;
+  free(results);
+  if (!ours) pd_error_set(err, out, 0, 0, "exists and is not a gedanken directory (no results.csv); not replacing it");
+  return ours;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// cases and jobs
+
+typedef struct gkCase {
+  const pdGkExperiment* experiment;
+  double input;
+  char label[64];        // "e=0.5" or ""
+  char* sceneText;       // the generated scene (owned)
+  pdModel* model;        // compiled from it (owned)
+  pdGkExpected expected; // tolerance already scaled
+} gkCase;
+
+typedef struct gkJob {
+  gkCase* c;
+  pdGkEngine engine;
+  pdRefVariant variant;
+  // the row
+  pdGkStatus status;
+  double measured, error, wallSeconds;
+  char runDir[512];      // relative to the output directory; "" when there is none
+  char note[PD_GK_NOTE_MAX + 160];
+  pdGkText series;       // series rows of this run
+  bool done;
+} gkJob;
+
+static const char* variant_name(const gkJob* job) {
+  if (job->engine == pd_gkSoft) return "adaptive";
+  return job->variant == pd_refMatched ? "matched" : "native";
+}
+
+typedef struct gkSuite {
+  const pdGkOptions* options;
+  char* root;             // the temporary output directory
+  gkCase* cases;
+  int caseCount;
+  gkJob* jobs;
+  int jobCount;
+  int* softQueue;         // job indices of soft runs, in order
+  int softCount, softNext;
+  int doneCount;
+  pthread_mutex_t lock;   // softNext, doneCount, progress
+  pthread_mutex_t fileLock;  // file creation: pd_run_open briefly sets the process umask to 0 (output.c)
+} gkSuite;
+
+static bool interrupted(const gkSuite* s) { return s->options->interrupt && *s->options->interrupt; }
+
+typedef struct gkObserver {
+  pdGkRecord* rec;
+  pdRunWriter* writer;  // soft runs write through it here; pd_ref_run writes its own samples
+  const gkSuite* suite;
+} gkObserver;
+
+static bool observe_soft(const pdModel* model, const pdState* state, void* user) {
+  gkObserver* o = user;
+  pd_gk_record_observe(model, state, o->rec);
+  if (!pd_run_observe(model, state, o->writer)) return false;
+  return !interrupted(o->suite);
+}
+
+static bool observe_ref(const pdModel* model, const pdState* state, void* user) {
+  gkObserver* o = user;
+  pd_gk_record_observe_ref(model, state, o->rec);
+  return !interrupted(o->suite);
+}
+
+static void job_note(gkJob* job, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+static void job_note(gkJob* job, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(job->note, sizeof job->note, fmt, ap);
+  va_end(ap);
+}
+
+// Verdict of one measured run.
+static void judge(gkJob* job, const pdGkRecord* rec) {
+  const gkCase* c = job->c;
+  const pdGkExperiment* e = c->experiment;
+  if (!rec->finite || rec->count < 2) {
+    job->status = pd_gkFail;
+    job_note(job, "the run produced %s", rec->count < 2 ? "fewer than 2 samples" : "a non-finite state");
+    return;
+  }
+  pdGkMeasured m = {.value = NAN};
+  e->measure(c->model, rec, c->input, &m);
+  job->measured = isfinite(m.value) ? m.value : NAN;
+  const char* prefix = e->relative && isfinite(c->expected.value) ? "relative error; " : "";
+  job_note(job, "%s%s", prefix, m.note);
+  if (!isfinite(c->expected.value)) {  // a qualitative check: the measure decides
+    job->status = m.pass ? pd_gkPass : pd_gkFail;
+    return;
+  }
+  if (isnan(job->measured)) {
+    job->status = pd_gkFail;
+    return;
+  }
+  job->error = e->relative ? fabs(job->measured / c->expected.value - 1.0) : fabs(job->measured - c->expected.value);
+  job->status = job->error <= c->expected.tolerance ? pd_gkPass : pd_gkFail;
+}
+
+static void write_series(gkJob* job, const pdGkRecord* rec) {
+  const gkCase* c = job->c;
+  int stride = (rec->count + SERIES_MAX_ROWS - 1) / SERIES_MAX_ROWS;
+  if (stride < 1) stride = 1;
+  for (int k = 0; k < rec->count; k += stride) {
+    double analytic = NAN;
+    double value = c->experiment->series(c->model, rec, k, c->input, &analytic);
+    if (!isfinite(value)) continue;
+    pd_gk_text_printf(&job->series, "%.17g,%s,%s,%s,%.17g,", rec->t[k], pdGkEngineNames[job->engine],
+                      variant_name(job), c->label, value);
+    if (isfinite(analytic)) pd_gk_text_printf(&job->series, "%.17g", analytic);
+    pd_gk_text_printf(&job->series, "\n");
+  }
+}
+
+// Writes the generated scene beside the run's files, so `polydyn run DIR/scene.scene` repeats the run.
+static bool write_scene_copy(const char* dir, const char* text) {
+  char* path = path_join(dir, "scene.scene");
+  FILE* f = fopen(path, "w");
+  free(path);
+  if (!f) return false;
+  fputs(text, f);
+  return fclose(f) == 0;
+}
+
+static void run_job(gkSuite* s, gkJob* job) {
+  const gkCase* c = job->c;
+  const pdModel* model = c->model;
+  job->measured = job->error = job->wallSeconds = NAN;
+  const pdRefAdapter* adapter = NULL;
+  if (job->engine != pd_gkSoft) {
+    adapter = pd_ref_adapter(pdGkEngineNames[job->engine]);
+    if (!adapter) {
+      job->status = pd_gkNotBuilt;
+      job_note(job, "this build of polydyn has no %s adapter", pdGkEngineNames[job->engine]);
+      return;
+    }
+  }
+  char name[160];
+  snprintf(name, sizeof name, "%s-%s%s%s", pdGkEngineNames[job->engine], variant_name(job), c->label[0] ? "-" : "",
+           c->label);
+  snprintf(job->runDir, sizeof job->runDir, "runs/%s/%s", c->experiment->name, name);
+  char* dir = path_join(s->root, job->runDir);
+  pdError err = {0};
+  pthread_mutex_lock(&s->fileLock);
+  pdRunWriter* writer = pd_run_open(dir, &err);
+  pthread_mutex_unlock(&s->fileLock);
+  if (!writer) {
+    job->status = pd_gkError;
+    job->runDir[0] = '\0';
+    job_note(job, "%s", err.message);
+    free(dir);
+    return;
+  }
+  pdGkRecord rec;
+  pd_gk_record_init(&rec, model->movingCount);
+  gkObserver observer = {&rec, writer, s};
+  bool written = false, completed = false;
+  if (job->engine == pd_gkSoft) {
+    pdState* state = pd_state_create(model);
+    double energyStart = pd_state_energy(model, state), t0 = wall_now();
+    completed = pd_advance(model, state, model->settings.tend, observe_soft, &observer);
+    job->wallSeconds = wall_now() - t0;
+    if (state->stopped) {
+      pd_run_abort(writer);
+    } else {
+      pdRunInfo info = {.engine = "polydyn-soft", .energyStart = energyStart, .energyEnd = pd_state_energy(model, state),
+                        .wallSeconds = job->wallSeconds, .completed = completed};
+      pthread_mutex_lock(&s->fileLock);
+      written = pd_run_finish(writer, model, state, &info, &err);
+      pthread_mutex_unlock(&s->fileLock);
+      if (!completed) job_note(job, "the run stopped at t = %.6g s", state->t);
+    }
+    pd_state_free(state);
+  } else {
+    pdRefOptions options = {.variant = job->variant, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
+    pdRefRunStats stats;
+    // the whole run under the file lock: pd_ref_run creates summary.json itself
+    pthread_mutex_lock(&s->fileLock);
+    written = pd_ref_run(model, adapter, &options, writer, observe_ref, &observer, &stats, &err);
+    pthread_mutex_unlock(&s->fileLock);
+    job->wallSeconds = stats.wallSeconds;
+    completed = stats.completed;
+    if (!written && stats.refused) {
+      job->status = pd_gkRefused;
+      job->runDir[0] = '\0';
+      job_note(job, "%s", err.message);
+      pd_gk_record_free(&rec);
+      free(dir);
+      return;
+    }
+    if (written && !completed) job_note(job, "%s produced a non-finite state after %ld steps", adapter->name, stats.steps);
+  }
+  if (interrupted(s)) {
+    job->status = pd_gkError;
+  } else if (!written) {
+    job->status = pd_gkError;
+    job->runDir[0] = '\0';
+    job_note(job, "the run directory could not be written: %s", err.message[0] ? err.message : "a write failed");
+  } else {
+    pthread_mutex_lock(&s->fileLock);
+    bool copied = write_scene_copy(dir, c->sceneText);
+    pthread_mutex_unlock(&s->fileLock);
+    if (!completed) {
+      job->status = pd_gkFail;
+    } else if (!copied) {
+      job->status = pd_gkError;
+      job_note(job, "cannot write %s/scene.scene", job->runDir);
+    } else {
+      judge(job, &rec);
+    }
+    write_series(job, &rec);
+  }
+  pd_gk_record_free(&rec);
+  free(dir);
+}
+
+static void finish_job(gkSuite* s, gkJob* job) {
+  pthread_mutex_lock(&s->lock);
+  job->done = true;
+  ++s->doneCount;
+  if (s->options->progress) {
+    char engine[32];
+    snprintf(engine, sizeof engine, "%s%s%s", pdGkEngineNames[job->engine], job->engine == pd_gkSoft ? "" : "-",
+             job->engine == pd_gkSoft ? "" : variant_name(job));
+    pdGkProgress p = {s->doneCount, s->jobCount, job->c->experiment->name, engine, job->c->label};
+    s->options->progress(&p, s->options->progressUser);
+  }
+  pthread_mutex_unlock(&s->lock);
+}
+
+static gkJob* next_soft_job(gkSuite* s) {
+  pthread_mutex_lock(&s->lock);
+  gkJob* job = !interrupted(s) && s->softNext < s->softCount ? &s->jobs[s->softQueue[s->softNext++]] : NULL;
+  pthread_mutex_unlock(&s->lock);
+  return job;
+}
+
+static void* soft_worker(void* user) {
+  gkSuite* s = user;
+  for (gkJob* job; (job = next_soft_job(s));) {
+    run_job(s, job);
+    finish_job(s, job);
+  }
+  return NULL;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// the output files
+
+static bool write_results(const gkSuite* s, pdError* err) {
+  char* path = path_join(s->root, "results.csv");
+  FILE* out = fopen(path, "w");
+  free(path);
+  if (!out) {
+    pd_error_set(err, s->options->out, 0, 0, "cannot write results.csv: %s", strerror(errno));
+    return false;
+  }
+  fputs("experiment,group,title,engine,variant,quantity,unit,input,measured,expected,error,tolerance,status,"
+        "wall_seconds,run_dir,note\n",
+        out);
+  for (int i = 0; i < s->jobCount; ++i) {
+    const gkJob* job = &s->jobs[i];
+    const pdGkExperiment* e = job->c->experiment;
+    bool judged = job->status == pd_gkPass || job->status == pd_gkFail;
+    bool quantitative = isfinite(job->c->expected.value);
+    pd_write_csv_text(out, e->name);
+    fprintf(out, ",%c,", e->group);
+    pd_write_csv_text(out, e->title);
+    fprintf(out, ",%s,%s,", pdGkEngineNames[job->engine], variant_name(job));
+    pd_write_csv_text(out, e->quantity);
+    fputc(',', out);
+    pd_write_csv_text(out, e->unit);
+    fputc(',', out);
+    pd_write_csv_text(out, job->c->label);
+    fputc(',', out);
+    if (judged) csv_number(out, job->measured);
+    fputc(',', out);
+    if (quantitative) csv_number(out, job->c->expected.value);
+    fputc(',', out);
+    if (judged && quantitative) csv_number(out, job->error);
+    fputc(',', out);
+    if (quantitative) csv_number(out, job->c->expected.tolerance);
+    fprintf(out, ",%s,", pdGkStatusNames[job->status]);
+    csv_number(out, job->wallSeconds);
+    fputc(',', out);
+    pd_write_csv_text(out, job->runDir);
+    fputc(',', out);
+    pd_write_csv_text(out, job->note);
+    fputc('\n', out);
+  }
+  bool ok = !ferror(out);
+  ok = fclose(out) == 0 && ok;
+  if (!ok) pd_error_set(err, s->options->out, 0, 0, "cannot write results.csv");
+  return ok;
+}
+
+static bool write_experiments(const gkSuite* s, pdError* err) {
+  char* path = path_join(s->root, "experiments.json");
+  FILE* out = fopen(path, "w");
+  free(path);
+  if (!out) {
+    pd_error_set(err, s->options->out, 0, 0, "cannot write experiments.json: %s", strerror(errno));
+    return false;
+  }
+  fputs("[", out);
+  const pdGkExperiment* previous = NULL;
+  for (int i = 0; i < s->caseCount; ++i) {
+    const pdGkExperiment* e = s->cases[i].experiment;
+    if (e == previous) continue;
+    fputs(previous ? ",\n " : "\n ", out);
+    previous = e;
+    const struct {
+      const char* key;
+      const char* value;
+    } fields[] = {{"name", e->name}, {"group", (char[]){e->group, '\0'}}, {"title", e->title},
+                  {"quantity", e->quantity}, {"unit", e->unit}, {"formula", e->formula},
+                  {"tolerance_reason", e->toleranceReason}};
+    fputc('{', out);
+    for (size_t f = 0; f < sizeof fields / sizeof fields[0]; ++f) {
+      fprintf(out, "%s\"%s\": ", f ? ", " : "", fields[f].key);
+      pd_write_json_string(out, fields[f].value);
+    }
+    fprintf(out, ", \"qualitative\": %s, \"scene\": \"generated\", \"series_label\": ", e->qualitative ? "true" : "false");
+    pd_write_json_string(out, e->seriesLabel);
+    fputc('}', out);
+  }
+  fputs("\n]\n", out);
+  bool ok = !ferror(out);
+  ok = fclose(out) == 0 && ok;
+  if (!ok) pd_error_set(err, s->options->out, 0, 0, "cannot write experiments.json");
+  return ok;
+}
+
+static bool write_series_files(const gkSuite* s, pdError* err) {
+  char* dir = path_join(s->root, "series");
+  bool ok = make_dir(dir, err);
+  for (int i = 0; ok && i < s->jobCount;) {
+    const pdGkExperiment* e = s->jobs[i].c->experiment;
+    char file[160];
+    snprintf(file, sizeof file, "%s.csv", e->name);
+    char* path = path_join(dir, file);
+    FILE* out = fopen(path, "w");
+    free(path);
+    if (!out) {
+      pd_error_set(err, s->options->out, 0, 0, "cannot write series/%s: %s", file, strerror(errno));
+      ok = false;
+      break;
+    }
+    fputs("t,engine,variant,input,value,analytic\n", out);
+    for (; i < s->jobCount && s->jobs[i].c->experiment == e; ++i)
+      if (s->jobs[i].series.data) fputs(s->jobs[i].series.data, out);
+    ok = !ferror(out);
+    ok = fclose(out) == 0 && ok;
+    if (!ok) pd_error_set(err, s->options->out, 0, 0, "cannot write series/%s", file);
+  }
+  free(dir);
+  return ok;
+}
+
+// Moves the finished temporary directory into place, replacing a previous gedanken directory.
+static bool install(const gkSuite* s, pdError* err) {
+  const char* out = s->options->out;
+  char* old = NULL;
+  struct stat st;
+  bool ok = true;
+  if (stat(out, &st) == 0) {
+    if (!pd_gk_out_replaceable(out, err)) return false;
+    size_t n = strlen(out) + 16;
+    old = malloc(n);
+    PD_ASSERT(old != NULL);
+    snprintf(old, n, "%s.old-XXXXXX", out);
+    ok = mkdtemp(old) != NULL && rename(out, old) == 0;
+  }
+  ok = ok && rename(s->root, out) == 0;
+  if (!ok) pd_error_set(err, out, 0, 0, "cannot move the results into place: %s", strerror(errno));
+  if (old) {
+    if (ok) remove_tree(old);
+    free(old);
+  }
+  return ok;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// the suite
+
+static bool selected(const pdGkOptions* o, const pdGkExperiment* e) {
+  if (o->fast && !e->fast) return false;
+  if (!o->only) return true;
+  for (int i = 0; i < o->onlyCount; ++i)
+    if (strcmp(o->only[i], e->name) == 0) return true;
+  return false;
+}
+
+int pd_gk_selected_count(const pdGkOptions* options) {
+  int count = 0;
+  for (int i = 0; i < pd_gk_experiment_count(); ++i) count += selected(options, pd_gk_experiment(i));
+  return count;
+}
+
+static bool build_case(gkCase* c, const pdGkExperiment* e, double input, double toleranceScale, pdError* err) {
+  c->experiment = e;
+  c->input = input;
+  pd_gk_input_label(e, input, c->label, sizeof c->label);
+  pdGkText text = {0};
+  e->scene(input, &text);
+  c->sceneText = text.data;
+  pdScene* scene = pd_scene_parse_buffer("scene.scene", text.data, text.length, err);
+  if (scene) {
+    c->model = pd_model_compile(scene, err);
+    pd_scene_free(scene);
+  }
+  if (!c->model) {
+    // a generated scene that does not compile is a bug of the catalogue: say which one
+    char message[PD_ERROR_MESSAGE_MAX];
+    snprintf(message, sizeof message, "%s", err->message);
+    pd_error_set(err, e->name, err->line, err->col, "generated scene %s: %s", c->label, message);
+    return false;
+  }
+  c->expected = e->expect(c->model, input);
+  PD_ASSERT(!e->relative || !isfinite(c->expected.value) || c->expected.value != 0.0);
+  c->expected.tolerance *= toleranceScale;
+  return true;
+}
+
+static void free_suite(gkSuite* s) {
+  for (int i = 0; i < s->caseCount; ++i) {
+    free(s->cases[i].sceneText);
+    if (s->cases[i].model) pd_model_free(s->cases[i].model);
+  }
+  for (int i = 0; i < s->jobCount; ++i) pd_gk_text_free(&s->jobs[i].series);
+  free(s->cases);
+  free(s->jobs);
+  free(s->softQueue);
+  if (s->root) {
+    remove_tree(s->root);  // nothing when it was installed (renamed away)
+    free(s->root);
+  }
+  pthread_mutex_destroy(&s->lock);
+  pthread_mutex_destroy(&s->fileLock);
+}
+
+bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* err) {
+  PD_ASSERT(options && options->out && summary && options->jobs >= 1 && options->toleranceScale > 0.0);
+  memset(summary, 0, sizeof *summary);
+  double wall0 = wall_now();
+  for (int i = 0; i < options->onlyCount; ++i)
+    if (!pd_gk_find(options->only[i])) {
+      pd_error_set(err, options->only[i], 0, 0, "no such experiment");
+      return false;
+    }
+  if (!pd_gk_out_replaceable(options->out, err)) return false;
+
+  gkSuite s = {.options = options};
+  pthread_mutex_init(&s.lock, NULL);
+  pthread_mutex_init(&s.fileLock, NULL);
+  int maxCases = pd_gk_experiment_count() * PD_GK_MAX_INPUTS;
+  s.cases = calloc((size_t)maxCases, sizeof *s.cases);
+  s.jobs = calloc((size_t)maxCases * 5, sizeof *s.jobs);
+  s.softQueue = calloc((size_t)maxCases, sizeof *s.softQueue);
+  PD_ASSERT(s.cases && s.jobs && s.softQueue);
+  bool ok = true;
+  for (int i = 0; ok && i < pd_gk_experiment_count(); ++i) {
+    const pdGkExperiment* e = pd_gk_experiment(i);
+    if (!selected(options, e)) continue;
+    for (int k = 0; ok && k < e->inputCount; ++k) {
+      gkCase* c = &s.cases[s.caseCount++];
+      ok = build_case(c, e, e->inputs[k], options->toleranceScale, err);
+      for (int engine = 0; ok && engine < pd_gkEngineCount; ++engine) {
+        if (!options->engines[engine]) continue;
+        for (int v = 0; v < (engine == pd_gkSoft ? 1 : 2); ++v) {
+          gkJob* job = &s.jobs[s.jobCount];
+          *job = (gkJob){.c = c, .engine = (pdGkEngine)engine, .variant = v ? pd_refMatched : pd_refNative};
+          if (engine == pd_gkSoft) s.softQueue[s.softCount++] = s.jobCount;
+          ++s.jobCount;
+        }
+      }
+    }
+  }
+  if (ok && s.jobCount == 0) {
+    pd_error_set(err, options->out, 0, 0, "no experiment selected");
+    ok = false;
+  }
+  if (ok) {
+    size_t n = strlen(options->out) + 24;
+    s.root = malloc(n);
+    PD_ASSERT(s.root != NULL);
+    snprintf(s.root, n, "%s.partial-XXXXXX", options->out);
+    make_parents(options->out);
+    if (!mkdtemp(s.root)) {
+      pd_error_set(err, options->out, 0, 0, "cannot create the output directory: %s", strerror(errno));
+      free(s.root);
+      s.root = NULL;
+      ok = false;
+    } else {
+      mode_t mask = umask(0);  // mkdtemp makes the directory private; the results get the usual permissions
+      umask(mask);
+      chmod(s.root, 0777 & ~mask);
+    }
+  }
+  if (ok) {
+    char* runs = path_join(s.root, "runs");
+    ok = make_dir(runs, err);
+    for (int i = 0; ok && i < s.caseCount; ++i) {
+      if (i > 0 && s.cases[i].experiment == s.cases[i - 1].experiment) continue;
+      char* dir = path_join(runs, s.cases[i].experiment->name);
+      ok = make_dir(dir, err);
+      free(dir);
+    }
+    free(runs);
+  }
+  if (ok) {
+    // workers take the soft runs; this thread runs the reference engines first, then helps with the rest
+    int workers = options->jobs - 1;
+    pthread_t* threads = calloc((size_t)(workers > 0 ? workers : 1), sizeof *threads);
+    PD_ASSERT(threads != NULL);
+    int started = 0;
+    for (; started < workers; ++started)
+      if (pthread_create(&threads[started], NULL, soft_worker, &s) != 0) break;
+    for (int i = 0; i < s.jobCount && !interrupted(&s); ++i) {
+      if (s.jobs[i].engine == pd_gkSoft) continue;
+      run_job(&s, &s.jobs[i]);
+      finish_job(&s, &s.jobs[i]);
+    }
+    soft_worker(&s);
+    for (int i = 0; i < started; ++i) pthread_join(threads[i], NULL);
+    free(threads);
+    if (interrupted(&s)) {
+      summary->interrupted = true;
+      pd_error_set(err, options->out, 0, 0, "interrupted; nothing written");
+      ok = false;
+    }
+  }
+  ok = ok && write_results(&s, err) && write_experiments(&s, err) && write_series_files(&s, err) && install(&s, err);
+  if (ok) {
+    free(s.root);
+    s.root = NULL;
+    summary->rows = s.jobCount;
+    for (int i = 0; i < s.jobCount; ++i) {
+      const gkJob* job = &s.jobs[i];
+      ++summary->count[job->status];
+      if (job->engine == pd_gkSoft && (job->status == pd_gkFail || job->status == pd_gkError)) {
+        size_t used = strlen(summary->softFailed), room = sizeof summary->softFailed - used;
+        int n = snprintf(summary->softFailed + used, room, "%s%s%s%s", summary->softFailures ? ", " : "",
+                         job->c->experiment->name, job->c->label[0] ? " " : "", job->c->label);
+        if (n < 0 || (size_t)n >= room) strcpy(summary->softFailed + sizeof summary->softFailed - 4, "...");
+        ++summary->softFailures;
+      }
+    }
+  }
+  summary->wallSeconds = wall_now() - wall0;
+  free_suite(&s);
+  return ok;
+}

@@ -1,0 +1,153 @@
+#!/usr/bin/env bash
+# End-to-end tests of polydyn gedanken (gedanken/RESULT_SCHEMAS.md): the fast subset passes on the soft
+# engine, the output files have the fixed schema, an engine without an adapter gives NOT_BUILT rows and no
+# failure, a failing soft experiment exits 1, bad arguments exit 2 with nothing written, the results do not
+# depend on the number of threads, a previous result directory is replaced, an interrupt leaves nothing.
+#
+# usage: test_gedanken_cli.sh POLYDYN_BINARY
+set -u
+
+if [ $# -ne 1 ]; then
+  echo "usage: $0 POLYDYN_BINARY" >&2
+  exit 2
+fi
+PD=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_gedanken.XXXXXX") || exit 1
+trap 'rm -rf "$SCRATCH"' EXIT
+OUT=$SCRATCH/stdout
+ERR=$SCRATCH/stderr
+HEADER='experiment,group,title,engine,variant,quantity,unit,input,measured,expected,error,tolerance,status,wall_seconds,run_dir,note'
+
+passed=0
+failed=0
+check() {
+  local name=$1
+  shift
+  if eval "$@"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAIL: $name  [$*]"
+  fi
+}
+run_pd() {
+  "$PD" "$@" >"$OUT" 2>"$ERR"
+  rc=$?
+}
+no_partial() { ! compgen -G "$1.partial-*" >/dev/null && ! compgen -G "$1.old-*" >/dev/null; }
+# csv_query FILE EXPRESSION: evaluates a Python expression over rows = list of dicts of results.csv
+csv_query() {
+  python3 -c 'import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1], newline="")))
+print(eval(sys.argv[2], {"rows": rows}))' "$1" "$2"
+}
+
+# --- help and list ------------------------------------------------------------------------------------
+run_pd gedanken --help
+check "--help exits 0" '[ $rc -eq 0 ] && grep -q "^usage: polydyn gedanken" "$OUT"'
+run_pd gedanken --list
+check "--list exits 0 and lists at least 20 experiments" '[ $rc -eq 0 ] && [ "$(wc -l <"$OUT")" -ge 20 ]'
+check "--list covers groups A to G" \
+  '[ "$(awk "{print \$2}" "$OUT" | sort -u | tr -d "\n")" = ABCDEFG ]'
+
+# --- the fast subset on the soft engine ---------------------------------------------------------------
+FAST=$SCRATCH/fast
+run_pd gedanken --fast --engines soft --out "$FAST"
+check "fast subset, soft engine: exit 0" '[ $rc -eq 0 ]'
+check "results.csv has the fixed header" '[ "$(head -n 1 "$FAST/results.csv")" = "$HEADER" ]'
+check "every soft row of the fast subset PASSes" \
+  '[ "$(csv_query "$FAST/results.csv" "len(rows) > 0 and all(r[\"status\"] == \"PASS\" for r in rows)")" = True ]'
+check "rows are soft/adaptive only" \
+  '[ "$(csv_query "$FAST/results.csv" "{(r[\"engine\"], r[\"variant\"]) for r in rows}")" = "{('"'"'soft'"'"', '"'"'adaptive'"'"')}" ]'
+check "every row has 16 fields and no NaN" \
+  '[ "$(csv_query "$FAST/results.csv" "all(len(r) == 16 and None not in r and \"nan\" not in \",\".join(r.values()).lower() for r in rows)")" = True ]'
+check "quantitative rows carry measured, expected, error and tolerance as numbers" \
+  '[ "$(csv_query "$FAST/results.csv" "all(float(r[\"error\"]) <= float(r[\"tolerance\"]) for r in rows if r[\"expected\"])")" = True ]'
+check "the friction cone has 7 push directions" \
+  '[ "$(csv_query "$FAST/results.csv" "sorted(int(r[\"input\"].split(\"=\")[1]) for r in rows if r[\"experiment\"] == \"b2_friction_cone\")")" = "[0, 15, 30, 45, 60, 75, 90]" ]'
+check "restitution rows for several requested e" \
+  '[ "$(csv_query "$FAST/results.csv" "len([r for r in rows if r[\"experiment\"] == \"a1_restitution\"])")" -ge 3 ]'
+check "every run directory exists with trajectory, summary and scene" \
+  '[ "$(csv_query "$FAST/results.csv" "all(all(__import__(\"os\").path.isfile(\"$FAST/\" + r[\"run_dir\"] + \"/\" + f) for f in (\"trajectory.csv\", \"summary.json\", \"scene.scene\")) for r in rows)")" = True ]'
+check "experiments.json lists the experiments run, with the schema's fields" \
+  '[ "$(python3 -c "import json; d = json.load(open(\"$FAST/experiments.json\")); print(all(set(e) == {\"name\", \"group\", \"title\", \"quantity\", \"unit\", \"formula\", \"tolerance_reason\", \"qualitative\", \"scene\", \"series_label\"} for e in d) and len(d))")" = "$(csv_query "$FAST/results.csv" "len({r[\"experiment\"] for r in rows})")" ]'
+check "one series file per experiment, with its header and at most 500 rows per run" \
+  '[ "$(python3 -c "import csv, glob, collections; fs = glob.glob(\"$FAST/series/*.csv\"); n = [collections.Counter((r[\"engine\"], r[\"variant\"], r[\"input\"]) for r in csv.DictReader(open(f))) for f in fs]; print(len(fs), all(open(f).readline().strip() == \"t,engine,variant,input,value,analytic\" for f in fs), max(max(c.values()) for c in n) <= 500)")" = "$(csv_query "$FAST/results.csv" "len({r[\"experiment\"] for r in rows})") True True" ]'
+check "a run directory replays: its scene.scene gives the same trajectory" \
+  '"$PD" run "$FAST/runs/c2_momentum/soft-adaptive/scene.scene" --out "$SCRATCH/replay" >/dev/null 2>&1 &&
+   cmp -s "$SCRATCH/replay/trajectory.csv" "$FAST/runs/c2_momentum/soft-adaptive/trajectory.csv"'
+
+# --- reference engines: rows for every variant, never a failure of the exit status ---------------------
+REF=$SCRATCH/ref
+run_pd gedanken --only a3_sinkage --out "$REF"
+check "all engines: exit 0 when the soft engine passes" '[ $rc -eq 0 ]'
+check "all engines: one soft row and ode/bullet native and matched rows" \
+  '[ "$(csv_query "$REF/results.csv" "[(r[\"engine\"], r[\"variant\"]) for r in rows]")" = "[('"'"'soft'"'"', '"'"'adaptive'"'"'), ('"'"'ode'"'"', '"'"'native'"'"'), ('"'"'ode'"'"', '"'"'matched'"'"'), ('"'"'bullet'"'"', '"'"'native'"'"'), ('"'"'bullet'"'"', '"'"'matched'"'"')]" ]'
+check "all engines: statuses from the schema; a run directory exactly for PASS and FAIL (and some ERRORs)" \
+  '[ "$(csv_query "$REF/results.csv" "all(r[\"status\"] in (\"PASS\", \"FAIL\", \"REFUSED\", \"NOT_BUILT\", \"ERROR\") and (r[\"status\"] == \"ERROR\" or (r[\"run_dir\"] != \"\") == (r[\"status\"] in (\"PASS\", \"FAIL\"))) for r in rows)")" = True ]'
+
+# --- a failing soft experiment exits 1, and still writes its results -----------------------------------
+FAILDIR=$SCRATCH/failing
+run_pd gedanken --only a3_sinkage --engines soft --tolerance-scale 1e-12 --out "$FAILDIR"
+check "a soft FAIL exits 1" '[ $rc -eq 1 ]'
+check "a soft FAIL is named on stderr" 'grep -q "a3_sinkage" "$ERR"'
+check "a soft FAIL is written as FAIL" '[ "$(csv_query "$FAILDIR/results.csv" "rows[0][\"status\"]")" = FAIL ]'
+
+# --- determinism: same bytes whatever the number of threads, except wall times ------------------------
+strip_wall() { python3 -c 'import csv, sys
+for r in csv.reader(open(sys.argv[1], newline="")): print(r[:13] + r[14:])' "$1"; }
+run_pd gedanken --only a1_restitution,c2_momentum,e1_painleve --engines soft --jobs 1 --out "$SCRATCH/det1"
+run_pd gedanken --only a1_restitution,c2_momentum,e1_painleve --engines soft --jobs 3 --out "$SCRATCH/det3"
+check "results.csv identical with 1 and 3 threads (but wall times)" \
+  '[ "$(strip_wall "$SCRATCH/det1/results.csv")" = "$(strip_wall "$SCRATCH/det3/results.csv")" ]'
+check "series and trajectories identical with 1 and 3 threads" \
+  'diff -r -q -x summary.json -x results.csv "$SCRATCH/det1" "$SCRATCH/det3" >/dev/null'
+
+# --- replacing a previous result directory ----------------------------------------------------------------
+touch "$SCRATCH/det1/stale-marker"
+run_pd gedanken --only c2_momentum --engines soft --out "$SCRATCH/det1"
+check "a previous gedanken directory is replaced" \
+  '[ $rc -eq 0 ] && [ ! -e "$SCRATCH/det1/stale-marker" ] && [ "$(csv_query "$SCRATCH/det1/results.csv" "len(rows)")" = 1 ] && no_partial "$SCRATCH/det1"'
+
+# --- bad arguments: exit 2, a message, nothing written ----------------------------------------------
+BADOUT=$SCRATCH/bad
+bad_args() {
+  local name=$1
+  shift
+  run_pd gedanken "$@"
+  check "$name exits 2" '[ $rc -eq 2 ]'
+  check "$name says why as 'polydyn gedanken: ...'" 'grep -q "^polydyn gedanken: " "$ERR"'
+  check "$name writes nothing" '[ ! -e "$BADOUT" ] && no_partial "$BADOUT"'
+}
+bad_args "no --out" --engines soft
+bad_args "an unknown option" --out "$BADOUT" --frobnicate
+bad_args "an unknown experiment" --out "$BADOUT" --only a1_restitution,nosuch
+bad_args "an empty --only item" --out "$BADOUT" --only a1_restitution,
+bad_args "an unknown engine" --out "$BADOUT" --engines soft,physx
+bad_args "an empty engine list" --out "$BADOUT" --engines ""
+bad_args "--jobs 0" --out "$BADOUT" --jobs 0
+bad_args "--jobs not a number" --out "$BADOUT" --jobs two
+bad_args "a negative tolerance scale" --out "$BADOUT" --tolerance-scale -1
+bad_args "--out without a value" --out
+bad_args "an empty selection" --out "$BADOUT" --fast --only a4_elastic_apex
+mkdir -p "$SCRATCH/precious"
+touch "$SCRATCH/precious/keep"
+run_pd gedanken --only c2_momentum --engines soft --out "$SCRATCH/precious"
+check "an existing non-gedanken directory is refused with exit 2" '[ $rc -eq 2 ] && grep -q "not a gedanken directory" "$ERR"'
+check "an existing non-gedanken directory is left alone" '[ -e "$SCRATCH/precious/keep" ] && no_partial "$SCRATCH/precious"'
+
+# --- interruption: exit 130, nothing written ------------------------------------------------------------
+INT=$SCRATCH/interrupted
+"$PD" gedanken --only g1_stack_drift,g1_stack_sinkage,f1_top_precession,d1_rimless_wheel --engines soft --jobs 1 \
+  --out "$INT" >"$OUT" 2>"$ERR" &
+pid=$!
+sleep 0.5
+kill -INT "$pid"
+wait "$pid"
+rc=$?
+check "SIGINT exits 130" '[ $rc -eq 130 ]'
+check "SIGINT says nothing was written" 'grep -q "interrupted" "$ERR"'
+check "SIGINT leaves no directory" '[ ! -e "$INT" ] && no_partial "$INT"'
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
