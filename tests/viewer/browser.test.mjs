@@ -230,3 +230,35 @@ test('a report page with two replays shares one bundle and opens each replay on 
   assert.deepEqual(errors, []);
   await tab.close();
 });
+
+test('PolydynViewer.mount (the report hook) builds from the CSV texts the same run the page embeds, and draws', async () => {
+  const tab = await browser.context.newPage();
+  const errors = [];
+  tab.on('pageerror', (e) => errors.push(e.message));
+  tab.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  await tab.goto(pathToFileURL(pagePath).href);
+  await tab.evaluate(() => window.pdViewer.ready);
+  const files = {
+    run: 'demo',
+    summary: JSON.parse(readFileSync(join(runA, 'summary.json'), 'utf8')),
+    trajectory: readFileSync(join(runA, 'trajectory.csv'), 'utf8'),
+    contacts: readFileSync(join(runA, 'contacts.csv'), 'utf8'),
+  };
+  const r = await tab.evaluate((files) => {
+    const div = document.createElement('div');
+    document.body.prepend(div);
+    const v = window.PolydynViewer.mount(div, files), a = v.runs[0], b = window.pdViewer.main.runs[0];
+    const same = ['t', 'pose', 'vel', 'contactStart', 'contactFloat', 'contactInt']
+      .filter((k) => a[k].length !== b[k].length || a[k].some((x, i) => x !== b[k][i]));
+    v.setTime(a.t[37]);
+    v.renderNow();
+    return { differ: same, contacts: a.contacts, m: v.bodyMatrix(0, 'box'), t: v.t, canvases: div.querySelectorAll('.pdv-view canvas').length };
+  }, files);
+  assert.deepEqual(r.differ, [], 'arrays equal to the embedded (C-read) ones');
+  assert.ok(r.contacts > 0);
+  assert.equal(r.canvases, 1);
+  const row = trajectory(runA, 'box').find((x) => x.t === r.t);
+  assert.ok(maxDiff(r.m.slice(0, 12), poseRows(row)) <= TOL);
+  assert.deepEqual(errors, []);
+  await tab.close();
+});

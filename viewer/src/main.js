@@ -11,11 +11,17 @@
 //   pdViewer.setTime(t)     the main replay at time t, drawn before it returns
 //   pdViewer.loadMs         ms from navigation start to the main replay's first frame
 //   pdViewer.main.timings   ms: start (document parsed), decode (base64 → arrays), build (geometry, UI)
+//
+// window.PolydynViewer is the report's hook (reports/generator/README.md, "Replay hook"):
+//   PolydynViewer.mount(element, { run, summary, trajectory, contacts })
+//                           builds one replay in element from a run directory's files (summary.json
+//                           parsed, the CSV texts) and returns it; on bad input, null (the error is shown in element)
 import css from './style.css';
-import { readReplay } from './data.js';
+import { readReplay, readRunFiles } from './data.js';
 import { Replay } from './replay.js';
 
 const MAX_OPEN = 6;
+const MOUNT_HEIGHT = 600;  // px, of a replay PolydynViewer.mount builds
 const opened = [];
 const api = {
   version: 1,
@@ -85,10 +91,41 @@ function showError(section, e) {
   section.append(p);
 }
 
-function start() {
+let styled = false;
+function addStyle() {
+  if (styled) return;
+  styled = true;
   const style = document.createElement('style');
   style.textContent = css;
   document.head.append(style);
+}
+
+window.PolydynViewer = {
+  version: 1,
+  mount(element, files) {
+    addStyle();
+    try {
+      const t0 = performance.now();
+      const data = readRunFiles(files);
+      const t1 = performance.now();
+      // the replay's own height (as in a report of polydyn view), whatever the element's
+      const holder = document.createElement('div');
+      holder.className = 'pdv-holder';
+      holder.style.height = `${MOUNT_HEIGHT}px`;
+      element.style.height = 'auto';
+      element.append(holder);
+      const replay = new Replay(holder, data);
+      replay.timings = { start: t0, decode: t1 - t0, build: performance.now() - t1 };
+      return replay;
+    } catch (e) {
+      showError(element, e);
+      return null;
+    }
+  },
+};
+
+function start() {
+  addStyle();
   let standalone = false;
   for (const section of document.querySelectorAll('section.pd-replay')) {
     const id = section.id.replace(/^pd-replay-/, '');
