@@ -651,7 +651,7 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   bool written = write_result_csvs(tmp, set, specs, engineCount, &group, 1, path, sizeof path);
   for (int e = 0; e < engineCount && written; ++e) {
     snprintf(path, sizeof path, "%s/params-%s.scene", tmp, specs[e].name);
-    char comment[512], inertia[64] = "that of a uniform cube";
+    char comment[1024], inertia[64] = "that of a uniform cube";
     if (specs[e].params.inertia > 0.0) snprintf(inertia, sizeof inertia, "%g kg m^2", specs[e].params.inertia);
     snprintf(comment, sizeof comment,
              "polydyn cubetoss: parameters of the %s engine in this run (%.300s),\n"
