@@ -275,7 +275,7 @@ bool pd_broad_grid_update(pdBroadGrid* g, const pdAabb* boxes) {
       if (overlap(&g->boxes[p], &g->boxes[q]) && !add_pair(g, p, q)) return false;
     }
   }
-  qsort(g->pairs, g->pairCount, sizeof *g->pairs, compare_pairs);
+  if (g->pairCount > 1) qsort(g->pairs, g->pairCount, sizeof *g->pairs, compare_pairs);  // pairs may be NULL when empty
   g->stats.entries = (long long)count;
   g->stats.large = largeCount;
   g->stats.tests = tests;
