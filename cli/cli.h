@@ -11,6 +11,7 @@ enum { PD_EXIT_OK = 0, PD_EXIT_FAILURE = 1, PD_EXIT_BAD_INPUT = 2 };
 
 int pd_cmd_run(int argc, char** argv);
 int pd_cmd_check(int argc, char** argv);
+int pd_cmd_oracle(int argc, char** argv);
 
 // Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr; returns 2.
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) __attribute__((format(printf, 2, 3)));

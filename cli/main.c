@@ -17,6 +17,7 @@ static const char* const usage =
     "  run SCENE [--out DIR] [--tend T] [--sample HZ] [--stepper adaptive|fixed]\n"
     "                 simulate a scene, write trajectory.csv and summary.json into DIR\n"
     "  check SCENE    parse and compile a scene; print masses, inertias, polyhedra, settings\n"
+    "  oracle (SCENE | --random N --seed S | --replay FILE)  interference test vs libccd\n"
     "  help           this text\n"
     "  --version      print the version\n"
     "\n"
@@ -53,6 +54,7 @@ int main(int argc, char** argv) {
   const char* cmd = argv[1];
   if (strcmp(cmd, "run") == 0) return pd_cmd_run(argc - 1, argv + 1);
   if (strcmp(cmd, "check") == 0) return pd_cmd_check(argc - 1, argv + 1);
+  if (strcmp(cmd, "oracle") == 0) return pd_cmd_oracle(argc - 1, argv + 1);
   if (strcmp(cmd, "help") == 0 || pd_cli_is_help(cmd)) {
     fputs(usage, stdout);
     return PD_EXIT_OK;
