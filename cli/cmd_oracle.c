@@ -30,12 +30,13 @@ static const char* const help =
     "  --sample HZ    SCENE: output samples per second, overrides the scene's sample\n"
     "  --replay FILE  checks again every pair listed in a CSV written by this command\n"
     "  --out FILE     the CSV of every pair that is not a plain agreement, with both shapes and poses\n"
-    "                 (default for --random: out/oracle/random-seed-S-N.csv; for SCENE:\n"
-    "                 out/oracle/NAME.csv; --replay writes one only when asked)\n"
+    "                 (default for --random: out/random-seed-S-N.oracle.csv; for SCENE:\n"
+    "                 out/NAME.oracle.csv; --replay writes one only when asked)\n"
     "\n"
-    "A verdict mismatch where either depth is within 1e-7 x (r_A + r_B) of touching is counted as\n"
-    "touching, not as a failure. Exit status: 0 no disagreement outside that band, 1 a disagreement\n"
-    "outside it (or the soft run failed), 2 bad input, 130 interrupted (no CSV written).\n";
+    "libccd's verdict is GJK's (MPR is reported beside it). A verdict mismatch where either depth is\n"
+    "within 1e-7 x (r_A + r_B) of touching is counted as touching, not as a failure. Exit status: 0 no\n"
+    "disagreement with GJK outside that band, 1 a disagreement outside it (or the soft run failed),\n"
+    "2 bad input, 130 interrupted (no CSV written).\n";
 
 static volatile sig_atomic_t interrupted = 0;
 static void on_signal(int sig) {
@@ -43,11 +44,14 @@ static void on_signal(int sig) {
   interrupted = 1;
 }
 
-static double wall_now(void) {
+static double clock_now(clockid_t id) {
   struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
+  clock_gettime(id, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+static double wall_now(void) { return clock_now(CLOCK_MONOTONIC); }
+// on a shared machine the CPU time says what the work costs
+static double cpu_now(void) { return clock_now(CLOCK_PROCESS_CPUTIME_ID); }
 
 // ---------------------------------------------------------------- the CSV, written under a temporary name
 
@@ -58,18 +62,6 @@ typedef struct csvOut {
   long rows;
 } csvOut;
 
-// mkdir -p of the directories above `path`; a real failure shows when the file is created
-static void make_parents(const char* path) {
-  char* p = strdup(path);
-  if (!p) abort();
-  for (char* slash = strchr(p + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
-    *slash = '\0';
-    mkdir(p, 0777);
-    *slash = '/';
-  }
-  free(p);
-}
-
 static bool csv_open(csvOut* c, const char* path) {
   memset(c, 0, sizeof *c);
   c->path = strdup(path);
@@ -77,7 +69,7 @@ static bool csv_open(csvOut* c, const char* path) {
   c->partial = malloc(n);
   if (!c->path || !c->partial) abort();
   snprintf(c->partial, n, "%s.partial-XXXXXX", path);
-  make_parents(path);
+  pd_cli_make_parents(path);
   int fd = mkstemp(c->partial);
   if (fd < 0 || !(c->f = fdopen(fd, "w"))) {
     fprintf(stderr, "polydyn oracle: %s: cannot write: %s\n", path, strerror(errno));
@@ -149,7 +141,7 @@ static void progress_end(const progress* p) {
 static int run_random(long n, unsigned long long seed, const char* out) {
   char defaultOut[96];
   if (!out) {
-    snprintf(defaultOut, sizeof defaultOut, "out/oracle/random-seed-%llu-%ld.csv", seed, n);
+    snprintf(defaultOut, sizeof defaultOut, "out/random-seed-%llu-%ld.oracle.csv", seed, n);
     out = defaultOut;
   }
   csvOut csv;
@@ -160,7 +152,7 @@ static int run_random(long n, unsigned long long seed, const char* out) {
   pd_oracle_stats_init(&stats);
   long placements[3] = {0, 0, 0};
   progress prog = {isatty(STDERR_FILENO) == 1, wall_now()};
-  double t0 = wall_now();
+  double t0 = wall_now(), c0 = cpu_now();
   for (long i = 0; i < n && !interrupted; ++i) {
     pdOraclePair p;
     pd_oracle_random_pair(&g, &p);
@@ -183,7 +175,7 @@ static int run_random(long n, unsigned long long seed, const char* out) {
   printf("polydyn oracle: %ld random pairs, seed %llu (placed near touching %ld, at touching %ld, anywhere %ld)\n", n,
          seed, placements[pd_placeNear], placements[pd_placeTouch], placements[pd_placeFar]);
   pd_oracle_stats_print(&stats, stdout);
-  printf("time: total %.2f s (shapes, placement and checks)\n", wall_now() - t0);
+  printf("time: total wall %.2f s, CPU %.2f s (shapes, placement and checks)\n", wall_now() - t0, cpu_now() - c0);
   long rows = csv.rows;
   bool written = csv_finish(&csv);
   if (written) printf("listed: %ld pairs in %s\n", rows, out);
@@ -225,17 +217,14 @@ static bool observe(const pdModel* model, const pdState* state, void* user) {
   return !interrupted;
 }
 
-// out/oracle/NAME.csv for scene path .../NAME.ext
+// out/NAME.oracle.csv for scene path .../NAME.ext
 static char* default_scene_out(const char* scene) {
-  const char* base = strrchr(scene, '/');
-  base = base ? base + 1 : scene;
-  size_t n = strlen(base);
-  const char* dot = strrchr(base, '.');
-  if (dot && dot != base) n = (size_t)(dot - base);
-  size_t size = n + 20;
+  char* dir = pd_cli_default_out_dir(scene);
+  size_t size = strlen(dir) + sizeof ".oracle.csv";
   char* path = malloc(size);
   if (!path) abort();
-  snprintf(path, size, "out/oracle/%.*s.csv", (int)n, base);
+  snprintf(path, size, "%s.oracle.csv", dir);
+  free(dir);
   return path;
 }
 
@@ -264,9 +253,9 @@ static int run_scene(const char* path, const pdCliOverrides* overrides, const ch
   pdState* state = NULL;
   if (!csv_open(&c.csv, out)) goto done;
   state = pd_state_create(model);
-  double t0 = wall_now();
+  double t0 = wall_now(), c0 = cpu_now();
   bool completed = pd_advance(model, state, model->settings.tend, observe, &c);
-  double wall = wall_now() - t0;
+  double wall = wall_now() - t0, cpu = cpu_now() - c0;
   progress_end(&c.prog);
   if (interrupted) {
     csv_abort(&c.csv);
@@ -276,7 +265,7 @@ static int run_scene(const char* path, const pdCliOverrides* overrides, const ch
   }
   printf("polydyn oracle: %s, %d bodies, %ld samples to t = %.6g s\n", path, model->bodyCount, c.sample, state->t);
   pd_oracle_stats_print(&c.stats, stdout);
-  printf("time: total %.2f s (the soft run and the checks)\n", wall);
+  printf("time: total wall %.2f s, CPU %.2f s (the soft run and the checks)\n", wall, cpu);
   long rows = c.csv.rows;
   bool written = csv_finish(&c.csv);
   if (written) printf("listed: %ld pairs in %s\n", rows, out);

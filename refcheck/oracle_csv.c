@@ -14,7 +14,7 @@
 static const char* const header =
     "source,index,t,kind,name_a,name_b,shape_a,shape_b,"
     "ax,ay,az,aqw,aqx,aqy,aqz,bx,by,bz,bqw,bqx,bqy,bqz,"
-    "our_verdict,our_depth,gjk_verdict,mpr_verdict,epa_depth,mpr_depth,scale,size\n";
+    "our_verdict,our_depth,gjk_verdict,mpr_verdict,epa_depth,mpr_depth,scale,size,epa_tol\n";
 
 void pd_oracle_csv_header(FILE* out) { fputs(header, out); }
 
@@ -63,6 +63,7 @@ void pd_oracle_csv_write(FILE* out, const pdOracleRow* row) {
   put_optional(out, r->hasMprDepth, r->mprDepth);
   put_number(out, r->scale);
   put_number(out, r->size);
+  put_optional(out, r->hasEpa, r->epaTol);
   fputc('\n', out);
 }
 
@@ -180,5 +181,7 @@ bool pd_oracle_csv_read(char* buf, pdOracleRow* row, int* col, char* why, int wh
     return fail(col, at[27], why, whySize, "not a finite number", f[27]);
   if (!read_number(f[28], &r->scale)) return fail(col, at[28], why, whySize, "not a finite number", f[28]);
   if (!read_number(f[29], &r->size)) return fail(col, at[29], why, whySize, "not a finite number", f[29]);
+  if (r->hasEpa != (f[30][0] != '\0') || (r->hasEpa && !read_number(f[30], &r->epaTol)))
+    return fail(col, at[30], why, whySize, "not a finite number, or given without epa_depth", f[30]);
   return true;
 }

@@ -9,7 +9,8 @@
 //   along a face normal of the Minkowski difference (a lower bound of the distance). libccd gives no
 //   depth for a separated pair (libccd 2.1 has no distance query).
 // - The verdicts: ours is pd_interference (touching counts as overlapping); libccd's is ccdGJKIntersect;
-//   ccdMPRIntersect is compared too and reported on its own.
+//   ccdMPRIntersect is a second opinion, reported on its own (it has false positives on near-degenerate
+//   portals, e.g. a cube falling vertex first onto a cube's vertex, 1 mm apart).
 // - Scales: `scale` = r_A + r_B, the radii about each body's vertex average; libccd works in coordinates
 //   divided by it (so its absolute epsilons become relative), and the touching band is relative to it.
 //   `size` = the smaller body's average dimension (mean of its bounding-box extents, as pdBody.size);
@@ -43,28 +44,28 @@
 // the support points (measured: README "Interference oracle").
 #define PD_ORACLE_TOUCH_REL 1e-7
 
-// EPA stops when the new support point gains less than this over the nearest face, in libccd's
-// units: the gain times the current depth, in scaled lengths squared (libccd's default, 1e-4, leaves
-// shallow depths wrong by up to the whole depth). Measured on 3000 random pairs near touching: at 1e-12
-// … 1e-16 the depths agree with ours to 1.4e-14 × size; at 1e-16 and below EPA keeps adding points
-// that gain only rounding noise on a few pairs (3 in 3000 reached the support cap at 1e-16, 2 in 300
-// at 1e-18); 1e-15 had none and is the tightest value without that.
+// EPA's stopping rule, in libccd's units (scaled coordinates): it stops when the new support point gains
+// less than `tol` over the nearest face, the gain multiplied by the current depth d (units²), or lies
+// within √tol of that face. Its depth, a lower bound, is then short by at most
+//     epaBound = scale · max(tol / d, √tol)                        (d in scaled lengths)
+// (libccd's default, 1e-4, allows a whole shallow depth). We ask for PD_ORACLE_EPA_TOL. On some face–face
+// contacts (a block resting on a slab) libccd's EPA, which does not keep its polytope convex, adds the
+// same Minkowski vertex again and again and never stops at that tolerance: when a query runs out of
+// support calls it is retried PD_ORACLE_EPA_RETRIES times, each 100 times looser (cases/hard/mass_ratio
+// at t = 0.14 s: cycles at 1e-15, answers at 1e-13 short by 5.6e-8 m, its bound 4.5e-7 m).
+// At 1e-15 the random pairs agree with our depth to 1.4e-14 × size (README "Interference oracle").
 #define PD_ORACLE_EPA_TOL 1e-15
+#define PD_ORACLE_EPA_RETRIES 2
 // MPR stops refining its portal when a new support point moves it by less than this, in scaled
 // lengths (1e-12 × scale; libccd's default 1e-4 stops that far from the boundary).
 #define PD_ORACLE_MPR_TOL 1e-12
-// GJK iterations before libccd gives up (its default is unbounded); a pair of polyhedra with V_A·V_B
-// Minkowski vertices needs far fewer.
+// Support calls per libccd query before the support function stops moving (see the top of this file).
+// A converging EPA or MPR query took at most 60 on 5000 random pairs; a cycling EPA's polytope search
+// costs O(calls²), about 5 ms at this cap.
+#define PD_ORACLE_SUPPORT_CAP 1000
+// GJK's own iteration limit (libccd's default is unbounded; at the limit it silently answers "separate"):
+// two support calls per iteration, so the support cap above ends a stuck GJK first and marks it stalled.
 #define PD_ORACLE_GJK_ITERATIONS 1000
-// Support calls per libccd query before the support function stops moving (see above): 2000 EPA
-// iterations. EPA's polytope search is linear in its size, so a stuck query costs O(cap²) (0.15 s at
-// 2000 calls), and a converging one on two 642-vertex spheres needs far fewer.
-#define PD_ORACLE_SUPPORT_CAP 4000
-
-// Depth agreement: |EPA − ours| above PD_ORACLE_DEPTH_TOL_REL × size, on a pair both call overlapping
-// and deeper than the touching band, is listed as a `depth` row. EPA's depth is a lower bound that
-// converges to the exact one (ours is exact up to rounding, tests/engine/test_interference.c).
-#define PD_ORACLE_DEPTH_TOL_REL 1e-6
 
 typedef struct pdOracleBody {
   const pdPolyhedron* shape;  // in the body's own frame
@@ -80,8 +81,9 @@ typedef enum pdOracleKind {
   pd_oracleWeSeparate,     // we separate, GJK overlaps, outside the touching band
   pd_oracleTouching,       // verdicts differ (ours vs GJK or vs MPR) inside the touching band
   pd_oracleMprDiffers,     // ours and GJK agree, MPR differs, outside the band
-  pd_oracleDepth,          // both overlap; |EPA − ours| > PD_ORACLE_DEPTH_TOL_REL × size
-  pd_oracleStalled,        // libccd hit PD_ORACLE_SUPPORT_CAP or EPA gave no depth: not compared
+  pd_oracleDepth,          // both overlap outside the band; |EPA − ours| > epaBound
+  pd_oracleStalled,        // a libccd query ran out of support calls (every EPA tolerance), or EPA gave
+                           // no depth: not compared
   pd_oracleKindCount
 } pdOracleKind;
 
@@ -97,12 +99,14 @@ typedef struct pdOracleResult {
   bool mpr;            // ccdMPRIntersect
   bool hasEpa;         // epaDepth is valid: GJK overlaps and EPA returned a finite depth >= 0
   double epaDepth;     // m: ccdGJKPenetration's depth (0 when !hasEpa)
+  double epaTol;       // the EPA tolerance that answered (PD_ORACLE_EPA_TOL or a retry's; 0 when !hasEpa)
+  double epaBound;     // m: how far EPA's stopping rule lets its depth fall short (see above)
   bool hasMprDepth;    // mprDepth is valid
   double mprDepth;     // m: ccdMPRPenetration's depth along its portal (not the minimum) (0 when not)
-  bool stalled;        // a libccd query hit PD_ORACLE_SUPPORT_CAP
+  bool stalled;        // a libccd query ran out of support calls (EPA: at every tolerance)
   bool touching;       // min(|ourDepth|, epaDepth) < PD_ORACLE_TOUCH_REL × scale
   pdOracleKind kind;
-  double secondsOurs, secondsCcd;  // wall time of our SAT and of the four libccd queries
+  double secondsOurs, secondsCcd;  // CPU time of our SAT and of the four libccd queries, s
 } pdOracleResult;
 
 // Checks one pair: our SAT (minimum-depth mode, no cache) and libccd's four queries. Never fails; a
@@ -121,17 +125,22 @@ typedef struct pdOracleStats {
   long kinds[pd_oracleKindCount];
   long inBand;            // pairs inside the touching band (whatever their verdicts)
   long gjkMprDiffer;      // GJK and MPR verdicts differ (any band)
-  long mprDepthMissing;   // both overlap but ccdMPRPenetration gave no depth
-  pdOracleSample epaError;  // (EPA − ours)/size over pairs both call overlapping
-  pdOracleSample mprError;  // (MPR − ours)/size over the same pairs
-  pdOracleSample ourDepth;  // ours/size over the same pairs (to read the errors against)
-  double secondsOurs, secondsCcd;
+  long mprDepthMissing;   // all three overlap outside the band but ccdMPRPenetration gave no depth
+  long epaRetried;        // EPA answered only at a looser tolerance
+  // over the pairs ours, GJK and EPA call overlapping, outside the touching band:
+  pdOracleSample epaError;  // (EPA − ours)/size
+  pdOracleSample mprError;  // (MPR − ours)/size, where MPR overlaps and gave a depth
+  pdOracleSample ourDepth;  // ours/size (to read the errors against)
+  // and inside the band:
+  pdOracleSample epaErrorInBand;  // (EPA − ours)/size
+  double secondsOurs, secondsCcd;  // CPU time
 } pdOracleStats;
 
 void pd_oracle_stats_init(pdOracleStats* s);
 void pd_oracle_stats_add(pdOracleStats* s, const pdOracleResult* r);
 void pd_oracle_stats_free(pdOracleStats* s);
-// Pairs whose verdicts disagree outside the touching band (ours vs GJK, ours vs MPR): the failures.
+// Pairs whose verdict disagrees with libccd's (GJK's) outside the touching band: the failures. (MPR
+// differing from both ours and GJK is libccd against itself: listed, not a failure.)
 long pd_oracle_stats_failures(const pdOracleStats* s);
 // The summary: counts by kind, the band, depth error statistics (max, median, 99th percentile of
 // |error|/size, and the signed extremes), time. Deterministic except the line starting with "time".
@@ -210,5 +219,5 @@ void pd_oracle_csv_write(FILE* out, const pdOracleRow* row);
 // Reads one data line of that CSV (no newline) into `fields` (borrowed pointers into `buf`, a copy of
 // the line the caller owns) and the row's poses. Returns false with a message and the 1-based column
 // of the bad field in *col.
-enum { PD_ORACLE_CSV_FIELDS = 30 };
+enum { PD_ORACLE_CSV_FIELDS = 31 };
 bool pd_oracle_csv_read(char* buf, pdOracleRow* row, int* col, char* why, int whySize);
