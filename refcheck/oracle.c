@@ -129,9 +129,10 @@ static void epa(const ccdBody* A, const ccdBody* B, ccd_t* ccd, pdOracleResult* 
     bool stalled;
     out->hasEpa = ccd_depth(ccdGJKPenetration, A, B, ccd, out->scale, &stalled, &out->epaDepth);
     if (!stalled) {
+      // a depth below the band is EPA calling the pair touching: held to the bound at the band's edge
+      double d = fmax(out->epaDepth / out->scale, PD_ORACLE_TOUCH_REL);
       out->epaTol = out->hasEpa ? tol : 0.0;
-      double d = out->epaDepth / out->scale;
-      out->epaBound = out->hasEpa ? out->scale * fmax(d > 0.0 ? tol / d : INFINITY, sqrt(tol)) : 0.0;
+      out->epaBound = out->hasEpa ? out->scale * fmax(tol / d, sqrt(tol)) : 0.0;
       return;
     }
   }
@@ -147,7 +148,9 @@ static pdOracleKind classify(const pdOracleResult* r) {
     return pd_oracleMprDiffers;
   }
   if (!r->ours) return pd_oracleAgreeSeparate;
-  if (!r->touching && fabs(r->epaDepth - r->ourDepth) > r->epaBound) return pd_oracleDepth;
+  // EPA's depth against ours wherever ours is outside the band (an EPA depth near 0 included)
+  if (r->ourDepth >= PD_ORACLE_TOUCH_REL * r->scale && fabs(r->epaDepth - r->ourDepth) > r->epaBound)
+    return pd_oracleDepth;
   return pd_oracleAgreeOverlap;
 }
 
@@ -189,14 +192,13 @@ void pd_oracle_check(const pdOracleBody* a, const pdOracleBody* b, pdOracleResul
   calls = 0;
   out->mpr = ccdMPRIntersect(&A, &B, &ccd) != 0;
   stalled = stalled || calls > PD_ORACLE_SUPPORT_CAP;
-  if (out->gjk) epa(&A, &B, &ccd, out);
-  if (out->mpr) {
+  // depths only from usable verdicts; an MPR depth that stalls is only missing (counted in the stats)
+  if (out->gjk && !stalled) epa(&A, &B, &ccd, out);
+  if (out->mpr && !stalled) {
     bool mprStalled;
     out->hasMprDepth = ccd_depth(ccdMPRPenetration, &A, &B, &ccd, out->scale, &mprStalled, &out->mprDepth);
-    stalled = stalled || mprStalled;
   }
   out->stalled = out->stalled || stalled;
-  if (out->stalled) out->hasEpa = out->hasMprDepth = false;
   double t2 = cpu_seconds();
 
   double band = PD_ORACLE_TOUCH_REL * out->scale;
@@ -231,12 +233,14 @@ void pd_oracle_stats_add(pdOracleStats* s, const pdOracleResult* r) {
   ++s->pairs;
   ++s->kinds[r->kind];
   if (r->hasEpa && r->epaTol > PD_ORACLE_EPA_TOL) ++s->epaRetried;
+  if (r->kind == pd_oracleDepth && r->hasMprDepth && fabs(r->mprDepth - r->ourDepth) <= r->epaBound) ++s->depthMprAgrees;
   if (r->touching) ++s->inBand;
   if (!r->stalled && r->gjk != r->mpr) ++s->gjkMprDiffer;
   s->secondsOurs += r->secondsOurs;
   s->secondsCcd += r->secondsCcd;
   if (!(r->ours && r->gjk && r->hasEpa)) return;
-  if (r->touching) {
+  // split by our depth: an EPA depth near 0 on a pair we find deep is an EPA error, not touching
+  if (r->ourDepth < PD_ORACLE_TOUCH_REL * r->scale) {
     sample_push(&s->epaErrorInBand, (r->epaDepth - r->ourDepth) / r->size);
     return;
   }
@@ -293,13 +297,15 @@ void pd_oracle_stats_print(const pdOracleStats* s, FILE* out) {
   fprintf(out, "GJK and MPR verdicts differ: %ld (any band)\n", s->gjkMprDiffer);
   fprintf(out, "not compared (libccd stalled or EPA gave no depth): %ld\n", k[pd_oracleStalled]);
   fprintf(out, "EPA answered only at a looser tolerance (it cycles at %g): %ld\n", PD_ORACLE_EPA_TOL, s->epaRetried);
-  fprintf(out, "depth outliers (|EPA - ours| beyond EPA's own error bound, outside the band): %ld\n", k[pd_oracleDepth]);
-  fprintf(out, "depth errors over the pairs ours, GJK and EPA call overlapping, relative to the smaller body's size:\n");
-  print_errors(out, "  |EPA - ours|, outside the band", &s->epaError);
-  print_errors(out, "  |EPA - ours|, inside the band", &s->epaErrorInBand);
-  print_errors(out, "  |MPR - ours|, outside the band (MPR: along its portal, not the minimum)", &s->mprError);
+  fprintf(out, "depth outliers (|EPA - ours| beyond EPA's own error bound, our depth outside the band): %ld, "
+               "MPR's depth agrees with ours on %ld of them\n", k[pd_oracleDepth], s->depthMprAgrees);
+  fprintf(out, "depth errors over the pairs ours, GJK and EPA call overlapping, relative to the smaller body's size,\n"
+               "with our depth outside or inside the band:\n");
+  print_errors(out, "  |EPA - ours|, outside", &s->epaError);
+  print_errors(out, "  |EPA - ours|, inside", &s->epaErrorInBand);
+  print_errors(out, "  |MPR - ours|, outside (MPR: along its portal, not the minimum)", &s->mprError);
   if (s->mprDepthMissing) fprintf(out, "  (MPR overlapped but gave no depth on %ld of these pairs)\n", s->mprDepthMissing);
-  print_errors(out, "  ours, outside the band", &s->ourDepth);
+  print_errors(out, "  ours, outside", &s->ourDepth);
   double n = s->pairs > 0 ? (double)s->pairs : 1.0;
   fprintf(out, "time (CPU): ours %.3f s (%.1f us/pair), libccd %.3f s (%.1f us/pair)\n", s->secondsOurs,
           1e6 * s->secondsOurs / n, s->secondsCcd, 1e6 * s->secondsCcd / n);

@@ -150,6 +150,30 @@ static void test_a_block_resting_on_a_slab_gets_an_epa_depth_within_its_bound(vo
   pd_oracle_shape_free(&block);
 }
 
+static void test_resting_block_depth_equals_mprs_when_epa_takes_its_touching_shortcut(void** state) {
+  (void)state;
+  // cases/hard/mass_ratio.scene at t = 0.152 s, block resting flat on the floor 1.34e-4 m deep: libccd's
+  // GJK ends with the origin within DBL_EPSILON (squared) of a simplex face, and EPA then reports that
+  // face's distance, ~4e-9 m. MPR, along the centre line onto the floor's face, gives the exact depth.
+  pdOracleShape floor = shape("cube 1.5 1.5 0.10000000000000001");
+  pdOracleShape block = shape("cube 0.5 0.5 0.20000000000000001");
+  pdOracleBody A = {&floor.poly, {0, 0, -0.050000000000000003}, {1, 0, 0, 0}};
+  pdOracleBody B = {&block.poly,
+                    {-7.1233592156859987e-09, 2.6378821116571543e-08, 0.09986604738503238},
+                    {0.99999999999999867, -5.070507188534073e-08, 1.5371519245006506e-08, 4.7885366486010021e-09}};
+  pdOracleResult r;
+  pd_oracle_check(&A, &B, &r);
+  print_message("ours %.17g, MPR %.17g, EPA %.17g (tol %g, bound %.3g m) -> %s\n", r.ourDepth, r.mprDepth, r.epaDepth,
+                r.epaTol, r.epaBound, pdOracleKindNames[r.kind]);
+  assert_true(r.ours && r.gjk && r.mpr && r.hasMprDepth);
+  assert_true(fabs(r.mprDepth - r.ourDepth) <= CLOSED_TOL);
+  assert_true(r.ourDepth > 1e-4 && r.ourDepth < 2e-4);
+  // EPA either agrees within its bound, or the pair is listed as a depth outlier (never a verdict failure)
+  assert_true(fabs(r.epaDepth - r.ourDepth) <= r.epaBound ? r.kind == pd_oracleAgreeOverlap : r.kind == pd_oracleDepth);
+  pd_oracle_shape_free(&floor);
+  pd_oracle_shape_free(&block);
+}
+
 static void test_2000_random_pairs_near_touching_agree_outside_the_band(void** state) {
   (void)state;
   enum { PAIRS = 2000 };
@@ -322,6 +346,7 @@ int main(void) {
       cmocka_unit_test(test_vertex_on_face_and_crossed_edges_give_the_closed_form_depth),
       cmocka_unit_test(test_exact_touching_is_never_a_failure_and_gives_no_nan),
       cmocka_unit_test(test_a_block_resting_on_a_slab_gets_an_epa_depth_within_its_bound),
+      cmocka_unit_test(test_resting_block_depth_equals_mprs_when_epa_takes_its_touching_shortcut),
       cmocka_unit_test(test_2000_random_pairs_near_touching_agree_outside_the_band),
       cmocka_unit_test(test_seeded_generator_repeats_and_seeds_differ),
       cmocka_unit_test(test_specs_rebuild_the_models_polyhedra_bit_for_bit),

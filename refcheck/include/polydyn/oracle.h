@@ -24,8 +24,10 @@
 // - GJK and MPR declare touching when a squared distance is below DBL_EPSILON, i.e. within about
 //   1.5e-8 × scale: verdicts closer to touching than the band below are not comparable;
 // - the EPA and MPR loops have no iteration bound: the support function counts its calls and, past
-//   PD_ORACLE_SUPPORT_CAP, answers the body's centre, which ends every libccd loop; the pair is then
-//   reported as `ccd_stalled` and not compared.
+//   PD_ORACLE_SUPPORT_CAP, answers the body's centre, which ends every libccd loop; EPA is then retried
+//   at a looser tolerance (below), and a pair with no usable answer is `ccd_stalled`, not compared;
+// - when GJK calls a separated pair touching (a gap below ~2e-8 × scale), EPA's depth is meaningless
+//   (measured up to 0.59 × scale): the touching band takes the smaller of the two depths.
 // - pkg-config reports libccd as version 2.0 although Debian ships 2.1 (upstream never bumped it).
 #pragma once
 
@@ -47,15 +49,17 @@
 // EPA's stopping rule, in libccd's units (scaled coordinates): it stops when the new support point gains
 // less than `tol` over the nearest face, the gain multiplied by the current depth d (units²), or lies
 // within √tol of that face. Its depth, a lower bound, is then short by at most
-//     epaBound = scale · max(tol / d, √tol)                        (d in scaled lengths)
+//     epaBound = scale · max(tol / d, √tol)       (d in scaled lengths, at least PD_ORACLE_TOUCH_REL)
 // (libccd's default, 1e-4, allows a whole shallow depth). We ask for PD_ORACLE_EPA_TOL. On some face–face
 // contacts (a block resting on a slab) libccd's EPA, which does not keep its polytope convex, adds the
 // same Minkowski vertex again and again and never stops at that tolerance: when a query runs out of
-// support calls it is retried PD_ORACLE_EPA_RETRIES times, each 100 times looser (cases/hard/mass_ratio
-// at t = 0.14 s: cycles at 1e-15, answers at 1e-13 short by 5.6e-8 m, its bound 4.5e-7 m).
+// support calls it is retried PD_ORACLE_EPA_RETRIES times, each 100 times looser, up to 1e-7
+// (cases/hard/mass_ratio, block on floor: at t = 0.14 s it cycles at 1e-15 and answers at 1e-13, short
+// by 5.6e-8 m, bound 4.5e-7 m; at t = 0.164 s it cycles up to 1e-9 and answers at 1e-7, short by 1e-8 m,
+// bound 1.4e-3 m: at such a tolerance EPA says little).
 // At 1e-15 the random pairs agree with our depth to 1.4e-14 × size (README "Interference oracle").
 #define PD_ORACLE_EPA_TOL 1e-15
-#define PD_ORACLE_EPA_RETRIES 2
+#define PD_ORACLE_EPA_RETRIES 4
 // MPR stops refining its portal when a new support point moves it by less than this, in scaled
 // lengths (1e-12 × scale; libccd's default 1e-4 stops that far from the boundary).
 #define PD_ORACLE_MPR_TOL 1e-12
@@ -81,8 +85,8 @@ typedef enum pdOracleKind {
   pd_oracleWeSeparate,     // we separate, GJK overlaps, outside the touching band
   pd_oracleTouching,       // verdicts differ (ours vs GJK or vs MPR) inside the touching band
   pd_oracleMprDiffers,     // ours and GJK agree, MPR differs, outside the band
-  pd_oracleDepth,          // both overlap outside the band; |EPA − ours| > epaBound
-  pd_oracleStalled,        // a libccd query ran out of support calls (every EPA tolerance), or EPA gave
+  pd_oracleDepth,          // both overlap, our depth outside the band; |EPA − ours| > epaBound
+  pd_oracleStalled,        // GJK or MPR ran out of support calls, or EPA did at every tolerance or gave
                            // no depth: not compared
   pd_oracleKindCount
 } pdOracleKind;
@@ -103,7 +107,7 @@ typedef struct pdOracleResult {
   double epaBound;     // m: how far EPA's stopping rule lets its depth fall short (see above)
   bool hasMprDepth;    // mprDepth is valid
   double mprDepth;     // m: ccdMPRPenetration's depth along its portal (not the minimum) (0 when not)
-  bool stalled;        // a libccd query ran out of support calls (EPA: at every tolerance)
+  bool stalled;        // GJK or MPR (verdict) ran out of support calls, or EPA did at every tolerance
   bool touching;       // min(|ourDepth|, epaDepth) < PD_ORACLE_TOUCH_REL × scale
   pdOracleKind kind;
   double secondsOurs, secondsCcd;  // CPU time of our SAT and of the four libccd queries, s
@@ -127,11 +131,12 @@ typedef struct pdOracleStats {
   long gjkMprDiffer;      // GJK and MPR verdicts differ (any band)
   long mprDepthMissing;   // all three overlap outside the band but ccdMPRPenetration gave no depth
   long epaRetried;        // EPA answered only at a looser tolerance
-  // over the pairs ours, GJK and EPA call overlapping, outside the touching band:
+  long depthMprAgrees;    // depth outliers where MPR's depth is within EPA's bound of ours (EPA is off)
+  // over the pairs ours, GJK and EPA call overlapping, our depth outside the touching band:
   pdOracleSample epaError;  // (EPA − ours)/size
   pdOracleSample mprError;  // (MPR − ours)/size, where MPR overlaps and gave a depth
   pdOracleSample ourDepth;  // ours/size (to read the errors against)
-  // and inside the band:
+  // and our depth inside it:
   pdOracleSample epaErrorInBand;  // (EPA − ours)/size
   double secondsOurs, secondsCcd;  // CPU time
 } pdOracleStats;
