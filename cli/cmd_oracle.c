@@ -31,7 +31,7 @@ static const char* const help =
     "  --replay FILE  checks again every pair listed in a CSV written by this command\n"
     "  --out FILE     the CSV of every pair that is not a plain agreement, with both shapes and poses\n"
     "                 (default for --random: out/random-seed-S-N.oracle.csv; for SCENE:\n"
-    "                 out/NAME.oracle.csv; --replay writes one only when asked)\n"
+    "                 out/NAME.oracle.csv); with --replay, every replayed pair, only when asked\n"
     "\n"
     "libccd's verdict is GJK's (MPR is reported beside it). A verdict mismatch where either depth is\n"
     "within 1e-7 x (r_A + r_B) of touching is counted as touching, not as a failure. Exit status: 0 no\n"
@@ -381,6 +381,7 @@ static bool replay_rows(const char* path, const lines* l, char* rowBuf, bool che
            row.r.ours ? "overlap" : "separate", row.r.ourDepth, row.r.gjk ? "overlap" : "separate",
            row.r.mpr ? "overlap" : "separate");
     if (row.r.hasEpa) printf(", EPA %.3g m", row.r.epaDepth);
+    if (row.r.hasMprDepth) printf(", MPR depth %.3g m", row.r.mprDepth);
     printf(")\n");
   }
   for (int k = 0; k < 2; ++k)

@@ -199,8 +199,9 @@ static void test_2000_random_pairs_near_touching_agree_outside_the_band(void** s
         fail_msg("pair %d (%s | %s): depth ours %.17g, EPA %.17g (size %g)", i, p.a.spec, p.b.spec, r.ourDepth,
                  r.epaDepth, r.size);
     }
-    // a mismatch inside the band is one of libccd's touching calls: within 2e-8 of the scale
-    if (r.kind == pd_oracleTouching) assert_true(fabs(r.ourDepth) < 2e-8 * r.scale || r.epaDepth < 2e-8 * r.scale);
+    // a mismatch inside the band is one of libccd's touching calls, within √DBL_EPSILON ≈ 1.5e-8 of the
+    // scale (measured at most 1.9e-8 on 100 000 pairs): below 3e-8
+    if (r.kind == pd_oracleTouching) assert_true(fabs(r.ourDepth) < 3e-8 * r.scale || r.epaDepth < 3e-8 * r.scale);
     pd_oracle_pair_free(&p);
   }
   long both = s.kinds[pd_oracleAgreeOverlap] + s.kinds[pd_oracleDepth], apart = s.kinds[pd_oracleAgreeSeparate];

@@ -42,8 +42,9 @@
 // Touching band, relative to the pair's scale r_A + r_B: a pair whose |depth| by either method is
 // below PD_ORACLE_TOUCH_REL × scale is "touching", and a verdict mismatch there is counted apart, not
 // as a failure. libccd's touching tests (ccdIsZero on squared distances, DBL_EPSILON) decide within
-// sqrt(2.2e-16) ≈ 1.5e-8 of the scaled Minkowski difference; 1e-7 leaves a factor 7 for the rounding of
-// the support points (measured: README "Interference oracle").
+// sqrt(2.2e-16) ≈ 1.5e-8 of the scaled Minkowski difference; the largest mismatch measured on 100 000
+// random pairs was at 1.9e-8 × scale (GJK calling a separated pair intersecting), so 1e-7 leaves a
+// factor 5.
 #define PD_ORACLE_TOUCH_REL 1e-7
 
 // EPA's stopping rule, in libccd's units (scaled coordinates): it stops when the new support point gains
