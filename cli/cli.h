@@ -17,9 +17,14 @@ int pd_cmd_report(int argc, char** argv);
 int pd_cmd_view(int argc, char** argv);
 int pd_cmd_cubetoss(int argc, char** argv);
 int pd_cmd_gedanken(int argc, char** argv);
+int pd_cmd_oracle(int argc, char** argv);
 
 // Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr; returns 2.
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+
+// mkdir -p of the directories above `path`; out/NAME for scene path .../NAME.ext (free with free()).
+void pd_cli_make_parents(const char* path);
+char* pd_cli_default_out_dir(const char* scene);
 
 // Parses a finite number > 0 from an option value; false when it is not one.
 bool pd_cli_positive(const char* text, double* value);

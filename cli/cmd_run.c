@@ -74,7 +74,7 @@ static bool observe(const pdModel* model, const pdState* state, void* user) {
 }
 
 // mkdir -p of the directories above `path`; a real failure shows when the run directory is made
-static void make_parents(const char* path) {
+void pd_cli_make_parents(const char* path) {
   char* p = strdup(path);
   if (!p) abort();
   for (char* slash = strchr(p + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
@@ -86,7 +86,7 @@ static void make_parents(const char* path) {
 }
 
 // out/NAME for scene path .../NAME.ext
-static char* default_out_dir(const char* scene) {
+char* pd_cli_default_out_dir(const char* scene) {
   const char* base = strrchr(scene, '/');
   base = base ? base + 1 : scene;
   size_t n = strlen(base);
@@ -173,10 +173,10 @@ int pd_cmd_run(int argc, char** argv) {
 
   char* defaultOut = NULL;
   if (!out) {
-    defaultOut = default_out_dir(scene);
+    defaultOut = pd_cli_default_out_dir(scene);
     out = defaultOut;
   }
-  make_parents(out);
+  pd_cli_make_parents(out);
   // from here on an interrupt must remove the partial directory, so catch it before making one
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);

@@ -26,6 +26,7 @@ static const char* const usage =
     "  view DIR...    self-contained HTML replay of run directories (or --movie OUT.mp4)\n"
     "  cubetoss [fit] --data FILE.csv --out DIR [--engines soft,ode,bullet]\n"
     "                 real cube tosses in every engine against the record; fit each engine's parameters\n"
+    "  oracle (SCENE | --random N --seed S | --replay FILE)  interference test vs libccd\n"
     "  help           this text\n"
     "  --version      print the version\n"
     "\n"
@@ -68,6 +69,7 @@ int main(int argc, char** argv) {
   if (strcmp(cmd, "view") == 0) return pd_cmd_view(argc - 1, argv + 1);
   if (strcmp(cmd, "cubetoss") == 0) return pd_cmd_cubetoss(argc - 1, argv + 1);
   if (strcmp(cmd, "gedanken") == 0) return pd_cmd_gedanken(argc - 1, argv + 1);
+  if (strcmp(cmd, "oracle") == 0) return pd_cmd_oracle(argc - 1, argv + 1);
   if (strcmp(cmd, "help") == 0 || pd_cli_is_help(cmd)) {
     fputs(usage, stdout);
     return PD_EXIT_OK;

@@ -1,0 +1,187 @@
+// polydyn refcheck — the oracle's disagreement CSV: one row per listed pair, enough to replay it
+// (polydyn/oracle.h). RFC 4180 quoting for the text fields (scene body names may hold commas).
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "polydyn/oracle.h"
+
+// A quaternion read back must be unit to this (|q| − 1): %.17g round-trips exactly, so only a
+// hand-edited file can miss it; a non-unit q would scale the body.
+#define UNIT_QUAT_TOL 1e-9
+
+static const char* const header =
+    "source,index,t,kind,name_a,name_b,shape_a,shape_b,"
+    "ax,ay,az,aqw,aqx,aqy,aqz,bx,by,bz,bqw,bqx,bqy,bqz,"
+    "our_verdict,our_depth,gjk_verdict,mpr_verdict,epa_depth,mpr_depth,scale,size,epa_tol\n";
+
+void pd_oracle_csv_header(FILE* out) { fputs(header, out); }
+
+static void put_text(FILE* out, const char* s) {
+  if (!strpbrk(s, ",\"\n\r")) {
+    fputs(s, out);
+    return;
+  }
+  fputc('"', out);
+  for (const char* c = s; *c; ++c) {
+    if (*c == '"') fputc('"', out);
+    fputc(*c, out);
+  }
+  fputc('"', out);
+}
+
+static void put_number(FILE* out, double v) { fprintf(out, ",%.17g", v); }
+
+// an empty field for a value libccd did not give (never a NaN)
+static void put_optional(FILE* out, bool has, double v) {
+  if (has)
+    put_number(out, v);
+  else
+    fputc(',', out);
+}
+
+static const char* verdict(bool overlap) { return overlap ? "overlap" : "separate"; }
+
+void pd_oracle_csv_write(FILE* out, const pdOracleRow* row) {
+  const pdOracleResult* r = &row->r;
+  put_text(out, row->source);
+  fprintf(out, ",%ld,%.17g,%s,", row->index, row->t, pdOracleKindNames[r->kind]);
+  const char* texts[4] = {row->nameA, row->nameB, row->specA, row->specB};
+  for (int i = 0; i < 4; ++i) {
+    put_text(out, texts[i]);
+    fputc(',', out);
+  }
+  const double pose[14] = {row->xa.x, row->xa.y, row->xa.z, row->qa.w, row->qa.x, row->qa.y, row->qa.z,
+                           row->xb.x, row->xb.y, row->xb.z, row->qb.w, row->qb.x, row->qb.y, row->qb.z};
+  fprintf(out, "%.17g", pose[0]);
+  for (int i = 1; i < 14; ++i) put_number(out, pose[i]);
+  fprintf(out, ",%s", verdict(r->ours));
+  put_number(out, r->ourDepth);
+  fprintf(out, ",%s,%s", verdict(r->gjk), verdict(r->mpr));
+  put_optional(out, r->hasEpa, r->epaDepth);
+  put_optional(out, r->hasMprDepth, r->mprDepth);
+  put_number(out, r->scale);
+  put_number(out, r->size);
+  put_optional(out, r->hasEpa, r->epaTol);
+  fputc('\n', out);
+}
+
+// Splits buf into fields in place (quotes removed, "" unescaped); start[i] is field i's 1-based column.
+static int split(char* buf, char** fields, int* start, int max, int* badCol) {
+  int n = 0;
+  char* p = buf;
+  for (;;) {
+    if (n == max) {
+      *badCol = (int)(p - buf) + 1;
+      return -1;
+    }
+    start[n] = (int)(p - buf) + 1;
+    if (*p == '"') {
+      char *w = p, *r = p + 1;
+      fields[n] = w;
+      for (;; ++r) {
+        if (*r == '\0') {
+          *badCol = start[n];
+          return -1;  // unterminated quote
+        }
+        if (*r == '"') {
+          if (r[1] != '"') break;
+          ++r;
+        }
+        *w++ = *r;
+      }
+      ++r;
+      if (*r != ',' && *r != '\0') {
+        *badCol = (int)(r - buf) + 1;
+        return -1;
+      }
+      *w = '\0';
+      p = r;
+    } else {
+      fields[n] = p;
+      p += strcspn(p, ",");
+    }
+    ++n;
+    if (*p == '\0') return n;
+    *p++ = '\0';
+  }
+}
+
+static bool read_number(const char* s, double* v) {
+  char* end = NULL;
+  errno = 0;
+  *v = strtod(s, &end);
+  return end != s && *end == '\0' && errno != ERANGE && isfinite(*v);
+}
+
+static bool read_verdict(const char* s, bool* overlap) {
+  if (strcmp(s, "overlap") == 0) return (*overlap = true);
+  if (strcmp(s, "separate") == 0) return !(*overlap = false);
+  return false;
+}
+
+static bool fail(int* col, int at, char* why, int whySize, const char* message, const char* field) {
+  *col = at;
+  snprintf(why, (size_t)whySize, "%s: '%.60s'", message, field);
+  return false;
+}
+
+bool pd_oracle_csv_read(char* buf, pdOracleRow* row, int* col, char* why, int whySize) {
+  PD_ASSERT(buf != NULL && row != NULL && col != NULL);
+  memset(row, 0, sizeof *row);
+  char* f[PD_ORACLE_CSV_FIELDS + 1];
+  int at[PD_ORACLE_CSV_FIELDS + 1];
+  int n = split(buf, f, at, PD_ORACLE_CSV_FIELDS + 1, col);
+  if (n < 0) {
+    snprintf(why, (size_t)whySize, "malformed quoted field or too many fields");
+    return false;
+  }
+  if (n != PD_ORACLE_CSV_FIELDS) {
+    *col = 1;
+    snprintf(why, (size_t)whySize, "%d fields, expected %d", n, PD_ORACLE_CSV_FIELDS);
+    return false;
+  }
+  row->source = f[0];
+  double v[14];
+  if (!read_number(f[1], &v[0]) || v[0] < 0 || v[0] != floor(v[0]) || v[0] > 9e15)
+    return fail(col, at[1], why, whySize, "index is not a whole number >= 0", f[1]);
+  row->index = (long)v[0];
+  if (!read_number(f[2], &row->t)) return fail(col, at[2], why, whySize, "t is not a finite number", f[2]);
+  int kind = 0;
+  while (kind < pd_oracleKindCount && strcmp(f[3], pdOracleKindNames[kind]) != 0) ++kind;
+  if (kind == pd_oracleKindCount) return fail(col, at[3], why, whySize, "unknown kind", f[3]);
+  row->r.kind = (pdOracleKind)kind;
+  row->nameA = f[4];
+  row->nameB = f[5];
+  row->specA = f[6];
+  row->specB = f[7];
+  for (int i = 0; i < 14; ++i)
+    if (!read_number(f[8 + i], &v[i])) return fail(col, at[8 + i], why, whySize, "pose value is not a finite number", f[8 + i]);
+  row->xa = (pdVec3){v[0], v[1], v[2]};
+  row->qa = (pdQuat){v[3], v[4], v[5], v[6]};
+  row->xb = (pdVec3){v[7], v[8], v[9]};
+  row->qb = (pdQuat){v[10], v[11], v[12], v[13]};
+  const pdQuat* q[2] = {&row->qa, &row->qb};
+  for (int k = 0; k < 2; ++k) {
+    double norm = sqrt(q[k]->w * q[k]->w + q[k]->x * q[k]->x + q[k]->y * q[k]->y + q[k]->z * q[k]->z);
+    if (!(fabs(norm - 1.0) <= UNIT_QUAT_TOL))
+      return fail(col, at[11 + 7 * k], why, whySize, "quaternion is not unit", f[11 + 7 * k]);
+  }
+  // what the file says was found (the replay computes its own)
+  pdOracleResult* r = &row->r;
+  if (!read_verdict(f[22], &r->ours)) return fail(col, at[22], why, whySize, "verdict is not overlap or separate", f[22]);
+  if (!read_number(f[23], &r->ourDepth)) return fail(col, at[23], why, whySize, "not a finite number", f[23]);
+  if (!read_verdict(f[24], &r->gjk)) return fail(col, at[24], why, whySize, "verdict is not overlap or separate", f[24]);
+  if (!read_verdict(f[25], &r->mpr)) return fail(col, at[25], why, whySize, "verdict is not overlap or separate", f[25]);
+  r->hasEpa = f[26][0] != '\0';
+  if (r->hasEpa && !read_number(f[26], &r->epaDepth)) return fail(col, at[26], why, whySize, "not a finite number", f[26]);
+  r->hasMprDepth = f[27][0] != '\0';
+  if (r->hasMprDepth && !read_number(f[27], &r->mprDepth))
+    return fail(col, at[27], why, whySize, "not a finite number", f[27]);
+  if (!read_number(f[28], &r->scale)) return fail(col, at[28], why, whySize, "not a finite number", f[28]);
+  if (!read_number(f[29], &r->size)) return fail(col, at[29], why, whySize, "not a finite number", f[29]);
+  if (r->hasEpa != (f[30][0] != '\0') || (r->hasEpa && !read_number(f[30], &r->epaTol)))
+    return fail(col, at[30], why, whySize, "not a finite number, or given without epa_depth", f[30]);
+  return true;
+}
