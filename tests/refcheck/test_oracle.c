@@ -127,51 +127,44 @@ static void test_exact_touching_is_never_a_failure_and_gives_no_nan(void** state
   pd_oracle_shape_free(&cube);
 }
 
-static void test_a_block_resting_on_a_slab_gets_an_epa_depth_within_its_bound(void** state) {
-  (void)state;
-  // cases/hard/mass_ratio.scene at t = 0.14 s: the block rests on the floor, face on face, tilted by
-  // ~1e-7; libccd's EPA cycles on this pair at the tightest tolerance, the oracle retries looser
+// cases/hard/mass_ratio.scene: the 0.5 × 0.5 × 0.2 m block resting on the fixed 1.5 × 1.5 × 0.1 m floor,
+// face on face, at a pose of the soft run (tilted by ~1e-7). MPR goes straight down the centre line onto
+// the floor's top face: its depth is exact there, and ours must equal it.
+static pdOracleResult block_on_floor(pdVec3 x, pdQuat q) {
   pdOracleShape floor = shape("cube 1.5 1.5 0.10000000000000001");
   pdOracleShape block = shape("cube 0.5 0.5 0.20000000000000001");
-  pdOracleBody A = {&floor.poly, {0, 0, -0.050000000000000003}, {1, 0, 0, 0}};
-  pdOracleBody B = {&block.poly,
-                    {2.2999227383557647e-08, -1.9755720129624577e-08, 0.099866104313912657},
-                    {0.99999999999999389, 2.5295599845141236e-08, 1.0609642471246841e-07, -1.3037715786162735e-08}};
-  pdOracleResult r;
-  pd_oracle_check(&A, &B, &r);
-  print_message("ours %.17g, EPA %.17g at tol %g (bound %.3g m), MPR %.17g -> %s\n", r.ourDepth, r.epaDepth, r.epaTol,
-                r.epaBound, r.mprDepth, pdOracleKindNames[r.kind]);
-  assert_int_equal(r.kind, pd_oracleAgreeOverlap);
-  assert_true(r.hasEpa && !r.stalled);
-  assert_true(fabs(r.epaDepth - r.ourDepth) <= r.epaBound);
-  // MPR goes straight down the centre line onto the floor's top face: exact here
-  assert_true(fabs(r.mprDepth - r.ourDepth) <= CLOSED_TOL);
-  pd_oracle_shape_free(&floor);
-  pd_oracle_shape_free(&block);
-}
-
-static void test_resting_block_depth_equals_mprs_when_epa_takes_its_touching_shortcut(void** state) {
-  (void)state;
-  // cases/hard/mass_ratio.scene at t = 0.152 s, block resting flat on the floor 1.34e-4 m deep: libccd's
-  // GJK ends with the origin within DBL_EPSILON (squared) of a simplex face, and EPA then reports that
-  // face's distance, ~4e-9 m. MPR, along the centre line onto the floor's face, gives the exact depth.
-  pdOracleShape floor = shape("cube 1.5 1.5 0.10000000000000001");
-  pdOracleShape block = shape("cube 0.5 0.5 0.20000000000000001");
-  pdOracleBody A = {&floor.poly, {0, 0, -0.050000000000000003}, {1, 0, 0, 0}};
-  pdOracleBody B = {&block.poly,
-                    {-7.1233592156859987e-09, 2.6378821116571543e-08, 0.09986604738503238},
-                    {0.99999999999999867, -5.070507188534073e-08, 1.5371519245006506e-08, 4.7885366486010021e-09}};
+  pdOracleBody A = {&floor.poly, {0, 0, -0.050000000000000003}, {1, 0, 0, 0}}, B = {&block.poly, x, q};
   pdOracleResult r;
   pd_oracle_check(&A, &B, &r);
   print_message("ours %.17g, MPR %.17g, EPA %.17g (tol %g, bound %.3g m) -> %s\n", r.ourDepth, r.mprDepth, r.epaDepth,
                 r.epaTol, r.epaBound, pdOracleKindNames[r.kind]);
-  assert_true(r.ours && r.gjk && r.mpr && r.hasMprDepth);
+  assert_true(r.ours && r.gjk && r.mpr && r.hasMprDepth && !r.stalled);
   assert_true(fabs(r.mprDepth - r.ourDepth) <= CLOSED_TOL);
   assert_true(r.ourDepth > 1e-4 && r.ourDepth < 2e-4);
-  // EPA either agrees within its bound, or the pair is listed as a depth outlier (never a verdict failure)
-  assert_true(fabs(r.epaDepth - r.ourDepth) <= r.epaBound ? r.kind == pd_oracleAgreeOverlap : r.kind == pd_oracleDepth);
   pd_oracle_shape_free(&floor);
   pd_oracle_shape_free(&block);
+  return r;
+}
+
+static void test_a_block_resting_on_a_slab_gets_an_epa_depth_within_its_bound(void** state) {
+  (void)state;
+  // t = 0.14 s: libccd's EPA cycles on this pair at the tightest tolerance, the oracle retries looser
+  pdOracleResult r = block_on_floor((pdVec3){2.2999227383557647e-08, -1.9755720129624577e-08, 0.099866104313912657},
+                                    (pdQuat){0.99999999999999389, 2.5295599845141236e-08, 1.0609642471246841e-07,
+                                             -1.3037715786162735e-08});
+  assert_int_equal(r.kind, pd_oracleAgreeOverlap);
+  assert_true(r.hasEpa && fabs(r.epaDepth - r.ourDepth) <= r.epaBound);
+}
+
+static void test_resting_block_depth_equals_mprs_when_epa_takes_its_touching_shortcut(void** state) {
+  (void)state;
+  // t = 0.152 s, 1.34e-4 m deep: libccd's GJK ends with the origin within DBL_EPSILON (squared) of a
+  // simplex face, and EPA then reports that face's distance, ~4e-9 m
+  pdOracleResult r = block_on_floor((pdVec3){-7.1233592156859987e-09, 2.6378821116571543e-08, 0.09986604738503238},
+                                    (pdQuat){0.99999999999999867, -5.070507188534073e-08, 1.5371519245006506e-08,
+                                             4.7885366486010021e-09});
+  // EPA either agrees within its bound, or the pair is listed as a depth outlier (never a verdict failure)
+  assert_true(fabs(r.epaDepth - r.ourDepth) <= r.epaBound ? r.kind == pd_oracleAgreeOverlap : r.kind == pd_oracleDepth);
 }
 
 static void test_2000_random_pairs_near_touching_agree_outside_the_band(void** state) {
