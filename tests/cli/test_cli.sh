@@ -18,29 +18,9 @@ HEADER='t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz'
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_cli.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
 
-passed=0
-failed=0
-# check NAME CONDITION...: evaluates the condition (a shell command) and counts the result.
-check() {
-  local name=$1
-  shift
-  if eval "$@"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAIL: $name  [$*]"
-  fi
-}
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
 
-# run_pd OUT ERR ARGS...: runs polydyn with stdout/stderr to files; the exit status goes to $rc.
-run_pd() {
-  local out=$1 err=$2
-  shift 2
-  "$PD" "$@" >"$out" 2>"$err"
-  rc=$?
-}
 
-no_partial() { ! compgen -G "$1.partial-*" >/dev/null && ! compgen -G "$1.old-*" >/dev/null; }
 # message_at FILE ERRFILE line|file: the message starts with `FILE:LINE:COL: ` (line) or `FILE: ` (file)
 message_at() {
   local text rest

@@ -18,27 +18,8 @@ HEADER='source,index,t,kind,name_a,name_b,shape_a,shape_b,ax,ay,az,aqw,aqx,aqy,a
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_oracle_cli.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
 
-passed=0
-failed=0
-# check NAME CONDITION...: evaluates the condition (a shell command) and counts the result.
-check() {
-  local name=$1
-  shift
-  if eval "$@"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAIL: $name  [$*]"
-  fi
-}
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
 
-# run_pd OUT ERR ARGS...: runs polydyn with stdout/stderr to files; the exit status goes to $rc.
-run_pd() {
-  local out=$1 err=$2
-  shift 2
-  "$PD" "$@" >"$out" 2>"$err"
-  rc=$?
-}
 
 OUT=$SCRATCH/stdout
 ERR=$SCRATCH/stderr

@@ -18,23 +18,11 @@ OUT=$SCRATCH/stdout
 ERR=$SCRATCH/stderr
 HEADER='experiment,group,title,engine,variant,quantity,unit,input,measured,expected,error,tolerance,status,wall_seconds,run_dir,note'
 
-passed=0
-failed=0
-check() {
-  local name=$1
-  shift
-  if eval "$@"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAIL: $name  [$*]"
-  fi
-}
-run_pd() {
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
+run_pd() {  # this script's own: its stdout and stderr files are fixed
   "$PD" "$@" >"$OUT" 2>"$ERR"
   rc=$?
 }
-no_partial() { ! compgen -G "$1.partial-*" >/dev/null && ! compgen -G "$1.old-*" >/dev/null; }
 # csv_query FILE EXPRESSION: evaluates a Python expression over rows = list of dicts of results.csv
 csv_query() {
   python3 -c 'import csv, sys

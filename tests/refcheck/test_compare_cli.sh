@@ -12,13 +12,7 @@ fi
 PD=$1
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_compare.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
-passed=0
-failed=0
-check() {
-  local name=$1
-  shift
-  if eval "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name  [$*]"; fi
-}
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
 
 # a cube sliding to rest on a floor (μ 0.4, 2 m/s): smooth, so the default tolerance is close to the reference
 SCENE=$SCRATCH/slide.scene

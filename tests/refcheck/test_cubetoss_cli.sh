@@ -15,13 +15,7 @@ PD=$1
 DATA_FULL=$2/../shared/data/cube-toss/tosses-train.csv
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_cubetoss_cli.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
-passed=0
-failed=0
-check() {
-  local name=$1
-  shift
-  if eval "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name  [$*]"; fi
-}
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
 
 # ---- usage errors: exit 2, a message naming the problem, nothing written (no data needed)
 BAD=$SCRATCH/bad.csv

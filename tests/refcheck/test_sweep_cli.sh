@@ -9,13 +9,7 @@ PD=$1
 SRC=$2
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_sweep.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
-passed=0
-failed=0
-check() {
-  local name=$1
-  shift
-  if eval "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name  [$*]"; fi
-}
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
 SCENE=$SRC/cases/sweep/slide_to_rest.scene
 "$PD" sweep >/dev/null 2>&1; rc=$?; check "no scene: exit 2" '[ $rc -eq 2 ]'
 "$PD" sweep "$SCENE" >/dev/null 2>&1; rc=$?; check "no --out: exit 2" '[ $rc -eq 2 ]'

@@ -8,14 +8,8 @@ PD=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
 SRC=$(cd "$2" && pwd)
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_view.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
-passed=0
-failed=0
-check() {
-  local name=$1
-  shift
-  if eval "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name  [$*]"; fi
-}
-run_pd() { "$PD" "$@" >"$SCRATCH/out" 2>"$SCRATCH/err"; rc=$?; }
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
+run_pd() { "$PD" "$@" >"$SCRATCH/out" 2>"$SCRATCH/err"; rc=$?; }  # this script's own (fixed files)
 nothing_left() { ! compgen -G "$SCRATCH/page.html*" >/dev/null; }
 
 RUN=$SCRATCH/demo
