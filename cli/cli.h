@@ -2,6 +2,7 @@
 #pragma once
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
@@ -22,9 +23,22 @@ int pd_cmd_oracle(int argc, char** argv);
 // Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr; returns 2.
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 
-// mkdir -p of the directories above `path`; out/NAME for scene path .../NAME.ext (free with free()).
+// Output directories (cli/out_dir.c): mkdir -p of the directories above `path`; out/NAME for scene path
+// .../NAME.ext (free with free()); rm -r of a directory this command made.
 void pd_cli_make_parents(const char* path);
 char* pd_cli_default_out_dir(const char* scene);
+void pd_cli_remove_tree(const char* path);
+// A whole output directory is written as OUT.partial-PID (tmp) and renamed to OUT when complete.
+// pd_cli_out_open refuses (message, false) an existing OUT without `marker` in it — not a directory of
+// this command — and makes tmp. pd_cli_out_close moves tmp into place, replacing a previous OUT; on
+// failure it prints why, removes tmp and returns false.
+bool pd_cli_out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize);
+bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out);
+
+// Seconds of CLOCK_MONOTONIC (wall time of runs and progress displays).
+double pd_cli_wall_seconds(void);
+// True when the comma-separated `list` contains `word` as one of its items.
+bool pd_cli_list_has(const char* list, const char* word);
 
 // Parses a finite number > 0 from an option value; false when it is not one.
 bool pd_cli_positive(const char* text, double* value);

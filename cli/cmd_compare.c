@@ -1,6 +1,5 @@
 // polydyn compare — one scene in every engine, metrics against a tighter soft run (DESIGN §5).
 #include <errno.h>
-#include <ftw.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -61,23 +60,6 @@ static bool observe_soft(const pdModel* model, const pdState* state, void* user)
   return pd_run_observe(model, state, o->writer) && pd_trajectory_observe(model, state, o->trajectory);
 }
 
-static double wall_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static bool list_has(const char* list, const char* word) {
-  size_t n = strlen(word);
-  for (const char* p = list; p && *p;) {
-    const char* comma = strchr(p, ',');
-    size_t len = comma ? (size_t)(comma - p) : strlen(p);
-    if (len == n && strncmp(p, word, n) == 0) return true;
-    p = comma ? comma + 1 : NULL;
-  }
-  return false;
-}
-
 // Every word of `list` is one of `allowed` (NULL-terminated); false names the first stranger in *bad.
 static bool list_valid(const char* list, const char* const* allowed, char* bad, size_t badSize) {
   for (const char* p = list; p && *p;) {
@@ -112,9 +94,9 @@ static void run_soft(const char* scene, const pdCliOverrides* overrides, const c
   pdState* state = pd_state_create(model);
   r->trajectory = pd_trajectory_create(model);
   softObserver o = {writer, r->trajectory};
-  double e0 = pd_state_energy(model, state), t0 = wall_now();
+  double e0 = pd_state_energy(model, state), t0 = pd_cli_wall_seconds();
   bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
-  r->wallSeconds = wall_now() - t0;
+  r->wallSeconds = pd_cli_wall_seconds() - t0;
   r->steps = state->count.accepted;
   pdRunInfo info = {.engine = "polydyn-soft", .energyStart = e0, .energyEnd = pd_state_energy(model, state),
                     .wallSeconds = r->wallSeconds, .completed = completed};
@@ -218,17 +200,6 @@ static bool write_results(const char* dir, const char* scene, const pdModel* mod
   return fclose(out) == 0 && ok;
 }
 
-static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw) {
-  (void)st, (void)flag, (void)ftw;
-  return remove(path);
-}
-
-// rm -r of a directory this command made (DIR.partial-PID, or the previous DIR moved aside)
-static void remove_tree(const char* path) {
-  if (nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS) != 0)
-    fprintf(stderr, "polydyn compare: could not remove %s\n", path);
-}
-
 int pd_cmd_compare(int argc, char** argv) {
   const char* scene = NULL;
   const char* out = NULL;
@@ -280,23 +251,18 @@ int pd_cmd_compare(int argc, char** argv) {
 
   pdModel* model = pd_cli_load_model(scene, &overrides, NULL);
   if (!model) return PD_EXIT_BAD_INPUT;
-  struct stat st;
-  char marker[4096];
-  snprintf(marker, sizeof marker, "%s/metrics.csv", out);
-  if (stat(out, &st) == 0 && stat(marker, &st) != 0) {
-    fprintf(stderr, "polydyn compare: %s exists and is not a compare directory (no metrics.csv); not replacing it\n",
-            out);
+  char tmp[4096];
+  if (!pd_cli_out_open("compare", out, "metrics.csv", tmp, sizeof tmp)) {
     pd_model_free(model);
     return PD_EXIT_BAD_INPUT;
   }
-  char tmp[4096];
-  snprintf(tmp, sizeof tmp, "%s.partial-%ld", out, (long)getpid());
   char runsDir[4200];
   snprintf(runsDir, sizeof runsDir, "%s/runs", tmp);
-  if (mkdir(tmp, 0777) != 0 || mkdir(runsDir, 0777) != 0) {
-    fprintf(stderr, "polydyn compare: cannot create %s: %s\n", tmp, strerror(errno));
+  if (mkdir(runsDir, 0777) != 0) {
+    fprintf(stderr, "polydyn compare: cannot create %s: %s\n", runsDir, strerror(errno));
+    pd_cli_remove_tree(tmp);
     pd_model_free(model);
-    return PD_EXIT_BAD_INPUT;
+    return PD_EXIT_FAILURE;
   }
   bool progress = isatty(STDERR_FILENO) == 1;
 
@@ -309,7 +275,7 @@ int pd_cmd_compare(int argc, char** argv) {
   runs[count] = (compareRun){.engine = "soft", .variant = "reference", .isReference = true, .status = "failed"};
   snprintf(runs[count].name, sizeof runs[count].name, "soft-reference");
   ++count;
-  if (list_has(engines, "soft")) {
+  if (pd_cli_list_has(engines, "soft")) {
     runs[count] = (compareRun){.engine = "soft", .variant = "adaptive", .status = "failed"};
     snprintf(runs[count].name, sizeof runs[count].name, "soft-adaptive");
     ++count;
@@ -318,7 +284,7 @@ int pd_cmd_compare(int argc, char** argv) {
   static const char* const refVariants[] = {"native", "matched"};
   for (int e = 0; e < 2; ++e)
     for (int v = 0; v < 2; ++v)
-      if (list_has(engines, refEngines[e]) && list_has(variants, refVariants[v])) {
+      if (pd_cli_list_has(engines, refEngines[e]) && pd_cli_list_has(variants, refVariants[v])) {
         runs[count] = (compareRun){.engine = refEngines[e], .variant = refVariants[v], .status = "failed"};
         snprintf(runs[count].name, sizeof runs[count].name, "%s-%s", refEngines[e], refVariants[v]);
         ++count;
@@ -359,16 +325,12 @@ int pd_cmd_compare(int argc, char** argv) {
       runs[i].metrics = pd_compare_metrics(model, runs[i].trajectory,
                                            reference && reference != &runs[i] ? reference->trajectory : NULL);
   bool written = write_results(tmp, scene, model, runs, count, tolReference);
-  if (written) {
-    char old[4200];
-    snprintf(old, sizeof old, "%s.old-%ld", out, (long)getpid());
-    bool hadOld = stat(out, &st) == 0;
-    written = (!hadOld || rename(out, old) == 0) && rename(tmp, out) == 0;
-    if (written && hadOld) remove_tree(old);
-  }
   if (!written) {
-    fprintf(stderr, "polydyn compare: cannot write %s: %s\n", out, strerror(errno));
-    remove_tree(tmp);
+    fprintf(stderr, "polydyn compare: cannot write %s: %s\n", tmp, strerror(errno));
+    pd_cli_remove_tree(tmp);
+  }
+  written = written && pd_cli_out_close("compare", tmp, out);
+  if (!written) {
     status = PD_EXIT_FAILURE;
   } else {
     // the table on stdout: what a person reads first

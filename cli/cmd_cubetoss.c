@@ -1,7 +1,6 @@
 // polydyn cubetoss — real cube tosses in every engine, and fitting each engine's free parameters to them
 // (DESIGN §5 "Real data"; the library part is refcheck/include/polydyn/cubetoss.h).
 #include <errno.h>
-#include <ftw.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -70,12 +69,6 @@ static void on_signal(int sig) {
   interrupted = 1;
 }
 
-static double wall_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 // ---------------------------------------------------------------- options
 
 typedef struct engineSpec {
@@ -123,17 +116,6 @@ static bool known_engine(const char* name, size_t len) {
   static const char* const known[] = {"soft", "ode", "bullet"};
   for (int i = 0; i < 3; ++i)
     if (strlen(known[i]) == len && strncmp(name, known[i], len) == 0) return true;
-  return false;
-}
-
-static bool list_has(const char* list, const char* word) {
-  size_t n = strlen(word);
-  for (const char* p = list; p && *p;) {
-    const char* comma = strchr(p, ',');
-    size_t len = comma ? (size_t)(comma - p) : strlen(p);
-    if (len == n && strncmp(p, word, n) == 0) return true;
-    p = comma ? comma + 1 : NULL;
-  }
   return false;
 }
 
@@ -240,7 +222,7 @@ static int parse_options(int argc, char** argv, options* o) {
     size_t len = (size_t)(strchr(o->paramEngine[k], '=') - o->paramEngine[k]);
     char name[16];
     snprintf(name, sizeof name, "%.*s", (int)len, o->paramEngine[k]);
-    if (!list_has(o->engines, name)) return pd_cli_usage_error(cmd, "--params %s=...: %s is not among --engines", name, name);
+    if (!pd_cli_list_has(o->engines, name)) return pd_cli_usage_error(cmd, "--params %s=...: %s is not among --engines", name, name);
   }
   return -1;
 }
@@ -250,7 +232,7 @@ static int make_engines(const options* o, engineSpec* specs, char* why, size_t w
   static const char* const order[] = {"soft", "ode", "bullet"};
   int n = 0;
   for (int e = 0; e < 3; ++e) {
-    if (!list_has(o->engines, order[e])) continue;
+    if (!pd_cli_list_has(o->engines, order[e])) continue;
     engineSpec* s = &specs[n++];
     memset(s, 0, sizeof *s);
     s->name = order[e];
@@ -283,45 +265,6 @@ static int make_engines(const options* o, engineSpec* specs, char* why, size_t w
 }
 
 // ---------------------------------------------------------------- output directory
-
-static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw) {
-  (void)st, (void)flag, (void)ftw;
-  return remove(path);
-}
-
-static void remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
-
-// Makes DIR.partial-PID; refuses a DIR that exists and is not one of ours (no `marker` file in it).
-static bool open_out(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize) {
-  struct stat st;
-  char path[4200];
-  snprintf(path, sizeof path, "%s/%s", out, marker);
-  if (stat(out, &st) == 0 && stat(path, &st) != 0) {
-    fprintf(stderr, "polydyn %s: %s exists and is not a %s directory (no %s); not replacing it\n", cmd, out, cmd, marker);
-    return false;
-  }
-  snprintf(tmp, tmpSize, "%s.partial-%ld", out, (long)getpid());
-  if (mkdir(tmp, 0777) != 0) {
-    fprintf(stderr, "polydyn %s: cannot create %s: %s\n", cmd, tmp, strerror(errno));
-    return false;
-  }
-  return true;
-}
-
-// Moves tmp into place as out (replacing a previous one); false on failure (tmp is then removed).
-static bool close_out(const char* cmd, const char* tmp, const char* out) {
-  struct stat st;
-  char old[4200];
-  snprintf(old, sizeof old, "%s.old-%ld", out, (long)getpid());
-  bool hadOld = stat(out, &st) == 0;
-  bool ok = (!hadOld || rename(out, old) == 0) && rename(tmp, out) == 0;
-  if (ok && hadOld) remove_tree(old);
-  if (!ok) {
-    fprintf(stderr, "polydyn %s: cannot write %s: %s\n", cmd, out, strerror(errno));
-    remove_tree(tmp);
-  }
-  return ok;
-}
 
 // ---------------------------------------------------------------- CSVs
 
@@ -375,7 +318,7 @@ static bool show_progress(int done, int total, void* user) {
   progressState* p = user;
   if (p->fitting && done == 0) ++p->evaluation;
   if (p->terminal) {
-    double now = wall_now();
+    double now = pd_cli_wall_seconds();
     if (now - p->lastPrint > 0.2 || done == total) {
       p->lastPrint = now;
       if (p->fitting)
@@ -605,18 +548,18 @@ static void catch_signals(void) {
 static int finish_interrupted(const char* cmd, const char* tmp) {
   if (isatty(STDERR_FILENO) == 1) fputs("\r\033[K", stderr);
   fprintf(stderr, "polydyn %s: interrupted; nothing written\n", cmd);
-  remove_tree(tmp);
+  pd_cli_remove_tree(tmp);
   return 130;
 }
 
 static int run_tosses(const options* o, const pdTossSet* set, const int* indices, int count, engineSpec* specs,
                       int engineCount) {
   char tmp[4200], runsDir[4300];
-  if (!open_out("cubetoss", o->out, "per_toss.csv", tmp, sizeof tmp)) return PD_EXIT_BAD_INPUT;
+  if (!pd_cli_out_open("cubetoss", o->out, "per_toss.csv", tmp, sizeof tmp)) return PD_EXIT_BAD_INPUT;
   snprintf(runsDir, sizeof runsDir, "%s/runs", tmp);
   if (o->runs && mkdir(runsDir, 0777) != 0) {
     fprintf(stderr, "polydyn cubetoss: cannot create %s: %s\n", runsDir, strerror(errno));
-    remove_tree(tmp);
+    pd_cli_remove_tree(tmp);
     return PD_EXIT_FAILURE;
   }
   for (int e = 0; e < engineCount; ++e)
@@ -627,7 +570,7 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   tossJobResult* results = calloc((size_t)count, sizeof *results);
   if (!results) abort();
   runContext ctx = {set, indices, specs, engineCount, o->runs ? runsDir : NULL, NULL};
-  progressState progress = {.what = "", .terminal = isatty(STDERR_FILENO) == 1, .start = wall_now()};
+  progressState progress = {.what = "", .terminal = isatty(STDERR_FILENO) == 1, .start = pd_cli_wall_seconds()};
   char what[128] = "";
   for (int e = 0; e < engineCount; ++e)
     if (specs[e].built) snprintf(what + strlen(what), sizeof what - strlen(what), "%s%s", what[0] ? "," : "", specs[e].label);
@@ -640,7 +583,7 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
     free(results);
     if (interrupted) return finish_interrupted("cubetoss", tmp);
     fprintf(stderr, "polydyn cubetoss: %s\n", why);
-    remove_tree(tmp);
+    pd_cli_remove_tree(tmp);
     return PD_EXIT_FAILURE;
   }
 
@@ -675,9 +618,9 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   }
   if (!written) {
     fprintf(stderr, "polydyn cubetoss: cannot write %s: %s\n", path, strerror(errno));
-    remove_tree(tmp);
+    pd_cli_remove_tree(tmp);
     status = PD_EXIT_FAILURE;
-  } else if (!close_out("cubetoss", tmp, o->out)) {
+  } else if (!pd_cli_out_close("cubetoss", tmp, o->out)) {
     status = PD_EXIT_FAILURE;
   } else {
     print_tables(specs, engineCount, &group, 1);
@@ -707,7 +650,7 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
                               o->tosses, trainCount, testCount);
   }
   char tmp[4200];
-  if (!open_out("cubetoss fit", o->out, "fit.csv", tmp, sizeof tmp)) {
+  if (!pd_cli_out_open("cubetoss fit", o->out, "fit.csv", tmp, sizeof tmp)) {
     free(train);
     free(test);
     return PD_EXIT_BAD_INPUT;
@@ -717,7 +660,7 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   FILE* trace = fopen(path, "w");
   if (!trace) {
     fprintf(stderr, "polydyn cubetoss fit: cannot write %s: %s\n", path, strerror(errno));
-    remove_tree(tmp);
+    pd_cli_remove_tree(tmp);
     free(train);
     free(test);
     return PD_EXIT_FAILURE;
@@ -728,7 +671,7 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   pdTossParams fitted[ENGINES_MAX];
   bool ok = true;
   char why[256] = "";
-  progressState progress = {.terminal = isatty(STDERR_FILENO) == 1, .start = wall_now(), .fitting = true};
+  progressState progress = {.terminal = isatty(STDERR_FILENO) == 1, .start = pd_cli_wall_seconds(), .fitting = true};
   for (int e = 0; e < engineCount && ok; ++e) {
     fitted[e] = specs[e].params;
     if (!specs[e].built) {
@@ -778,7 +721,7 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
     free(test);
     if (interrupted) return finish_interrupted("cubetoss fit", tmp);
     fprintf(stderr, "polydyn cubetoss fit: %s\n", why);
-    remove_tree(tmp);
+    pd_cli_remove_tree(tmp);
     return PD_EXIT_FAILURE;
   }
 
@@ -834,9 +777,9 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   int status = PD_EXIT_OK;
   if (!written) {
     fprintf(stderr, "polydyn cubetoss fit: cannot write %s: %s\n", path, strerror(errno));
-    remove_tree(tmp);
+    pd_cli_remove_tree(tmp);
     status = PD_EXIT_FAILURE;
-  } else if (!close_out("cubetoss fit", tmp, o->out)) {
+  } else if (!pd_cli_out_close("cubetoss fit", tmp, o->out)) {
     status = PD_EXIT_FAILURE;
   } else {
     for (int e = 0; e < engineCount; ++e) {

@@ -41,11 +41,6 @@ static void on_signal(int sig) {
   interrupted = 1;
 }
 
-static double wall_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 typedef struct runObserver {
   pdRunWriter* writer;
@@ -58,7 +53,7 @@ typedef struct runObserver {
 static bool observe_progress(const pdModel* model, const pdState* state, void* user) {
   runObserver* o = user;
   if (o->progress) {
-    double now = wall_now();
+    double now = pd_cli_wall_seconds();
     if (now - o->lastPrint > 0.5) {
       fprintf(stderr, "\rpolydyn run: t = %.4g / %.4g s", state->t, model->settings.tend);
       o->lastPrint = now;
@@ -73,30 +68,6 @@ static bool observe(const pdModel* model, const pdState* state, void* user) {
   return observe_progress(model, state, user);
 }
 
-// mkdir -p of the directories above `path`; a real failure shows when the run directory is made
-void pd_cli_make_parents(const char* path) {
-  char* p = strdup(path);
-  if (!p) abort();
-  for (char* slash = strchr(p + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
-    *slash = '\0';
-    mkdir(p, 0777);
-    *slash = '/';
-  }
-  free(p);
-}
-
-// out/NAME for scene path .../NAME.ext
-char* pd_cli_default_out_dir(const char* scene) {
-  const char* base = strrchr(scene, '/');
-  base = base ? base + 1 : scene;
-  size_t n = strlen(base);
-  const char* dot = strrchr(base, '.');
-  if (dot && dot != base) n = (size_t)(dot - base);
-  char* dir = malloc(n + 5);
-  if (!dir) abort();
-  snprintf(dir, n + 5, "out/%.*s", (int)n, base);
-  return dir;
-}
 
 int pd_cmd_run(int argc, char** argv) {
   const char* scene = NULL;
@@ -193,7 +164,7 @@ int pd_cmd_run(int argc, char** argv) {
   }
 
   if (!soft) {
-    runObserver observer = {NULL, isatty(STDERR_FILENO) == 1, wall_now()};
+    runObserver observer = {NULL, isatty(STDERR_FILENO) == 1, pd_cli_wall_seconds()};
     pdRefRunStats stats;
     bool ok = pd_ref_run(model, pd_ref_adapter(engine), &ref, writer, observe_progress, &observer, &stats, &err);
     if (observer.progress) fputs("\r\033[K", stderr);
@@ -217,11 +188,11 @@ int pd_cmd_run(int argc, char** argv) {
 
   pdState* state = pd_state_create(model);
   state->stepper = stepper;
-  runObserver observer = {writer, isatty(STDERR_FILENO) == 1, wall_now()};
+  runObserver observer = {writer, isatty(STDERR_FILENO) == 1, pd_cli_wall_seconds()};
   double energyStart = pd_state_energy(model, state);
-  double t0 = wall_now();
+  double t0 = pd_cli_wall_seconds();
   bool completed = pd_advance(model, state, model->settings.tend, observe, &observer);
-  double wall = wall_now() - t0;
+  double wall = pd_cli_wall_seconds() - t0;
   if (observer.progress) fputs("\r\033[K", stderr);
 
   int status = PD_EXIT_OK;

@@ -35,12 +35,6 @@ static const char* const help =
     "Writes DIR/sweep.csv (reports/FORMATS.md) and DIR/reference.json; DIR is replaced atomically.\n"
     "Progress goes to stderr on a terminal. Exit status: 0 ok, 1 the reference run failed, 2 bad input.\n";
 
-static double wall_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static int compare_doubles(const void* a, const void* b) {
   double x = *(const double*)a, y = *(const double*)b;
   return (x > y) - (x < y);
@@ -84,9 +78,9 @@ typedef struct point {
 static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* trajectory, double* wall, long* steps) {
   pdState* state = pd_state_create(model);
   state->stepper = stepper;
-  double t0 = wall_now();
+  double t0 = pd_cli_wall_seconds();
   bool ok = pd_advance(model, state, model->settings.tend, trajectory ? pd_trajectory_observe : NULL, trajectory);
-  *wall = wall_now() - t0;
+  *wall = pd_cli_wall_seconds() - t0;
   *steps = state->count.accepted;
   pd_state_free(state);
   return ok;
@@ -137,17 +131,6 @@ static void measure_reference_engine(const pdModel* model, const pdRefAdapter* a
     p->wall = median(walls, repeats);
   }
   pd_trajectory_free(tr);
-}
-
-static bool list_has(const char* list, const char* word) {
-  size_t n = strlen(word);
-  for (const char* q = list; q && *q;) {
-    const char* comma = strchr(q, ',');
-    size_t len = comma ? (size_t)(comma - q) : strlen(q);
-    if (len == n && strncmp(q, word, n) == 0) return true;
-    q = comma ? comma + 1 : NULL;
-  }
-  return false;
 }
 
 int pd_cmd_sweep(int argc, char** argv) {
@@ -234,10 +217,10 @@ int pd_cmd_sweep(int argc, char** argv) {
   static const double fixedSteps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};
   static const double refSteps_[] = {1.0 / 60, 1.0 / 250, 1.0 / 1000, 1.0 / 4000, 1.0 / 16000};
   int total = 0;
-  if (list_has(engines, "soft")) total += 14;
-  if (list_has(engines, "ode") && pd_ref_adapter("ode")) total += 10;
-  if (list_has(engines, "bullet") && pd_ref_adapter("bullet")) total += 10;
-  if (list_has(engines, "soft")) {
+  if (pd_cli_list_has(engines, "soft")) total += 14;
+  if (pd_cli_list_has(engines, "ode") && pd_ref_adapter("ode")) total += 10;
+  if (pd_cli_list_has(engines, "bullet") && pd_ref_adapter("bullet")) total += 10;
+  if (pd_cli_list_has(engines, "soft")) {
     for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i) {
       if (progress) fprintf(stderr, "\rpolydyn sweep: soft tol %g (%d/%d)\033[K", tols[i], count + 1, total);
       measure_soft(scene, &base, "adaptive", tols[i], (int)repeats, ref, &points[count++]);
@@ -250,7 +233,7 @@ int pd_cmd_sweep(int argc, char** argv) {
   static const char* const refNames[] = {"ode", "bullet"};
   for (int e = 0; e < 2; ++e) {
     const pdRefAdapter* adapter = pd_ref_adapter(refNames[e]);
-    if (!list_has(engines, refNames[e])) continue;
+    if (!pd_cli_list_has(engines, refNames[e])) continue;
     if (!adapter) {
       fprintf(stderr, "polydyn sweep: this build has no %s adapter; skipped\n", refNames[e]);
       continue;
@@ -268,15 +251,8 @@ int pd_cmd_sweep(int argc, char** argv) {
 
   // write DIR under a temporary name, then rename
   char tmp[4096], path[4400];
-  snprintf(tmp, sizeof tmp, "%s.partial-%ld", out, (long)getpid());
-  struct stat st;
-  snprintf(path, sizeof path, "%s/sweep.csv", out);
   int status = PD_EXIT_OK;
-  if (stat(out, &st) == 0 && stat(path, &st) != 0) {
-    fprintf(stderr, "polydyn sweep: %s exists and is not a sweep directory (no sweep.csv); not replacing it\n", out);
-    status = PD_EXIT_BAD_INPUT;
-  } else if (mkdir(tmp, 0777) != 0) {
-    fprintf(stderr, "polydyn sweep: cannot create %s: %s\n", tmp, strerror(errno));
+  if (!pd_cli_out_open("sweep", out, "sweep.csv", tmp, sizeof tmp)) {
     status = PD_EXIT_BAD_INPUT;
   } else {
     char refName[128];
@@ -312,24 +288,11 @@ int pd_cmd_sweep(int argc, char** argv) {
     } else {
       ok = false;
     }
-    char old[4096];
-    snprintf(old, sizeof old, "%s.old-%ld", out, (long)getpid());
-    bool hadOld = stat(out, &st) == 0;
-    ok = ok && (!hadOld || rename(out, old) == 0) && rename(tmp, out) == 0;
-    if (ok && hadOld) {
-      snprintf(path, sizeof path, "%s/sweep.csv", old);
-      remove(path);
-      snprintf(path, sizeof path, "%s/reference.json", old);
-      remove(path);
-      rmdir(old);
-    }
     if (!ok) {
-      fprintf(stderr, "polydyn sweep: cannot write %s: %s\n", out, strerror(errno));
-      snprintf(path, sizeof path, "%s/sweep.csv", tmp);
-      remove(path);
-      snprintf(path, sizeof path, "%s/reference.json", tmp);
-      remove(path);
-      rmdir(tmp);
+      fprintf(stderr, "polydyn sweep: cannot write %s: %s\n", tmp, strerror(errno));
+      pd_cli_remove_tree(tmp);
+    }
+    if (!ok || !pd_cli_out_close("sweep", tmp, out)) {
       status = PD_EXIT_FAILURE;
     } else {
       printf("%-8s %-9s %-5s %10s %12s %12s\n", "engine", "variant", "set", "value", "error", "wall/sim s");

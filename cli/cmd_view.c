@@ -1,7 +1,6 @@
 // polydyn view — a self-contained HTML replay of run directories, and movies of it.
 #include <errno.h>
 #include <signal.h>
-#include <ftw.h>
 #include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,11 +38,6 @@ static const char* const help =
     "130 interrupted (nothing written).\n";
 
 enum { MAX_RUNS = 16 };
-
-static int remove_entry(const char* path, const struct stat* sb, int flag, struct FTW* ftw) {
-  (void)sb, (void)flag, (void)ftw;
-  return remove(path);
-}
 
 // DIR.html for DIR (trailing slashes dropped)
 static char* default_page(const char* dir) {
@@ -142,7 +136,7 @@ static int make_movie(pdViewRun* const* runs, int count, const char* title, cons
   }
   if (status != PD_EXIT_OK) unlink(partial);
   free(partial);
-  nftw(dir, remove_entry, 8, FTW_DEPTH | FTW_PHYS);
+  pd_cli_remove_tree(dir);
   return status;
 }
 

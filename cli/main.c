@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "cli.h"
 
@@ -51,6 +52,23 @@ bool pd_cli_positive(const char* text, double* value) {
   if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v) || !(v > 0.0)) return false;
   *value = v;
   return true;
+}
+
+double pd_cli_wall_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+bool pd_cli_list_has(const char* list, const char* word) {
+  size_t n = strlen(word);
+  for (const char* p = list; p && *p;) {
+    const char* comma = strchr(p, ',');
+    size_t len = comma ? (size_t)(comma - p) : strlen(p);
+    if (len == n && strncmp(p, word, n) == 0) return true;
+    p = comma ? comma + 1 : NULL;
+  }
+  return false;
 }
 
 bool pd_cli_is_help(const char* arg) { return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0; }

@@ -1,0 +1,73 @@
+// polydyn CLI — output directories: default names, parents, and the write-then-rename of a whole
+// directory (DIR.partial-PID, renamed to DIR when complete; a previous DIR replaced only when it is ours).
+#include <errno.h>
+#include <ftw.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+// mkdir -p of the directories above `path`; a real failure shows when the run directory is made
+void pd_cli_make_parents(const char* path) {
+  char* p = strdup(path);
+  if (!p) abort();
+  for (char* slash = strchr(p + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
+    *slash = '\0';
+    mkdir(p, 0777);
+    *slash = '/';
+  }
+  free(p);
+}
+
+// out/NAME for scene path .../NAME.ext
+char* pd_cli_default_out_dir(const char* scene) {
+  const char* base = strrchr(scene, '/');
+  base = base ? base + 1 : scene;
+  size_t n = strlen(base);
+  const char* dot = strrchr(base, '.');
+  if (dot && dot != base) n = (size_t)(dot - base);
+  char* dir = malloc(n + 5);
+  if (!dir) abort();
+  snprintf(dir, n + 5, "out/%.*s", (int)n, base);
+  return dir;
+}
+
+static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw) {
+  (void)st, (void)flag, (void)ftw;
+  return remove(path);
+}
+
+void pd_cli_remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
+
+bool pd_cli_out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize) {
+  struct stat st;
+  char path[4200];
+  snprintf(path, sizeof path, "%s/%s", out, marker);
+  if (stat(out, &st) == 0 && stat(path, &st) != 0) {
+    fprintf(stderr, "polydyn %s: %s exists and is not a %s directory (no %s); not replacing it\n", cmd, out, cmd, marker);
+    return false;
+  }
+  snprintf(tmp, tmpSize, "%s.partial-%ld", out, (long)getpid());
+  if (mkdir(tmp, 0777) != 0) {
+    fprintf(stderr, "polydyn %s: cannot create %s: %s\n", cmd, tmp, strerror(errno));
+    return false;
+  }
+  return true;
+}
+
+bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out) {
+  struct stat st;
+  char old[4200];
+  snprintf(old, sizeof old, "%s.old-%ld", out, (long)getpid());
+  bool hadOld = stat(out, &st) == 0;
+  bool ok = (!hadOld || rename(out, old) == 0) && rename(tmp, out) == 0;
+  if (ok && hadOld) pd_cli_remove_tree(old);
+  if (!ok) {
+    fprintf(stderr, "polydyn %s: cannot write %s: %s\n", cmd, out, strerror(errno));
+    pd_cli_remove_tree(tmp);
+  }
+  return ok;
+}
