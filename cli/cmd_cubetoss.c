@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "polydyn/output.h"
 #include "polydyn/cubetoss.h"
 
 // Longest --out path: the run directories' paths below it fit the fixed buffers.
@@ -335,19 +336,6 @@ static void write_number(FILE* out, double v) {
   if (isfinite(v)) fprintf(out, "%.9g", v);
 }
 
-static void write_csv_text(FILE* out, const char* s) {
-  if (!strpbrk(s, ",\"\r\n")) {
-    fputs(s, out);
-    return;
-  }
-  fputc('"', out);
-  for (; *s; ++s) {
-    if (*s == '"') fputc('"', out);
-    fputc(*s, out);
-  }
-  fputc('"', out);
-}
-
 static void per_toss_header(FILE* out) {
   fputs("toss,split,engine,variant,params,status,samples,duration_s,pos_err_end,pos_err_rms,rot_err_end_rad,"
         "rot_err_rms_rad,wall_seconds,cpu_seconds,steps,run_dir,message\n",
@@ -370,7 +358,7 @@ static void per_toss_row(FILE* out, const pdToss* toss, int index, const engineS
   }
   if (runs && r->runWritten) fprintf(out, "runs/%ld/%s", toss->id, s->label);
   fputc(',', out);
-  write_csv_text(out, r->message);
+  pd_write_csv_text(out, r->message);
   fputc('\n', out);
 }
 
