@@ -149,6 +149,22 @@ static inline uint32_t cell_bucket(uint64_t key, int shift) {
   return (uint32_t)((key * 0x9E3779B97F4A7C15ull) >> shift);
 }
 
+// The three per-entry arrays grow together to hold `count` entries.
+static bool grow_entries(pdBroadGrid* g, size_t count) {
+  if (count <= g->entryCap) return true;
+  size_t cap = g->entryCap ? g->entryCap : 64;
+  while (cap < count) cap *= 2;
+  entry* e = realloc(g->entries, cap * sizeof *e);
+  if (e) g->entries = e;
+  entry* b = realloc(g->binned, cap * sizeof *b);
+  if (b) g->binned = b;
+  uint32_t* k = realloc(g->bucketOf, cap * sizeof *k);
+  if (k) g->bucketOf = k;
+  if (!e || !b || !k) return false;  // those that grew are kept; entryCap stays the old, safe, size
+  g->entryCap = cap;
+  return true;
+}
+
 static bool add_pair(pdBroadGrid* g, int a, int b) {
   if (!grow((void**)&g->pairs, &g->pairCap, g->pairCount + 1, sizeof *g->pairs)) return false;
   g->pairs[g->pairCount++] = a < b ? (pdPair){a, b} : (pdPair){b, a};
@@ -205,13 +221,7 @@ bool pd_broad_grid_update(pdBroadGrid* g, const pdAabb* boxes) {
     if (g->isLarge[i]) g->large[largeCount++] = i;
     else count += (size_t)g->span[i][0] * g->span[i][1] * g->span[i][2];
   }
-  size_t cap = g->entryCap;
-  if (!grow((void**)&g->entries, &cap, count, sizeof *g->entries)) return false;
-  cap = g->entryCap;
-  if (!grow((void**)&g->binned, &cap, count, sizeof *g->binned)) return false;
-  cap = g->entryCap;
-  if (!grow((void**)&g->bucketOf, &cap, count, sizeof *g->bucketOf)) return false;
-  g->entryCap = cap;
+  if (!grow_entries(g, count)) return false;
   size_t buckets = 64;
   int bits = 6;
   while (buckets < count) buckets *= 2, ++bits;
