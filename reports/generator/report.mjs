@@ -1,8 +1,9 @@
 #!/usr/bin/env node
 // polydyn report DIR [-o FILE] [--viewer FILE | --no-viewer]
 //
-// Reads what `polydyn gedanken`, `polydyn sweep` and `polydyn compare` wrote into DIR (any subset:
-// results.csv, experiments.json, series/*.csv, runs/*/*/summary.json, sweep.csv, metrics.csv) and
+// Reads what `polydyn gedanken`, `polydyn sweep`, `polydyn compare` and `polydyn cubetoss` wrote into DIR
+// (any subset: results.csv, experiments.json, series/*.csv, runs/*/*/summary.json, sweep.csv, metrics.csv,
+// cubetoss/ — or DIR itself being a cubetoss directory) and
 // writes one self-contained HTML page (Apache ECharts and the page script inlined: no network at view
 // time), the numbers it shows as JSON beside it, and its derived tables as CSV:
 //   FILE (default DIR/report.html), FILE without .html + .json, FILE without .html + -TABLE.csv.
@@ -13,7 +14,8 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { InputError, UsageError, SetupError } from './lib/errors.mjs';
-import { readResults, readExperiments, readSeries, readSweep, readMetrics, readSummary } from './lib/inputs.mjs';
+import { readResults, readExperiments, readSeries, readSweep, readMetrics, readSummary, readCubetoss } from './lib/inputs.mjs';
+import { loadTypical } from './lib/cubetoss.mjs';
 import * as derive from './lib/derive.mjs';
 import { esc, colorOf } from './lib/html.mjs';
 import { writeCsv } from './lib/csv.mjs';
@@ -36,6 +38,8 @@ plus the numbers it shows as JSON and CSV beside it. Sections appear when their 
   runs/*/*/summary.json           the parameters every engine actually used
   sweep.csv                       work-precision diagrams and the cost to reach error 1e-3
   metrics.csv                     comparison metrics
+  cubetoss/summary.csv            cube tosses against reality (per_toss.csv, fit.csv, replay/TOSS/ or
+                                  runs/TOSS/ beside it); DIR may also be a polydyn cubetoss directory
 
   -o FILE         the page (default DIR/report.html); FILE.json (without .html) and FILE-TABLE.csv
                   are written beside it
@@ -75,9 +79,12 @@ export function loadInputs(dir) {
     series: readSeries(dir),
     sweep: readSweep(dir),
     metrics: readMetrics(dir),
+    cubetoss: readCubetoss(dir),
   };
-  if (!inputs.results && !inputs.experiments && !inputs.series && !inputs.sweep && !inputs.metrics)
-    throw new InputError(dir, 0, 'nothing to report: none of results.csv, experiments.json, series/*.csv, sweep.csv, metrics.csv is there');
+  if (!inputs.results && !inputs.experiments && !inputs.series && !inputs.sweep && !inputs.metrics && !inputs.cubetoss)
+    throw new InputError(dir, 0, 'nothing to report: none of results.csv, experiments.json, series/*.csv, sweep.csv, metrics.csv, ' +
+      'cubetoss/summary.csv is there');
+  inputs.cubetossTypical = inputs.cubetoss ? loadTypical(dir, inputs.cubetoss) : null;
   // run directories named in results.csv, each once
   inputs.runs = [];
   if (inputs.results) {
@@ -131,7 +138,7 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
   const matrix = lazy(() => (results && results.rows.length ? derive.matrix(results, inputs.experiments) : null));
   const wp = lazy(() => (inputs.sweep && inputs.sweep.rows.length ? derive.workPrecision(inputs.sweep) : null));
   const evOrder = derive.orderEngineVariants([...(results ? results.rows : []), ...(inputs.sweep ? inputs.sweep.rows : []),
-    ...(inputs.metrics ? inputs.metrics.rows : [])]).map((x) => x.ev);
+    ...(inputs.metrics ? inputs.metrics.rows : []), ...(inputs.cubetoss ? inputs.cubetoss.summary : [])]).map((x) => x.ev);
   const ctx = {
     dir,
     results,
@@ -139,6 +146,8 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
     series: inputs.series,
     sweep: inputs.sweep,
     metrics: inputs.metrics,
+    cubetoss: inputs.cubetoss,
+    cubetossTypical: inputs.cubetossTypical,
     runs: inputs.runs,
     viewer: viewerSource,
     evOrder,
@@ -175,7 +184,7 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
     const out = s.build(ctx);
     if (out) built.push({ section: s, ...out });
   }
-  if (!built.length) throw new InputError(dir, 0, 'nothing to report: the inputs there give no section (results.csv, series/*.csv, sweep.csv or metrics.csv with rows)');
+  if (!built.length) throw new InputError(dir, 0, 'nothing to report: the inputs there give no section (results.csv, series/*.csv, sweep.csv, metrics.csv or cubetoss/summary.csv with rows)');
   const json = {
     format: 'polydyn-report/1',
     directory: dir,
@@ -230,6 +239,7 @@ function inputList(inputs) {
   if (inputs.runs.some((r) => r.summary)) list.push(`${inputs.runs.filter((r) => r.summary).length} × runs/…/summary.json`);
   if (inputs.sweep) list.push('sweep.csv');
   if (inputs.metrics) list.push('metrics.csv');
+  if (inputs.cubetoss) list.push(`${inputs.cubetoss.at === '.' ? '' : inputs.cubetoss.at + '/'}summary.csv`);
   return list;
 }
 
@@ -243,6 +253,7 @@ function shortInputs(inputs) {
   if (summaries) list.push(`${summaries} run summaries`);
   if (inputs.sweep) list.push(`sweep.csv (${inputs.sweep.rows.length} points)`);
   if (inputs.metrics) list.push('metrics.csv');
+  if (inputs.cubetoss) list.push(`cube-toss results (${new Set(inputs.cubetoss.summary.map((r) => r.ev)).size} engines)`);
   return list.join(', ');
 }
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Browser smoke test: the fixture report (with a stand-in viewer bundle for the replay hook) and a
-# sweep-only report load in headless Debian Chromium with no console error and no network request,
-# every chart draws, and both embedded replays mount.
+# Browser smoke test: the fixture report with cube-toss results (and a stand-in viewer bundle for the
+# replay hook) and a sweep-only report load in headless Debian Chromium with no console error and no network request,
+# every chart draws, and every embedded replay mounts (one of them the cube toss's record with each engine's run).
 # usage: test_report_browser.sh POLYDYN SOURCE_DIR
 set -euo pipefail
 polydyn=$1
@@ -10,10 +10,14 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export PD_REPORT_GENERATOR=$src/reports/generator/report.mjs
 fixtures=$src/tests/reports/fixtures
-"$polydyn" report "$fixtures/gedanken" -o "$work/full.html" --viewer "$fixtures/fake-viewer.js" 2>/dev/null
+# the Gedanken fixture with cube-toss results beside it (synthetic tosses, polydyn cubetoss)
+cp -r "$fixtures/gedanken" "$work/g"
+python3 "$src/tests/reports/make_tosses.py" "$work/tosses.csv" 4
+"$polydyn" cubetoss --data "$work/tosses.csv" --out "$work/g/cubetoss" --tosses all >/dev/null 2>&1
+"$polydyn" report "$work/g" -o "$work/full.html" --viewer "$fixtures/fake-viewer.js" 2>/dev/null
 replays=$(grep -o '<details class="replay"' "$work/full.html" | wc -l)
-if [[ $replays -ne 2 ]]; then echo "FAIL - the fixture report embeds $replays replays, expected 2"; exit 1; fi
-echo "ok - the fixture report embeds 2 replays and the viewer bundle once ($(grep -c 'id="pd-viewer-bundle"' "$work/full.html"))"
+if [[ $replays -ne 3 ]]; then echo "FAIL - the fixture report embeds $replays replays, expected 3 (2 runs, 1 cube toss)"; exit 1; fi
+echo "ok - the fixture report embeds 3 replays (one of a cube toss) and the viewer bundle once ($(grep -c 'id="pd-viewer-bundle"' "$work/full.html"))"
 mkdir "$work/s"
 cp "$fixtures/gedanken/sweep.csv" "$work/s/"
 "$polydyn" report "$work/s" --no-viewer 2>/dev/null

@@ -110,3 +110,35 @@ test('arguments: DIR, -o, --viewer, --no-viewer; outputs beside the page', () =>
   assert.deepEqual(outputPaths('d', null, ['matrix']), { page: 'd/report.html', json: 'd/report.json', csv: { matrix: 'd/report-matrix.csv' } });
   assert.equal(outputPaths('d', 'out/x.html', []).json, 'out/x.json');
 });
+
+import { rotationAngle, errorsOverTime, ecdf, typicalToss, paramsOrder } from '../../reports/generator/lib/cubetoss.mjs';
+
+test('cube tosses: rotation angle of q_ref⁻¹ q is the angle between orientations, whatever the sign of q', () => {
+  const about = (deg, axis) => { const h = deg * Math.PI / 360; return [Math.cos(h), ...axis.map((c) => Math.sin(h) * c)]; };
+  const ref = about(30, [0, 0, 1]);
+  assert.ok(Math.abs(rotationAngle(about(120, [0, 0, 1]), ref) - Math.PI / 2) < 1e-15);
+  assert.ok(Math.abs(rotationAngle(about(120, [0, 0, 1]).map((c) => -c), ref) - Math.PI / 2) < 1e-15);
+  // small angles keep their digits (an arccos of the scalar part would be off by ~1e-8 rad here)
+  const small = 1e-7 * Math.PI / 180;
+  assert.ok(Math.abs(rotationAngle(about(30 + 1e-7, [0, 0, 1]), ref) - small) < 1e-6 * small);
+  assert.equal(rotationAngle(ref, ref), 0);
+});
+
+test('cube tosses: errors over time use only run samples at the record\'s times, positions in widths', () => {
+  const s = (t, x) => ({ t, x: [x, 0, 0], q: [1, 0, 0, 0] });
+  const rec = [s(0, 0), s(1, 0), s(2, 0)];
+  const run = [s(0, 0.1), s(0.5, 9), s(1 + 1e-12, 0.2), s(2.5, 9)];
+  assert.deepEqual(errorsOverTime(rec, run, 0.1).map((e) => [e.t, Math.round(e.pos * 1e12) / 1e12]), [[0, 1], [1, 2]]);
+});
+
+test('cube tosses: the typical toss is nearest the median, among tosses with a replay, ties to the lower toss', () => {
+  const row = (toss, e) => ({ toss, split: 'test', engine: 'soft', variant: 'adaptive', ev: 'soft adaptive', params: 'fitted', status: 'ok', pos_err_end: e });
+  const rows = [row(5, 0.125), row(3, 0.25), row(9, 0.75), row(7, 1), row(1, 0.5)];  // median 0.5 (exact binary fractions)
+  assert.equal(typicalToss(rows, { params: 'fitted', split: 'test' }, () => true).toss, 1);
+  assert.equal(typicalToss(rows, { params: 'fitted', split: 'test' }, (t) => t !== 1).toss, 3, '0.25 and 0.75 tie: toss 3');
+  const none = typicalToss(rows, { params: 'fitted', split: 'test' }, () => false);
+  assert.equal(none.toss, 1);
+  assert.equal(none.replay, false);
+  assert.deepEqual(ecdf([3, 1, 2, NaN]), [[1, 1 / 3], [2, 2 / 3], [3, 1]]);
+  assert.deepEqual(paramsOrder([{ params: 'x' }, { params: 'fitted' }, { params: 'default' }]), ['default', 'fitted', 'x']);
+});

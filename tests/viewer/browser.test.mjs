@@ -262,3 +262,42 @@ test('PolydynViewer.mount (the report hook) builds from the CSV texts the same r
   assert.deepEqual(errors, []);
   await tab.close();
 });
+
+test('PolydynViewer.mount with several runs (a cube toss and its engines in a report) overlays them as polydyn view does', async () => {
+  const tab = await browser.context.newPage();
+  const errors = [];
+  tab.on('pageerror', (e) => errors.push(e.message));
+  tab.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  await tab.goto(pathToFileURL(pagePath).href);
+  await tab.evaluate(() => window.pdViewer.ready);
+  const files = (dir, name) => ({
+    run: name,
+    summary: JSON.parse(readFileSync(join(dir, 'summary.json'), 'utf8')),
+    trajectory: readFileSync(join(dir, 'trajectory.csv'), 'utf8'),
+    contacts: readFileSync(join(dir, 'contacts.csv'), 'utf8'),
+  });
+  const r = await tab.evaluate((payload) => {
+    const div = document.createElement('div');
+    document.body.prepend(div);
+    const v = window.PolydynViewer.mount(div, payload), main = window.pdViewer.main;
+    const differ = v.runs.map((a, k) => ['t', 'pose', 'vel', 'contactStart', 'contactFloat', 'contactInt']
+      .filter((key) => a[key].length !== main.runs[k][key].length || a[key].some((x, i) => x !== main.runs[k][key][i])));
+    const t = v.runs[1].t[20];  // a sample of the 50/s run, between samples of neither
+    v.setTime(t);
+    v.renderNow();
+    return { runs: v.runs.length, labels: v.runs.map((x) => x.label), differ, t,
+      m0: v.bodyMatrix(0, 'box'), m1: v.bodyMatrix(1, 'box'),
+      runLabels: Array.from(div.querySelectorAll('.pdv-runlabel')).map((l) => l.textContent) };
+  }, { title: 'two runs', runs: [files(runA, 'demo'), files(runB, 'demo-50')] });
+  assert.equal(r.runs, 2);
+  assert.deepEqual(r.differ, [[], []], 'each run equal to the one polydyn view embedded');
+  assert.notEqual(r.labels[0], r.labels[1], 'two runs of one engine are told apart by their directory');
+  assert.equal(r.runLabels.length, 2);
+  assert.match(r.runLabels[1], /ghost/);
+  // both runs sample the same motion: at a sample time of the 50/s run the two draw the same pose
+  const rowB = trajectory(runB, 'box').find((x) => x.t === r.t);
+  assert.ok(maxDiff(r.m1.slice(0, 12), poseRows(rowB)) <= TOL);
+  assert.ok(maxDiff(r.m0.slice(0, 12), poseRows(rowB)) <= TOL);
+  assert.deepEqual(errors, []);
+  await tab.close();
+});

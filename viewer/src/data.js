@@ -82,10 +82,15 @@ export function readReplay(id) {
     return new Run(m, blockArrays(m, bytes));
   });
   // runs of one engine are told apart by their directories
+  labelDuplicates(runs);
+  return { title: meta.title, runs };
+}
+
+// Runs of the same engine are told apart by their directory's last component.
+function labelDuplicates(runs) {
   const engines = runs.map((r) => r.engine);
   if (new Set(engines).size < engines.length)
     runs.forEach((r) => { r.label = `${r.engine} (${r.dir.replace(/\/+$/, '').replace(/^.*\//, '')})`; });
-  return { title: meta.title, runs };
 }
 
 // ---------------------------------------------------------------- a run directory's files
@@ -258,8 +263,17 @@ function readContacts(text, meta, ts) {
   return { contactStart: start, contactFloat: cf.done(), contactInt: ci.done(), contacts: count };
 }
 
-// One run from a run directory's files (PolydynViewer.mount's input): { title, runs: [Run] }, as readReplay.
-export function readRunFiles({ run, summary, trajectory, contacts }) {
+// PolydynViewer.mount's input: one run directory's files, or { title, runs: [files, ...] } — several
+// shown together, the first drawn solid and the others as overlays — into { title, runs: [Run] }, as readReplay.
+export function readRunFiles(files) {
+  if (!Array.isArray(files?.runs)) return readOneRun(files);
+  if (files.runs.length === 0) throw new Error('no runs to show');
+  const runs = files.runs.map((f) => readOneRun(f).runs[0]);
+  labelDuplicates(runs);
+  return { title: String(files.title ?? runs.map((r) => r.dir).join(' + ')), runs };
+}
+
+function readOneRun({ run, summary, trajectory, contacts }) {
   const dir = String(run ?? 'run');
   if (typeof trajectory !== 'string') throw new Error(`${dir}: no trajectory.csv`);
   const meta = readSummary(summary, dir);

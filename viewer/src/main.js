@@ -16,6 +16,9 @@
 //   PolydynViewer.mount(element, { run, summary, trajectory, contacts })
 //                           builds one replay in element from a run directory's files (summary.json
 //                           parsed, the CSV texts) and returns it; on bad input, null (the error is shown in element)
+//   PolydynViewer.mount(element, { title, runs: [{ run, summary, trajectory, contacts }, ...] })
+//                           several runs of one scene in one replay: the first solid, the others overlaid
+//                           (as polydyn view DIR DIR...), e.g. a recorded cube toss and each engine's run
 import css from './style.css';
 import { readReplay, readRunFiles } from './data.js';
 import { Replay } from './replay.js';

@@ -246,3 +246,140 @@ export function readSummary(dir, run) {
   if ('bodies' in v && !Array.isArray(v.bodies)) throw new InputError(src.file, lineOf(v), '"bodies" must be an array');
   return { file: src.file, summary: v };
 }
+
+// ---------------------------------------------------------------- cube tosses (polydyn cubetoss)
+
+export const TOSS_SUMMARY_HEADER = ['engine', 'variant', 'params', 'split', 'status', 'tosses', 'completed', 'quantity', 'unit',
+  'mean', 'median', 'p90'];
+export const PER_TOSS_HEADER = ['toss', 'split', 'engine', 'variant', 'params', 'status', 'samples', 'duration_s', 'pos_err_end',
+  'pos_err_rms', 'rot_err_end_rad', 'rot_err_rms_rad', 'wall_seconds', 'cpu_seconds', 'steps', 'run_dir', 'message'];
+export const FIT_HEADER = ['engine', 'variant', 'status', 'fitted', 'mu', 'restitution', 'kn', 'objective_train',
+  'pos_err_end_mean_train', 'rot_err_end_mean_train_rad', 'failed_train', 'evaluations', 'converged', 'train_tosses',
+  'train_every', 'test_tosses', 'start_mu', 'start_restitution', 'start_kn', 'start_objective_train'];
+const TOSS_SPLITS = ['all', 'train', 'test'];
+const TOSS_SUMMARY_STATUSES = ['ok', 'partial', 'failed', 'not built'];
+const TOSS_STATUSES = ['ok', 'failed', 'refused', 'not built'];
+const PROVENANCE = /^- (command|commit|machine|data|split|fit): (.+)$/;
+
+function oneOf(value, list, column, file, line) {
+  if (!list.includes(value)) throw new InputError(file, line, `${column}: expected one of ${list.join(', ')}, found '${value}'`);
+  return value;
+}
+
+function exists(file) {
+  try { return fs.statSync(file).isFile(); } catch { return false; }
+}
+
+// The cube-toss results of a report directory: DIR/cubetoss/ (scripts/gedanken-report copies the
+// committed reports/cubetoss/ there), or DIR itself when it is what `polydyn cubetoss --out DIR` wrote
+// (per_toss.csv and summary.csv). Reads summary.csv, per_toss.csv, fit.csv and the provenance lines of
+// README.md (scripts/cubetoss-all writes them) when present; null when there are no cube-toss results.
+// `at` is the directory relative to DIR ('cubetoss' or '.').
+export function readCubetoss(dir) {
+  let at;
+  if (fs.existsSync(path.join(dir, 'cubetoss'))) at = 'cubetoss';
+  else if (exists(path.join(dir, 'per_toss.csv')) && exists(path.join(dir, 'summary.csv'))) at = '.';
+  else return null;
+  const sub = path.join(dir, at);
+  const summarySrc = readText(sub, 'summary.csv');
+  if (!summarySrc) throw new InputError(path.join(sub, 'summary.csv'), 0, 'missing (a cube-toss directory needs the summary.csv of polydyn cubetoss)');
+  const summary = [];
+  for (const { line, f } of table(summarySrc, TOSS_SUMMARY_HEADER)) {
+    const file = summarySrc.file;
+    const row = {
+      line,
+      engine: word(f.engine, 'engine', file, line),
+      variant: word(f.variant, 'variant', file, line),
+      params: word(f.params, 'params', file, line),
+      split: oneOf(f.split, TOSS_SPLITS, 'split', file, line),
+      status: oneOf(f.status, TOSS_SUMMARY_STATUSES, 'status', file, line),
+      tosses: number(f.tosses, 'tosses', file, line, { required: true, integer: true }),
+      completed: number(f.completed, 'completed', file, line, { required: true, integer: true }),
+      quantity: word(f.quantity, 'quantity', file, line),
+      unit: f.unit,
+      mean: number(f.mean, 'mean', file, line),
+      median: number(f.median, 'median', file, line),
+      p90: number(f.p90, 'p90', file, line),
+    };
+    if (row.completed > row.tosses) throw new InputError(file, line, `completed (${row.completed}) is more than tosses (${row.tosses})`);
+    row.ev = `${row.engine} ${row.variant}`;
+    summary.push(row);
+  }
+  if (!summary.length) throw new InputError(summarySrc.file, 1, 'no rows');
+
+  let perToss = null;
+  const perSrc = readText(sub, 'per_toss.csv');
+  if (perSrc) {
+    perToss = [];
+    for (const { line, f } of table(perSrc, PER_TOSS_HEADER)) {
+      const file = perSrc.file;
+      const row = {
+        line,
+        toss: number(f.toss, 'toss', file, line, { required: true, integer: true }),
+        split: oneOf(f.split, TOSS_SPLITS, 'split', file, line),
+        engine: word(f.engine, 'engine', file, line),
+        variant: word(f.variant, 'variant', file, line),
+        params: word(f.params, 'params', file, line),
+        status: oneOf(f.status, TOSS_STATUSES, 'status', file, line),
+        run_dir: runDir(f.run_dir, file, line),
+        message: f.message,
+      };
+      for (const h of ['samples', 'steps']) row[h] = number(f[h], h, file, line, { integer: true });
+      for (const h of ['duration_s', 'pos_err_end', 'pos_err_rms', 'rot_err_end_rad', 'rot_err_rms_rad', 'wall_seconds', 'cpu_seconds'])
+        row[h] = number(f[h], h, file, line);
+      if (row.status === 'ok' && !(Number.isFinite(row.pos_err_end) && Number.isFinite(row.rot_err_end_rad)))
+        throw new InputError(file, line, 'status ok needs finite pos_err_end and rot_err_end_rad');
+      row.ev = `${row.engine} ${row.variant}`;
+      perToss.push(row);
+    }
+  }
+
+  let fit = null;
+  const fitSrc = readText(sub, 'fit.csv');
+  if (fitSrc) {
+    fit = [];
+    for (const { line, f } of table(fitSrc, FIT_HEADER)) {
+      const file = fitSrc.file;
+      const row = { line, engine: word(f.engine, 'engine', file, line), variant: word(f.variant, 'variant', file, line),
+        status: oneOf(f.status, ['ok', 'not built'], 'status', file, line), fitted: f.fitted.split(';').filter((x) => x !== '') };
+      if (f.converged !== '' && f.converged !== 'true' && f.converged !== 'false')
+        throw new InputError(file, line, `converged: expected true, false or empty, found '${f.converged}'`);
+      row.converged = f.converged === '' ? null : f.converged === 'true';
+      for (const h of ['failed_train', 'evaluations', 'train_tosses', 'train_every', 'test_tosses'])
+        row[h] = number(f[h], h, file, line, { integer: true });
+      for (const h of ['mu', 'restitution', 'kn', 'objective_train', 'pos_err_end_mean_train', 'rot_err_end_mean_train_rad',
+        'start_mu', 'start_restitution', 'start_kn', 'start_objective_train']) row[h] = number(f[h], h, file, line);
+      row.ev = `${row.engine} ${row.variant}`;
+      fit.push(row);
+    }
+  }
+
+  const provenance = {};
+  const readme = readText(sub, 'README.md');
+  if (readme) {
+    for (const l of readme.text.split('\n')) {
+      const m = PROVENANCE.exec(l.trimEnd());
+      if (m && !(m[1] in provenance)) provenance[m[1]] = m[2].replace(/`/g, '');
+    }
+  }
+  return { at, file: summarySrc.file, summary, perToss, fit, provenance, readme: readme ? readme.file : null };
+}
+
+export const TRAJECTORY_HEADER = ['t', 'body', 'x', 'y', 'z', 'qw', 'qx', 'qy', 'qz', 'vx', 'vy', 'vz', 'wx', 'wy', 'wz'];
+
+// The samples of one body in a run directory's trajectory.csv (relative to DIR): [{t, x: [3], q: [4]}];
+// null when the file does not exist.
+export function readBodyTrajectory(dir, run, body) {
+  const src = readText(dir, path.join(run, 'trajectory.csv'));
+  if (!src) return null;
+  const out = [];
+  for (const { line, f } of table(src, TRAJECTORY_HEADER)) {
+    if (f.body !== body) continue;
+    const v = TRAJECTORY_HEADER.slice(2, 9).map((h) => number(f[h], h, src.file, line, { required: true }));
+    const t = number(f.t, 't', src.file, line, { required: true });
+    if (!v.every(Number.isFinite) || !Number.isFinite(t)) throw new InputError(src.file, line, 'a pose that is not finite');
+    if (out.length && !(t > out[out.length - 1].t)) throw new InputError(src.file, line, `t = ${f.t} does not follow the previous sample of '${body}'`);
+    out.push({ t, x: v.slice(0, 3), q: v.slice(3, 7) });
+  }
+  return { file: src.file, samples: out };
+}

@@ -4,7 +4,7 @@
 //   { html, data, csv: [{name, header, rows}] }
 // html goes into the page under the section's title, data into report.json under the section's id,
 // each csv into report-NAME.csv beside the page. Charts are made with ctx.chart(echartsOption).
-// To add a section (e.g. the cube tosses), write sections/NAME.mjs and list it here.
+// To add a section, write sections/NAME.mjs and list it here.
 import verdict from './verdict.mjs';
 import matrix from './matrix.mjs';
 import restitution from './restitution.mjs';
@@ -14,5 +14,6 @@ import cost from './cost.mjs';
 import compare from './compare.mjs';
 import experiments from './experiments.mjs';
 import parameters from './parameters.mjs';
+import cubetoss from './cubetoss.mjs';
 
-export const sections = [verdict, matrix, restitution, frictionCone, workPrecision, cost, compare, experiments, parameters];
+export const sections = [verdict, matrix, restitution, frictionCone, workPrecision, cost, compare, cubetoss, experiments, parameters];
