@@ -31,7 +31,7 @@ const GROUP_NAMES = { A: 'contact-model calibration', B: 'friction', C: 'impacts
 
 const USAGE = `usage: polydyn report DIR [-o FILE] [--viewer FILE | --no-viewer]
 
-Writes one self-contained HTML report of DIR (what polydyn gedanken, sweep and compare wrote there),
+Writes one self-contained HTML report of DIR (what polydyn gedanken, sweep, compare and cubetoss wrote there),
 plus the numbers it shows as JSON and CSV beside it. Sections appear when their inputs exist:
   results.csv, experiments.json   verdict, PASS/FAIL matrix, restitution, friction cone, experiments
   series/EXPERIMENT.csv           each experiment's quantity over time against the analytic line
