@@ -99,6 +99,7 @@ pdVec3* gk_positions(const pdGkRecord* rec, int j) {
 }
 
 double gk_get_z(const pdBodyState* b) { return b->x.z; }
+double gk_get_x(const pdBodyState* b) { return b->x.x; }
 double gk_get_vx(const pdBodyState* b) { return b->v.x; }
 double gk_get_vz(const pdBodyState* b) { return b->v.z; }
 double gk_get_wy(const pdBodyState* b) { return b->w.y; }

@@ -14,7 +14,8 @@
 extern const pdGkExperiment pd_gk_a1_restitution, pd_gk_a2_restitution_contacts, pd_gk_a3_sinkage,
     pd_gk_a4_elastic_apex;
 extern const pdGkExperiment pd_gk_b1_incline_slide, pd_gk_b1_incline_stick, pd_gk_b2_stopping_distance,
-    pd_gk_b2_stop_time, pd_gk_b2_friction_cone, pd_gk_b4_block_on_block, pd_gk_b6_slide_spin;
+    pd_gk_b2_stop_time, pd_gk_b2_friction_cone, pd_gk_b3_ramp_onset, pd_gk_b4_block_on_block, pd_gk_b5_tip_or_slide,
+    pd_gk_b6_slide_spin;
 extern const pdGkExperiment pd_gk_c1_bounce_apex, pd_gk_c2_momentum, pd_gk_c3_eccentric_bar,
     pd_gk_c4_velocity_exchange, pd_gk_c6_energy_gain;
 extern const pdGkExperiment pd_gk_d1_rimless_wheel, pd_gk_d2_slide_to_roll, pd_gk_d3_tumbling_cube;
@@ -40,6 +41,7 @@ void gk_text_floor(pdGkText* out, double sx, double sy, double sz, double cx, co
 // Per-sample values of moving body j through `get`, into a new array (free it).
 typedef double gkGetter(const pdBodyState* b);
 double* gk_column(const pdGkRecord* rec, int j, gkGetter* get);
+double gk_get_x(const pdBodyState* b);
 double gk_get_z(const pdBodyState* b);
 double gk_get_vx(const pdBodyState* b);
 double gk_get_vz(const pdBodyState* b);

@@ -1,4 +1,4 @@
-// polydyn gedanken — group B: friction (catalogue §2 B1, B2, B4, B6, and the friction cone of DESIGN §5).
+// polydyn gedanken — group B: friction (catalogue §2 B1–B6, and the friction cone of DESIGN §5).
 #include <stdlib.h>
 
 #include "gedanken_internal.h"
@@ -296,6 +296,183 @@ const pdGkExperiment pd_gk_b2_friction_cone = {
     .expect = slide_distance_expect,
     .measure = slide_distance_measure,
     .series = slide_distance_series,
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// B3: a 0.1 m cube (1 kg) at rest on a level plate, μ = 0.4, pushed at its centre of mass (the CoM height) by
+// F = β t along x. It sticks, creeping by the tangential springs' deflection β t/(4 k_t,s), until the push
+// reaches μ m g at t* = μ m g/β, then slides with m v̇ = β (t − t*). Two rates, as the catalogue asks (a
+// damper-weighted stick test would make the breakaway rate dependent).
+
+// The pushed blocks of B3 and B5 stand on a floor whose springs are as stiff as theirs (1e6 N/m ~ m vmax²/(0.01
+// size)²) instead of sized by the floor's own 1.4 m extent (5e3 N/m): B3's creep while sticking, β/(4 k_t,s),
+// then stays far below B3_V_LO, and B5's tilt on its springs (~0.02 deg) far below the ~0.4 deg at which the
+// 1.5 % margin of the moments about the front edge is used up.
+#define STIFF_FLOOR "kn 1e6\nkt 1e6\n"
+
+#define B3_MU 0.4
+#define B3_AFTER 0.1  // s of sliding after t*: v reaches β (0.1 s)²/(2m) = 0.02..0.04 m/s, past B3_V_HI
+// The onset is read from the slide between these speeds (pd_gk_ramp_slip_onset): far above the creep of
+// the sticking springs (β/(4 k_t,s) ~ 4e-6 m/s here), reached 20..70 ms after t*, 1 ms samples.
+#define B3_V_LO 2e-3  // m/s
+#define B3_V_HI 1e-2  // m/s
+
+static double b3_onset(const pdModel* model, double beta) {
+  double m = model->bodies[gk_body(model, "box")].mass;
+  return pair_mu(model, "box", "floor") * m * gravity(model) / beta;
+}
+
+static void b3_scene(double beta, pdGkText* out) {
+  double tStar = B3_MU * 1.0 * GK_G / beta;  // the cube's 1 kg: 0.1 m of water
+  pd_gk_text_printf(out, "tend %.17g\nsample 1000\ntol 1e-9\nvmax 1\n", tStar + B3_AFTER);
+  gk_text_floor(out, 2.0, 2.0, 0.2, 0.0, "mu 0.4\nrestitution 0.5\n" STIFF_FLOOR);
+  pd_gk_text_printf(out, "cube box red 0.1 0.1 0.1\nloc 0 0 0.05\nmu %g\nrestitution 0.5\nforce 0 0 0 ramp %.17g 0 0\n",
+                    B3_MU, beta);
+}
+
+static pdGkExpected b3_expect(const pdModel* model, double beta) { return (pdGkExpected){b3_onset(model, beta), 0.005}; }
+
+static void b3_measure(const pdModel* model, const pdGkRecord* rec, double beta, pdGkMeasured* out) {
+  double* v = gk_column(rec, gk_moving(model, "box"), gk_get_vx);
+  double m = model->bodies[gk_body(model, "box")].mass, tStar, slope;
+  if (pd_gk_ramp_slip_onset(rec->t, v, rec->count, m, beta, B3_V_LO, B3_V_HI, &tStar, &slope)) {
+    out->value = tStar;
+    gk_note(out, "zero of the line fitted to sqrt(2 m v/beta) while v rose from %g to %g m/s; slope %.4g (1: "
+            "m dv/dt = beta (t - t*))", B3_V_LO, B3_V_HI, slope);
+  } else {
+    gk_note(out, "did not slide: speed at the end %.3g m/s", v[rec->count - 1]);
+  }
+  free(v);
+}
+
+// displacement along the push: β t/(4 k_t,s) while it sticks, then that plus β (t − t*)³/(6 m)
+static double b3_series(const pdModel* model, const pdGkRecord* rec, int k, double beta, double* analytic) {
+  int box = gk_body(model, "box");
+  double kt = pd_model_pair_contact(model, box, gk_body(model, "floor")).kt, m = model->bodies[box].mass;
+  double t = rec->t[k], tStar = b3_onset(model, beta), after = fmax(0.0, t - tStar);
+  *analytic = beta * fmin(t, tStar) / (4.0 * kt) + beta * after * after * after / (6.0 * m);
+  return gk_series_value(rec, k, gk_moving(model, "box"), gk_get_x);
+}
+
+const pdGkExperiment pd_gk_b3_ramp_onset = {
+    .name = "b3_ramp_onset",
+    .group = 'B',
+    .title = "Cube pushed by a ramp force beta t at its centre of mass, mu 0.4: slip onset",
+    .quantity = "onset_time",
+    .unit = "s",
+    .formula = "t* = mu m g/beta: gross slip when the push reaches the Coulomb bound, one mu for stick and slip "
+               "(catalogue B3)",
+    .toleranceReason = "catalogue B3 [REC]: 0.5 %; t* is where the fitted slide extrapolates to zero speed, free of "
+                       "any threshold's lag",
+    .seriesLabel = "displacement of the cube along the push, m",
+    .relative = true,
+    .fast = true,
+    .inputName = "beta",
+    .inputCount = 2,
+    .inputs = {4, 8},
+    .scene = b3_scene,
+    .expect = b3_expect,
+    .measure = b3_measure,
+    .series = b3_series,
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// B5: a block w = 0.1 m along the push, 0.1 m across, h = 0.2 m tall (2 kg, CoM at h_c = 0.1 m) on a level
+// plate, pushed along x by a constant force at the middle of its rear face, H = 0.12 m above the plate.
+// Statics: it slides if μ < w/(2H) and tips over its front edge if μ > w/(2H); the tip force is m g w/(2H).
+// Inputs: μ/(w/(2H)) = 0.98 and 1.02 (catalogue: ±2 %). The push is 1 % above the tip force. With μ 2 % above
+// the threshold it stays below μ m g: the block tips and does not slide. With μ 2 % below it exceeds μ m g and
+// stays below m g (w/2 − μ h_c)/(H − h_c), the push that tips a block sliding on friction μ m g (10 % above the
+// tip force here: pushing close to the CoM height makes that margin hc/(H − hc) = 5 times the 2 %), so the
+// block slides and does not tip; pushing at the top (H = h) would leave 1 %, which a soft contact's rocking
+// under the suddenly applied push overshoots. The regime is whichever shows first: a tilt of B5_TIP_DEG or a
+// slide of the front bottom edge by B5_SLIDE_M.
+
+#define B5_W 0.1          // m, along the push (x)
+#define B5_D 0.1          // m, across (y)
+#define B5_H 0.2          // m, height (z)
+#define B5_PUSH_H 0.12    // m, height of the push above the plate
+#define B5_PUSH_OVER 1.01 // push / tip force
+#define B5_TIP_DEG 5.0    // deg: far above the springs' static tilt (~1e-2 deg), and past it the push's lever
+                          // grows while gravity's shrinks, so the block goes on over
+#define B5_SLIDE_M 0.01   // m: far above the tangential springs' deflection (~1e-4 m)
+
+static double b5_threshold(void) { return B5_W / (2.0 * B5_PUSH_H); }
+
+static void b5_scene(double ratio, pdGkText* out) {
+  double m = 1000.0 * B5_W * B5_D * B5_H;  // kg, spgrav 1
+  double push = B5_PUSH_OVER * m * GK_G * b5_threshold(), mu = ratio * b5_threshold();
+  pd_gk_text_printf(out, "tend 1.5\nsample 200\ntol 1e-8\nvmax 1\n");
+  // the floor's μ is the block's, so the pair's √(μ₁μ₂) is μ
+  gk_text_floor(out, 2.0, 2.0, 0.2, 0.0, "");
+  pd_gk_text_printf(out, "mu %.17g\nrestitution 0.5\n" STIFF_FLOOR, mu);
+  pd_gk_text_printf(out,
+                    "cube block red %g %g %g\nloc 0 0 %g\nmu %.17g\nrestitution 0.5\nforce %.17g 0 0 at %g 0 %.17g\n",
+                    B5_W, B5_D, B5_H, B5_H / 2.0, mu, push, -B5_W / 2.0, B5_PUSH_H - B5_H / 2.0);
+}
+
+static pdGkExpected b5_expect(const pdModel* model, double ratio) {
+  (void)model, (void)ratio;
+  return (pdGkExpected){NAN, 0.0};
+}
+
+// x of the middle of the front bottom edge, the edge it would tip over
+static double front_edge_x(const pdBodyState* b) {
+  return pd_v3_add(b->x, pd_quat_rotate(b->q, pd_v3(B5_W / 2.0, 0.0, -B5_H / 2.0))).x;
+}
+
+static void b5_measure(const pdModel* model, const pdGkRecord* rec, double ratio, pdGkMeasured* out) {
+  (void)ratio;
+  int j = gk_moving(model, "block");
+  double pairMu = pair_mu(model, "block", "floor");
+  bool tipsExpected = pairMu > b5_threshold();
+  double* tilt = gk_column(rec, j, gk_get_tilt_deg);
+  double* edge = gk_column(rec, j, front_edge_x);
+  int tip = 0, slide = 0;
+  while (tip < rec->count && tilt[tip] < B5_TIP_DEG) ++tip;
+  while (slide < rec->count && edge[slide] - edge[0] < B5_SLIDE_M) ++slide;
+  if (tip == rec->count && slide == rec->count) {
+    gk_note(out, "neither tipped (%.3g deg) nor slid (%.3g m) by the end", tilt[rec->count - 1],
+            edge[rec->count - 1] - edge[0]);
+  } else {
+    bool tips = tip < slide;
+    out->value = tips ? 1.0 : 0.0;
+    out->pass = tips == tipsExpected;
+    int at = tips ? tip : slide;
+    gk_note(out, "%s at %.3g s (expected: %s; mu %.4g against w/(2H) = %.4g); at %.3g s: tilt %.3g deg, edge moved %.3g m",
+            tips ? "tips" : "slides", rec->t[at], tipsExpected ? "tips" : "slides", pairMu, b5_threshold(), rec->t[at],
+            tilt[at], edge[at] - edge[0]);
+  }
+  free(tilt);
+  free(edge);
+}
+
+static double b5_series(const pdModel* model, const pdGkRecord* rec, int k, double ratio, double* analytic) {
+  (void)ratio;
+  *analytic = NAN;
+  return gk_series_value(rec, k, gk_moving(model, "block"), gk_get_tilt_deg);
+}
+
+const pdGkExperiment pd_gk_b5_tip_or_slide = {
+    .name = "b5_tip_or_slide",
+    .group = 'B',
+    .title = "Block pushed just past the tip force: slides or tips across mu = w/(2H) (qualitative)",
+    .quantity = "tips",
+    .unit = "",
+    .formula = "slides (0) if mu < w/(2H), tips (1) if mu > w/(2H) (w = 0.1 m, H = 0.12 m); tip force m g w/(2H) "
+               "(catalogue B5)",
+    .toleranceReason = "catalogue B5 [REC]: the regime is classified right 2 % either side of the threshold",
+    .seriesLabel = "tilt of the block from upright, deg",
+    .qualitative = true,
+    .relative = false,
+    .fast = true,
+    .inputName = "mu_ratio",
+    .inputCount = 2,
+    .inputs = {0.98, 1.02},
+    .scene = b5_scene,
+    .expect = b5_expect,
+    .measure = b5_measure,
+    .series = b5_series,
 };
 
 // ---------------------------------------------------------------------------------------------------------

@@ -128,6 +128,26 @@ bool pd_gk_first_fall(const double* t, const double* y, int n, double level, dou
   return false;
 }
 
+bool pd_gk_ramp_slip_onset(const double* t, const double* v, int n, double mass, double beta, double vLo, double vHi,
+                           double* onset, double* slope) {
+  PD_ASSERT(mass > 0.0 && beta > 0.0 && 0.0 < vLo && vLo < vHi);
+  int lo = 0;
+  while (lo < n && v[lo] < vLo) ++lo;
+  int hi = lo;
+  while (hi < n && v[hi] < vHi) ++hi;
+  if (hi >= n) return false;
+  double* root = malloc((size_t)n * sizeof *root);
+  PD_ASSERT(root != NULL);
+  for (int k = lo; k <= hi; ++k) root[k] = sqrt(2.0 * mass * fmax(v[k], 0.0) / beta);  // s
+  double b, c;
+  bool ok = pd_gk_fit_line(t + lo, root + lo, hi - lo + 1, t[lo], t[hi], &b, &c) && b > 0.0;
+  free(root);
+  if (!ok) return false;
+  *onset = -c / b;
+  *slope = b;
+  return true;
+}
+
 double pd_gk_largest_rise(const double* y, int n, double scale) {
   PD_ASSERT(scale > 0.0);
   if (n < 1) return 0.0;

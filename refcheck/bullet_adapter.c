@@ -71,6 +71,7 @@ struct pdRefWorld {
   int fixedCount;           // Bullet numbers the fixed bodies first
   pdQuat* principal;        // (movingCount) q_P of each moving body
   pdQuat* last;             // (movingCount) last orientation reported: the next keeps its sign
+  long steps;               // steps taken: the step starts at t = steps·h
 };
 
 static void pair_material(void* user, int a, int b, btsContactMaterial* out) {
@@ -187,8 +188,30 @@ static pdRefWorld* bullet_create(const pdModel* model, const pdRefOptions* optio
   return w;
 }
 
+// The scene's applied forces for the step from t = steps·h: F at mid-step (refcheck.h), at the force point
+// turned into the world (R p from the centre of mass, as btRigidBody::applyForce takes it). Bullet clears
+// its force accumulators at the end of every stepSimulation.
+static void apply_forces(pdRefWorld* w, double h) {
+  double tMid = ((double)w->steps + 0.5) * h;  // s
+  for (int i = 0; i < w->model->movingCount; ++i) {
+    const pdBody* body = &w->model->bodies[w->model->movingBodies[i]];
+    if (!body->hasForce) continue;
+    double x[3], q[4], v[3], omega[3];
+    bts_body_state(w->bullet, w->fixedCount + i, x, q, v, omega);
+    // Bullet's orientation is of the principal frame; R p is the same vector either way: rotate the
+    // principal-frame point by q_bullet
+    pdQuat qb = {q[0], q[1], q[2], q[3]};
+    pdVec3 r = pd_quat_rotate(qb, pd_quat_rotate(quat_conjugate(w->principal[i]), body->forcePoint));
+    pdVec3 f = pd_body_applied_force(body, tMid);
+    const double force[3] = {f.x, f.y, f.z}, at[3] = {r.x, r.y, r.z};
+    bts_apply_force(w->bullet, w->fixedCount + i, force, at);
+  }
+}
+
 static bool bullet_step(pdRefWorld* w, double h) {
+  apply_forces(w, h);
   bts_step(w->bullet, h);
+  ++w->steps;
   for (int i = 0; i < w->model->movingCount; ++i) {
     double x[3], q[4], v[3], omega[3];
     bts_body_state(w->bullet, w->fixedCount + i, x, q, v, omega);
@@ -288,6 +311,10 @@ static void bullet_settings_json(const pdRefWorld* w, FILE* out) {
           out);
   else
     fputs("\"normal_contact\": \"rigid; Newton restitution = pair e above the velocity threshold\", ", out);
+  if (pd_model_has_applied_force(w->model))
+    fputs("\"applied_force_call\": \"btRigidBody::applyForce (world force, world-oriented R p from the centre of "
+          "mass) before stepSimulation\", ",
+          out);
   write_pairs(w, out);
   fputc('}', out);
 }

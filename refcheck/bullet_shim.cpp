@@ -134,6 +134,10 @@ extern "C" void bts_add_hull(btsWorld* w, int id, const btsHull* hull, double ma
   w->bodies.push_back(std::move(body));
 }
 
+extern "C" void bts_apply_force(btsWorld* w, int index, const double force[3], const double relPos[3]) {
+  w->bodies[(size_t)index]->applyForce(btVector3(force[0], force[1], force[2]), btVector3(relPos[0], relPos[1], relPos[2]));
+}
+
 extern "C" void bts_step(btsWorld* w, double h) { w->dynamics.stepSimulation(h, 0); }
 
 extern "C" void bts_body_state(const btsWorld* w, int index, double position[3], double quaternion[4],

@@ -80,6 +80,10 @@ void bts_add_hull(btsWorld* world, int id, const btsHull* hull, double mass, con
 
 void bts_solver_info(const btsWorld* world, btsSolverInfo* out);
 
+// Adds a force (N, world) at `relPos` (m, world-oriented, from the centre of mass) to the body added as number
+// `index`, for the next step only (btRigidBody::applyForce; stepSimulation clears it).
+void bts_apply_force(btsWorld* world, int index, const double force[3], const double relPos[3]);
+
 // One step of exactly h seconds (stepSimulation(h, 0)).
 void bts_step(btsWorld* world, double h);
 

@@ -520,6 +520,18 @@ static pdRefWorld* ode_create(const pdModel* model, const pdRefOptions* options,
   return w;
 }
 
+// The scene's applied forces for the step from t = steps·h: F at mid-step (refcheck.h), at the body-frame
+// point (ODE's body frame is ours, origin at the centre of mass). ODE clears the accumulators after each step.
+static void add_applied_forces(pdRefWorld* w, double h) {
+  double tMid = ((double)w->steps + 0.5) * h;  // s
+  for (int m = 0; m < w->model->movingCount; ++m) {
+    const pdBody* body = &w->model->bodies[w->model->movingBodies[m]];
+    if (!body->hasForce) continue;
+    pdVec3 f = pd_body_applied_force(body, tMid), p = body->forcePoint;
+    dBodyAddForceAtRelPos(w->bodies[m], f.x, f.y, f.z, p.x, p.y, p.z);
+  }
+}
+
 static bool ode_step(pdRefWorld* w, double h) {
   PD_ASSERT(w && h > 0.0);
   pdRefWorld* previous = currentWorld;
@@ -528,6 +540,7 @@ static bool ode_step(pdRefWorld* w, double h) {
   w->contactCount = 0;
   check_planes(w);
   dSpaceCollide(w->space, w, near_callback);
+  add_applied_forces(w, h);
   int ok = dWorldStep(w->world, h);
   dJointGroupEmpty(w->contactGroup);
   ++w->steps;
@@ -683,6 +696,8 @@ static void ode_settings_json(const pdRefWorld* w, FILE* out) {
     fprintf(out, ", \"aligned_slip_min\": %.17g, \"aligned_contacts\": %ld, \"pyramid_fallback_contacts\": %ld",
             PD_ODE_ALIGNED_SLIP_MIN, w->alignedContacts, w->pyramidFallbacks);
   fputc('}', out);
+  if (pd_model_has_applied_force(w->model))
+    fputs(", \"applied_force_call\": \"dBodyAddForceAtRelPos (world force, body-frame point) before dWorldStep\"", out);
   fprintf(out, ", \"max_contacts_per_collide\": %d", w->maxContacts);
   fputs(", \"colliders\": {\"convex-convex\": \"dCollideConvexConvexCCD (libccd MPR): 1 contact per pair\", "
         "\"convex-plane\": \"dCollideConvexPlane (native): 1 contact per vertex below the plane\"}, ",

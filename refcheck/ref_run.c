@@ -129,9 +129,11 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
   if (!mem) abort();
   fprintf(mem, "{\"engine\": \"%s\", \"library_version\": \"%s\", \"variant\": \"%s\", \"step_requested\": %.17g, "
           "\"step_used\": %.17g, \"sample_interval_used\": %.17g, \"steps\": %ld, \"steps_with_contact\": %ld, "
-          "\"max_contacts\": %ld, \"adapter\": ",
+          "\"max_contacts\": %ld, ",
           adapter->name, adapter->version, options->variant == pd_refMatched ? "matched" : "native", options->step,
           plan.step, plan.sampleInterval, stats->steps, stats->contactSteps, stats->maxContacts);
+  if (pd_model_has_applied_force(model)) fputs("\"applied_force\": \"" PD_REF_APPLIED_FORCE_SAMPLING "\", ", mem);
+  fputs("\"adapter\": ", mem);
   adapter->settings_json(world, mem);
   fputc('}', mem);
   fclose(mem);

@@ -1,5 +1,6 @@
 // polydyn — the state derivative (paper §2): Newton–Euler with the gyroscopic term, quaternion
-// kinematics, gravity, and the contact forces with their spring rates (contact_set.c).
+// kinematics, gravity, the scene's applied forces, and the contact forces with their spring rates
+// (contact_set.c).
 
 #include "clock.h"
 #include "contact_set.h"
@@ -7,7 +8,6 @@
 #include "state_layout.h"
 
 void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt) {
-  (void)t;
   double t0 = pd_clock_seconds();
   pdContactSet* set = state->contacts;
   pd_contact_forces(model, set, y, dydt);
@@ -27,8 +27,14 @@ void pd_state_derivative(const pdModel* model, pdState* state, double t, const d
     // inside a Runge–Kutta stage q drifts off unit length; the rotation uses its direction only
     const pdMat3* r = &poses[model->movingBodies[k]].R;
 
-    pdVec3 force = pd_v3_add(pd_v3_scale(g, b->mass), contactForce[k]);
-    pdVec3 torque = contactTorque[k];
+    pdVec3 force = pd_v3_add(pd_v3_scale(g, b->mass), contactForce[k]);  // N, world
+    pdVec3 torque = contactTorque[k];                                    // N·m about the centre of mass, world
+    if (b->hasForce) {
+      // the scene's F(t) at the stage time t, at its body-frame point: it turns with the body
+      pdVec3 applied = pd_body_applied_force(b, t);
+      force = pd_v3_add(force, applied);
+      torque = pd_v3_add(torque, pd_body_applied_torque(b, r, applied));
+    }
 
     // Euler's equations in the body frame: I ω̇ = τ − ω × I ω
     pdVec3 wb = pd_mat3_tmulv(r, w);

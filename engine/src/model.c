@@ -220,6 +220,14 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
     }
     b->requested = requested_material(o);
     b->used = b->requested;
+    // the parser refuses a force on a fixed body
+    PD_ASSERT(!(b->fixed && (o->setMask & PD_SET_FORCE)));
+    if (o->setMask & PD_SET_FORCE) {
+      b->hasForce = true;
+      b->force0 = (pdVec3){o->force[0], o->force[1], o->force[2]};
+      b->forceRate = (pdVec3){o->forceRate[0], o->forceRate[1], o->forceRate[2]};
+      b->forcePoint = (pdVec3){o->forcePoint[0], o->forcePoint[1], o->forcePoint[2]};
+    }
   }
 
   const pdSceneSettings* s = &scene->settings;

@@ -293,6 +293,17 @@ static void write_body(FILE* out, const pdModel* model, int index) {
   fputs(",\n                  \"used\": ", out);
   write_used(out, &b->used, &info);
   fputs("},\n", out);
+  if (b->hasForce) {
+    // the scene's applied force, so a run directory says what pushed the body
+    fputs("     \"applied_force\": {\"force\": ", out);
+    write_vec(out, b->force0);
+    fputs(", \"rate\": ", out);
+    write_vec(out, b->forceRate);
+    fputs(", \"point\": ", out);
+    write_vec(out, b->forcePoint);
+    fputs(", \"law\": \"F(t) = force + t rate (N, N/s, world frame) at point (m, body frame from the centre of "
+          "mass)\"},\n", out);
+  }
   // the shape in the body frame (origin at the centre of mass), for viewers and other engines
   fprintf(out, "     \"shape\": {\"V\": %d, \"E\": %d, \"F\": %d, \"vertices\": [", b->shape.vertexCount,
           b->shape.edgeCount, b->shape.faceCount);
@@ -369,6 +380,8 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   write_number(out, info->energyStart);
   fputs(", \"end\": ", out);
   write_number(out, info->energyEnd);
+  // the energy is kinetic + gravitational + springs: the work of an applied force is not in it
+  if (pd_model_has_applied_force(model)) fputs(", \"excludes_applied_work\": true", out);
   // timing last: the only part of a run directory that differs between two identical runs
   fputs("},\n  \"timing\": {\"wall_seconds\": ", out);
   write_number(out, info->wallSeconds);

@@ -7,8 +7,8 @@
 // line before blanks and a comment, and refuses NUL and control bytes anywhere (comments too).
 //
 // Memory stays bounded by what the scene holds, never by the length of a line: a token is at most
-// TOKEN_MAX bytes in a fixed buffer, a fixed-arity command keeps at most nine tokens and stops at
-// the first extra one, hull coordinates are converted as they arrive, and blanks and comments are
+// TOKEN_MAX bytes in a fixed buffer, a fixed-arity command keeps at most thirteen tokens and stops
+// at the first extra one, hull coordinates are converted as they arrive, and blanks and comments are
 // skipped without being stored. Junk therefore ends the parse at its first bad token.
 //
 // First error wins: every check returns false after filling the pdError once, and the caller
@@ -36,7 +36,7 @@
 enum {
   TOKEN_MAX = 4096,         // bytes in one token; longer is an error
   CHUNK_BYTES = 64 * 1024,     // file read size
-  MAX_ARGS = 7,                // most arguments of a fixed-arity command (tprism, loc, vel)
+  MAX_ARGS = 11,               // most arguments of a fixed-arity command (force with ramp and at)
   MAX_OBJECTS = 1 << 24,       // keeps counts and indices far from int overflow
   SHOWN_CHARS = 40,            // user text quoted in messages
   SHOWN_BUF = SHOWN_CHARS * 4 + 4,
@@ -237,7 +237,7 @@ static TokenKind lex(Lexer* lx, Token* tok) {
 typedef enum CommandId {
   cmd_gravity, cmd_tend, cmd_tol, cmd_dt, cmd_dtmin, cmd_dtmax, cmd_sample, cmd_vmax, cmd_deflection,
   cmd_cube, cmd_prism, cmd_tprism, cmd_sphere, cmd_hull,
-  cmd_fixed, cmd_loc, cmd_vel, cmd_spgrav, cmd_mu, cmd_kn, cmd_kt, cmd_cn, cmd_ct, cmd_restitution,
+  cmd_fixed, cmd_loc, cmd_vel, cmd_spgrav, cmd_mu, cmd_kn, cmd_kt, cmd_cn, cmd_ct, cmd_restitution, cmd_force,
 } CommandId;
 
 typedef enum CommandClass { class_setting, class_object, class_property } CommandClass;
@@ -246,7 +246,7 @@ typedef struct Command {
   const char* name;
   CommandId id;
   CommandClass cls;
-  int minArgs, maxArgs;  // loc and vel take 3 or 7; hull streams its coordinates
+  int minArgs, maxArgs;  // loc and vel take 3 or 7, force 3, 7 or 11; hull streams its coordinates
   const char* usage;
 } Command;
 
@@ -275,6 +275,7 @@ static const Command commands[] = {
     {"cn", cmd_cn, class_property, 1, 1, "c"},
     {"ct", cmd_ct, class_property, 1, 1, "c"},
     {"restitution", cmd_restitution, class_property, 1, 1, "e"},
+    {"force", cmd_force, class_property, 3, 11, "fx fy fz [ramp rx ry rz] [at x y z]"},
 };
 
 static const Command* find_command(const Token* tok) {
@@ -590,11 +591,70 @@ static bool pose_command(Parser* ps, const Command* cmd, int nargs, pdSceneObjec
   return true;
 }
 
+// Three numbers from t[0], each finite and, when `bounded`, within the size sanity bound.
+static bool triple(Parser* ps, const Token* t, const char* what, bool bounded, double out[3]) {
+  for (int i = 0; i < 3; ++i) {
+    if (!number(ps, &t[i], what, &out[i])) return false;
+    if (bounded && fabs(out[i]) > MAX_SIZE) {
+      char buf[SHOWN_BUF];
+      return fail(ps, t[i].loc, "%s must be within +-1e6 m (a sanity bound), got %s", what,
+                  shown(buf, t[i].text, t[i].len));
+    }
+  }
+  return true;
+}
+
+// `force fx fy fz [ramp rx ry rz] [at x y z]`: one applied force per body, never on a fixed one (it could not
+// move); `ramp` and `at` in either order, each at most once.
+static bool force_command(Parser* ps, int nargs, pdSceneObject* o) {
+  const Token* t = ps->toks;
+  if (o->fixed) return fail(ps, t[0].loc, "'force' on the fixed body '%s': a fixed body cannot be pushed", o->name);
+  if (o->setMask & PD_SET_FORCE) {
+    return fail(ps, t[0].loc, "body '%s' already has a force (line %d): at most one force per body", o->name,
+                o->forceWhere.line);
+  }
+  double f[3], rate[3] = {0, 0, 0}, point[3] = {0, 0, 0};
+  if (!triple(ps, &t[1], "force", false, f)) return false;
+  bool sawRamp = false, sawAt = false;
+  for (int a = 4; a <= nargs; a += 4) {
+    char buf[SHOWN_BUF];
+    bool isRamp = strcmp(t[a].text, "ramp") == 0, isAt = strcmp(t[a].text, "at") == 0;
+    if (!isRamp && !isAt) {
+      return fail(ps, t[a].loc, "expected 'ramp' or 'at' after the force, got '%s'", shown(buf, t[a].text, t[a].len));
+    }
+    if ((isRamp && sawRamp) || (isAt && sawAt)) return fail(ps, t[a].loc, "'%s' given twice", t[a].text);
+    if (a + 3 > nargs) {
+      return fail(ps, t[a].loc, "'%s' expects 3 numbers (%s), got %d", t[a].text, isRamp ? "rx ry rz" : "x y z",
+                  nargs - a);
+    }
+    if (isRamp) {
+      sawRamp = true;
+      if (!triple(ps, &t[a + 1], "force ramp", false, rate)) return false;
+    } else {
+      sawAt = true;
+      if (!triple(ps, &t[a + 1], "force point", true, point)) return false;
+    }
+  }
+  memcpy(o->force, f, sizeof f);
+  memcpy(o->forceRate, rate, sizeof rate);
+  memcpy(o->forcePoint, point, sizeof point);
+  o->forceWhere = t[0].loc;
+  o->setMask |= PD_SET_FORCE;
+  return true;
+}
+
 static bool property_command(Parser* ps, const Command* cmd, int nargs) {
   pdSceneObject* o = &ps->scene->objects[ps->scene->objectCount - 1];
   const Token* arg = &ps->toks[1];
   switch (cmd->id) {
-    case cmd_fixed: o->fixed = true; return true;
+    case cmd_fixed:
+      if (o->setMask & PD_SET_FORCE) {
+        return fail(ps, ps->toks[0].loc, "'fixed' on body '%s', which has a force (line %d): a fixed body cannot "
+                    "be pushed", o->name, o->forceWhere.line);
+      }
+      o->fixed = true;
+      return true;
+    case cmd_force: return force_command(ps, nargs, o);
     case cmd_loc:
     case cmd_vel: return pose_command(ps, cmd, nargs, o);
     case cmd_spgrav: o->setMask |= PD_SET_SPGRAV; return ranged(ps, arg, "spgrav", range_pos, &o->spgrav);
@@ -664,7 +724,8 @@ static bool command(Parser* ps, const Command* cmd) {
     }
     nargs++;
   }
-  if (cmd->minArgs != cmd->maxArgs && nargs != cmd->minArgs && nargs != cmd->maxArgs) {
+  // force checks its optional parts itself, naming the part that is short
+  if (cmd->id != cmd_force && cmd->minArgs != cmd->maxArgs && nargs != cmd->minArgs && nargs != cmd->maxArgs) {
     return fail(ps, t[0].loc, "'%s' expects %d or %d arguments (%s), got %d", cmd->name, cmd->minArgs, cmd->maxArgs,
                 cmd->usage, nargs);
   }

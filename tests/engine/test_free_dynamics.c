@@ -532,6 +532,80 @@ static const char* const twoBodies =
     "cube box red 0.1 0.2 0.3\nloc 0 0 1  30 1 0 0\nvel 1 0 2  720 0.2 1 0.1\n"
     "tprism cone blue 8 0.3 0.3 0.3 0.5\nloc 1 0 1\nvel 0 1 3  90 0 0 1\n";
 
+// ---------------------------------------------------------------------------------------------
+// applied force (scene `force`)
+
+// A constant force at the centre of mass in zero gravity: x(t) = x0 + F t²/(2m); with a ramp Ḟ added,
+// + Ḟ t³/(6m). RK4 integrates polynomials of degree <= 4 in t exactly, so only round-off of a few hundred
+// steps on values of order 1 remains (~1e-13); 1e-9 m would still catch a factor 2 or a force evaluated at
+// the step's start instead of the stage time (an error h·Ḟ t/(2m) ~ 1e-4 m at dtmax 1e-2 s).
+#define APPLIED_POSITION_TOL 1e-9  // m
+#define APPLIED_VELOCITY_TOL 1e-9  // m/s
+
+static void check_pushed_free_box(const char* scene, pdVec3 f0, pdVec3 rate) {
+  pdModel* model = compile_text(scene);
+  const pdBody* b = &model->bodies[0];
+  assert_true(b->hasForce);
+  pdState* s = pd_state_create(model);
+  assert_true(pd_advance(model, s, model->settings.tend, NULL, NULL));
+  double t = s->t, m = b->mass;
+  pdBodyState bs = pd_state_body(model, s, 0);
+  pdVec3 x = pd_v3_add(pd_v3_add(b->x0, pd_v3_scale(f0, t * t / (2.0 * m))), pd_v3_scale(rate, t * t * t / (6.0 * m)));
+  pdVec3 v = pd_v3_add(pd_v3_scale(f0, t / m), pd_v3_scale(rate, t * t / (2.0 * m)));
+  assert_true(t == 2.0);  // pd_advance lands exactly on tend
+  assert_true(pd_v3_norm(pd_v3_sub(bs.x, x)) < APPLIED_POSITION_TOL);
+  assert_true(pd_v3_norm(pd_v3_sub(bs.v, v)) < APPLIED_VELOCITY_TOL);
+  assert_true(pd_v3_norm(bs.w) == 0.0);  // a force through the centre of mass exerts no torque
+  pd_state_free(s);
+  pd_model_free(model);
+}
+
+static void test_constant_force_at_centre_of_mass_gives_x_equal_f_t2_over_2m(void** state) {
+  (void)state;
+  // 0.2 × 0.1 × 0.1 m of water: 2 kg; 3 N gives x(2 s) = 3 m
+  check_pushed_free_box("gravity 0 0 0\ntend 2\ncube b red 0.2 0.1 0.1\nloc 1 2 3\nforce 3 -1 0.5\n",
+                        pd_v3(3, -1, 0.5), pd_v3(0, 0, 0));
+}
+
+static void test_ramp_force_gives_x_equal_rate_t3_over_6m(void** state) {
+  (void)state;
+  check_pushed_free_box("gravity 0 0 0\ntend 2\ncube b red 0.2 0.1 0.1\nforce 1 0 0 ramp 0.5 2 -1\n",
+                        pd_v3(1, 0, 0), pd_v3(0.5, 2, -1));
+}
+
+// At t = 0 the derivative is exact arithmetic on the model: ω̇ = I⁻¹ (R p × F) (ω = 0, no gyroscopic term)
+// and a = F/m, to the rounding of a 3×3 product (~1e-15 relative).
+#define DERIVATIVE_REL_TOL 1e-12
+
+static void test_force_at_an_offset_point_gives_angular_acceleration_inverse_inertia_p_cross_f(void** state) {
+  (void)state;
+  // turned 30° about z, so the body-frame point turns with the body; F(t) = (2, 1, −1) + t (0, 3, 0) N
+  pdModel* model = compile_text("gravity 0 0 0\ncube b red 0.3 0.2 0.1\nloc 0 0 0 30 0 0 1\n"
+                                "force 2 1 -1 ramp 0 3 0 at 0.15 -0.1 0.05\n");
+  const pdBody* b = &model->bodies[0];
+  pdState* s = pd_state_create(model);
+  double* dydt = calloc((size_t)s->n, sizeof *dydt);
+  assert_non_null(dydt);
+  const double times[] = {0.0, 0.5};
+  for (int i = 0; i < 2; ++i) {
+    double t = times[i];
+    pd_state_derivative(model, s, t, s->y, dydt);
+    pdVec3 f = pd_v3_add(pd_v3(2, 1, -1), pd_v3_scale(pd_v3(0, 3, 0), t));
+    pdMat3 r = pd_quat_to_mat3(b->q0);
+    pdVec3 torqueBody = pd_mat3_tmulv(&r, pd_v3_cross(pd_mat3_mulv(&r, pd_v3(0.15, -0.1, 0.05)), f));
+    pdVec3 alpha = pd_mat3_mulv(&r, pd_mat3_mulv(&b->invInertia, torqueBody));
+    pdVec3 a = pd_v3_scale(f, 1.0 / b->mass);
+    // layout per body: v̇ (3), ω̇ (3), ẋ (3), q̇ (4) (polydyn/state.h)
+    pdVec3 gotA = pd_v3(dydt[0], dydt[1], dydt[2]), gotAlpha = pd_v3(dydt[3], dydt[4], dydt[5]);
+    assert_true(pd_v3_norm(pd_v3_sub(gotA, a)) <= DERIVATIVE_REL_TOL * pd_v3_norm(a));
+    assert_true(pd_v3_norm(pd_v3_sub(gotAlpha, alpha)) <= DERIVATIVE_REL_TOL * pd_v3_norm(alpha));
+    assert_true(pd_v3_norm(alpha) > 1.0);  // not a vacuous comparison: the offset point gives a real torque
+  }
+  free(dydt);
+  pd_state_free(s);
+  pd_model_free(model);
+}
+
 static void test_two_runs_of_one_scene_are_bit_identical(void** state) {
   (void)state;
   pdModel* m1 = compile_text(twoBodies);
@@ -598,6 +672,9 @@ int main(void) {
       cmocka_unit_test(test_dt_equal_to_dtmin_and_dtmax_takes_exactly_1000_steps),
       cmocka_unit_test(test_adaptive_step_costs_11_evaluations_and_a_rejection_10),
       cmocka_unit_test(test_quaternion_stays_unit_at_every_sample),
+      cmocka_unit_test(test_constant_force_at_centre_of_mass_gives_x_equal_f_t2_over_2m),
+      cmocka_unit_test(test_ramp_force_gives_x_equal_rate_t3_over_6m),
+      cmocka_unit_test(test_force_at_an_offset_point_gives_angular_acceleration_inverse_inertia_p_cross_f),
       cmocka_unit_test(test_two_runs_of_one_scene_are_bit_identical),
       cmocka_unit_test(test_one_model_drives_two_interleaved_states_like_one_alone),
   };

@@ -277,6 +277,47 @@ static void test_properties_apply_to_the_last_object_with_mask_bits(void** state
   pd_scene_free(sc);
 }
 
+static void test_force_with_ramp_and_point_in_either_order(void** state) {
+  (void)state;
+  pdScene* sc = parse_text("cube a red 1 1 1\nforce 1 -2 3\n"
+                           "cube b red 1 1 1\nforce 0 0 0 at 0.5 0 -0.25 ramp 4 0 -1\n"
+                           "cube c red 1 1 1\nforce 0 1e3 0 ramp 0x1p-2 0 0\n"
+                           "cube d red 1 1 1\n");
+  const pdSceneObject *a = &sc->objects[0], *b = &sc->objects[1], *c = &sc->objects[2], *d = &sc->objects[3];
+  assert_int_equal(a->setMask, PD_SET_FORCE);
+  assert_true(a->force[0] == 1 && a->force[1] == -2 && a->force[2] == 3);
+  assert_true(a->forceRate[0] == 0 && a->forceRate[1] == 0 && a->forceRate[2] == 0);
+  assert_true(a->forcePoint[0] == 0 && a->forcePoint[1] == 0 && a->forcePoint[2] == 0);
+  assert_int_equal(a->forceWhere.line, 2);
+  assert_int_equal(a->forceWhere.col, 1);
+  assert_true(b->forceRate[0] == 4 && b->forceRate[1] == 0 && b->forceRate[2] == -1);
+  assert_true(b->forcePoint[0] == 0.5 && b->forcePoint[1] == 0 && b->forcePoint[2] == -0.25);
+  assert_true(c->force[1] == 1e3 && c->forceRate[0] == 0.25);
+  assert_int_equal(d->setMask, 0);
+  assert_int_equal(d->forceWhere.line, 0);
+  pd_scene_free(sc);
+}
+
+static void test_error_force_arity_keywords_values_and_fixed_bodies(void** state) {
+  (void)state;
+  expect_error("force 1 2 3\n", 1, 1, "property 'force' before any object");
+  expect_error("cube a red 1 1 1\nforce 1 2\n", 2, 1, "'force' expects 3 arguments (fx fy fz [ramp rx ry rz] [at x y z]), got 2");
+  expect_error("cube a red 1 1 1\nforce 1 2 3 ramp 1 2\n", 2, 13, "'ramp' expects 3 numbers (rx ry rz), got 2");
+  expect_error("cube a red 1 1 1\nforce 1 2 3 at\n", 2, 13, "'at' expects 3 numbers (x y z), got 0");
+  expect_error("cube a red 1 1 1\nforce 1 2 3 push 1 2 3\n", 2, 13, "expected 'ramp' or 'at' after the force, got 'push'");
+  expect_error("cube a red 1 1 1\nforce 1 2 3 at 0 0 0 at 1 1 1\n", 2, 22, "'at' given twice");
+  expect_error("cube a red 1 1 1\nforce 1 2 3 ramp 0 0 0 at 0 0 0 9\n", 2, 33,
+               "too many arguments: 'force' expects at most 11");
+  expect_error("cube a red 1 1 1\nforce 1 nan 3\n", 2, 9, "not a finite number: 'nan' (for force)");
+  expect_error("cube a red 1 1 1\nforce 1 2 3 ramp 1e999 0 0\n", 2, 18, "not a finite number: '1e999' (for force ramp)");
+  expect_error("cube a red 1 1 1\nforce 1 2 3 at 0 x 0\n", 2, 18, "not a number: 'x' (for force point)");
+  expect_error("cube a red 1 1 1\nforce 1 2 3 at 0 0 2e6\n", 2, 20, "force point must be within +-1e6 m");
+  expect_error("cube a red 1 1 1\nfixed\nforce 1 2 3\n", 3, 1, "'force' on the fixed body 'a'");
+  expect_error("cube a red 1 1 1\nforce 1 2 3\nfixed\n", 3, 1, "'fixed' on body 'a', which has a force (line 2)");
+  expect_error("cube a red 1 1 1\nforce 1 2 3\nforce 0 0 1\n", 3, 1,
+               "body 'a' already has a force (line 2): at most one force per body");
+}
+
 static void test_loc_angle_in_degrees_is_stored_in_radians(void** state) {
   (void)state;
   pdScene* sc = parse_text("cube a red 1 1 1\nloc 0 0 0.5 90 1 0 0\ncube b red 1 1 1\nloc 1 1 1 -45 0 2 0\n");
@@ -828,6 +869,8 @@ int main(void) {
       cmocka_unit_test(test_error_token_too_long_on_a_1mb_line),
       cmocka_unit_test(test_error_100mb_junk_file_is_refused_fast_at_line_1),
       cmocka_unit_test(test_10mb_comments_only_file_parses_fast),
+      cmocka_unit_test(test_force_with_ramp_and_point_in_either_order),
+      cmocka_unit_test(test_error_force_arity_keywords_values_and_fixed_bodies),
       cmocka_unit_test(test_error_print_formats_with_and_without_line),
       cmocka_unit_test(test_error_set_truncates_long_message_and_file_name),
   };

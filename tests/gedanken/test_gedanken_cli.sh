@@ -65,6 +65,18 @@ check "a run directory replays: its scene.scene gives the same trajectory" \
   '"$PD" run "$FAST/runs/c2_momentum/soft-adaptive/scene.scene" --out "$SCRATCH/replay" >/dev/null 2>&1 &&
    cmp -s "$SCRATCH/replay/trajectory.csv" "$FAST/runs/c2_momentum/soft-adaptive/trajectory.csv"'
 
+# --- the applied-force experiments (catalogue B3, B5) on the soft engine --------------------------------
+FORCE=$SCRATCH/force
+run_pd gedanken --only b3_ramp_onset,b5_tip_or_slide --engines soft --out "$FORCE"
+check "B3 and B5, soft engine: exit 0" '[ $rc -eq 0 ]'
+check "B3: the onset at two ramp rates, each within 0.5 % of mu m g/beta" \
+  '[ "$(csv_query "$FORCE/results.csv" "[(r[\"input\"], r[\"status\"], float(r[\"error\"]) <= 0.005) for r in rows if r[\"experiment\"] == \"b3_ramp_onset\"]")" = "[('"'"'beta=4'"'"', '"'"'PASS'"'"', True), ('"'"'beta=8'"'"', '"'"'PASS'"'"', True)]" ]'
+check "B5: slides (0) 2 % below mu = w/(2H), tips (1) 2 % above" \
+  '[ "$(csv_query "$FORCE/results.csv" "[(r[\"input\"], r[\"measured\"], r[\"status\"]) for r in rows if r[\"experiment\"] == \"b5_tip_or_slide\"]")" = "[('"'"'mu_ratio=0.98'"'"', '"'"'0'"'"', '"'"'PASS'"'"'), ('"'"'mu_ratio=1.02'"'"', '"'"'1'"'"', '"'"'PASS'"'"')]" ]'
+check "B3: the run directory records the applied force" \
+  'grep -q "\"applied_force\": {\"force\": \[0,0,0\], \"rate\": \[4,0,0\]" "$FORCE/runs/b3_ramp_onset/soft-adaptive-beta=4/summary.json" &&
+   grep -q "\"excludes_applied_work\": true" "$FORCE/runs/b3_ramp_onset/soft-adaptive-beta=4/summary.json"'
+
 # --- reference engines: rows for every variant, never a failure of the exit status ---------------------
 REF=$SCRATCH/ref
 run_pd gedanken --only a3_sinkage --out "$REF"

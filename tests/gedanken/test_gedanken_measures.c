@@ -125,6 +125,32 @@ static void test_first_fall_is_the_stop_time_of_a_linear_deceleration(void** sta
   assert_false(pd_gk_first_fall(t, rising, 3, 0.5, &tStop));  // never falls back
 }
 
+static void test_ramp_slip_onset_is_where_the_fitted_slide_starts(void** state) {
+  (void)state;
+  // m = 2 kg, β = 5 N/s, t* = 1.2 s: a creep of 1e-5 m/s, then v = 1e-5 + β (t − t*)²/(2m); samples 1 ms apart
+  enum { M = 1500 };
+  static double t[M], v[M];
+  for (int k = 0; k < M; ++k) {
+    t[k] = 1e-3 * k;
+    double after = fmax(0.0, t[k] - 1.2);
+    v[k] = 1e-5 + 5.0 * after * after / 4.0;
+  }
+  double onset, slope;
+  assert_true(pd_gk_ramp_slip_onset(t, v, M, 2.0, 5.0, 2e-3, 1e-2, &onset, &slope));
+  // the creep shifts √(2 m v/β) by at most 1e-5/(2 v) relative, ~2.5e-3 of the ~0.04 s after t*: ~1e-4 s
+  assert_true(fabs(onset - 1.2) < 2e-4);
+  assert_true(fabs(slope - 1.0) < 1e-2);
+  // a threshold crossing would lag by √(2 m vLo/β) = 0.04 s: the fit does not
+  double tCross = 0.0;
+  for (int k = 0; k < M; ++k)
+    if (v[k] >= 2e-3) {
+      tCross = t[k];
+      break;
+    }
+  assert_true(tCross - 1.2 > 0.03);
+  assert_false(pd_gk_ramp_slip_onset(t, v, M, 2.0, 5.0, 2e-3, 1.0, &onset, &slope));  // never reaches 1 m/s
+}
+
 static void test_largest_rise_of_a_series(void** state) {
   (void)state;
   const double e[] = {10.0, 8.0, 9.0, 7.0, 7.5, 6.0};  // rises: 1 (8 → 9), 0.5 (7 → 7.5)
@@ -175,6 +201,7 @@ int main(void) {
       cmocka_unit_test(test_first_impact_needs_an_impact),
       cmocka_unit_test(test_apex_heights_of_a_bouncing_ball),
       cmocka_unit_test(test_first_fall_is_the_stop_time_of_a_linear_deceleration),
+      cmocka_unit_test(test_ramp_slip_onset_is_where_the_fitted_slide_starts),
       cmocka_unit_test(test_largest_rise_of_a_series),
       cmocka_unit_test(test_drift_speed_of_a_uniform_motion),
       cmocka_unit_test(test_unwrap_restores_a_steadily_turning_angle),

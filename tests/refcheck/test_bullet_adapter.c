@@ -412,8 +412,20 @@ static void test_spin_too_fast_for_the_step_is_refused(void** state) {
   pd_model_free(m);
 }
 
+// ---------------------------------------------------------------------------------------------
+// applied force (scene `force`)
+
+#include "applied_force_checks.h"
+
+static void test_applied_force_gives_the_exact_impulse_and_torque(void** state) {
+  (void)state;
+  check_applied_force(bullet(), pd_refNative);
+  check_applied_force(bullet(), pd_refMatched);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_applied_force_gives_the_exact_impulse_and_torque),
       cmocka_unit_test(test_initial_pose_is_the_scene_pose),
       cmocka_unit_test(test_free_body_keeps_its_angular_momentum),
       cmocka_unit_test(test_matched_cube_rests_at_the_spring_sinkage),

@@ -526,8 +526,20 @@ static void test_every_case_scene_finishes_or_is_refused(void** state) {
   run_cases_in(PD_SOURCE_DIR "/cases/hard");
 }
 
+// ---------------------------------------------------------------------------------------------
+// applied force (scene `force`)
+
+#include "applied_force_checks.h"
+
+static void test_applied_force_gives_the_exact_impulse_and_torque(void** state) {
+  (void)state;
+  check_applied_force(ode(), pd_refNative);
+  check_applied_force(ode(), pd_refMatched);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_applied_force_gives_the_exact_impulse_and_torque),
       cmocka_unit_test(test_trajectory_starts_at_the_scene_pose),
       cmocka_unit_test(test_matched_cube_rests_at_the_static_sinkage),
       cmocka_unit_test(test_sliding_cube_stops_at_the_coulomb_distance),

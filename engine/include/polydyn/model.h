@@ -50,6 +50,12 @@ typedef struct pdBody {
   pdVec3 w0;              // initial angular velocity, world, rad/s
   pdMaterial requested;   // what the scene said (mu's default filled in; -1 for what it did not set)
   pdMaterial used;        // what the engine uses (per body; pair constants: engine/src/model_contact.h)
+  // Applied load (scene `force`): F(t) = force0 + t·forceRate in the world frame, acting at forcePoint (body
+  // frame, from the centre of mass). Never on a fixed body; all zero when hasForce is false.
+  bool hasForce;
+  pdVec3 force0;          // N, world
+  pdVec3 forceRate;       // N/s, world
+  pdVec3 forcePoint;      // m, body frame
   pdSourceLoc where;      // the object command in the scene file
 } pdBody;
 
@@ -86,6 +92,17 @@ void pd_model_free(pdModel* model);
 
 // Total mechanical energy contributions of one moving body in a given state (J).
 double pd_body_kinetic_energy(const pdBody* body, pdVec3 v, pdVec3 w, pdQuat q);
+
+// ---------------------------------------------------------------- applied loads (engine/src/applied_force.c)
+
+// The applied force on `body` at time t: force0 + t·forceRate, N, world frame (zero without a force).
+pdVec3 pd_body_applied_force(const pdBody* body, double t);
+// The torque about the centre of mass of the applied force `force` (N, world) acting at the body's
+// forcePoint, with `r` the body's rotation (body → world): (r · forcePoint) × force, N·m, world frame.
+pdVec3 pd_body_applied_torque(const pdBody* body, const pdMat3* r, pdVec3 force);
+// True when at least one body carries an applied force. Its work is not part of the state's energy
+// (pd_state_energy), so an energy balance of such a run does not close.
+bool pd_model_has_applied_force(const pdModel* model);
 
 // ---------------------------------------------------------------- contact material (paper §3.2, §3.3)
 

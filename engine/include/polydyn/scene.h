@@ -40,6 +40,7 @@ enum {
   PD_SET_SPGRAV = 1u << 6,
   PD_SET_LOC = 1u << 7,
   PD_SET_VEL = 1u << 8,
+  PD_SET_FORCE = 1u << 9,
 };
 enum {
   PD_SET_GRAVITY = 1u << 0,
@@ -80,6 +81,12 @@ typedef struct pdSceneObject {
   double kn, kt;          // spring constants, N/m (0 = derive, issue: contact model)
   double cn, ct;          // damper constants, N·s/m (0 = none unless derived from restitution)
   double restitution;     // requested coefficient of restitution in [0, 1] (valid when PD_SET_RESTITUTION)
+  // `force`: an applied force F(t) = force + t·forceRate (world frame) at the point forcePoint (object axes,
+  // relative to the centre of mass); valid when PD_SET_FORCE, else zero
+  double force[3];        // N
+  double forceRate[3];    // N/s
+  double forcePoint[3];   // m
+  pdSourceLoc forceWhere; // the `force` command (line 0 when none)
   unsigned setMask;       // PD_SET_* bits: which properties the file set
   pdSourceLoc where;      // the object command
 } pdSceneObject;

@@ -79,6 +79,15 @@ int pd_gk_apexes(const double* z, const double* vz, int n, double g, double* ape
 // time it stays below, because a soft contact rings at its springs' frequency after the stop.
 bool pd_gk_first_fall(const double* t, const double* y, int n, double level, double* tCross);
 
+// Onset of gross slip under a ramp force F = β t (catalogue B3), from the speed v along the push (m/s) of a body
+// of mass m (kg). Once it slides against Coulomb friction μ m g, m v̇ = β t − μ m g = β (t − t*), so
+// √(2 m v/β) = t − t*: a line fitted to √(2 m v/β) against t over the samples from the first with v >= vLo to the
+// first with v >= vHi crosses zero at t* (s) with slope 1 (the slope is returned as a check). Reading t* where
+// the line crosses zero, not where v crosses a level, removes the lag √(2 m v/β) of any threshold. False when v
+// never reaches vHi.
+bool pd_gk_ramp_slip_onset(const double* t, const double* v, int n, double mass, double beta, double vLo, double vHi,
+                           double* onset, double* slope);
+
 // The largest rise of y between an earlier and a later sample (max over k of y[k] − min_{j<k} y[j]),
 // divided by `scale` (> 0): the energy gain of a series that should never increase.
 double pd_gk_largest_rise(const double* y, int n, double scale);

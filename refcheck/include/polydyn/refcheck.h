@@ -29,6 +29,15 @@ typedef enum pdOdeFriction {
   pd_odeFrictionAligned,  // fdir1 along the slip velocity: isotropic Coulomb to first order
 } pdOdeFriction;
 
+// Applied forces (scene `force`). Both engines integrate by semi-implicit Euler: a force held constant over a
+// step of h changes the velocity by h·F/m. Each adapter applies F at mid-step, F(t + h/2) with t the step's
+// start, at the body's force point (world-oriented R·p from the centre of mass for Bullet, body frame for
+// ODE): the step's impulse ∫F dt is then exact for the linear F(t) = F0 + t·Ḟ of the scene language, where the
+// step's start would lag it by h·Ḟ/2. pd_ref_run records this in engine_settings.
+#define PD_REF_APPLIED_FORCE_SAMPLING                                                                           \
+  "F(t + h/2) once per step, held over the step: exact impulse for the linear F(t) of the scene (semi-implicit " \
+  "Euler)"
+
 // Default step of the reference engines, s: 1 kHz, the rate both engines' documentation treats as
 // accurate for contact; sweeps set other steps explicitly.
 #define PD_REF_DEFAULT_STEP 1e-3
