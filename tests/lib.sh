@@ -2,6 +2,9 @@
 #   check NAME CONDITION...   evaluates the condition (a shell command) and counts the result
 #   run_pd OUT ERR ARGS...    runs $PD with stdout/stderr to files; the exit status goes to $rc
 #   no_partial DIR            no DIR.partial-* or DIR.old-* left behind
+#   check_interrupted OUT ERR DIR ARGS...
+#                             runs $PD ARGS in the background, sends SIGINT after 0.5 s, and checks the
+#                             documented answer: exit 130, "interrupted" on stderr, no DIR and no partial one
 # The script prints "$passed passed, $failed failed" and exits non-zero when a check failed.
 passed=0
 failed=0
@@ -22,3 +25,16 @@ run_pd() {
   rc=$?
 }
 no_partial() { ! compgen -G "$1.partial-*" >/dev/null && ! compgen -G "$1.old-*" >/dev/null; }
+check_interrupted() {
+  local out=$1 err=$2 dir=$3
+  shift 3
+  "$PD" "$@" >"$out" 2>"$err" &
+  local pid=$!
+  sleep 0.5
+  kill -INT "$pid"
+  wait "$pid"
+  rc=$?
+  check "SIGINT exits 130" '[ $rc -eq 130 ]'
+  check "SIGINT says nothing was written" 'grep -q "interrupted" "$err"'
+  check "SIGINT leaves no directory" '[ ! -e "$dir" ] && no_partial "$dir"'
+}

@@ -18,7 +18,7 @@ HEADER='t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz'
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_cli.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
 
-. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial, check_interrupted
 
 
 # message_at FILE ERRFILE line|file: the message starts with `FILE:LINE:COL: ` (line) or `FILE: ` (file)
@@ -177,15 +177,7 @@ LONG=$SCRATCH/long.scene
 printf 'gravity 0 0 -9.81\ntend 100\ntol 1e-12\ndt 1e-5\ndtmax 1e-5\nsample 100\n%s\n%s\n' \
   'cube box red 0.1 0.2 0.3' 'vel 1 0 2  720 1 2 3' >"$LONG"
 INT=$SCRATCH/interrupted
-"$PD" run "$LONG" --out "$INT" >"$OUT" 2>"$ERR" &
-pid=$!
-sleep 0.5
-kill -INT "$pid"
-wait "$pid"
-rc=$?
-check "SIGINT exits 130" '[ $rc -eq 130 ]'
-check "SIGINT says nothing was written" 'grep -q "interrupted" "$ERR"'
-check "SIGINT leaves no directory" '[ ! -e "$INT" ] && no_partial "$INT"'
+check_interrupted "$OUT" "$ERR" "$INT" run "$LONG" --out "$INT"
 
 # --- check ---------------------------------------------------------------------------------------
 run_pd "$OUT" "$ERR" check "$DEMO"

@@ -18,7 +18,7 @@ OUT=$SCRATCH/stdout
 ERR=$SCRATCH/stderr
 HEADER='experiment,group,title,engine,variant,quantity,unit,input,measured,expected,error,tolerance,status,wall_seconds,run_dir,note'
 
-. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial, check_interrupted
 run_pd() {  # this script's own: its stdout and stderr files are fixed
   "$PD" "$@" >"$OUT" 2>"$ERR"
   rc=$?
@@ -138,16 +138,8 @@ check "an existing non-gedanken directory is left alone" '[ -e "$SCRATCH/preciou
 
 # --- interruption: exit 130, nothing written ------------------------------------------------------------
 INT=$SCRATCH/interrupted
-"$PD" gedanken --only g1_stack_drift,g1_stack_sinkage,f1_top_precession,d1_rimless_wheel --engines soft --jobs 1 \
-  --out "$INT" >"$OUT" 2>"$ERR" &
-pid=$!
-sleep 0.5
-kill -INT "$pid"
-wait "$pid"
-rc=$?
-check "SIGINT exits 130" '[ $rc -eq 130 ]'
-check "SIGINT says nothing was written" 'grep -q "interrupted" "$ERR"'
-check "SIGINT leaves no directory" '[ ! -e "$INT" ] && no_partial "$INT"'
+check_interrupted "$OUT" "$ERR" "$INT" gedanken --only g1_stack_drift,g1_stack_sinkage,f1_top_precession,d1_rimless_wheel \
+  --engines soft --jobs 1 --out "$INT"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -73,6 +73,28 @@ async function viewPixels() {
   }, png.toString('base64'));
 }
 
+// A new tab on the page `file`, after its main replay is ready; `errors` collects page errors and, with
+// consoleErrors, console errors.
+async function openTab(file, { consoleErrors = true } = {}) {
+  const tab = await browser.context.newPage();
+  const errors = [];
+  tab.on('pageerror', (e) => errors.push(e.message));
+  if (consoleErrors) tab.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  await tab.goto(pathToFileURL(file).href);
+  await tab.evaluate(() => window.pdViewer.ready);
+  return { tab, errors };
+}
+
+// A run directory's files as a report hands them to PolydynViewer.mount.
+function runFiles(dir, name) {
+  return {
+    run: name,
+    summary: JSON.parse(readFileSync(join(dir, 'summary.json'), 'utf8')),
+    trajectory: readFileSync(join(dir, 'trajectory.csv'), 'utf8'),
+    contacts: readFileSync(join(dir, 'contacts.csv'), 'utf8'),
+  };
+}
+
 const runA = join(scratch, 'demo');      // 100 samples/s
 const runB = join(scratch, 'demo-50');   // the same scene at 50 samples/s: the ghost overlay
 const pagePath = join(scratch, 'demo.html');
@@ -206,11 +228,7 @@ test('polydyn view --movie makes an MP4 of N = floor(T·fps/speed) + 1 frames la
 });
 
 test('a report page with two replays shares one bundle and opens each replay on a click', { skip: !reportPage && 'no report page given' }, async () => {
-  const tab = await browser.context.newPage();
-  const errors = [];
-  tab.on('pageerror', (e) => errors.push(e.message));
-  await tab.goto(pathToFileURL(reportPage).href);
-  await tab.evaluate(() => window.pdViewer.ready);
+  const { tab, errors } = await openTab(reportPage, { consoleErrors: false });
   assert.equal(await tab.locator('script:not([type])').count(), 1);
   assert.equal(await tab.locator('button.pdv-open').count(), 2);
   assert.deepEqual(await tab.evaluate(() => Object.keys(window.pdViewer.replays)), []);
@@ -232,18 +250,8 @@ test('a report page with two replays shares one bundle and opens each replay on 
 });
 
 test('PolydynViewer.mount (the report hook) builds from the CSV texts the same run the page embeds, and draws', async () => {
-  const tab = await browser.context.newPage();
-  const errors = [];
-  tab.on('pageerror', (e) => errors.push(e.message));
-  tab.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  await tab.goto(pathToFileURL(pagePath).href);
-  await tab.evaluate(() => window.pdViewer.ready);
-  const files = {
-    run: 'demo',
-    summary: JSON.parse(readFileSync(join(runA, 'summary.json'), 'utf8')),
-    trajectory: readFileSync(join(runA, 'trajectory.csv'), 'utf8'),
-    contacts: readFileSync(join(runA, 'contacts.csv'), 'utf8'),
-  };
+  const { tab, errors } = await openTab(pagePath);
+  const files = runFiles(runA, 'demo');
   const r = await tab.evaluate((files) => {
     const div = document.createElement('div');
     document.body.prepend(div);
@@ -264,18 +272,7 @@ test('PolydynViewer.mount (the report hook) builds from the CSV texts the same r
 });
 
 test('PolydynViewer.mount with several runs (a cube toss and its engines in a report) overlays them as polydyn view does', async () => {
-  const tab = await browser.context.newPage();
-  const errors = [];
-  tab.on('pageerror', (e) => errors.push(e.message));
-  tab.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  await tab.goto(pathToFileURL(pagePath).href);
-  await tab.evaluate(() => window.pdViewer.ready);
-  const files = (dir, name) => ({
-    run: name,
-    summary: JSON.parse(readFileSync(join(dir, 'summary.json'), 'utf8')),
-    trajectory: readFileSync(join(dir, 'trajectory.csv'), 'utf8'),
-    contacts: readFileSync(join(dir, 'contacts.csv'), 'utf8'),
-  });
+  const { tab, errors } = await openTab(pagePath);
   const r = await tab.evaluate((payload) => {
     const div = document.createElement('div');
     document.body.prepend(div);
@@ -288,7 +285,7 @@ test('PolydynViewer.mount with several runs (a cube toss and its engines in a re
     return { runs: v.runs.length, labels: v.runs.map((x) => x.label), differ, t,
       m0: v.bodyMatrix(0, 'box'), m1: v.bodyMatrix(1, 'box'),
       runLabels: Array.from(div.querySelectorAll('.pdv-runlabel')).map((l) => l.textContent) };
-  }, { title: 'two runs', runs: [files(runA, 'demo'), files(runB, 'demo-50')] });
+  }, { title: 'two runs', runs: [runFiles(runA, 'demo'), runFiles(runB, 'demo-50')] });
   assert.equal(r.runs, 2);
   assert.deepEqual(r.differ, [[], []], 'each run equal to the one polydyn view embedded');
   assert.notEqual(r.labels[0], r.labels[1], 'two runs of one engine are told apart by their directory');

@@ -27,15 +27,11 @@ export function typicalParams(rows) {
   return order.includes('fitted') ? 'fitted' : order[0];
 }
 
-export function engineVariants(rows) {
-  return orderEngineVariants(rows);
-}
-
 // The typical toss: of the tosses in `split` that the first engine (soft when there) completed with
 // `params`, the one whose end position error is nearest that engine's median; among the tosses with a
 // replay (hasReplay(toss)) when there are any. Ties go to the lower toss number.
 export function typicalToss(perToss, { params, split }, hasReplay) {
-  const evs = engineVariants(perToss);
+  const evs = orderEngineVariants(perToss);
   if (!evs.length) return null;
   const ev = evs[0].ev;
   const rows = perToss.filter((r) => r.params === params && (split === 'all' || r.split === split) && r.ev === ev && r.status === 'ok');
@@ -87,7 +83,7 @@ export function loadTypical(dir, ct) {
     if (r.toss !== typical.toss || r.params !== params || !r.run_dir || r.status !== 'ok') continue;
     const name = r.run_dir.split('/').pop();
     if (runs.some((x) => x.name === name)) continue;
-    if (fs.existsSync(path.join(root, base, name, 'trajectory.csv'))) runs.push({ name, label: r.ev, ev: r.ev, row: r });
+    if (fs.existsSync(path.join(root, base, name, 'trajectory.csv'))) runs.push({ name, label: r.ev, ev: r.ev });
     else out.missing.push(r.ev);
   }
   for (const run of runs) {

@@ -3,7 +3,8 @@
 // typical toss — its errors over time and, with a viewer bundle, a 3-D replay of the record with every
 // engine's run overlaid.
 import { esc, num, table, ANALYTIC_COLOR } from '../lib/html.mjs';
-import { DEG, headlineSplit, paramsOrder, engineVariants, errorsOverTime, ecdf } from '../lib/cubetoss.mjs';
+import { orderEngineVariants } from '../lib/derive.mjs';
+import { DEG, headlineSplit, paramsOrder, errorsOverTime, ecdf } from '../lib/cubetoss.mjs';
 
 const QUANTITIES = ['pos_err_end', 'rot_err_end', 'pos_err_rms', 'rot_err_rms', 'wall_seconds', 'cpu_seconds'];
 const RECORD_COLOR = ANALYTIC_COLOR;
@@ -16,7 +17,7 @@ export default {
     const ct = ctx.cubetoss;
     if (!ct) return null;
     const split = headlineSplit(ct.summary);
-    const evs = engineVariants(ct.summary).map((x) => x.ev);
+    const evs = orderEngineVariants(ct.summary).map((x) => x.ev);
     const params = paramsOrder(ct.summary);
     const where = ct.at === '.' ? 'this directory' : `<code>${esc(ct.at)}/</code>`;
 
