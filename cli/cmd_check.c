@@ -76,30 +76,51 @@ static void print_requested(const pdMaterial* r) {
   printf("\n");
 }
 
-static void print_time(const char* name, double tau, const char* separator) {
-  if (isfinite(tau))
-    printf("%s %.4g s%s", name, tau, separator);
-  else
-    printf("%s none (no damper)%s", name, separator);
-}
-
 static void print_contact_material(const pdModel* m, int i) {
   const pdBody* b = &m->bodies[i];
   pdBodyContactInfo info = pd_model_body_contact_info(m, i);
   print_requested(&b->requested);
-  printf("    material used   mu %.6g, kn %.6g N/m, kt %.6g N/m, cn %.6g N s/m, ct %.6g N s/m", b->used.mu, b->used.kn,
-         b->used.kt, b->used.cn, b->used.ct);
-  if (info.zeta >= 0.0) printf(" (damping ratio %.4f from the restitution)", info.zeta);
-  printf("\n");
-  printf("    sizing mass     %.10g kg%s\n", info.mass,
-         b->fixed && info.mass != b->mass ? " (fixed body: the heaviest moving body's mass)" : "");
-  printf("    min eff. mass   %.10g kg%s\n", info.mMin,
-         b->fixed && info.mass != b->mass ? " (fixed body: the lightest moving body's)" : " (App. B, exact)");
-  printf("    time constants  ");
-  print_time("kn", info.tauKn, ", ");
-  print_time("kt", info.tauKt, ", ");
-  print_time("cn", info.tauCn, ", ");
-  print_time("ct", info.tauCt, " (2 pi sqrt(m_min/k), 2 m_min/c)\n");
+  printf("    material used   mu %.6g, restitution %.6g%s (damping ratio %.4f, eq. 15)", b->used.mu,
+         b->used.restitution, b->requested.restitution >= 0.0 ? "" : " (default)", info.zeta);
+  const struct {
+    const char* name;
+    double value;
+  } given[] = {{"kn", b->used.kn}, {"kt", b->used.kt}, {"cn", b->used.cn}, {"ct", b->used.ct}};
+  for (size_t k = 0; k < sizeof given / sizeof given[0]; ++k)
+    if (given[k].value >= 0.0) printf(", %s %.6g (given)", given[k].name, given[k].value);
+  printf("; springs and dampers: per pair, below\n");
+  if (!b->fixed) printf("    min eff. mass   %.10g kg (App. B, exact)\n", info.mMin);
+}
+
+// At most this many pairs of material classes are printed.
+#define PD_CHECK_CONTACT_PAIRS_MAX 50
+
+static void print_contact_pairs(const pdModel* m) {
+  int a[PD_CHECK_CONTACT_PAIRS_MAX], b[PD_CHECK_CONTACT_PAIRS_MAX];
+  int total = pd_model_contact_class_pairs(m, a, b, PD_CHECK_CONTACT_PAIRS_MAX);
+  printf("contact pairs: %d (one line per pair of material classes that can touch)\n", total);
+  for (int i = 0; i < total && i < PD_CHECK_CONTACT_PAIRS_MAX; ++i) {
+    pdPairContact p = pd_model_pair_contact(m, a[i], b[i]);
+    printf("  %s / %s: mu %.6g, restitution %.6g (%s)\n", m->bodies[a[i]].name, m->bodies[b[i]].name, p.mu,
+           p.restitution, p.restitutionSource);
+    printf("    springs       kn %.6g N/m, kt %.6g N/m per contact (series of both sides; delta_max %.4g m of the "
+           "smaller body, m_pair %.6g kg)\n",
+           p.kn, p.kt, p.deltaMax, p.massPair);
+    if (p.modalN)
+      printf("    normal damper modal: damping ratio %.4f for the mass each contact carries (cn %.6g N s/m for one "
+             "contact at m_pair)\n",
+             p.zetaN, p.cn);
+    else
+      printf("    normal damper given: cn %.6g N s/m per contact (damping ratio %.4f at m_pair)\n", p.cn, p.zetaN);
+    if (p.modalT)
+      printf("    tang. damper  modal: damping ratio %.4f (critical; ct %.6g N s/m for one contact at m_pair)\n",
+             p.zetaT, p.ct);
+    else
+      printf("    tang. damper  given: ct %.6g N s/m per contact\n", p.ct);
+    printf("    time scales   period 2 pi sqrt(m_pair/kn) %.4g s, min eff. mass of the pair %.6g kg\n", p.period,
+           p.massMin);
+  }
+  if (total > PD_CHECK_CONTACT_PAIRS_MAX) printf("  ... and %d more pairs\n", total - PD_CHECK_CONTACT_PAIRS_MAX);
 }
 
 static void print_adjustments(const pdModel* m) {
@@ -164,6 +185,7 @@ int pd_cmd_check(int argc, char** argv) {
   }
   printf("material classes: %d (contact constants are derived once per pair of classes)\n",
          pd_model_material_class_count(m));
+  print_contact_pairs(m);
   print_adjustments(m);
   pd_model_free(m);
   return PD_EXIT_OK;

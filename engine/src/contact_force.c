@@ -15,6 +15,11 @@
 //   slip of the surface elements (Δw_t parallel to the spring, so Δw_t = −λ F_t with λ >= 0 holds). In
 //   the same family a state beyond the cone (F_n fell within a step) reports the force clipped to the
 //   cone; the springs themselves are clipped by pd_springs_realign at the end of the step.
+// Proportional dampers (c1/k1 = c2/k2 = τ, params->proportionalN/T): the surface elements obey
+// (c1 + c2) ẋ + (k1 + k2) x = 0 for x ∝ k1 s1 + k2 s2 (eq. (16)), which starts at 0 and stays there; its
+// decay rate 1/τ is the fastest in the model (for small ζ far faster than the contact's own frequency), so
+// integrating it would set the step. Those branches drop the term (it is 0 up to roundoff, and
+// pd_springs_realign restores it exactly after each step): what remains is one Kelvin–Voigt element.
 // Notation: F⁺ = μ max(F_n, 0) is the friction limit; x̂ = x/|x|.
 #include "contact_force.h"
 
@@ -27,7 +32,14 @@
 // Fills out->fn, out->rate.s1n, out->rate.s2n. du_n = Δu·n.
 static void normal_force(const pdContactParams* p, double s1, double s2, double du_n, pdContactForce* out) {
   const double k1 = p->k1n, k2 = p->k2n, c1 = p->c1n, c2 = p->c2n;
-  if (c1 > 0.0 && c2 > 0.0) {
+  if (c1 > 0.0 && c2 > 0.0 && p->proportionalN) {
+    // One Kelvin–Voigt element (see the design note): with k1 s1 + k2 s2 = 0 the damped branch below gives
+    //   ṡ1 = c2 Δu_n/(c1 + c2) = k2 Δu_n/(k1 + k2), ṡ2 = −k1 Δu_n/(k1 + k2), F_n = −k1 s1 − c_s Δu_n.
+    const double k = k1 + k2;
+    out->fn = -k1 * s1 - (c1 * c2 / (c1 + c2)) * du_n;
+    out->rate.s1n = k2 * du_n / k;
+    out->rate.s2n = -k1 * du_n / k;
+  } else if (c1 > 0.0 && c2 > 0.0) {
     // Both damped (§3.1.4). From (1) and (4) with ṡ2 = ṡ1 − Δu_n:
     //   −k1 s1 − c1 ṡ1 = k2 s2 + c2 (ṡ1 − Δu_n)  ⇒  ṡ1 = (c2 Δu_n − k1 s1 − k2 s2)/(c1 + c2),
     //   ṡ2 = ṡ1 − Δu_n = (−c1 Δu_n − k1 s1 − k2 s2)/(c1 + c2),
@@ -96,7 +108,8 @@ static void tangential_damped(const pdContactParams* p, pdVec3 s1, pdVec3 s2, pd
   }
   out->dw = dw;
   pdVec3 v = pd_v3_sub(dut, dw);
-  pdVec3 spring = pd_v3_add(pd_v3_scale(s1, k1), pd_v3_scale(s2, k2));
+  // proportional dampers: the surface elements' relaxation is 0 (design note), not integrated
+  pdVec3 spring = p->proportionalT ? (pdVec3){0, 0, 0} : pd_v3_add(pd_v3_scale(s1, k1), pd_v3_scale(s2, k2));
   out->rate.s1t = pd_v3_scale(pd_v3_sub(pd_v3_scale(v, c2), spring), 1.0 / c);
   out->rate.s2t = pd_v3_scale(pd_v3_add(pd_v3_scale(v, c1), spring), -1.0 / c);
 }
@@ -257,10 +270,23 @@ static pdVec3 clip_to_cone(pdVec3 s, double k, double limit) {
   return f > limit ? pd_v3_scale(s, limit / f) : s;
 }
 
+// Puts a proportional pair of springs back on k1 s1 + k2 s2 = 0, keeping the total deflection s2 − s1.
+static void rebalance(double k1, double k2, double* s1, double* s2) {
+  double d = *s2 - *s1, k = k1 + k2;
+  *s1 = -d * k2 / k;
+  *s2 = d * k1 / k;
+}
+
 void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const pdContactParams* p, double fn) {
   PD_ASSERT(mu >= 0.0);
   s->s1t = realign_one(s->s1t, nOld, nNew);
   s->s2t = realign_one(s->s2t, nOld, nNew);
+  if (p->proportionalN && p->k1n + p->k2n > 0.0) rebalance(p->k1n, p->k2n, &s->s1n, &s->s2n);
+  if (p->proportionalT && p->k1t + p->k2t > 0.0) {
+    rebalance(p->k1t, p->k2t, &s->s1t.x, &s->s2t.x);
+    rebalance(p->k1t, p->k2t, &s->s1t.y, &s->s2t.y);
+    rebalance(p->k1t, p->k2t, &s->s1t.z, &s->s2t.z);
+  }
   double limit = mu * fmax(fn, 0.0);
   s->s1t = clip_to_cone(s->s1t, p->k1t, limit);
   s->s2t = clip_to_cone(s->s2t, p->k2t, limit);

@@ -27,10 +27,18 @@
 #include "polydyn/vecmath.h"
 
 // Spring and damper constants of one contact (body 1 side, body 2 side) and the pair friction coefficient.
+// "Proportional" directions have c1/k1 = c2/k2 by construction: the two sides are then one Kelvin–Voigt
+// element (k_s = k1k2/(k1+k2), c_s = c1c2/(c1+c2)) and the surface elements stay where k1 s1 + k2 s2 = 0;
+// their relaxation, fast and identically zero, is not integrated (contact_force.c).
 typedef struct pdContactParams {
   double k1n, k2n, k1t, k2t;  // N/m, >= 0
   double c1n, c2n, c1t, c2t;  // N·s/m, >= 0; an exact 0 selects the zero-damping branch
   double mu;                  // pair friction coefficient √(μ₁μ₂), >= 0
+  bool proportionalN, proportionalT;  // c1/k1 = c2/k2 along n, in P_t (set where that holds by construction)
+  bool modalN, modalT;        // the dampers are set per contact from the pair's modal mass (material.h)
+  double zetaN, zetaT;        // damping ratios the modal dampers reach
+  double massPair;            // kg: the pair's reduced mass (a fixed body counts as infinite)
+  double massMin;             // kg: the pair's minimum effective mass (both bodies' m_min in series)
 } pdContactParams;
 
 // The 8 numbers of a contact in the state vector: spring deflections, m.
@@ -60,7 +68,8 @@ static inline bool pd_contact_force_pulls(const pdContactForce* f) { return f->f
 
 // After an accepted step (paper §3.4): rotates the tangential springs from the old tangent plane (⊥ nOld)
 // into the new one (⊥ nNew) by the smallest rotation taking nOld to nNew, keeping each spring's length
-// exactly (a residual out-of-plane part is removed and the length restored); then clips each tangential
+// exactly (a residual out-of-plane part is removed and the length restored); in a proportional direction
+// the two sides are put back exactly on k1 s1 + k2 s2 = 0 keeping their difference; then clips each tangential
 // spring to the friction cone, |k_it s_it| <= mu max(fn, 0) (shortened along itself; a spring with
 // k_it = 0 carries no force and is left alone), and clamps the normal springs out of tension
 // (s1n <= 0 <= s2n). nOld and nNew must be unit vectors; fn is the normal force at the accepted state, N.

@@ -97,15 +97,6 @@ bool pd_damping_ratio_from_restitution(double e, double* zeta, char* why, int wh
   return true;
 }
 
-// Fig. 5: a body of mass m on a plate of the same material; the two springs (k each) and the two dampers
-// (c each) are in series, and equal c/k ratios make the series a single Kelvin–Voigt element with k/2 and
-// c/2. Eq. (13) then has ζ = (c/2)/(2 m ω_n), ω_n = √((k/2)/m), i.e. ζ = (c/2)/(2√((k/2) m)), so
-// c = 4ζ√(k m/2) = 2ζ√(2 k m).
-double pd_body_damper_from_ratio(double zeta, double k, double m) {
-  PD_ASSERT(zeta >= 0.0 && k >= 0.0 && m > 0.0);
-  return 2.0 * zeta * sqrt(2.0 * k * m);
-}
-
 // ---------------------------------------------------------------- effective mass
 
 static bool invert3(const pdMat3* a, pdMat3* inv) {
@@ -219,12 +210,15 @@ int pd_adjustment_describe(const pdAdjustment* a, const char* bodyName, const ch
   const char* unit = (a->param == pd_paramKn || a->param == pd_paramKt) ? "N/m" : "N·s/m";
   const char* name = pd_material_param_name(a->param);
   switch (a->rule) {
-    case pd_adjustBodyPeriod:
-      return snprintf(buf, (size_t)size, "%s: %s %.6g -> %.6g %s (§3.3.1: τ = 2π√(m_min/k) = %.3g s < dt_min = %.3g s)",
-                      bodyName, name, a->from, a->to, unit, a->tau, a->dtmin);
-    case pd_adjustBodyDecay:
-      return snprintf(buf, (size_t)size, "%s: %s %.6g -> %.6g %s (§3.3.1: τ = 2 m_min/c = %.3g s < dt_min = %.3g s)",
-                      bodyName, name, a->from, a->to, unit, a->tau, a->dtmin);
+    case pd_adjustPairStiffness:
+      return snprintf(buf, (size_t)size,
+                      "%s: %s %.6g -> %.6g %s in contacts with %s (§3.3.1: 1/ω = √(m_min/k_s) = %.3g s < dt_min = "
+                      "%.3g s)",
+                      bodyName, name, a->from, a->to, unit, partnerName, a->tau, a->dtmin);
+    case pd_adjustPairDecay:
+      return snprintf(buf, (size_t)size,
+                      "%s: %s %.6g -> %.6g %s in contacts with %s (§3.3.1: τ = 2 m_min/c_s = %.3g s < dt_min = %.3g s)",
+                      bodyName, name, a->from, a->to, unit, partnerName, a->tau, a->dtmin);
     case pd_adjustContactNormal:
       return snprintf(buf, (size_t)size,
                       "%s: %s %.6g -> %.6g %s in contacts with %s (§3.3.2: τ = (c1n+c2n)/(k1n+k2n) = %.3g s < "
@@ -239,135 +233,166 @@ int pd_adjustment_describe(const pdAdjustment* a, const char* bodyName, const ch
   return snprintf(buf, (size_t)size, "%s: %s %.6g -> %.6g", bodyName, name, a->from, a->to);
 }
 
-// §3.3.1, stiffness: the undamped period 2π/ω_n = 2π√(m_min/k) must not be below Δt_min; if it is, the
-// stiffness that makes it equal is k = m_min (2π/Δt_min)².
-static double check_period(double k, const pdMaterialBody* b, double mMin, pdMaterialParam param, double dtmin,
-                           pdAdjustmentList* adj) {
-  if (!(k > 0.0) || !(dtmin > 0.0)) return k;
-  double tau = 2.0 * PI * sqrt(mMin / k);
-  if (dtmin <= tau) return k;
-  double lowered = mMin * (2.0 * PI / dtmin) * (2.0 * PI / dtmin);
-  record(adj, pd_adjustBodyPeriod, b->index, -1, param, k, lowered, tau, dtmin);
-  return lowered;
-}
+// ---------------------------------------------------------------- sides and pairs
 
-// §3.3.1, damping: the decay time 1/(ζ ω_n) = 2 m/c must not be below Δt_min; if it is, c = 2 m_min/Δt_min.
-static double check_decay(double c, const pdMaterialBody* b, double mMin, pdMaterialParam param, double dtmin,
-                          pdAdjustmentList* adj) {
-  if (!(c > 0.0) || !(dtmin > 0.0)) return c;
-  double tau = 2.0 * mMin / c;
-  if (dtmin <= tau) return c;
-  double lowered = 2.0 * mMin / dtmin;
-  record(adj, pd_adjustBodyDecay, b->index, -1, param, c, lowered, tau, dtmin);
-  return lowered;
-}
-
-bool pd_material_body(const pdMaterialBody* body, const pdMaterialRequest* req, const pdMaterialSettings* s,
-                      pdMaterialUsed* out, pdAdjustmentList* adj, char* why, int whySize) {
+bool pd_material_side(const pdMaterialBody* body, const pdMaterialRequest* req, pdMaterialSide* out, char* why,
+                      int whySize) {
   const unsigned set = req->setMask;
-  if (!(body->mass > 0.0 && isfinite(body->mass) && body->mMin > 0.0 &&
-        body->size > 0.0 && isfinite(body->size))) {
+  if (!(body->size > 0.0 && isfinite(body->size)) ||
+      (!body->fixed && !(body->mass > 0.0 && isfinite(body->mass) && body->mMin > 0.0 && isfinite(body->mMin)))) {
     pd_why(why, whySize, "invalid body (mass %g kg, minimum effective mass %g kg, size %g m)", body->mass,
            body->mMin, body->size);
     return false;
   }
-  if (!(s->vmax > 0.0 && isfinite(s->vmax) && s->deflection > 0.0 && s->deflection < 1.0 && s->dtmin >= 0.0)) {
-    pd_why(why, whySize, "invalid material settings (vmax %g m/s, deflection %g, dtmin %g s)", s->vmax,
-           s->deflection, s->dtmin);
-    return false;
-  }
-  if (((set & PD_SET_KN) && !(req->kn > 0.0)) || ((set & PD_SET_KT) && !(req->kt > 0.0)) ||
-      ((set & PD_SET_CN) && !(req->cn >= 0.0)) || ((set & PD_SET_CT) && !(req->ct >= 0.0)) || !(req->mu >= 0.0)) {
+  if (((set & PD_SET_KN) && !(req->kn > 0.0 && isfinite(req->kn))) ||
+      ((set & PD_SET_KT) && !(req->kt > 0.0 && isfinite(req->kt))) ||
+      ((set & PD_SET_CN) && !(req->cn >= 0.0 && isfinite(req->cn))) ||
+      ((set & PD_SET_CT) && !(req->ct >= 0.0 && isfinite(req->ct))) || !(req->mu >= 0.0 && isfinite(req->mu))) {
     pd_why(why, whySize, "invalid material request (kn %g, kt %g, cn %g, ct %g, mu %g)", req->kn, req->kt, req->cn,
            req->ct, req->mu);
     return false;
   }
-  const double m = body->mass, mMin = body->mMin;
-  *out = (pdMaterialUsed){.mu = req->mu, .mass = m, .mMin = mMin, .zeta = -1.0};
-
-  // eq. (11): k_n = 2 E_max/δ_max², E_max = ½ m v_max², δ_max = deflection × size
-  double delta = s->deflection * body->size;
-  double kn = (set & PD_SET_KN) ? req->kn : m * s->vmax * s->vmax / (delta * delta);
-  double kt = (set & PD_SET_KT) ? req->kt : kn;
-  out->kn = check_period(kn, body, mMin, pd_paramKn, s->dtmin, adj);
-  out->kt = check_period(kt, body, mMin, pd_paramKt, s->dtmin, adj);
-
-  if (set & PD_SET_RESTITUTION) {
-    if (!pd_damping_ratio_from_restitution(req->restitution, &out->zeta, why, whySize)) return false;
-  }
-  const bool fromE = out->zeta >= 0.0;
-  double cn = (set & PD_SET_CN) ? req->cn : (fromE ? pd_body_damper_from_ratio(out->zeta, out->kn, m) : 0.0);
-  double ct;
-  if (set & PD_SET_CT)
-    ct = req->ct;
-  else if (s->ctRule == pd_ctCritical)
-    ct = sqrt(4.0 * m * out->kt);
-  else
-    ct = fromE ? pd_body_damper_from_ratio(out->zeta, out->kt, m) : 0.0;
-  out->cn = check_decay(cn, body, mMin, pd_paramCn, s->dtmin, adj);
-  out->ct = check_decay(ct, body, mMin, pd_paramCt, s->dtmin, adj);
+  double e = (set & PD_SET_RESTITUTION) ? req->restitution : PD_DEFAULT_RESTITUTION;
+  double zeta;
+  if (!pd_damping_ratio_from_restitution(e, &zeta, why, whySize)) return false;
+  *out = (pdMaterialSide){
+      .mu = req->mu,
+      .restitution = e,
+      .kn = (set & PD_SET_KN) ? req->kn : 0.0,
+      .kt = (set & PD_SET_KT) ? req->kt : 0.0,
+      .cn = (set & PD_SET_CN) ? req->cn : -1.0,
+      .ct = (set & PD_SET_CT) ? req->ct : -1.0,
+      .mass = body->fixed ? 0.0 : body->mass,
+      .mMin = body->fixed ? 0.0 : body->mMin,
+      .size = body->size,
+  };
   return true;
 }
 
-bool pd_material_fixed_reference(const pdMaterialBody* bodies, int count, double* mass, double* mMin) {
-  double heaviest = 0.0, lightest = INFINITY;
-  bool any = false;
-  for (int i = 0; i < count; ++i) {
-    if (bodies[i].fixed) continue;
-    any = true;
-    heaviest = fmax(heaviest, bodies[i].mass);
-    lightest = fmin(lightest, bodies[i].mMin);
-  }
-  if (!any) return false;
-  *mass = heaviest;
-  *mMin = lightest;
-  return true;
+// Two masses in series (the pair's relative motion); 0 stands for an infinite (fixed) mass.
+static double reduced_mass(double m1, double m2) {
+  if (m1 <= 0.0) return m2;
+  if (m2 <= 0.0) return m1;
+  return m1 * m2 / (m1 + m2);
 }
 
-bool pd_material_bodies(const pdMaterialBody* bodies, const pdMaterialRequest* reqs, int count,
-                        const pdMaterialSettings* s, pdMaterialUsed* used, pdAdjustmentList* adj, int* failed,
-                        char* why, int whySize) {
-  double refMass = 0.0, refMMin = 0.0;
-  bool haveRef = pd_material_fixed_reference(bodies, count, &refMass, &refMMin);
-  for (int i = 0; i < count; ++i) {
-    pdMaterialBody b = bodies[i];
-    if (b.fixed && haveRef) b.mass = refMass, b.mMin = refMMin;
-    if (!pd_material_body(&b, &reqs[i], s, &used[i], adj, why, whySize)) {
-      if (failed) *failed = i;
-      return false;
-    }
+static double series(double a, double b) { return (a > 0.0 && b > 0.0) ? a * b / (a + b) : 0.0; }
+
+bool pd_pair_damping_ratio(const pdMaterialSide* s1, const pdMaterialSide* s2, double* e, double* zeta) {
+  *e = sqrt(s1->restitution * s2->restitution);
+  // both factors are >= e⁻², so is their geometric mean (up to the last bit: clamp)
+  char why[PD_ERROR_MESSAGE_MAX];
+  return pd_damping_ratio_from_restitution(fmax(*e, PD_RESTITUTION_MIN), zeta, why, sizeof why);
+}
+
+// The damper of side i when the pair's dampers are derived: the pair's c/k times the side's k.
+static void derived_dampers(double ratio, double k1, double k2, double* c1, double* c2) {
+  *c1 = ratio * k1;
+  *c2 = ratio * k2;
+}
+
+// c_s/k_s of a Kelvin–Voigt pair reaching damping ratio zeta for mass m: 2ζ√(k_s m)/k_s = 2ζ√(m/k_s).
+static double damping_over_stiffness(double zeta, double kSeries, double mass) {
+  return kSeries > 0.0 ? 2.0 * zeta * sqrt(mass / kSeries) : 0.0;
+}
+
+void pd_contact_modal_damping(pdContactParams* p, double massN, double massT) {
+  if (p->modalN) {
+    double m = fmin(massN, p->massPair);
+    derived_dampers(damping_over_stiffness(p->zetaN, series(p->k1n, p->k2n), m), p->k1n, p->k2n, &p->c1n, &p->c2n);
   }
-  return true;
+  if (p->modalT) {
+    double m = fmin(massT, p->massPair);
+    derived_dampers(damping_over_stiffness(p->zetaT, series(p->k1t, p->k2t), m), p->k1t, p->k2t, &p->c1t, &p->c2t);
+  }
+}
+
+// §3.3.1 for the pair: 1/ω = √(m_min/k_s) >= Δt_min, which bounds the period 2π/ω and, for ζ <= 1, the
+// decay time 1/(ζω) too. Scales both sides of one direction by the factor that makes it equal.
+static void check_pair_stiffness(double* k1, double* k2, double mMin, pdMaterialParam param, int body1, int body2,
+                                 double dtmin, pdAdjustmentList* adj) {
+  double ks = series(*k1, *k2);
+  if (!(ks > 0.0) || !(dtmin > 0.0)) return;
+  double tau = sqrt(mMin / ks);
+  if (tau >= dtmin) return;
+  double f = (tau / dtmin) * (tau / dtmin);
+  record(adj, pd_adjustPairStiffness, body1, body2, param, *k1, f * *k1, tau, dtmin);
+  record(adj, pd_adjustPairStiffness, body2, body1, param, *k2, f * *k2, tau, dtmin);
+  *k1 *= f;
+  *k2 *= f;
+}
+
+// §3.3.1 for explicit dampers: the decay time 2 m_min/c_s must not be below Δt_min.
+static void check_pair_decay(double* c1, double* c2, double mMin, pdMaterialParam param, int body1, int body2,
+                             double dtmin, pdAdjustmentList* adj) {
+  double cs = series(*c1, *c2);
+  if (!(cs > 0.0) || !(dtmin > 0.0)) return;
+  double tau = 2.0 * mMin / cs;
+  if (tau >= dtmin) return;
+  double f = tau / dtmin;
+  record(adj, pd_adjustPairDecay, body1, body2, param, *c1, f * *c1, tau, dtmin);
+  record(adj, pd_adjustPairDecay, body2, body1, param, *c2, f * *c2, tau, dtmin);
+  *c1 *= f;
+  *c2 *= f;
 }
 
 // §3.3.2: the massless surface elements obey (c1 + c2) ẋ + (k1 + k2) x = 0 (eq. (16)), τ = (c1+c2)/(k1+k2)
-// (eq. (17)). Δt_min > τ along n: both normal dampers become 0 (the paper's rule; the contact then takes
-// the zero-damping branch). In P_t: both tangential stiffnesses are scaled by f = τ/Δt_min, which makes
-// τ = Δt_min. The tangential check is skipped for frictionless pairs (μ = 0: no tangential springs).
-void pd_contact_params_pair(const pdMaterialUsed* m1, const pdMaterialUsed* m2, int body1, int body2, double dtmin,
-                            pdContactParams* out, pdAdjustmentList* adj) {
-  *out = (pdContactParams){.k1n = m1->kn, .k2n = m2->kn, .k1t = m1->kt, .k2t = m2->kt,
-                           .c1n = m1->cn, .c2n = m2->cn, .c1t = m1->ct, .c2t = m2->ct,
-                           .mu = sqrt(m1->mu * m2->mu)};
-  if (!(dtmin > 0.0)) return;
+// (eq. (17)). Only where the sides' c/k differ: proportional dampers have no surface-element mode.
+// Δt_min > τ along n: both normal dampers become 0 (the paper's rule; the contact then takes the zero-
+// damping branch). In P_t: both tangential stiffnesses are scaled by f = τ/Δt_min, which makes τ = Δt_min.
+static void check_surface_elements(pdContactParams* out, int body1, int body2, double dtmin, pdAdjustmentList* adj) {
   double cn = out->c1n + out->c2n, kn = out->k1n + out->k2n;
-  if (cn > 0.0 && kn > 0.0) {
+  if (!out->proportionalN && cn > 0.0 && kn > 0.0 && dtmin > cn / kn) {
     double tau = cn / kn;
-    if (dtmin > tau) {
-      if (out->c1n > 0.0) record(adj, pd_adjustContactNormal, body1, body2, pd_paramCn, out->c1n, 0.0, tau, dtmin);
-      if (out->c2n > 0.0) record(adj, pd_adjustContactNormal, body2, body1, pd_paramCn, out->c2n, 0.0, tau, dtmin);
-      out->c1n = out->c2n = 0.0;
-    }
+    if (out->c1n > 0.0) record(adj, pd_adjustContactNormal, body1, body2, pd_paramCn, out->c1n, 0.0, tau, dtmin);
+    if (out->c2n > 0.0) record(adj, pd_adjustContactNormal, body2, body1, pd_paramCn, out->c2n, 0.0, tau, dtmin);
+    out->c1n = out->c2n = 0.0;
   }
   double ct = out->c1t + out->c2t, kt = out->k1t + out->k2t;
-  if (out->mu > 0.0 && ct > 0.0 && kt > 0.0) {
-    double tau = ct / kt;
-    if (dtmin > tau) {
-      double f = tau / dtmin;
-      record(adj, pd_adjustContactTangential, body1, body2, pd_paramKt, out->k1t, f * out->k1t, tau, dtmin);
-      record(adj, pd_adjustContactTangential, body2, body1, pd_paramKt, out->k2t, f * out->k2t, tau, dtmin);
-      out->k1t *= f;
-      out->k2t *= f;
-    }
+  if (!out->proportionalT && out->mu > 0.0 && ct > 0.0 && kt > 0.0 && dtmin > ct / kt) {
+    double tau = ct / kt, f = tau / dtmin;
+    record(adj, pd_adjustContactTangential, body1, body2, pd_paramKt, out->k1t, f * out->k1t, tau, dtmin);
+    record(adj, pd_adjustContactTangential, body2, body1, pd_paramKt, out->k2t, f * out->k2t, tau, dtmin);
+    out->k1t *= f;
+    out->k2t *= f;
   }
+}
+
+// One direction's dampers: modal when neither side gives one (set per contact later; here for one contact
+// at m_pair), else the explicit values with the derived c/k for a side that gives none.
+static void dampers(double given1, double given2, double k1, double k2, double zeta, double massPair, double* c1,
+                    double* c2, bool* modal, bool* proportional) {
+  double ratio = damping_over_stiffness(zeta, series(k1, k2), massPair);
+  derived_dampers(ratio, k1, k2, c1, c2);
+  *modal = given1 < 0.0 && given2 < 0.0;
+  if (given1 >= 0.0) *c1 = given1;
+  if (given2 >= 0.0) *c2 = given2;
+  // derived on both sides by construction; explicit on both sides when the exact products agree (one
+  // material on both sides); one explicit and one derived side in general not
+  *proportional = *modal || (given1 >= 0.0 && given2 >= 0.0 && given1 * k2 == given2 * k1);
+}
+
+void pd_contact_params_pair(const pdMaterialSide* s1, const pdMaterialSide* s2, double zetaN,
+                            const pdMaterialSettings* set, int body1, int body2, pdContactParams* out,
+                            pdAdjustmentList* adj) {
+  PD_ASSERT(s1->mass > 0.0 || s2->mass > 0.0);
+  const double massPair = reduced_mass(s1->mass, s2->mass), massMin = reduced_mass(s1->mMin, s2->mMin);
+  // eq. (11) for the pair: ½ m_pair v_max² = ½ k_s δ_max², δ_max of the smaller body; each side 2 k_s
+  const double delta = set->deflection * fmin(s1->size, s2->size);
+  const double kSide = 2.0 * massPair * set->vmax * set->vmax / (delta * delta);
+  *out = (pdContactParams){.mu = sqrt(s1->mu * s2->mu), .zetaN = zetaN, .zetaT = PD_TANGENTIAL_DAMPING_RATIO,
+                           .massPair = massPair, .massMin = massMin};
+  out->k1n = s1->kn > 0.0 ? s1->kn : kSide;
+  out->k2n = s2->kn > 0.0 ? s2->kn : kSide;
+  out->k1t = s1->kt > 0.0 ? s1->kt : out->k1n;
+  out->k2t = s2->kt > 0.0 ? s2->kt : out->k2n;
+  check_pair_stiffness(&out->k1n, &out->k2n, massMin, pd_paramKn, body1, body2, set->dtmin, adj);
+  check_pair_stiffness(&out->k1t, &out->k2t, massMin, pd_paramKt, body1, body2, set->dtmin, adj);
+  dampers(s1->cn, s2->cn, out->k1n, out->k2n, out->zetaN, massPair, &out->c1n, &out->c2n, &out->modalN,
+          &out->proportionalN);
+  dampers(s1->ct, s2->ct, out->k1t, out->k2t, out->zetaT, massPair, &out->c1t, &out->c2t, &out->modalT,
+          &out->proportionalT);
+  if (!out->modalN) check_pair_decay(&out->c1n, &out->c2n, massMin, pd_paramCn, body1, body2, set->dtmin, adj);
+  if (!out->modalT) check_pair_decay(&out->c1t, &out->c2t, massMin, pd_paramCt, body1, body2, set->dtmin, adj);
+  check_surface_elements(out, body1, body2, set->dtmin, adj);
 }

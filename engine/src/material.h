@@ -1,32 +1,32 @@
 // polydyn (internal) — material parameters of the contact model (paper §3.2, §3.3, Appendices A and B).
 //
-// What this module decides (each rule is derived in material.c):
-// - Stiffness (eq. (11)): k_n = 2 E_max/δ_max² with E_max = ½ m v_max², δ_max = deflection × size
-//   (size = the body's average dimension), i.e. k_n = m v_max²/δ_max². k_t = k_n unless the scene sets kt.
-// - Restitution → normal damper: ζ from eq. (15), ln(e²) = −4ζ/√(1−ζ²) · atan(√(1−ζ²)/ζ), solved with GSL's
-//   Brent root finder; e = 1 gives ζ = 0; e < e⁻² ≈ 0.1353 is refused (unreachable with k > 0, §3.2.2).
-//   The calibration experiment of Fig. 5 (a body of mass m on a plate of the same material) puts the two
-//   bodies' springs and dampers in series: half stiffness, half damping. So ζ = (c/2)/(2√((k/2) m)) and
-//   the per-body damper is c = 2ζ√(2 k m).
-// - Tangential damper (§3.2.2: "either from (15) or critical"): an explicit ct wins; otherwise the rule
-//   pd_ctFromRestitution (DEFAULT, DESIGN §4.1: `restitution` derives c_n and c_t) gives c_t = 2ζ√(2 k_t m)
-//   when a restitution is requested and 0 when not; pd_ctCritical gives the paper's √(4 m k_t).
-//   An explicit cn wins over a requested restitution for c_n.
-// - Fixed bodies (infinite mass) are sized as a body of their own size with the mass of the HEAVIEST
-//   moving body in the scene (k_n, c_n, c_t), and their §3.3.1 time-constant checks use the SMALLEST
-//   minimum effective mass of the moving bodies (the lightest thing that can touch them). With no moving
-//   body in the scene, a fixed body uses its own mass and minimum effective mass.
-// - Minimum effective mass (App. B): the paper defines m_min as the minimum of eq. (21) over surface points
-//   and directions, and approximates it with principal directions (eq. (22)). We compute it exactly:
-//   1/m_eff(r, n) = nᵀ M(r) n with M(r) = I/m + [r]ₓᵀ J⁻¹ [r]ₓ, so the worst direction at r is the top
-//   eigenvector of M(r); nᵀ M(r) n is convex in r for every n, so its maximum over the (convex) body is
-//   attained at a vertex. m_min = 1 / max over vertices of λ_max(M(r)). (Cube: 2m/11; eq. (22): m/4.)
-// - Time constants: §3.3.1 per body, τ = 2π√(m_min/k) for k_n, k_t and τ = 2 m_min/c for c_n, c_t; when
-//   Δt_min > τ the parameter is lowered to make τ = Δt_min (k = m_min (2π/Δt_min)², c = 2 m_min/Δt_min).
-//   Dampers derived from a restitution use the stiffness after its adjustment. §3.3.2 per contact pair,
-//   τ = (c1 + c2)/(k1 + k2): along n, Δt_min > τ sets both normal dampers to 0; in P_t it lowers both
-//   tangential stiffnesses by the common factor τ/Δt_min (so τ = Δt_min). No check when c1 + c2 = 0.
-//   Every change is appended to a pdAdjustmentList as data; nothing is adjusted silently.
+// Constants belong to a PAIR of bodies, not to one body: what a contact feels is the pair's stiffness,
+// damping and friction, and a spring sized by one body alone (a 10 m floor against a 0.1 m cube) makes
+// the softer side decide everything. What this module decides (each rule derived in material.c):
+// - Per body (pd_material_side): μ; the restitution e (requested, or PD_DEFAULT_RESTITUTION); explicit
+//   kn, kt, cn, ct when the scene gives them; mass, minimum effective mass and size.
+// - Per pair (pd_contact_params_pair):
+//   μ = √(μ₁μ₂); e = √(e₁e₂); ζ_n from eq. (15) for that e; ζ_t = PD_TANGENTIAL_DAMPING_RATIO (critical).
+//   Stiffness (eq. (11) for the pair): the relative kinetic energy ½ m_pair v_max² is stored at
+//   δ_max = deflection × the SMALLER body's size, m_pair = m₁m₂/(m₁+m₂) (a fixed body: infinite mass), so
+//   the series stiffness is k_s = m_pair v_max²/δ_max², and each side without an explicit kn gets 2 k_s
+//   (equal sides: the surface elements sit in the middle). kt = kn of the same side unless set.
+//   Damping: when neither side gives cn (ct), the pair's dampers are "modal": each contact gets
+//   c_s = 2ζ√(k_s m_c), with m_c the mass per contact of the pair's joint motion along the normals (in the
+//   tangent plane), recomputed between steps from the pair's active contacts (contact_set.c) — so the
+//   requested e holds for one vertex, an edge (2 contacts) or a face (4) alike. Both sides get the same
+//   c/k (c_i = (c_s/k_s) k_i): two Kelvin–Voigt elements with one c/k ARE one Kelvin–Voigt element, which
+//   is what makes eq. (15) exact for any two bodies; the contact force then takes its "proportional"
+//   branch, with no surface-element mode to integrate. When a side gives cn (ct), the paper's explicit
+//   forms hold for that pair: the given sides keep their values, the others get the c/k of the pair's ζ
+//   at m_pair, and the §3.3.2 surface-element check applies.
+// - Time constants (§3.3), per pair: 1/ω = √(m_min/k_s) with m_min the pair's minimum effective mass (App.
+//   B, both bodies in series) must not be below Δt_min (this bounds both the period 2π/ω and the decay
+//   1/(ζω) for ζ <= 1): otherwise both sides' stiffnesses are scaled down. Explicit dampers: 2 m_min/c_s
+//   >= Δt_min. Non-proportional explicit dampers: (c₁+c₂)/(k₁+k₂) >= Δt_min, else the normal dampers are
+//   dropped or the tangential stiffnesses lowered (§3.3.2). Every change is recorded as data.
+// - Minimum effective mass (App. B): computed exactly, 1/m_min = max over vertices of λ_max(M(r)) with
+//   M(r) = I/m + [r]ₓᵀ J⁻¹ [r]ₓ (nᵀ M(r) n is convex in r, so the maximum is at a vertex). Cube: 2m/11.
 #pragma once
 
 #include <stdbool.h>
@@ -46,9 +46,11 @@ bool pd_damping_ratio_from_restitution(double e, double* zeta, char* why, int wh
 // The forward map of eq. (15): e = exp(−2ζ arccos ζ/√(1−ζ²)) for ζ ∈ [0, 1] (e⁻² at ζ = 1).
 double pd_restitution_from_damping_ratio(double zeta);
 
-// Per-body damper giving damping ratio ζ in the Fig. 5 experiment (two equal bodies in series, mass m):
-// c = 2ζ√(2 k m), N·s/m.
-double pd_body_damper_from_ratio(double zeta, double k, double m);
+// The restitution a body without `restitution` has: a hard, moderately lossy material (wood, plastic,
+// stone on stone are 0.3–0.7); never 1, which would leave contacts ringing forever.
+#define PD_DEFAULT_RESTITUTION 0.5
+// The tangential springs are critically damped: a sticking contact settles in one period, no ringing.
+#define PD_TANGENTIAL_DAMPING_RATIO 1.0
 
 // ---------------------------------------------------------------- effective mass (App. A, B)
 
@@ -67,21 +69,21 @@ double pd_min_effective_mass(double mass, const pdMat3* inertia, const pdVec3* v
 double pd_min_effective_mass_principal(double mass, const double principal[3], const pdMat3* axes,
                                        const pdVec3* vertices, int count);
 
-// ---------------------------------------------------------------- adjustments (§3.3)
+// ---------------------------------------------------------------- adjustments (§3.3), all per pair
 
 typedef enum pdMaterialParam { pd_paramKn, pd_paramKt, pd_paramCn, pd_paramCt } pdMaterialParam;
 
 typedef enum pdAdjustmentRule {
-  pd_adjustBodyPeriod,         // §3.3.1: τ = 2π√(m_min/k) < Δt_min → k lowered to m_min (2π/Δt_min)²
-  pd_adjustBodyDecay,          // §3.3.1: τ = 2 m_min/c < Δt_min → c lowered to 2 m_min/Δt_min
+  pd_adjustPairStiffness,      // §3.3.1: 1/ω = √(m_min/k_s) < Δt_min → both sides' k scaled down
+  pd_adjustPairDecay,          // §3.3.1: 2 m_min/c_s < Δt_min (explicit dampers) → both sides' c scaled down
   pd_adjustContactNormal,      // §3.3.2: τ = (c1n + c2n)/(k1n + k2n) < Δt_min → normal dampers set to 0
   pd_adjustContactTangential,  // §3.3.2: τ = (c1t + c2t)/(k1t + k2t) < Δt_min → k_t scaled by τ/Δt_min
 } pdAdjustmentRule;
 
 typedef struct pdAdjustment {
   pdAdjustmentRule rule;
-  int body;               // the body whose parameter changed (caller's index)
-  int partner;            // the other body of the contact pair (§3.3.2 rules); -1 for §3.3.1 rules
+  int body;               // the body whose side changed (caller's index)
+  int partner;            // the other body of the pair
   pdMaterialParam param;  // which parameter
   double from, to;        // its value before and after (N/m or N·s/m)
   double tau;             // the time constant found, s
@@ -100,23 +102,17 @@ typedef struct pdAdjustmentList {
 const char* pd_material_param_name(pdMaterialParam param);
 
 // One line for `polydyn check` / summary.json, e.g.
-// "ball: cn 12.5 -> 0 N·s/m (§3.3.2 contact with floor: τ = (c1+c2)/(k1+k2) = 1e-09 s < dt_min = 1e-08 s)".
+// "ball: cn 12.5 -> 0 N·s/m in contacts with floor (§3.3.2: τ = (c1n+c2n)/(k1n+k2n) = 1e-09 s < dt_min = 1e-08 s)".
 // Names may be NULL (then "body N"). Returns snprintf's count.
 int pd_adjustment_describe(const pdAdjustment* a, const char* bodyName, const char* partnerName, char* buf,
                            int size);
 
-// ---------------------------------------------------------------- per-body and per-pair parameters
-
-typedef enum pdTangentialDamping {
-  pd_ctFromRestitution = 0,  // default: c_t = 2ζ√(2 k_t m) when a restitution is requested, else 0
-  pd_ctCritical,             // c_t = √(4 m k_t) (paper §3.2.2)
-} pdTangentialDamping;
+// ---------------------------------------------------------------- per-body sides, per-pair constants
 
 typedef struct pdMaterialSettings {
-  double vmax;        // m/s, > 0: the speed that sizes k_n (eq. (11))
-  double deflection;  // δ_max as a fraction of the body's size, in (0, 1)
-  double dtmin;       // s, > 0
-  pdTangentialDamping ctRule;
+  double vmax;        // m/s, > 0: the relative speed that sizes k (eq. (11))
+  double deflection;  // δ_max as a fraction of the smaller body's size, in (0, 1)
+  double dtmin;       // s, >= 0
 } pdMaterialSettings;
 
 // What the scene asked for. setMask holds scene.h's PD_SET_KN, PD_SET_KT, PD_SET_CN, PD_SET_CT and
@@ -131,46 +127,48 @@ typedef struct pdMaterialRequest {
 
 typedef struct pdMaterialBody {
   int index;    // caller's body index, used in adjustment records
-  bool fixed;   // pd_material_bodies replaces mass and mMin of fixed bodies by the rule above
-  double mass;  // kg, > 0
-  double mMin;  // kg, minimum effective mass (pd_min_effective_mass), > 0
+  bool fixed;   // infinite mass: the pair's masses are the other body's
+  double mass;  // kg, > 0 (ignored for a fixed body)
+  double mMin;  // kg, minimum effective mass (pd_min_effective_mass), > 0 (ignored for a fixed body)
   double size;  // m, average dimension, > 0
 } pdMaterialBody;
 
-typedef struct pdMaterialUsed {
-  double kn, kt;   // N/m
-  double cn, ct;   // N·s/m
+// What one body brings to each of its contacts. Bodies with bit-identical sides share a material class.
+typedef struct pdMaterialSide {
   double mu;
-  double mass;     // kg: the mass that sized k and c (the heaviest moving mass for fixed bodies)
-  double mMin;     // kg: the minimum effective mass of the §3.3.1 checks
-  double zeta;     // damping ratio from the requested restitution, or -1 when none was requested
-} pdMaterialUsed;
+  double restitution;  // requested, or PD_DEFAULT_RESTITUTION
+  double kn, kt;       // N/m as the scene gave them; 0 = derived for each pair
+  double cn, ct;       // N·s/m as the scene gave them; -1 = derived for each pair
+  double mass;         // kg; 0 for a fixed body (infinite mass)
+  double mMin;         // kg, minimum effective mass; 0 for a fixed body
+  double size;         // m
+} pdMaterialSide;
 
-// One body's parameters, with body->mass and body->mMin used as given (the fixed-body rule is applied by
-// pd_material_bodies). Appends §3.3.1 adjustments to adj (may be NULL only if the caller accepts losing
-// them: then nothing is recorded). Returns false and fills `why` for an unreachable restitution or
-// invalid inputs.
-bool pd_material_body(const pdMaterialBody* body, const pdMaterialRequest* req, const pdMaterialSettings* s,
-                      pdMaterialUsed* out, pdAdjustmentList* adj, char* why, int whySize);
+// One body's side. Returns false and fills `why` for an unreachable restitution (below e⁻²) or invalid
+// inputs.
+bool pd_material_side(const pdMaterialBody* body, const pdMaterialRequest* req, pdMaterialSide* out, char* why,
+                      int whySize);
 
-// The masses a fixed body is sized and checked with: the heaviest moving mass and the smallest moving
-// mMin. Returns false (and leaves the outputs alone) when no body moves.
-bool pd_material_fixed_reference(const pdMaterialBody* bodies, int count, double* mass, double* mMin);
+// The pair's restitution √(e₁e₂) and its damping ratio ζ_n (eq. (15)); false only if the root finder fails.
+bool pd_pair_damping_ratio(const pdMaterialSide* s1, const pdMaterialSide* s2, double* e, double* zeta);
 
-// All bodies of a scene: applies the fixed-body rule, then pd_material_body to each. On failure returns
-// false with `why` and *failed = the array position of the body refused.
-bool pd_material_bodies(const pdMaterialBody* bodies, const pdMaterialRequest* reqs, int count,
-                        const pdMaterialSettings* s, pdMaterialUsed* used, pdAdjustmentList* adj, int* failed,
-                        char* why, int whySize);
+// Contact parameters of a pair, body 1 = s1 (index body1), body 2 = s2 (index body2), by the rules above,
+// with the pair's ζ_n given (pd_pair_damping_ratio). Modal dampers are set for one contact carrying the
+// pair's reduced mass (m_c = m_pair) until pd_contact_modal_damping sets them per contact. Adjustments are
+// appended to adj (may be NULL). The result does not depend on which body is 1 except for the side
+// labels: compute a pair once and use pd_contact_params_swapped for contacts whose roles are reversed.
+void pd_contact_params_pair(const pdMaterialSide* s1, const pdMaterialSide* s2, double zetaN,
+                            const pdMaterialSettings* set, int body1, int body2, pdContactParams* out,
+                            pdAdjustmentList* adj);
 
-// Contact parameters of a pair, body 1 = m1 (index body1), body 2 = m2 (index body2): μ = √(μ₁μ₂), each
-// side's springs and dampers from its own body, then the §3.3.2 checks (adjustments appended to adj).
-// The result does not depend on which body is 1 except for the side labels: compute a pair once and use
-// pd_contact_params_swapped for contacts whose roles are reversed.
-void pd_contact_params_pair(const pdMaterialUsed* m1, const pdMaterialUsed* m2, int body1, int body2, double dtmin,
-                            pdContactParams* out, pdAdjustmentList* adj);
+// Sets the modal dampers of one contact (the directions whose p->modalN, p->modalT are set) for the mass
+// per contact of the pair's joint motion along n (massN) and in the tangent plane (massT), kg: c_s =
+// 2ζ√(k_s m_c), each side c_i = (c_s/k_s) k_i. Masses above the pair's reduced mass are clamped to it.
+void pd_contact_modal_damping(pdContactParams* p, double massN, double massT);
 
 static inline pdContactParams pd_contact_params_swapped(const pdContactParams* p) {
-  return (pdContactParams){.k1n = p->k2n, .k2n = p->k1n, .k1t = p->k2t, .k2t = p->k1t,
-                           .c1n = p->c2n, .c2n = p->c1n, .c1t = p->c2t, .c2t = p->c1t, .mu = p->mu};
+  pdContactParams q = *p;
+  q.k1n = p->k2n, q.k2n = p->k1n, q.k1t = p->k2t, q.k2t = p->k1t;
+  q.c1n = p->c2n, q.c2n = p->c1n, q.c1t = p->c2t, q.c2t = p->c1t;
+  return q;
 }

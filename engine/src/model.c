@@ -10,8 +10,9 @@
 #include "model_contact.h"
 #include "polydyn/state.h"
 
-// The characteristic speed never drops below one body length per second: it weights velocity
-// errors, and a scene at rest without gravity would otherwise have no velocity scale at all.
+// The characteristic speed never drops below one length per second of the largest MOVING body: it weights
+// velocity errors, and a scene at rest without gravity would otherwise have no velocity scale at all
+// (a fixed floor's size says nothing about how fast anything moves).
 #define PD_MIN_SPEED_LENGTHS_PER_SECOND 1.0
 
 // Bodies may touch at t = 0 but not interpenetrate (DESIGN §4.1): a soft contact that starts deep would
@@ -89,20 +90,41 @@ static pdMaterial requested_material(const pdSceneObject* o) {
   };
 }
 
-// Characteristic speed when the scene gives no vmax: the fastest initial surface speed combined
-// with the speed of a fall through the scene's whole extent along gravity.
+// Characteristic speed when the scene gives no vmax: the fastest initial surface speed combined with the
+// speed of a fall from the highest point of a moving body down to the lowest place it can land on — the
+// lowest point of a moving body, or the lowest point of a fixed body's upper surface (its faces that face
+// up). A fixed body's own depth does not count: a 1 m thick floor is not a 1 m drop (sizing the springs
+// for it made them 60 times too stiff for a cube sliding on such a floor).
 static double estimate_vmax(const pdModel* m) {
   double g = pd_v3_norm(m->settings.gravity);
   pdVec3 down = g > 0.0 ? pd_v3_scale(m->settings.gravity, 1.0 / g) : (pdVec3){0, 0, -1};
   double lowest = INFINITY, highest = -INFINITY, fastest = 0.0;
   for (int i = 0; i < m->bodyCount; ++i) {
     const pdBody* b = &m->bodies[i];
-    double h = -pd_v3_dot(down, b->x0);
-    lowest = fmin(lowest, h - b->radius);
-    highest = fmax(highest, h + b->radius);
-    if (!b->fixed) fastest = fmax(fastest, pd_v3_norm(b->v0) + pd_v3_norm(b->w0) * b->radius);
+    pdMat3 r = pd_quat_to_mat3(b->q0);
+    pdVec3 upBody = pd_mat3_tmulv(&r, pd_v3_scale(down, -1.0));  // "up" in the body frame
+    double centre = -pd_v3_dot(down, b->x0);
+    if (!b->fixed) {
+      double lo = INFINITY, hi = -INFINITY;
+      for (int v = 0; v < b->shape.vertexCount; ++v) {
+        double h = centre + pd_v3_dot(upBody, b->shape.vertices[v]);
+        lo = fmin(lo, h), hi = fmax(hi, h);
+      }
+      lowest = fmin(lowest, lo);
+      highest = fmax(highest, hi);
+      fastest = fmax(fastest, pd_v3_norm(b->v0) + pd_v3_norm(b->w0) * b->radius);
+      continue;
+    }
+    for (int f = 0; f < b->shape.faceCount; ++f) {
+      const pdFace* face = &b->shape.faces[f];
+      if (pd_v3_dot(face->normal, upBody) <= 0.0) continue;
+      for (int k = 0; k < face->count; ++k) {
+        pdVec3 v = b->shape.vertices[b->shape.faceVertices[face->first + k]];
+        lowest = fmin(lowest, centre + pd_v3_dot(upBody, v));
+      }
+    }
   }
-  double drop = m->bodyCount > 0 ? highest - lowest : 0.0;
+  double drop = isfinite(highest) && isfinite(lowest) ? fmax(0.0, highest - lowest) : 0.0;
   return sqrt(fastest * fastest + 2.0 * g * drop);
 }
 
@@ -244,7 +266,11 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
   if (s->setMask & PD_SET_VMAX) {
     m->settings.vmax = s->vmax;
   } else {
-    m->settings.vmax = fmax(estimate_vmax(m), PD_MIN_SPEED_LENGTHS_PER_SECOND * m->lengthScale);
+    double movingScale = 0.0;
+    for (int i = 0; i < m->bodyCount; ++i)
+      if (!m->bodies[i].fixed) movingScale = fmax(movingScale, m->bodies[i].size);
+    if (movingScale == 0.0) movingScale = m->lengthScale;
+    m->settings.vmax = fmax(estimate_vmax(m), PD_MIN_SPEED_LENGTHS_PER_SECOND * movingScale);
     m->settings.vmaxEstimated = true;
   }
   if (!pd_model_build_materials(m, scene, err) || !check_initial_overlap(m, err)) {

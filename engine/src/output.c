@@ -219,28 +219,55 @@ static void write_requested(FILE* out, const pdMaterial* m) {
   fputc('}', out);
 }
 
-// The material as used (per-body constants after §3.3.1), what sized it, and its time constants
-// (null for a damper that is 0).
+// The material as used: what the body itself decides (μ, e with its default, the constants the scene
+// gave; null where the pair derives them) and its masses. The contact constants are the pairs' (below).
 static void write_used(FILE* out, const pdMaterial* m, const pdBodyContactInfo* info) {
   const struct {
     const char* name;
     double value;
-  } fields[] = {{"mu", m->mu},       {"kn", m->kn},          {"kt", m->kt},
-                {"cn", m->cn},       {"ct", m->ct},          {"restitution", m->restitution},
-                {"zeta", info->zeta}, {"sizing_mass", info->mass}, {"m_min", info->mMin}};
+  } fields[] = {{"mu", m->mu},   {"kn", m->kn},   {"kt", m->kt},          {"cn", m->cn},
+                {"ct", m->ct},   {"restitution", m->restitution},          {"zeta", info->zeta},
+                {"mass", info->mass}, {"m_min", info->mMin}};
   for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i) {
     fprintf(out, "%s\"%s\": ", i ? ", " : "{", fields[i].name);
     write_optional(out, fields[i].value);
   }
-  fputs(", \"time_constants\": {\"kn\": ", out);
-  write_number(out, info->tauKn);
-  fputs(", \"kt\": ", out);
-  write_number(out, info->tauKt);
-  fputs(", \"cn\": ", out);
-  write_number(out, info->tauCn);
-  fputs(", \"ct\": ", out);
-  write_number(out, info->tauCt);
-  fputs("}}", out);
+  fputc('}', out);
+}
+
+// At most this many pairs of material classes are written (a scene of many body sizes has many).
+#define PD_OUTPUT_CONTACT_PAIRS_MAX 100
+
+// The contact constants of every pair of material classes that can touch, named by two of their bodies.
+static void write_contact_pairs(FILE* out, const pdModel* model) {
+  int a[PD_OUTPUT_CONTACT_PAIRS_MAX], b[PD_OUTPUT_CONTACT_PAIRS_MAX];
+  int total = pd_model_contact_class_pairs(model, a, b, PD_OUTPUT_CONTACT_PAIRS_MAX);
+  int listed = total < PD_OUTPUT_CONTACT_PAIRS_MAX ? total : PD_OUTPUT_CONTACT_PAIRS_MAX;
+  fputs("  \"contact_pairs\": [", out);
+  for (int i = 0; i < listed; ++i) {
+    pdPairContact p = pd_model_pair_contact(model, a[i], b[i]);
+    fputs(i ? ",\n    {\"bodies\": [" : "\n    {\"bodies\": [", out);
+    write_json_string(out, model->bodies[a[i]].name);
+    fputs(", ", out);
+    write_json_string(out, model->bodies[b[i]].name);
+    fputs("], \"restitution_source\": ", out);
+    write_json_string(out, p.restitutionSource);
+    fprintf(out, ", \"damping\": {\"n\": \"%s\", \"t\": \"%s\"}", p.modalN ? "modal" : "explicit",
+            p.modalT ? "modal" : "explicit");
+    const struct {
+      const char* name;
+      double value;
+    } fields[] = {{"mu", p.mu},           {"restitution", p.restitution}, {"zeta_n", p.zetaN}, {"zeta_t", p.zetaT},
+                  {"kn", p.kn},           {"kt", p.kt},                   {"cn", p.cn},        {"ct", p.ct},
+                  {"m_pair", p.massPair}, {"m_min", p.massMin},           {"period", p.period},
+                  {"delta_max", p.deltaMax}};
+    for (size_t k = 0; k < sizeof fields / sizeof fields[0]; ++k) {
+      fprintf(out, ", \"%s\": ", fields[k].name);
+      write_number(out, fields[k].value);
+    }
+    fputc('}', out);
+  }
+  fprintf(out, "%s],\n  \"contact_pairs_total\": %d,\n", listed ? "\n  " : "", total);
 }
 
 static const char* primitive_name(pdPrimitiveKind kind) {
@@ -350,8 +377,9 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
     fputs(i + 1 < model->bodyCount ? ",\n" : "\n", out);
   }
   fputs("  ],\n", out);
-  // the contact model's constants per pair of material classes are derived from the bodies' above; what
-  // the §3.3 time-constant checks changed is listed here, one line each, never silently
+  // the contact model's constants per pair of material classes, derived from the bodies' above; what the
+  // §3.3 time-constant checks changed is listed after them, one line each, never silently
+  write_contact_pairs(out, model);
   fprintf(out, "  \"material_classes\": %d, \"contact_period_min\": ", pd_model_material_class_count(model));
   write_number(out, pd_model_contact_period_min(model));
   fputs(",\n  \"adjustments\": [", out);

@@ -1,7 +1,8 @@
 // Material parameters (paper §3.2, §3.3, App. A, B): ζ(e) from eq. (15) against the catalogue's inverse
-// table, the refusal of e < e⁻², stiffness from eq. (11), dampers from restitution (Fig. 5 series rule),
-// the tangential-damper rules, the fixed-body rule, effective masses (point mass, slender bar, cube
-// minimum) and the time-constant adjustments of §3.3.1 and §3.3.2, recorded as data.
+// table, the refusal of e < e⁻², a body's side (defaults), the pair's stiffness from eq. (11) at the pair's
+// reduced mass and the smaller body's size, the pair's dampers (modal and proportional by default, the
+// explicit forms when given), effective masses (point mass, slender bar, cube minimum) and the pair's
+// time-constant adjustments of §3.3.1 and §3.3.2, recorded as data.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -83,92 +84,139 @@ static void test_restitution_below_e_minus_2_is_refused(void** state) {
   expect_near(zeta, 0.0, 0.0, "ζ(1)");
   assert_true(pd_damping_ratio_from_restitution(exp(-2.0), &zeta, why, sizeof why));
   expect_near(zeta, 1.0, 1e-6, "ζ(e^-2)");
-  // through the body function, too: the message reaches the caller
+  // through the side function, too: the message reaches the caller
   pdMaterialBody body = {.mass = 1, .mMin = 1, .size = 1};
   pdMaterialRequest req = {.mu = 0.5, .restitution = 0.1, .setMask = PD_SET_RESTITUTION};
-  pdMaterialSettings set = {.vmax = 1, .deflection = 0.01, .dtmin = 1e-9};
-  pdMaterialUsed used;
+  pdMaterialSide side;
   why[0] = 0;
-  assert_false(pd_material_body(&body, &req, &set, &used, NULL, why, sizeof why));
+  assert_false(pd_material_side(&body, &req, &side, why, sizeof why));
   assert_non_null(strstr(why, "unreachable"));
 }
 
-// ---------------------------------------------------------------- per-body parameters
+// ---------------------------------------------------------------- a body's side, a pair's constants
 
-static const pdMaterialSettings SETTINGS = {.vmax = 3.0, .deflection = 0.01, .dtmin = 1e-9,
-                                            .ctRule = pd_ctFromRestitution};
+static const pdMaterialSettings SETTINGS = {.vmax = 3.0, .deflection = 0.01, .dtmin = 1e-9};
 static const pdMaterialBody BODY = {.index = 7, .mass = 2.0, .mMin = 0.5, .size = 0.5};
+static const pdMaterialBody FLOOR = {.index = 8, .fixed = true, .mass = 1e5, .mMin = 1e4, .size = 10.0};
 
-static pdMaterialUsed body_used(const pdMaterialBody* b, const pdMaterialRequest* req, const pdMaterialSettings* s,
-                                pdAdjustmentList* adj) {
-  pdMaterialUsed used;
+static pdMaterialSide side_of(const pdMaterialBody* b, const pdMaterialRequest* req) {
+  pdMaterialSide side;
   char why[256] = "";
-  if (!pd_material_body(b, req, s, &used, adj, why, sizeof why)) fail_msg("pd_material_body: %s", why);
-  return used;
+  if (!pd_material_side(b, req, &side, why, sizeof why)) fail_msg("pd_material_side: %s", why);
+  return side;
 }
 
-static void test_stiffness_from_eq_11(void** state) {
+static pdContactParams pair_of(const pdMaterialSide* s1, const pdMaterialSide* s2, const pdMaterialSettings* set,
+                               pdAdjustmentList* adj) {
+  double e, zeta;
+  assert_true(pd_pair_damping_ratio(s1, s2, &e, &zeta));
+  pdContactParams p;
+  pd_contact_params_pair(s1, s2, zeta, set, 3, 4, &p, adj);
+  return p;
+}
+
+static double series(double a, double b) { return a * b / (a + b); }
+
+static void test_side_defaults(void** state) {
   (void)state;
-  // δ_max = 0.01 × 0.5 = 0.005 m, E_max = ½ 2 · 3² = 9 J: k_n = 2 E_max/δ_max² = 18/2.5e-5 = 720000 N/m.
   pdMaterialRequest req = {.mu = 0.4};
-  pdMaterialUsed u = body_used(&BODY, &req, &SETTINGS, NULL);
-  expect_rel(u.kn, 720000.0, FORMULA_TOL_REL, "k_n");
-  expect_rel(u.kt, 720000.0, FORMULA_TOL_REL, "k_t = k_n");
-  assert_true(u.cn == 0.0 && u.ct == 0.0 && u.zeta == -1.0 && u.mu == 0.4);
-  assert_true(u.mass == 2.0 && u.mMin == 0.5);
-  // an explicit kt is kept
-  req.kt = 5e5;
-  req.setMask = PD_SET_KT;
-  u = body_used(&BODY, &req, &SETTINGS, NULL);
-  assert_true(u.kt == 5e5);
-  expect_rel(u.kn, 720000.0, FORMULA_TOL_REL, "k_n unchanged by an explicit kt");
+  pdMaterialSide s = side_of(&BODY, &req);
+  assert_true(s.mu == 0.4 && s.restitution == PD_DEFAULT_RESTITUTION);
+  assert_true(s.kn == 0.0 && s.kt == 0.0 && s.cn == -1.0 && s.ct == -1.0);  // derived per pair
+  assert_true(s.mass == 2.0 && s.mMin == 0.5 && s.size == 0.5);
+  pdMaterialSide f = side_of(&FLOOR, &req);
+  assert_true(f.mass == 0.0 && f.mMin == 0.0 && f.size == 10.0);  // a fixed body: infinite mass
+  req = (pdMaterialRequest){.mu = 0.4, .kn = 1e6, .cn = 5.0, .restitution = 0.8,
+                            .setMask = PD_SET_KN | PD_SET_CN | PD_SET_RESTITUTION};
+  s = side_of(&BODY, &req);
+  assert_true(s.kn == 1e6 && s.kt == 0.0 && s.cn == 5.0 && s.ct == -1.0 && s.restitution == 0.8);
 }
 
-static void test_dampers_from_restitution_use_the_series_rule(void** state) {
+static void test_pair_stiffness_from_eq_11(void** state) {
   (void)state;
-  // Fig. 5: c = 2ζ√(2 k m) per body, for c_n (k_n) and, by default, for c_t (k_t).
-  pdMaterialRequest req = {.mu = 0.5, .restitution = 0.5, .setMask = PD_SET_RESTITUTION};
-  pdMaterialUsed u = body_used(&BODY, &req, &SETTINGS, NULL);
-  double zeta = -1;
-  assert_true(pd_damping_ratio_from_restitution(0.5, &zeta, NULL, 0));
-  expect_near(u.zeta, zeta, 0.0, "ζ");
-  expect_rel(u.cn, 2.0 * zeta * sqrt(2.0 * 720000.0 * 2.0), FORMULA_TOL_REL, "c_n");
-  expect_rel(u.ct, 2.0 * zeta * sqrt(2.0 * 720000.0 * 2.0), FORMULA_TOL_REL, "c_t (15)");
-  // the series experiment gives back ζ: (c/2)/(2√((k/2) m))
-  expect_rel((u.cn / 2.0) / (2.0 * sqrt(u.kn / 2.0 * 2.0)), zeta, FORMULA_TOL_REL, "ζ of the series system");
-  // critical rule: c_t = √(4 m k_t)
-  pdMaterialSettings crit = SETTINGS;
-  crit.ctRule = pd_ctCritical;
-  u = body_used(&BODY, &req, &crit, NULL);
-  expect_rel(u.ct, sqrt(4.0 * 2.0 * 720000.0), FORMULA_TOL_REL, "c_t critical");
-  // explicit values win
-  req.cn = 10.0;
-  req.ct = 3.0;
-  req.setMask |= PD_SET_CN | PD_SET_CT;
-  u = body_used(&BODY, &req, &crit, NULL);
-  assert_true(u.cn == 10.0 && u.ct == 3.0);
+  // Against a fixed floor of ANY size: m_pair = 2 kg, δ_max = 0.01 × 0.5 m (the smaller body), so the series
+  // stiffness stores ½ m v² = 9 J at 5 mm: k_s = 2 · 9/2.5e-5 = 720000 N/m, each side 2 k_s.
+  pdMaterialRequest req = {.mu = 0.4};
+  pdMaterialSide body = side_of(&BODY, &req), floor = side_of(&FLOOR, &req);
+  pdContactParams p = pair_of(&body, &floor, &SETTINGS, NULL);
+  expect_rel(series(p.k1n, p.k2n), 720000.0, FORMULA_TOL_REL, "k_s");
+  assert_true(p.k1n == p.k2n && p.k1t == p.k1n && p.k2t == p.k2n);
+  assert_true(p.massPair == 2.0 && p.massMin == 0.5);
+  pdMaterialBody small = FLOOR;
+  small.size = 1.0;
+  pdMaterialSide floor1 = side_of(&small, &req);
+  pdContactParams q = pair_of(&body, &floor1, &SETTINGS, NULL);
+  assert_true(q.k1n == p.k1n && q.k2n == p.k2n);
+  // two moving bodies (2 kg, 5 kg): m_pair = 10/7 kg, δ from the smaller (0.4 m), m_min in series
+  pdMaterialBody other = {.index = 9, .mass = 5.0, .mMin = 1.2, .size = 0.4};
+  pdMaterialSide o = side_of(&other, &req);
+  p = pair_of(&body, &o, &SETTINGS, NULL);
+  expect_rel(series(p.k1n, p.k2n), (10.0 / 7.0) * 9.0 / (0.004 * 0.004), FORMULA_TOL_REL, "k_s of two moving");
+  expect_rel(p.massPair, 10.0 / 7.0, FORMULA_TOL_REL, "m_pair");
+  expect_rel(p.massMin, series(0.5, 1.2), FORMULA_TOL_REL, "m_min in series");
+  // the pair does not depend on the order
+  pdContactParams r = pair_of(&o, &body, &SETTINGS, NULL);
+  assert_true(r.k1n == p.k2n && r.k2n == p.k1n && r.massPair == p.massPair);
+  // explicit stiffnesses are kept; kt follows the side's kn
+  req = (pdMaterialRequest){.mu = 0.4, .kn = 3e5, .setMask = PD_SET_KN};
+  pdMaterialSide stiff = side_of(&BODY, &req);
+  p = pair_of(&stiff, &floor, &SETTINGS, NULL);
+  assert_true(p.k1n == 3e5 && p.k1t == 3e5);
+  expect_rel(p.k2n, 1440000.0, FORMULA_TOL_REL, "derived side 2 k_s");
 }
 
-static void test_fixed_body_uses_heaviest_moving_mass(void** state) {
+static void test_pair_dampers_are_modal_and_proportional_by_default(void** state) {
   (void)state;
-  pdMaterialBody bodies[3] = {{.index = 0, .mass = 2.0, .mMin = 0.5, .size = 0.5},
-                              {.index = 1, .mass = 5.0, .mMin = 1.2, .size = 0.4},
-                              {.index = 2, .fixed = true, .mass = 1e4, .mMin = 3e3, .size = 2.0}};
-  pdMaterialRequest reqs[3] = {
-      {.mu = 0.5}, {.mu = 0.5}, {.mu = 0.5, .restitution = 0.8, .setMask = PD_SET_RESTITUTION}};
-  pdMaterialUsed used[3];
-  char why[256] = "";
-  int failed = -1;
-  assert_true(pd_material_bodies(bodies, reqs, 3, &SETTINGS, used, NULL, &failed, why, sizeof why));
-  // the floor: mass 5 (heaviest mover), size 2 → δ = 0.02, k_n = 5 · 9/4e-4; m_min = 0.5 (lightest mover)
-  expect_rel(used[2].kn, 5.0 * 9.0 / (0.02 * 0.02), FORMULA_TOL_REL, "fixed k_n");
-  assert_true(used[2].mass == 5.0 && used[2].mMin == 0.5);
-  expect_rel(used[2].cn, 2.0 * used[2].zeta * sqrt(2.0 * used[2].kn * 5.0), FORMULA_TOL_REL, "fixed c_n");
-  // moving bodies keep their own
-  assert_true(used[1].mass == 5.0 && used[1].mMin == 1.2);
-  // a scene of fixed bodies only: they keep their own masses
-  double m = 0, mm = 0;
-  assert_false(pd_material_fixed_reference(&bodies[2], 1, &m, &mm));
+  // e = √(e₁e₂) = √(0.3 · 0.8); ζ_n from eq. (15); ζ_t critical; both sides one c/k
+  pdMaterialRequest r1 = {.mu = 0.5, .restitution = 0.3, .setMask = PD_SET_RESTITUTION};
+  pdMaterialRequest r2 = {.mu = 0.5, .restitution = 0.8, .setMask = PD_SET_RESTITUTION};
+  pdMaterialSide s1 = side_of(&BODY, &r1), s2 = side_of(&FLOOR, &r2);
+  double e, zeta, zetaExpected;
+  assert_true(pd_pair_damping_ratio(&s1, &s2, &e, &zeta));
+  expect_rel(e, sqrt(0.24), FORMULA_TOL_REL, "pair e");
+  assert_true(pd_damping_ratio_from_restitution(sqrt(0.24), &zetaExpected, NULL, 0));
+  expect_near(zeta, zetaExpected, 0.0, "pair ζ");
+  pdContactParams p = pair_of(&s1, &s2, &SETTINGS, NULL);
+  assert_true(p.modalN && p.modalT && p.proportionalN && p.proportionalT);
+  assert_true(p.zetaN == zeta && p.zetaT == PD_TANGENTIAL_DAMPING_RATIO);
+  double ks = series(p.k1n, p.k2n);
+  // one contact carrying the pair's mass until the contact set says more
+  expect_rel(series(p.c1n, p.c2n), 2.0 * zeta * sqrt(ks * 2.0), 1e-13, "c_s at m_pair");
+  expect_rel(p.c1n / p.k1n, p.c2n / p.k2n, FORMULA_TOL_REL, "one c/k");
+  expect_rel(series(p.c1t, p.c2t), 2.0 * sqrt(series(p.k1t, p.k2t) * 2.0), 1e-13, "c_t critical");
+  // four contacts of a face: m_c = m/4 each, ζ per contact as requested
+  pd_contact_modal_damping(&p, 0.5, 0.5);
+  expect_rel(series(p.c1n, p.c2n), 2.0 * zeta * sqrt(ks * 0.5), 1e-13, "c_s at m/4");
+  // a mass above m_pair is clamped to it
+  pd_contact_modal_damping(&p, 50.0, INFINITY);
+  expect_rel(series(p.c1n, p.c2n), 2.0 * zeta * sqrt(ks * 2.0), 1e-13, "clamped to m_pair");
+  // restitution 1 on both: no normal damper
+  pdMaterialRequest elastic = {.mu = 0.5, .restitution = 1.0, .setMask = PD_SET_RESTITUTION};
+  s1 = side_of(&BODY, &elastic);
+  s2 = side_of(&FLOOR, &elastic);
+  p = pair_of(&s1, &s2, &SETTINGS, NULL);
+  assert_true(p.c1n == 0.0 && p.c2n == 0.0 && p.c1t > 0.0);
+}
+
+static void test_explicit_dampers_keep_the_papers_form(void** state) {
+  (void)state;
+  pdMaterialRequest given = {.mu = 0.5, .cn = 40.0, .ct = 10.0, .setMask = PD_SET_CN | PD_SET_CT};
+  pdMaterialRequest none = {.mu = 0.5};
+  pdMaterialSide s1 = side_of(&BODY, &given), s2 = side_of(&FLOOR, &none);
+  pdContactParams p = pair_of(&s1, &s2, &SETTINGS, NULL);
+  assert_false(p.modalN || p.modalT);
+  assert_true(p.c1n == 40.0 && p.c1t == 10.0);
+  // the side without dampers gets the c/k of the pair's ζ at m_pair
+  double ks = series(p.k1n, p.k2n);
+  expect_rel(p.c2n / p.k2n, 2.0 * p.zetaN * sqrt(2.0 / ks), 1e-13, "derived side's c/k");
+  assert_false(p.proportionalN);
+  // the same c/k on both sides: proportional (one Kelvin–Voigt element)
+  pdMaterialRequest a = {.mu = 0.5, .kn = 1e6, .cn = 100.0, .setMask = PD_SET_KN | PD_SET_CN};
+  pdMaterialRequest b = {.mu = 0.5, .kn = 3e6, .cn = 300.0, .setMask = PD_SET_KN | PD_SET_CN};
+  s1 = side_of(&BODY, &a);
+  s2 = side_of(&FLOOR, &b);
+  p = pair_of(&s1, &s2, &SETTINGS, NULL);
+  assert_true(p.proportionalN && !p.modalN && p.c1n == 100.0 && p.c2n == 300.0);
 }
 
 // ---------------------------------------------------------------- effective mass
@@ -249,70 +297,71 @@ static void test_small_dtmin_records_no_adjustment(void** state) {
   pdAdjustment items[8];
   pdAdjustmentList adj = {.items = items, .capacity = 8};
   pdMaterialRequest req = {.mu = 0.5, .restitution = 0.5, .setMask = PD_SET_RESTITUTION};
-  pdMaterialUsed u = body_used(&BODY, &req, &SETTINGS, &adj);
-  pdContactParams p;
-  pd_contact_params_pair(&u, &u, 0, 1, SETTINGS.dtmin, &p, &adj);
+  pdMaterialSide s = side_of(&BODY, &req), f = side_of(&FLOOR, &req);
+  pdContactParams p = pair_of(&s, &f, &SETTINGS, &adj);
   assert_int_equal(adj.count, 0);
   assert_int_equal(adj.dropped, 0);
-  assert_true(p.c1n == u.cn && p.c2n == u.cn && p.k1t == u.kt && p.mu == 0.5);
+  assert_true(p.mu == 0.5 && p.k1n > 0.0);
 }
 
-static void test_body_time_constants_lower_stiffness_and_damping(void** state) {
+static void test_pair_time_constant_lowers_stiffness(void** state) {
   (void)state;
-  // m_min = 0.5, k_n = k_t = 720000: τ = 2π√(0.5/720000) = 5.24e-3 s < Δt_min = 0.01 s →
-  // k = m_min (2π/Δt_min)² = 0.5 · (200π)² for both. Then c from e = 0.5 with that k exceeds
-  // 2 m_min/Δt_min = 100 N·s/m (τ = 2 m_min/c < Δt_min) → c_n = c_t = 100.
+  // k_s = 720000 N/m, m_min = 0.5 kg (the floor adds nothing): 1/ω = √(0.5/720000) = 8.3e-4 s < Δt_min =
+  // 0.01 s → both sides scaled by (τ/Δt_min)², so k_s = m_min/Δt_min² = 5000 N/m, in n and in P_t.
   pdAdjustment items[8];
   pdAdjustmentList adj = {.items = items, .capacity = 8};
   pdMaterialSettings set = SETTINGS;
   set.dtmin = 0.01;
-  pdMaterialRequest req = {.mu = 0.5, .restitution = 0.5, .setMask = PD_SET_RESTITUTION};
-  pdMaterialUsed u = body_used(&BODY, &req, &set, &adj);
-  const double kLow = 0.5 * (200.0 * PI) * (200.0 * PI);
-  expect_rel(u.kn, kLow, FORMULA_TOL_REL, "k_n lowered");
-  expect_rel(u.kt, kLow, FORMULA_TOL_REL, "k_t lowered");
-  expect_rel(u.cn, 100.0, FORMULA_TOL_REL, "c_n lowered");
-  expect_rel(u.ct, 100.0, FORMULA_TOL_REL, "c_t lowered");
+  pdMaterialRequest req = {.mu = 0.5};
+  pdMaterialSide s = side_of(&BODY, &req), f = side_of(&FLOOR, &req);
+  pdContactParams p = pair_of(&s, &f, &set, &adj);
+  expect_rel(series(p.k1n, p.k2n), 5000.0, 1e-13, "k_s lowered");
+  expect_rel(series(p.k1t, p.k2t), 5000.0, 1e-13, "k_t lowered");
   assert_int_equal(adj.count, 4);
-  const pdMaterialParam params[4] = {pd_paramKn, pd_paramKt, pd_paramCn, pd_paramCt};
+  const pdMaterialParam params[4] = {pd_paramKn, pd_paramKn, pd_paramKt, pd_paramKt};
   for (int i = 0; i < 4; ++i) {
-    assert_int_equal(items[i].body, 7);
-    assert_int_equal(items[i].partner, -1);
+    assert_int_equal(items[i].rule, pd_adjustPairStiffness);
     assert_int_equal(items[i].param, params[i]);
     assert_true(items[i].dtmin == 0.01 && items[i].tau < 0.01);
   }
-  assert_int_equal(items[0].rule, pd_adjustBodyPeriod);
-  expect_rel(items[0].from, 720000.0, FORMULA_TOL_REL, "k_n from");
-  expect_rel(items[0].tau, 2.0 * PI * sqrt(0.5 / 720000.0), FORMULA_TOL_REL, "k_n τ");
-  assert_int_equal(items[2].rule, pd_adjustBodyDecay);
-  expect_rel(items[2].from, 2.0 * u.zeta * sqrt(2.0 * kLow * 2.0), FORMULA_TOL_REL, "c_n from (with lowered k)");
-  assert_true(items[2].to == u.cn);
+  assert_int_equal(items[0].body, 3);
+  assert_int_equal(items[0].partner, 4);
+  assert_int_equal(items[1].body, 4);
+  expect_rel(items[0].from, 1440000.0, FORMULA_TOL_REL, "k_n from");
+  expect_rel(items[0].tau, sqrt(0.5 / 720000.0), FORMULA_TOL_REL, "τ");
+  // modal dampers follow the lowered stiffness: ζ stays as requested
+  expect_rel(series(p.c1n, p.c2n), 2.0 * p.zetaN * sqrt(5000.0 * 2.0), 1e-13, "c_s with the lowered k");
 }
 
 static void test_contact_time_constant_zeroes_normal_dampers(void** state) {
   (void)state;
-  // τ_n = (100 + 300)/(1e6 + 3e6) = 1e-4 s < Δt_min = 1e-3 s: both normal dampers → 0, two records.
-  // τ_t is the same: both tangential stiffnesses × τ/Δt_min = 0.1.
-  pdMaterialUsed m1 = {.kn = 1e6, .kt = 1e6, .cn = 100, .ct = 100, .mu = 0.25};
-  pdMaterialUsed m2 = {.kn = 3e6, .kt = 3e6, .cn = 300, .ct = 300, .mu = 1.0};
+  // explicit, non-proportional: τ_n = (100 + 600)/(1e6 + 3e6) = 1.75e-4 s < Δt_min = 1e-3 s: both normal
+  // dampers → 0, two records. τ_t the same: both tangential stiffnesses × τ/Δt_min = 0.175.
+  pdMaterialBody heavy = {.index = 3, .mass = 100.0, .mMin = 50.0, .size = 1.0};
+  pdMaterialRequest a = {.mu = 0.25, .kn = 1e6, .kt = 1e6, .cn = 100, .ct = 100,
+                         .setMask = PD_SET_KN | PD_SET_KT | PD_SET_CN | PD_SET_CT};
+  pdMaterialRequest b = {.mu = 1.0, .kn = 3e6, .kt = 3e6, .cn = 600, .ct = 600,
+                         .setMask = PD_SET_KN | PD_SET_KT | PD_SET_CN | PD_SET_CT};
+  pdMaterialSide m1 = side_of(&heavy, &a), m2 = side_of(&FLOOR, &b);
   pdAdjustment items[8];
   pdAdjustmentList adj = {.items = items, .capacity = 8};
-  pdContactParams p;
-  pd_contact_params_pair(&m1, &m2, 3, 4, 1e-3, &p, &adj);
+  pdMaterialSettings set = SETTINGS;
+  set.dtmin = 1e-3;
+  pdContactParams p = pair_of(&m1, &m2, &set, &adj);
   expect_rel(p.mu, 0.5, FORMULA_TOL_REL, "μ = √(μ₁μ₂)");
   assert_true(p.c1n == 0.0 && p.c2n == 0.0);
-  assert_true(p.c1t == 100.0 && p.c2t == 300.0 && p.k1n == 1e6 && p.k2n == 3e6);
-  expect_rel(p.k1t, 1e5, FORMULA_TOL_REL, "k1t lowered");
-  expect_rel(p.k2t, 3e5, FORMULA_TOL_REL, "k2t lowered");
+  assert_true(p.c1t == 100.0 && p.c2t == 600.0 && p.k1n == 1e6 && p.k2n == 3e6);
+  expect_rel(p.k1t, 1.75e5, 1e-13, "k1t lowered");
+  expect_rel(p.k2t, 5.25e5, 1e-13, "k2t lowered");
   assert_int_equal(adj.count, 4);
   assert_int_equal(items[0].rule, pd_adjustContactNormal);
   assert_int_equal(items[0].body, 3);
   assert_int_equal(items[0].partner, 4);
   assert_int_equal(items[0].param, pd_paramCn);
   assert_true(items[0].from == 100.0 && items[0].to == 0.0);
-  expect_rel(items[0].tau, 1e-4, FORMULA_TOL_REL, "τ_n");
+  expect_rel(items[0].tau, 1.75e-4, FORMULA_TOL_REL, "τ_n");
   assert_int_equal(items[1].body, 4);
-  assert_true(items[1].from == 300.0 && items[1].to == 0.0);
+  assert_true(items[1].from == 600.0 && items[1].to == 0.0);
   assert_int_equal(items[2].rule, pd_adjustContactTangential);
   assert_int_equal(items[2].param, pd_paramKt);
   char line[512];
@@ -323,22 +372,25 @@ static void test_contact_time_constant_zeroes_normal_dampers(void** state) {
   assert_non_null(strstr(line, "§3.3.2"));
   // the swapped view of the pair
   pdContactParams q = pd_contact_params_swapped(&p);
-  assert_true(q.k1n == p.k2n && q.c1t == p.c2t && q.mu == p.mu);
+  assert_true(q.k1n == p.k2n && q.c1t == p.c2t && q.mu == p.mu && q.modalN == p.modalN);
   // frictionless pairs have no tangential springs to adjust
-  m1.mu = 0.0;
+  a.mu = 0.0;
+  m1 = side_of(&heavy, &a);
   adj.count = 0;
-  pd_contact_params_pair(&m1, &m2, 3, 4, 1e-3, &p, &adj);
+  p = pair_of(&m1, &m2, &set, &adj);
   assert_int_equal(adj.count, 2);
   assert_true(p.k1t == 1e6);
 }
 
 static void test_adjustments_beyond_capacity_are_counted(void** state) {
   (void)state;
-  pdMaterialUsed m1 = {.kn = 1e6, .kt = 1e6, .cn = 100, .ct = 100, .mu = 1};
+  pdMaterialRequest req = {.mu = 0.5};
+  pdMaterialSide s = side_of(&BODY, &req), f = side_of(&FLOOR, &req);
   pdAdjustment items[1];
   pdAdjustmentList adj = {.items = items, .capacity = 1};
-  pdContactParams p;
-  pd_contact_params_pair(&m1, &m1, 0, 1, 1e-3, &p, &adj);
+  pdMaterialSettings set = SETTINGS;
+  set.dtmin = 0.01;
+  pair_of(&s, &f, &set, &adj);
   assert_int_equal(adj.count, 1);
   assert_int_equal(adj.dropped, 3);
 }
@@ -348,14 +400,15 @@ int main(void) {
       cmocka_unit_test(test_damping_ratio_matches_catalogue_inverse_table),
       cmocka_unit_test(test_damping_ratio_round_trips_through_eq_15),
       cmocka_unit_test(test_restitution_below_e_minus_2_is_refused),
-      cmocka_unit_test(test_stiffness_from_eq_11),
-      cmocka_unit_test(test_dampers_from_restitution_use_the_series_rule),
-      cmocka_unit_test(test_fixed_body_uses_heaviest_moving_mass),
+      cmocka_unit_test(test_side_defaults),
+      cmocka_unit_test(test_pair_stiffness_from_eq_11),
+      cmocka_unit_test(test_pair_dampers_are_modal_and_proportional_by_default),
+      cmocka_unit_test(test_explicit_dampers_keep_the_papers_form),
       cmocka_unit_test(test_effective_mass_of_a_point_mass_is_its_mass),
       cmocka_unit_test(test_effective_mass_of_a_slender_bar_hit_at_its_end),
       cmocka_unit_test(test_minimum_effective_mass_of_a_cube),
       cmocka_unit_test(test_small_dtmin_records_no_adjustment),
-      cmocka_unit_test(test_body_time_constants_lower_stiffness_and_damping),
+      cmocka_unit_test(test_pair_time_constant_lowers_stiffness),
       cmocka_unit_test(test_contact_time_constant_zeroes_normal_dampers),
       cmocka_unit_test(test_adjustments_beyond_capacity_are_counted),
   };

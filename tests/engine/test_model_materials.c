@@ -1,8 +1,9 @@
-// Material parameters in a compiled model (paper §3.2, §3.3; DESIGN §3.4, §4.1): k_n from eq. (11) with
-// the scene's vmax and deflection, dampers from a restitution (Fig. 5 series rule), explicit constants
-// winning, the fixed-body rule, pair constants (symmetry, μ = √(μ₁μ₂), tabulated or computed on the fly),
-// the §3.3.1 and §3.3.2 adjustments as listed data, material classes, the shortest contact period, and
-// the refusals of compile: an unreachable restitution and bodies interpenetrating at t = 0.
+// Material parameters in a compiled model (paper §3.2, §3.3; DESIGN §3.4, §4.1): the pair's k_n from
+// eq. (11) with the scene's vmax and deflection at the pair's reduced mass and the smaller body's size (a
+// floor's size does not matter), the default restitution and modal dampers, explicit constants winning,
+// pair constants (symmetry, μ = √(μ₁μ₂), e = √(e₁e₂), tabulated or computed on the fly), the §3.3.1 and
+// §3.3.2 adjustments as listed data, material classes, the shortest contact period, and the refusals of
+// compile: an unreachable restitution and bodies interpenetrating at t = 0.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -57,86 +58,114 @@ static void expect_refused(const char* text, int line, int col, const char* part
   assert_string_equal(err.file, "m.scene");
 }
 
-static pdMaterialUsed used_of(const pdModel* m, int body) {
+// A body's side as the material module sees it, rebuilt from what the model reports.
+static pdMaterialSide side_of(const pdModel* m, int body) {
   const pdBody* b = &m->bodies[body];
   pdBodyContactInfo info = pd_model_body_contact_info(m, body);
-  return (pdMaterialUsed){.kn = b->used.kn, .kt = b->used.kt, .cn = b->used.cn, .ct = b->used.ct, .mu = b->used.mu,
-                          .mass = info.mass, .mMin = info.mMin, .zeta = info.zeta};
+  return (pdMaterialSide){.mu = b->used.mu, .restitution = b->used.restitution,
+                          .kn = b->used.kn > 0.0 ? b->used.kn : 0.0, .kt = b->used.kt > 0.0 ? b->used.kt : 0.0,
+                          .cn = b->used.cn, .ct = b->used.ct, .mass = b->fixed ? 0.0 : info.mass,
+                          .mMin = b->fixed ? 0.0 : info.mMin, .size = b->size};
 }
 
-static bool same_params(const pdContactParams* a, const pdContactParams* b) { return memcmp(a, b, sizeof *a) == 0; }
+// The material module's constants for bodies i, j of m, adjustments into list (may be NULL).
+static pdContactParams direct_pair(const pdModel* m, int i, int j, pdAdjustmentList* list) {
+  pdMaterialSide si = side_of(m, i), sj = side_of(m, j);
+  double e, zeta;
+  assert_true(pd_pair_damping_ratio(&si, &sj, &e, &zeta));
+  pdMaterialSettings set = {.vmax = m->settings.vmax, .deflection = m->settings.deflection, .dtmin = m->settings.dtmin};
+  pdContactParams p;
+  pd_contact_params_pair(&si, &sj, zeta, &set, i, j, &p, list);
+  return p;
+}
 
-// ---------------------------------------------------------------- per-body constants
+// Field by field (the struct has padding after its flags): bit-identical values, same flags.
+static bool same_params(const pdContactParams* a, const pdContactParams* b) {
+  const double x[] = {a->k1n, a->k2n, a->k1t, a->k2t, a->c1n, a->c2n, a->c1t, a->c2t, a->mu, a->zetaN, a->zetaT,
+                      a->massPair, a->massMin};
+  const double y[] = {b->k1n, b->k2n, b->k1t, b->k2t, b->c1n, b->c2n, b->c1t, b->c2t, b->mu, b->zetaN, b->zetaT,
+                      b->massPair, b->massMin};
+  return memcmp(x, y, sizeof x) == 0 && a->proportionalN == b->proportionalN &&
+         a->proportionalT == b->proportionalT && a->modalN == b->modalN && a->modalT == b->modalT;
+}
 
-static void test_stiffness_of_a_moving_cube_follows_eq_11(void** state) {
+static double series(double a, double b) { return a * b / (a + b); }
+
+// ---------------------------------------------------------------- pair constants
+
+static void test_stiffness_of_a_cube_on_a_floor_follows_eq_11_for_the_pair(void** state) {
   (void)state;
-  // cube of side 0.1 m, water: m = 1 kg, size 0.1 m; δ_max = 0.02 × 0.1 = 2 mm; k_n = m vmax²/δ_max²
-  pdModel* m = compile("vmax 3\ndeflection 0.02\ncube box red 0.1 0.1 0.1\n");
-  const pdBody* b = &m->bodies[0];
-  double delta = 0.02 * b->size;
-  expect_rel(b->used.kn, b->mass * 3.0 * 3.0 / (delta * delta), FORMULA_TOL_REL, "k_n = m vmax²/δ²");
-  expect_rel(b->used.kn, 2.25e6, FORMULA_TOL_REL, "k_n of 1 kg at 3 m/s over 2 mm");
-  assert_true(b->used.kt == b->used.kn);  // k_t = k_n when unset
-  assert_true(b->used.cn == 0.0 && b->used.ct == 0.0);  // no restitution, no damper asked: none
-  assert_true(b->requested.kn == -1.0 && b->requested.cn == -1.0 && b->requested.restitution == -1.0);
-  pdBodyContactInfo info = pd_model_body_contact_info(m, 0);
-  assert_true(info.mass == b->mass && info.zeta == -1.0);
-  expect_rel(info.mMin, 2.0 * b->mass / 11.0, FORMULA_TOL_REL, "cube m_min = 2m/11 (App. B, exact)");
-  expect_rel(info.tauKn, 2.0 * PI * sqrt(info.mMin / b->used.kn), FORMULA_TOL_REL, "τ_kn");
-  assert_true(isinf(info.tauCn) && isinf(info.tauCt));
-  assert_int_equal(pd_model_adjustment_count(m), 0);
+  // a 1 kg cube of 0.1 m on a fixed floor: m_pair = 1 kg, δ_max = 0.02 × 0.1 m = 2 mm (the smaller body),
+  // k_s = m_pair vmax²/δ_max² = 2.25e6 N/m whatever the floor's size
+  for (int big = 0; big < 2; ++big) {
+    pdModel* m = compile(big ? "vmax 3\ndeflection 0.02\ncube floor grey 100 100 1\nfixed\nloc 0 0 -0.5\n"
+                               "cube box red 0.1 0.1 0.1\nloc 0 0 0.05\nmu 0.5\n"
+                             : "vmax 3\ndeflection 0.02\ncube floor grey 0.2 0.2 0.1\nfixed\nloc 0 0 -0.05\n"
+                               "cube box red 0.1 0.1 0.1\nloc 0 0 0.05\nmu 0.5\n");
+    const pdBody* b = &m->bodies[1];
+    pdPairContact p = pd_model_pair_contact(m, 1, 0);
+    expect_rel(b->mass, 1.0, FORMULA_TOL_REL, "mass");
+    expect_rel(p.kn, 2.25e6, FORMULA_TOL_REL, "k_s of 1 kg at 3 m/s over 2 mm");
+    assert_true(p.kt == p.kn && p.massPair == b->mass);
+    expect_rel(p.deltaMax, 0.002, FORMULA_TOL_REL, "δ_max of the smaller body");
+    // the default restitution, modal dampers, ζ_t critical
+    assert_true(p.restitution == PD_DEFAULT_RESTITUTION && strcmp(p.restitutionSource, "default") == 0);
+    assert_true(p.modalN && p.modalT && p.zetaT == PD_TANGENTIAL_DAMPING_RATIO);
+    assert_true(fabs(p.zetaN - 0.2553) <= ZETA_TABLE_TOL);
+    expect_rel(p.cn, 2.0 * p.zetaN * sqrt(p.kn * p.massPair), FORMULA_TOL_REL, "c_n at m_pair");
+    expect_rel(p.ct, 2.0 * sqrt(p.kt * p.massPair), FORMULA_TOL_REL, "c_t critical");
+    // per body: what the scene left to the pair is reported as derived (-1)
+    assert_true(b->used.kn == -1.0 && b->used.cn == -1.0 && b->used.restitution == PD_DEFAULT_RESTITUTION);
+    assert_true(b->requested.kn == -1.0 && b->requested.cn == -1.0 && b->requested.restitution == -1.0);
+    pdBodyContactInfo info = pd_model_body_contact_info(m, 1);
+    assert_true(info.mass == b->mass && isinf(pd_model_body_contact_info(m, 0).mass));
+    expect_rel(info.mMin, 2.0 * b->mass / 11.0, FORMULA_TOL_REL, "cube m_min = 2m/11 (App. B, exact)");
+    expect_rel(p.massMin, info.mMin, FORMULA_TOL_REL, "pair m_min (the floor adds nothing)");
+    assert_int_equal(pd_model_adjustment_count(m), 0);
+    pd_model_free(m);
+  }
+}
+
+static void test_two_moving_bodies_use_the_reduced_mass(void** state) {
+  (void)state;
+  pdModel* m = compile("vmax 2\n"
+                       "cube light red 0.1 0.1 0.1\nloc 0 0 0.05\nrestitution 0.3\n"
+                       "cube heavy blue 0.2 0.2 0.2\nloc 1 0 0.1\nspgrav 3\nrestitution 0.8\n");
+  const pdBody *light = &m->bodies[0], *heavy = &m->bodies[1];
+  expect_rel(heavy->mass, 24.0, FORMULA_TOL_REL, "heavy mass");
+  pdPairContact p = pd_model_pair_contact(m, 0, 1);
+  double mPair = series(light->mass, heavy->mass), delta = m->settings.deflection * light->size;
+  expect_rel(p.massPair, mPair, FORMULA_TOL_REL, "m_pair");
+  expect_rel(p.kn, mPair * 4.0 / (delta * delta), FORMULA_TOL_REL, "k_s = m_pair vmax²/δ²");
+  expect_rel(p.restitution, sqrt(0.3 * 0.8), FORMULA_TOL_REL, "e = √(e₁e₂)");
+  assert_string_equal(p.restitutionSource, "requested");
+  expect_rel(p.massMin,
+             series(pd_model_body_contact_info(m, 0).mMin, pd_model_body_contact_info(m, 1).mMin),
+             FORMULA_TOL_REL, "m_min in series");
   pd_model_free(m);
-}
-
-static void test_restitution_gives_the_series_damper(void** state) {
-  (void)state;
-  pdModel* m = compile("vmax 3\ncube box red 0.1 0.1 0.1\nrestitution 0.5\n");
-  const pdBody* b = &m->bodies[0];
-  pdBodyContactInfo info = pd_model_body_contact_info(m, 0);
-  print_message("e = 0.5: ζ = %.6f, k_n = %.6g N/m, c_n = %.6g N·s/m\n", info.zeta, b->used.kn, b->used.cn);
-  assert_true(fabs(info.zeta - 0.2553) <= ZETA_TABLE_TOL);
-  // Fig. 5: per-body c = 2ζ√(2 k m); c_t from the restitution too (the default rule)
-  expect_rel(b->used.cn, 2.0 * info.zeta * sqrt(2.0 * b->used.kn * b->mass), FORMULA_TOL_REL, "c_n = 2ζ√(2km)");
-  expect_rel(b->used.ct, 2.0 * info.zeta * sqrt(2.0 * b->used.kt * b->mass), FORMULA_TOL_REL, "c_t = 2ζ√(2 k_t m)");
-  assert_true(b->used.restitution == 0.5 && b->requested.restitution == 0.5);
-  expect_rel(info.tauCn, 2.0 * info.mMin / b->used.cn, FORMULA_TOL_REL, "τ_cn = 2 m_min/c_n");
+  m = compile("cube a red 0.1 0.1 0.1\nrestitution 0.3\ncube b red 0.1 0.1 0.1\nloc 1 0 0\n");
+  assert_string_equal(pd_model_pair_contact(m, 0, 1).restitutionSource, "one side requested, one default");
+  expect_rel(pd_model_pair_contact(m, 0, 1).restitution, sqrt(0.3 * 0.5), FORMULA_TOL_REL, "e with the default");
   pd_model_free(m);
 }
 
 static void test_explicit_constants_win(void** state) {
   (void)state;
   pdModel* m = compile("vmax 3\ncube box red 0.1 0.1 0.1\nrestitution 0.5\ncn 7\nkt 1e5\n"
-                       "cube bare red 0.1 0.1 0.1\nloc 1 0 0\ncn 0\nrestitution 0.5\n");
+                       "cube bare red 0.1 0.1 0.1\nloc 1 0 0\ncn 0\nrestitution 0.5\n"
+                       "cube other red 0.1 0.1 0.1\nloc 2 0 0\n");
   const pdBody* b = &m->bodies[0];
-  pdBodyContactInfo info = pd_model_body_contact_info(m, 0);
   assert_true(b->used.cn == 7.0 && b->requested.cn == 7.0);  // an explicit cn wins over the restitution
   assert_true(b->used.kt == 1e5 && b->requested.kt == 1e5);
-  // c_t still from the restitution, with the explicit k_t
-  expect_rel(b->used.ct, 2.0 * info.zeta * sqrt(2.0 * 1e5 * b->mass), FORMULA_TOL_REL, "c_t from e with kt 1e5");
-  // cn 0 is a request too: no normal damper, whatever the restitution
-  assert_true(m->bodies[1].used.cn == 0.0 && m->bodies[1].requested.cn == 0.0 && m->bodies[1].used.ct > 0.0);
+  pdContactParams p = pd_model_contact_params(m, 0, 2);
+  assert_true(p.c1n == 7.0 && p.k1t == 1e5 && !p.modalN && p.modalT);
+  pdPairContact pc = pd_model_pair_contact(m, 0, 2);
+  assert_string_equal(pc.restitutionSource, "predicted by eq. (15) from the explicit dampers");
+  // cn 0 is a request too: no normal damper on that side, whatever the restitution
+  p = pd_model_contact_params(m, 1, 2);
+  assert_true(p.c1n == 0.0 && !p.modalN && p.c1t > 0.0);
   pd_model_free(m);
 }
-
-static void test_fixed_floor_is_sized_with_the_heaviest_moving_mass(void** state) {
-  (void)state;
-  pdModel* m = compile("vmax 2\n"
-                       "cube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\n"
-                       "cube light red 0.1 0.1 0.1\nloc 0 0 0.05\n"
-                       "cube heavy blue 0.2 0.2 0.2\nloc 1 0 0.1\nspgrav 3\n");
-  const pdBody *floor = &m->bodies[0], *light = &m->bodies[1], *heavy = &m->bodies[2];
-  pdBodyContactInfo fi = pd_model_body_contact_info(m, 0);
-  pdBodyContactInfo li = pd_model_body_contact_info(m, 1);
-  expect_rel(heavy->mass, 24.0, FORMULA_TOL_REL, "heavy mass");
-  assert_true(fi.mass == heavy->mass);  // the heaviest moving body's mass sizes the floor
-  assert_true(fi.mMin == li.mMin);      // and the lightest moving mMin checks it (§3.3.1)
-  double delta = m->settings.deflection * floor->size;
-  expect_rel(floor->used.kn, heavy->mass * 2.0 * 2.0 / (delta * delta), FORMULA_TOL_REL, "floor k_n");
-  assert_true(light->used.kn != heavy->used.kn);
-  pd_model_free(m);
-}
-
-// ---------------------------------------------------------------- pair constants
 
 static void test_pair_constants_are_symmetric_with_mu_the_geometric_mean(void** state) {
   (void)state;
@@ -149,13 +178,9 @@ static void test_pair_constants_are_symmetric_with_mu_the_geometric_mean(void** 
     pdContactParams p = pd_model_contact_params(m, i, j), q = pd_model_contact_params(m, j, i);
     pdContactParams qs = pd_contact_params_swapped(&q);
     assert_true(same_params(&p, &qs));  // bit-identical under swap
-    // the side labels follow the arguments: k1n is body i's
-    assert_true(p.k1n == m->bodies[i].used.kn && p.k2n == m->bodies[j].used.kn);
     expect_rel(p.mu, sqrt(m->bodies[i].used.mu * m->bodies[j].used.mu), 1e-15, "μ = √(μ₁μ₂)");
     // the same as the material module's function on the two bodies
-    pdMaterialUsed ui = used_of(m, i), uj = used_of(m, j);
-    pdContactParams direct;
-    pd_contact_params_pair(&ui, &uj, i, j, m->settings.dtmin, &direct, NULL);
+    pdContactParams direct = direct_pair(m, i, j, NULL);
     assert_true(same_params(&p, &direct));
   }
   expect_rel(pd_model_contact_params(m, 0, 1).mu, sqrt(0.24), 1e-15, "μ(floor, a)");
@@ -178,9 +203,8 @@ static void test_many_distinct_materials_give_the_same_pair_constants(void** sta
   assert_int_equal(pd_model_material_class_count(m), BODIES);
   for (int i = 0; i < BODIES; i += 7)
     for (int j = i + 1; j < BODIES; j += 11) {
-      pdMaterialUsed ui = used_of(m, i), uj = used_of(m, j);
-      pdContactParams direct, p = pd_model_contact_params(m, i, j), q = pd_model_contact_params(m, j, i);
-      pd_contact_params_pair(&ui, &uj, i, j, m->settings.dtmin, &direct, NULL);
+      pdContactParams direct = direct_pair(m, i, j, NULL);
+      pdContactParams p = pd_model_contact_params(m, i, j), q = pd_model_contact_params(m, j, i);
       pdContactParams qs = pd_contact_params_swapped(&q);
       assert_true(same_params(&p, &direct) && same_params(&qs, &direct));
     }
@@ -206,44 +230,46 @@ static void print_adjustments(const pdModel* m) {
   }
 }
 
-static void test_dtmin_above_a_body_time_constant_lowers_it_by_the_rule(void** state) {
+static void test_dtmin_above_a_pair_time_constant_lowers_its_stiffness(void** state) {
   (void)state;
-  // vmax 10, deflection 0.01, a 1 kg cube of 0.1 m: k_n = 1e8 N/m, τ = 2π√((2/11)/1e8) ≈ 2.7e-4 s; with
-  // dtmin 1e-3 s, §3.3.1 lowers k to m_min (2π/dtmin)².
-  pdModel* m = compile("vmax 10\ndtmin 1e-3\ndt 1e-3\ncube box red 0.1 0.1 0.1\n");
-  const pdBody* b = &m->bodies[0];
-  pdBodyContactInfo info = pd_model_body_contact_info(m, 0);
+  // vmax 10, deflection 0.01, a 1 kg cube of 0.1 m on a fixed floor: k_s = 1e8 N/m, 1/ω = √((2/11)/1e8)
+  // ≈ 4.3e-5 s; with dtmin 1e-3 s, §3.3.1 lowers k_s to m_min/dtmin² (both sides, n and P_t).
+  pdModel* m = compile("vmax 10\ndtmin 1e-3\ndt 1e-3\ncube floor grey 1 1 0.1\nfixed\nloc 0 0 -0.05\n"
+                       "cube box red 0.1 0.1 0.1\nloc 0 0 0.05\n");
   print_adjustments(m);
-  assert_int_equal(pd_model_adjustment_count(m), 2);  // kn and kt
+  assert_int_equal(pd_model_adjustment_count(m), 4);  // kn and kt of both sides
   assert_int_equal(pd_model_adjustments_dropped(m), 0);
-  assert_true(listed(m, "box: kn 1e+08 -> ") && listed(m, "box: kt ") && listed(m, "§3.3.1"));
-  double rule = info.mMin * (2.0 * PI / 1e-3) * (2.0 * PI / 1e-3);
-  expect_rel(b->used.kn, rule, FORMULA_TOL_REL, "k_n = m_min (2π/dtmin)²");
-  expect_rel(info.tauKn, 1e-3, FORMULA_TOL_REL, "τ_kn = dtmin after the adjustment");
+  assert_true(listed(m, "box: kn 2e+08 -> ") && listed(m, "box: kt ") && listed(m, "§3.3.1"));
+  pdPairContact p = pd_model_pair_contact(m, 1, 0);
+  expect_rel(p.kn, pd_model_body_contact_info(m, 1).mMin / 1e-6, FORMULA_TOL_REL, "k_s = m_min/dtmin²");
   pd_model_free(m);
 }
 
 static void test_dtmin_above_a_contact_time_constant_adjusts_the_pair(void** state) {
   (void)state;
-  // explicit kn 1e4, cn 1, ct 1 on two 1 kg cubes: per body τ = 2π√((2/11)/1e4) ≈ 0.027 s and
-  // 2 m_min/c ≈ 0.36 s pass dtmin = 1e-3 s; the pair's τ = (1 + 1)/(1e4 + 1e4) = 1e-4 s does not (§3.3.2):
-  // normal dampers off, tangential stiffnesses scaled by τ/dtmin = 0.1.
+  // explicit kn 1e4 / 2e4, cn 1, ct 1 on two 1 kg cubes: the pair's 1/ω = √((1/11)/6667) ≈ 3.7e-3 s and
+  // 2 m_min/c_s ≈ 0.36 s pass dtmin = 1e-3 s; the sides' c/k differ, and the surface elements' τ =
+  // (1 + 1)/(1e4 + 2e4) = 6.7e-5 s does not (§3.3.2): normal dampers off, tangential stiffnesses × τ/dtmin.
   pdModel* m = compile("dtmin 1e-3\ndt 1e-3\n"
                        "cube a red 0.1 0.1 0.1\nkn 1e4\ncn 1\nct 1\n"
-                       "cube b red 0.1 0.1 0.1\nloc 1 0 0\nkn 1e4\ncn 1\nct 1\n");
+                       "cube b red 0.1 0.1 0.1\nloc 1 0 0\nkn 2e4\ncn 1\nct 1\n");
   print_adjustments(m);
-  assert_int_equal(pd_model_material_class_count(m), 1);
+  assert_int_equal(pd_model_material_class_count(m), 2);
   assert_true(m->bodies[0].used.cn == 1.0);  // the per-body value is unchanged: the pair is adjusted
   pdContactParams p = pd_model_contact_params(m, 0, 1);
   assert_true(p.c1n == 0.0 && p.c2n == 0.0);
-  double tau = (1.0 + 1.0) / (m->bodies[0].used.kt + m->bodies[1].used.kt);
-  expect_rel(p.k1t, m->bodies[0].used.kt * tau / 1e-3, FORMULA_TOL_REL, "k_1t scaled by τ/dtmin");
-  expect_rel(p.k2t, 1e3, FORMULA_TOL_REL, "k_2t = 0.1 × 1e4");
+  double tau = 2.0 / 3e4;
+  expect_rel(p.k1t, 1e4 * tau / 1e-3, FORMULA_TOL_REL, "k_1t scaled by τ/dtmin");
+  expect_rel(p.k2t, 2e4 * tau / 1e-3, FORMULA_TOL_REL, "k_2t scaled by τ/dtmin");
   assert_true(p.c1t == 1.0 && p.c2t == 1.0);
-  // one line per change within the class (its two sides are the same change)
-  assert_int_equal(pd_model_adjustment_count(m), 2);
-  assert_true(listed(m, "a: cn 1 -> 0") && listed(m, "a: kt 10000 -> 1000") && listed(m, "§3.3.2"));
-  assert_true(listed(m, "every contact among the 2 bodies of a's material"));
+  assert_int_equal(pd_model_adjustment_count(m), 4);
+  assert_true(listed(m, "a: cn 1 -> 0") && listed(m, "a: kt 10000 -> 666.6") && listed(m, "§3.3.2"));
+  pd_model_free(m);
+  // the same c/k on both sides (one material) is one Kelvin–Voigt element: no surface-element mode
+  m = compile("dtmin 1e-3\ndt 1e-3\ncube a red 0.1 0.1 0.1\nkn 1e4\ncn 1\nct 1\n"
+              "cube b red 0.1 0.1 0.1\nloc 1 0 0\nkn 1e4\ncn 1\nct 1\n");
+  assert_int_equal(pd_model_adjustment_count(m), 0);
+  assert_true(pd_model_contact_params(m, 0, 1).proportionalN);
   pd_model_free(m);
 }
 
@@ -267,9 +293,8 @@ static void pair_adjustments_against_brute_force(const char* dtmin, double cnBas
     for (int j = i + 1; j < m->bodyCount; ++j) {
       pdAdjustment items[4];
       pdAdjustmentList list = {.items = items, .capacity = 4};
-      pdMaterialUsed ui = used_of(m, i), uj = used_of(m, j);
-      pdContactParams p;
-      pd_contact_params_pair(&ui, &uj, i, j, m->settings.dtmin, &p, &list);
+      if (m->bodies[i].fixed && m->bodies[j].fixed) continue;
+      direct_pair(m, i, j, &list);
       expected += list.count;
     }
   int got = 0;
@@ -330,7 +355,7 @@ static void test_identical_bodies_share_one_material_class(void** state) {
   m = compile(text);
   free(text);
   print_adjustments(m);
-  assert_true(listed(m, "c0: kn ") && listed(m, "(and 999 more bodies adjusted alike)"));
+  assert_true(listed(m, "c0: kn ") && listed(m, "(every contact between the 1000 bodies of c0's material"));
   assert_true(pd_model_adjustment_count(m) <= 12);
   assert_int_equal(pd_model_adjustments_dropped(m), 0);
   pd_model_free(m);
@@ -343,16 +368,14 @@ static void test_shortest_contact_period_matches_the_pairs(void** state) {
                        "cube a red 0.1 0.1 0.1\nloc 0 0 0.05\nkt 1e9\n"
                        "sphere b blue 1 0.2 0.2 0.2\nloc 0.5 0 0.1\nspgrav 5\n"
                        "tprism c green 5 0.3 0.3 0.3 0.6\nloc -0.5 0 0.15\nkn 1e5\n");
-  // brute force over body pairs with at least one moving body
+  // brute force over body pairs with at least one moving body: 2π√(m_min/k_s) of each pair, n and P_t
   double best = INFINITY;
   for (int i = 0; i < m->bodyCount; ++i)
     for (int j = i + 1; j < m->bodyCount; ++j) {
       if (m->bodies[i].fixed && m->bodies[j].fixed) continue;
-      double mMin = fmin(pd_model_body_contact_info(m, i).mMin, pd_model_body_contact_info(m, j).mMin);
-      double kn = m->bodies[i].used.kn * m->bodies[j].used.kn / (m->bodies[i].used.kn + m->bodies[j].used.kn);
-      double kt = m->bodies[i].used.kt * m->bodies[j].used.kt / (m->bodies[i].used.kt + m->bodies[j].used.kt);
-      best = fmin(best, 2.0 * PI * sqrt(mMin / kn));
-      best = fmin(best, 2.0 * PI * sqrt(mMin / kt));
+      pdPairContact p = pd_model_pair_contact(m, i, j);
+      best = fmin(best, 2.0 * PI * sqrt(p.massMin / p.kn));
+      best = fmin(best, 2.0 * PI * sqrt(p.massMin / p.kt));
     }
   print_message("shortest contact period %.6g s (brute force %.6g s)\n", pd_model_contact_period_min(m), best);
   expect_rel(pd_model_contact_period_min(m), best, FORMULA_TOL_REL, "period_min");
@@ -409,13 +432,12 @@ static void test_touching_bodies_are_accepted(void** state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_stiffness_of_a_moving_cube_follows_eq_11),
-      cmocka_unit_test(test_restitution_gives_the_series_damper),
+      cmocka_unit_test(test_stiffness_of_a_cube_on_a_floor_follows_eq_11_for_the_pair),
+      cmocka_unit_test(test_two_moving_bodies_use_the_reduced_mass),
       cmocka_unit_test(test_explicit_constants_win),
-      cmocka_unit_test(test_fixed_floor_is_sized_with_the_heaviest_moving_mass),
       cmocka_unit_test(test_pair_constants_are_symmetric_with_mu_the_geometric_mean),
       cmocka_unit_test(test_many_distinct_materials_give_the_same_pair_constants),
-      cmocka_unit_test(test_dtmin_above_a_body_time_constant_lowers_it_by_the_rule),
+      cmocka_unit_test(test_dtmin_above_a_pair_time_constant_lowers_its_stiffness),
       cmocka_unit_test(test_dtmin_above_a_contact_time_constant_adjusts_the_pair),
       cmocka_unit_test(test_every_pair_adjustment_is_listed_or_counted),
       cmocka_unit_test(test_identical_bodies_share_one_material_class),

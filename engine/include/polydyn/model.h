@@ -16,13 +16,14 @@
 
 // Material of a body: as requested by the scene, and as finally used (README "Contact material
 // parameters"). In `requested`, a value the scene did not set is -1 (mu always has a value: its default).
-// In `used`, kn, kt, cn, ct are the per-body constants after the §3.3.1 time-constant adjustments; the
-// constants of a contact pair (with the §3.3.2 adjustments) come from the contact model.
+// In `used`, restitution is the requested e or the default (0.5); kn, kt, cn, ct are the values the scene
+// gave, or -1 where the contact model derives them for each pair of bodies (pd_model_pair_contact): springs
+// and dampers belong to a pair, not to one body.
 typedef struct pdMaterial {
   double mu;           // base friction coefficient (pair value: √(μ₁μ₂))
   double kn, kt;       // spring constants, N/m
   double cn, ct;       // damper constants, N·s/m
-  double restitution;  // requested e, or -1 when not requested (in `used` too: it derives cn and ct)
+  double restitution;  // e (pair value: √(e₁e₂)); in `requested`, -1 when not requested
 } pdMaterial;
 
 typedef struct pdBody {
@@ -108,24 +109,23 @@ bool pd_model_has_applied_force(const pdModel* model);
 
 // What the contact model derived for one body, beside body->used.
 typedef struct pdBodyContactInfo {
-  double mass;          // kg: the mass that sized k and c (a fixed body: the heaviest moving body's)
-  double mMin;          // kg: minimum effective mass of the §3.3.1 checks (a fixed body: the lightest
-                        // moving body's)
-  double zeta;          // damping ratio derived from the requested restitution, or -1 when none
-  double tauKn, tauKt;  // s: undamped periods 2π√(m_min/k) with the used kn, kt
-  double tauCn, tauCt;  // s: decay times 2 m_min/c with the used cn, ct; INFINITY when c = 0
+  double mass;  // kg (INFINITY for a fixed body)
+  double mMin;  // kg: minimum effective mass over the surface and all directions (App. B); INFINITY if fixed
+  double zeta;  // damping ratio of the body's own restitution (eq. (15)); a pair uses that of √(e₁e₂)
 } pdBodyContactInfo;
 
 pdBodyContactInfo pd_model_body_contact_info(const pdModel* model, int body);
 
-// Bodies whose used material (constants, sizing mass, minimum effective mass) is identical share a
-// material class; contact-pair constants are derived once per pair of classes.
+// Bodies whose side of a contact (material as used, mass, minimum effective mass, size) is identical
+// share a material class; contact-pair constants are derived once per pair of classes.
 int pd_model_material_class_count(const pdModel* model);
+// The pairs of classes that can touch (one body moving), each named by two bodies (a moving one first):
+// writes up to `capacity` into bodyA[], bodyB[] and returns how many there are.
+int pd_model_contact_class_pairs(const pdModel* model, int* bodyA, int* bodyB, int capacity);
 
-// The time-constant adjustments of §3.3.1 (per body) and §3.3.2 (per pair of material classes) made at
-// compile time. Identical §3.3.1 adjustments of several bodies are listed once, naming the first body
-// and how many more share it; a §3.3.2 adjustment names the first body of each class. Adjustments past
-// the list's capacity are not listed but counted (pd_model_adjustments_dropped).
+// The time-constant adjustments of §3.3.1 and §3.3.2 made at compile time, per pair of material classes
+// (naming the first body of each class). Adjustments past the list's capacity are not listed but counted
+// (pd_model_adjustments_dropped).
 int pd_model_adjustment_count(const pdModel* model);
 int pd_model_adjustments_dropped(const pdModel* model);
 // One line describing adjustment i (0 <= i < count) into buf (UTF-8, no newline); returns snprintf's count.
@@ -134,15 +134,24 @@ int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int siz
 // ---------------------------------------------------------------- one pair, as a reference engine sees it
 // A reference engine (refcheck: ODE, Bullet) takes one spring, one damper, one μ and one e per contact.
 // Our contact has each side's spring ∥ damper in series (paper Fig. 3); the single equivalent element is
-// k = k1 k2/(k1 + k2) and c = c1 c2/(c1 + c2), exact when both sides have the same c/k (every pair of one
-// material, and every pair whose dampers come from one restitution) and an approximation otherwise.
+// k = k1 k2/(k1 + k2) and c = c1 c2/(c1 + c2), exact when both sides have the same c/k (always, unless the
+// scene gives dampers explicitly). Derived ("modal") dampers are set per contact from the mass each
+// contact carries in the pair's joint motion; the c here is the one for a single contact carrying the
+// pair's reduced mass.
 typedef struct pdPairContact {
   double mu;           // √(μ₁μ₂)
   double kn, kt;       // N/m, per contact (one vertex–face or edge–edge contact)
-  double cn, ct;       // N·s/m, per contact; 0 when either side has no damper
-  double restitution;  // the pair's e: √(e₁e₂) when both bodies request one, the requested one when one
-                       // does, else e of eq. (15) with the pair's ζ for the lighter body's sizing mass
-  const char* restitutionSource;  // "requested", "one side requested" or "predicted by eq. (15)"
+  double cn, ct;       // N·s/m, per contact at one contact with the pair's reduced mass; 0 without damper
+  double restitution;  // the pair's e: √(e₁e₂) (each e requested or the default); with explicit dampers,
+                       // e of eq. (15) for one contact at the pair's reduced mass
+  const char* restitutionSource;  // "requested", "one side requested, one default", "default" or
+                                  // "predicted by eq. (15) from the explicit dampers"
+  double zetaN, zetaT;  // damping ratios along n and in P_t
+  bool modalN, modalT;  // dampers derived per contact (true unless the scene gives cn / ct)
+  double massPair;      // kg: reduced mass m₁m₂/(m₁+m₂) (a fixed body: the other's mass)
+  double massMin;       // kg: the pair's minimum effective mass (App. B, both bodies in series)
+  double period;        // s: 2π√(m_pair/k_n), one contact at the reduced mass
+  double deltaMax;      // m: δ_max = deflection × the smaller body's size
 } pdPairContact;
 
 // The pair constants of bodies a and b (model body indices, a != b, not both fixed), as used.

@@ -1,0 +1,73 @@
+// Test helper: see scene_run.h.
+#include "scene_run.h"
+
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "polydyn/scene.h"
+
+pdModel* compile_text(const char* text) {
+  pdError err;
+  memset(&err, 0, sizeof err);
+  pdScene* scene = pd_scene_parse_buffer("physics.scene", text, strlen(text), &err);
+  if (!scene) fail_msg("parse: %d:%d: %s", err.line, err.col, err.message);
+  pdModel* model = pd_model_compile(scene, &err);
+  pd_scene_free(scene);
+  if (!model) fail_msg("compile: %d:%d: %s", err.line, err.col, err.message);
+  return model;
+}
+
+static bool record_sample(const pdModel* model, const pdState* state, void* user) {
+  record* r = user;
+  if (r->count == SCENE_RUN_SAMPLES) return false;
+  int k = r->count++;
+  r->t[k] = state->t;
+  r->energy[k] = pd_state_energy(model, state);
+  r->contacts[k] = pd_state_contact_count(state);
+  for (int j = 0; j < model->movingCount && j < SCENE_RUN_TRACKED; ++j) {
+    pdBodyState b = pd_state_body(model, state, model->movingBodies[j]);
+    r->body[j][k] = b;
+    r->finite = r->finite && pd_v3_isfinite(b.x) && pd_v3_isfinite(b.v) && pd_v3_isfinite(b.w) && isfinite(b.q.w);
+  }
+  r->finite = r->finite && isfinite(r->energy[k]);
+  return true;
+}
+
+record* run(const pdModel* model, pdState** stateOut) {
+  record* r = calloc(1, sizeof *r);
+  assert_non_null(r);
+  r->finite = true;
+  pdState* s = pd_state_create(model);
+  assert_true(pd_advance(model, s, model->settings.tend, record_sample, r));
+  assert_true(r->finite);
+  assert_int_equal(s->warnings[pd_warnNonFinite], 0);
+  if (stateOut)
+    *stateOut = s;
+  else
+    pd_state_free(s);
+  return r;
+}
+
+double energy_gain(const record* r) {
+  double lowest = r->energy[0], gain = 0.0;
+  for (int k = 1; k < r->count; ++k) {
+    gain = fmax(gain, r->energy[k] - lowest);
+    lowest = fmin(lowest, r->energy[k]);
+  }
+  return gain / fabs(r->energy[0]);
+}
+
+int body_index(const pdModel* m, const char* name) {
+  for (int i = 0; i < m->bodyCount; ++i)
+    if (!strcmp(m->bodies[i].name, name)) return i;
+  fail_msg("no body %s", name);
+  return -1;
+}

@@ -1,0 +1,29 @@
+// Test helper: compile a scene text, run it through pd_advance and record every output sample (time,
+// energy, contact count, states of up to SCENE_RUN_TRACKED moving bodies). Shared by the physics tests.
+#pragma once
+
+#include <stdbool.h>
+
+#include "polydyn/model.h"
+#include "polydyn/state.h"
+
+enum { SCENE_RUN_SAMPLES = 20001, SCENE_RUN_TRACKED = 4 };
+
+typedef struct record {
+  int count;
+  double t[SCENE_RUN_SAMPLES];
+  double energy[SCENE_RUN_SAMPLES];
+  int contacts[SCENE_RUN_SAMPLES];
+  pdBodyState body[SCENE_RUN_TRACKED][SCENE_RUN_SAMPLES];  // by moving-body order
+  bool finite;
+} record;
+
+// Parses and compiles `text`; fails the test with the error's position otherwise.
+pdModel* compile_text(const char* text);
+// Runs the model to its tend; asserts that it got there with finite numbers only. The record is the
+// caller's (free); the final state too when stateOut is not NULL (pd_state_free).
+record* run(const pdModel* model, pdState** stateOut);
+// The largest rise of the energy between any earlier and any later sample, relative to |E(0)|.
+double energy_gain(const record* r);
+// Index of the body called `name`; fails the test when there is none.
+int body_index(const pdModel* m, const char* name);
