@@ -4,9 +4,10 @@
 // Contact parameters of a contact whose body 1 is `body1` and body 2 is `body2` (model body indices,
 // not both fixed). Side labels follow the arguments (k1n is body1's side). O(1), no allocation.
 pdContactParams pd_model_contact_params(const pdModel* model, int body1, int body2);
-// Shortest contact time constant of the scene over all class pairs that can touch, s: min over pairs of
-// 2π sqrt(mMinPair / kSeries) with mMinPair the smaller of the two sides' mMin and kSeries = k1n k2n/(k1n+k2n)
-// (normal; same with kt if both kt > 0). INFINITY when nothing can touch. Used to size step refinement.
+// Shortest contact period of the scene over all class pairs that can touch, s: min over pairs of
+// 2π sqrt(m_min / k_s) with m_min the pair's minimum effective mass (both sides in series) and k_s =
+// k1n k2n/(k1n+k2n) (normal; the same with kt when the pair has friction). INFINITY when nothing can touch,
+// NAN past PD_MATERIAL_PERIOD_CLASSES classes (not computed). Reported in summary.json and check.
 double pd_model_contact_period_min(const pdModel* model);
 
 // ---------------------------------------------------------------- for pd_model_compile only
