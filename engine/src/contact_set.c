@@ -69,7 +69,6 @@ typedef struct contactSlot {
   pdContactId id;
   pdContactParams params;  // modal dampers set per contact between steps (set_modal_dampers)
   double deltaMax;   // m: the springs' error weight, the smaller δ_max of the two bodies
-  double refineStep; // s: this contact's refinement bound, PD_REFINE_PERIOD_FRACTION of its shortest period
   // at the last accepted state (for realignment, refinement and output)
   pdVec3 normal, point;
   double depth;
@@ -138,6 +137,7 @@ struct pdContactSet {
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])
   int* bodyList;           // (2 capacity)
   double stableStep;       // s: the largest stable step for the current list (INFINITY: no contacts)
+  pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
 };
 
 static void* grow(void* p, int count, size_t size) {
@@ -169,6 +169,8 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   set->force = grow(NULL, model->movingCount, sizeof *set->force);
   set->width = grow(NULL, n, sizeof *set->width);
   set->bodyFirst = grow(NULL, n + 1, sizeof *set->bodyFirst);
+  set->invInertiaWorld = grow(NULL, n, sizeof *set->invInertiaWorld);
+  for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
   set->stableStep = INFINITY;
   set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
   PD_ASSERT(set->travel != NULL);
@@ -227,6 +229,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->stability);
   free(set->bodyFirst);
   free(set->bodyList);
+  free(set->invInertiaWorld);
   free(set->travel);
   free(set->torque);
   free(set->poses);
@@ -386,9 +389,7 @@ static double pair_delta_max(const pdModel* model, int body1, int body2) {
 // The shortest period of a contact, 2π√(m_min/k_s) over n and P_t (m_min: the pair's minimum effective
 // mass), times PD_REFINE_PERIOD_FRACTION: how finely a reversal in this contact is located.
 static double refine_step(const pdModel* model, const pdContactParams* p) {
-  double kn = p->k1n + p->k2n > 0.0 ? p->k1n * p->k2n / (p->k1n + p->k2n) : 0.0;
-  double kt = p->mu > 0.0 && p->k1t + p->k2t > 0.0 ? p->k1t * p->k2t / (p->k1t + p->k2t) : 0.0;
-  double k = fmax(kn, kt);
+  double k = fmax(pd_series(p->k1n, p->k2n), p->mu > 0.0 ? pd_series(p->k1t, p->k2t) : 0.0);
   double period = k > 0.0 ? 2.0 * PI * sqrt(p->massMin / k) : INFINITY;
   return fmax(model->settings.dtmin, isfinite(period) ? PD_REFINE_PERIOD_FRACTION * period : 0.0);
 }
@@ -399,7 +400,6 @@ static contactSlot new_slot(const pdModel* model, const pdContactGeom* g) {
   memset(&c, 0, sizeof c);
   c.id = g->id;
   c.params = pd_model_contact_params(model, g->id.body1, g->id.body2);
-  c.refineStep = refine_step(model, &c.params);
   c.deltaMax = pair_delta_max(model, g->id.body1, g->id.body2);
   c.normal = g->normal;
   c.point = g->point;
@@ -421,16 +421,15 @@ typedef struct modalSums {
   pdVec3 normal, moment, arm;  // N, L, Σ r about one body's centre of mass
 } modalSums;
 
-static void add_body_terms(const pdBody* b, const pdPose* pose, const modalSums* s, double* qn, pdMat3* mt) {
+static pdMat3 cross_matrix(pdVec3 r) { return (pdMat3){{{0, -r.z, r.y}, {r.z, 0, -r.x}, {-r.y, r.x, 0}}}; }
+
+// invWorld: the body's R I⁻¹ Rᵀ (set->invInertiaWorld).
+static void add_body_terms(const pdBody* b, const pdMat3* invWorld, const modalSums* s, double* qn, pdMat3* mt) {
   if (b->fixed) return;
-  pdMat3 rt = pd_mat3_transpose(&pose->R);
-  pdMat3 tmp = pd_mat3_mul(&b->invInertia, &rt);
-  pdMat3 invWorld = pd_mat3_mul(&pose->R, &tmp);
-  *qn += pd_v3_dot(s->normal, s->normal) * b->invMass + pd_v3_dot(s->moment, pd_mat3_mulv(&invWorld, s->moment));
-  const pdVec3 r = s->arm;
-  const pdMat3 rx = {{{0, -r.z, r.y}, {r.z, 0, -r.x}, {-r.y, r.x, 0}}};
+  *qn += pd_v3_dot(s->normal, s->normal) * b->invMass + pd_v3_dot(s->moment, pd_mat3_mulv(invWorld, s->moment));
+  const pdMat3 rx = cross_matrix(s->arm);
   pdMat3 rxT = pd_mat3_transpose(&rx);
-  pdMat3 a = pd_mat3_mul(&invWorld, &rx);
+  pdMat3 a = pd_mat3_mul(invWorld, &rx);
   pdMat3 m = pd_mat3_mul(&rxT, &a);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) mt->m[i][j] += m.m[i][j];
@@ -458,8 +457,8 @@ static void set_modal_dampers(const pdModel* model, pdContactSet* set, const pdP
     const pdBody *A = &model->bodies[a], *B = &model->bodies[b];
     double count = (double)(last - first), qn = 0.0;
     pdMat3 mt = {{{0}}};
-    add_body_terms(A, &poses[a], &sa, &qn, &mt);
-    add_body_terms(B, &poses[b], &sb, &qn, &mt);
+    add_body_terms(A, &set->invInertiaWorld[a], &sa, &qn, &mt);
+    add_body_terms(B, &set->invInertiaWorld[b], &sb, &qn, &mt);
     // tangent-plane average: (trace − N̂ᵀ M N̂)/2 plus the translational n²(1/m_a + 1/m_b)
     double nn = pd_v3_norm(sa.normal);
     pdVec3 axis = nn > 0.0 ? pd_v3_scale(sa.normal, 1.0 / nn) : c0->normal;
@@ -473,15 +472,8 @@ static void set_modal_dampers(const pdModel* model, pdContactSet* set, const pdP
 
 // ---------------------------------------------------------------- stability bound
 
-
-static pdMat3 cross_matrix(pdVec3 r) { return (pdMat3){{{0, -r.z, r.y}, {r.z, 0, -r.x}, {-r.y, r.x, 0}}}; }
-
 static double row_abs_sum(const pdMat3* m, int row) {
   return fabs(m->m[row][0]) + fabs(m->m[row][1]) + fabs(m->m[row][2]);
-}
-
-static bool same_pair(const pdContactId* a, const pdContactId* b) {
-  return (a->body1 == b->body1 && a->body2 == b->body2) || (a->body1 == b->body2 && a->body2 == b->body1);
 }
 
 static double overdamp_factor(double zeta) { return zeta > 1.0 ? zeta + sqrt(zeta * zeta - 1.0) : 1.0; }
@@ -498,11 +490,9 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
     const contactSlot* c = &set->items[i];
     const pdContactParams* p = &c->params;
     stabilityTerms* t = &set->stability[i];
-    double kn = p->k1n + p->k2n > 0.0 ? p->k1n * p->k2n / (p->k1n + p->k2n) : 0.0;
     // a sliding contact's tangential spring is held at the friction limit: no tangential mode
     bool sticks = p->mu > 0.0 && !c->force.slip;
-    double kt = sticks && p->k1t + p->k2t > 0.0 ? p->k1t * p->k2t / (p->k1t + p->k2t) : 0.0;
-    double sn = sqrt(kn), st = sqrt(kt);
+    double sn = sqrt(pd_series(p->k1n, p->k2n)), st = sticks ? sqrt(pd_series(p->k1t, p->k2t)) : 0.0;
     pdVec3 n = c->normal;
     double nv[3] = {n.x, n.y, n.z};
     for (int r = 0; r < 3; ++r)
@@ -516,11 +506,8 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
       ++set->bodyFirst[ends[e] + 1];
       pdMat3 rx = cross_matrix(pd_v3_sub(c->point, poses[ends[e]].x));
       pdMat3 rxT = pd_mat3_transpose(&rx);
-      pdMat3 Rt = pd_mat3_transpose(&poses[ends[e]].R);
-      pdMat3 tmp = pd_mat3_mul(&b->invInertia, &Rt);
-      pdMat3 w = pd_mat3_mul(&poses[ends[e]].R, &tmp);
       t->left[e] = pd_mat3_mul(&t->k, &rxT);
-      pdMat3 wrx = pd_mat3_mul(&w, &rx);
+      pdMat3 wrx = pd_mat3_mul(&set->invInertiaWorld[ends[e]], &rx);
       t->right[e] = pd_mat3_mul(&wrx, &t->k);
     }
   }
@@ -541,6 +528,7 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
     overdamp = fmax(overdamp, ti->overdamp);
     double rows[3] = {0, 0, 0};
     int ends[2] = {c->id.body1, c->id.body2};
+    int lo = ends[0] < ends[1] ? ends[0] : ends[1], hi = ends[0] < ends[1] ? ends[1] : ends[0];
     int firstMoving = model->bodies[ends[0]].fixed ? 1 : 0;
     for (int e = 0; e < 2; ++e) {
       if (model->bodies[ends[e]].fixed) continue;
@@ -550,7 +538,7 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
         const stabilityTerms* tj = &set->stability[j];
         // a contact of the same pair couples through both bodies: its block is summed over them before
         // the absolute value, once (from the first moving end); any other through body ends[e] alone
-        bool samePair = same_pair(&c->id, &cj->id);
+        bool samePair = compare_to_pair(&cj->id, lo, hi) == 0;
         if (samePair && e != firstMoving) continue;
         pdMat3 kk = pd_mat3_mul(&ti->k, &tj->k);
         pdMat3 m = {{{0}}};
@@ -590,6 +578,21 @@ static void record(const pdModel* model, pdContactSet* set, const double* y, con
     c->point = g.point;
     c->depth = g.depth;
   }
+}
+
+// After a new list is installed at state y (poses those of y): the bodies' world inverse inertias, the
+// modal dampers, each contact's geometry and force (record), and the stability bound, in that order (the
+// bound reads which contacts slip).
+static void prepare_list(const pdModel* model, pdContactSet* set, const double* y, const pdPose* poses) {
+  for (int k = 0; k < model->movingCount; ++k) {
+    int i = model->movingBodies[k];
+    pdMat3 rt = pd_mat3_transpose(&poses[i].R);
+    pdMat3 tmp = pd_mat3_mul(&model->bodies[i].invInertia, &rt);
+    set->invInertiaWorld[i] = pd_mat3_mul(&poses[i].R, &tmp);
+  }
+  set_modal_dampers(model, set, poses);
+  record(model, set, y, poses);
+  set->stableStep = stable_step(model, set, poses);
 }
 
 // ---------------------------------------------------------------- the contact search at y1
@@ -741,8 +744,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
 // Did a contact change mode inside the step (§3.4): stick ↔ slip? That is where the contact force has a
 // kink, which the error control would otherwise cross with a step of the wrong order. Reversals of Δu_n or
 // of Δu_t within one mode are smooth in this model (linear springs and dampers) and are left to the
-// error control: refining them cost pile_10 a third of its derivative evaluations for no change in the
-// sweep error.
+// error control (refining them cost pile_10 a third of its derivative evaluations).
 static bool changes_mode(const contactSlot* c, const pdContactForce* f) { return c->force.slip != f->slip; }
 
 pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, const double* y1, double* hRetry) {
@@ -762,7 +764,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
 
   // 1. C0 at y1: tracking, forces, reversals
   double t0c = pd_clock_seconds();
-  double refineStep = 0.0;  // the largest refinement bound among the contacts that reversed (0: none)
+  double refineStep = 0.0;  // the largest refinement bound among the contacts that changed mode (0: none)
   for (int i = 0; i < set->count; ++i) {
     contactSlot* c = &set->items[i];
     contactEval* e = &set->eval[i];
@@ -770,7 +772,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     pdVec3 du;
     evaluate(model, c, y1, set->poses1, &sp, &e->geom, &e->tracked, &du, &e->force);
     e->transferred = false;
-    if (changes_mode(c, &e->force)) refineStep = fmax(refineStep, c->refineStep);
+    if (changes_mode(c, &e->force)) refineStep = fmax(refineStep, refine_step(model, &c->params));
   }
   s->stageSeconds[pd_stageContactAnalysis] += pd_clock_seconds() - t0c;
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
@@ -827,9 +829,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
         s->count.contactsVirtual += added;
         install(model, s, count);
         poses_from(model, s->y, set->poses0);
-        set_modal_dampers(model, set, set->poses0);
-        record(model, set, s->y, set->poses0);
-        set->stableStep = stable_step(model, set, set->poses0);
+        prepare_list(model, set, s->y, set->poses0);
         verdict = pd_eventRestart;
       }
     }
@@ -884,9 +884,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
   memcpy(s->y, y1, (size_t)base * sizeof *s->y);
   install(model, s, count);
   poses_from(model, s->y, set->poses1);
-  set_modal_dampers(model, set, set->poses1);
-  record(model, set, s->y, set->poses1);
-  set->stableStep = stable_step(model, set, set->poses1);
+  prepare_list(model, set, s->y, set->poses1);
   s->stageSeconds[pd_stageContactAnalysis] += pd_clock_seconds() - t0;
 }
 

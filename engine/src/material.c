@@ -276,8 +276,6 @@ static double reduced_mass(double m1, double m2) {
   return m1 * m2 / (m1 + m2);
 }
 
-static double series(double a, double b) { return (a > 0.0 && b > 0.0) ? a * b / (a + b) : 0.0; }
-
 bool pd_pair_damping_ratio(const pdMaterialSide* s1, const pdMaterialSide* s2, double* e, double* zeta) {
   *e = sqrt(s1->restitution * s2->restitution);
   // both factors are >= e⁻², so is their geometric mean (up to the last bit: clamp)
@@ -299,11 +297,11 @@ static double damping_over_stiffness(double zeta, double kSeries, double mass) {
 void pd_contact_modal_damping(pdContactParams* p, double massN, double massT) {
   if (p->modalN) {
     double m = fmin(massN, p->massPair);
-    derived_dampers(damping_over_stiffness(p->zetaN, series(p->k1n, p->k2n), m), p->k1n, p->k2n, &p->c1n, &p->c2n);
+    derived_dampers(damping_over_stiffness(p->zetaN, pd_series(p->k1n, p->k2n), m), p->k1n, p->k2n, &p->c1n, &p->c2n);
   }
   if (p->modalT) {
     double m = fmin(massT, p->massPair);
-    derived_dampers(damping_over_stiffness(p->zetaT, series(p->k1t, p->k2t), m), p->k1t, p->k2t, &p->c1t, &p->c2t);
+    derived_dampers(damping_over_stiffness(p->zetaT, pd_series(p->k1t, p->k2t), m), p->k1t, p->k2t, &p->c1t, &p->c2t);
   }
 }
 
@@ -311,7 +309,7 @@ void pd_contact_modal_damping(pdContactParams* p, double massN, double massT) {
 // decay time 1/(ζω) too. Scales both sides of one direction by the factor that makes it equal.
 static void check_pair_stiffness(double* k1, double* k2, double mMin, pdMaterialParam param, int body1, int body2,
                                  double dtmin, pdAdjustmentList* adj) {
-  double ks = series(*k1, *k2);
+  double ks = pd_series(*k1, *k2);
   if (!(ks > 0.0) || !(dtmin > 0.0)) return;
   double tau = sqrt(mMin / ks);
   if (tau >= dtmin) return;
@@ -325,7 +323,7 @@ static void check_pair_stiffness(double* k1, double* k2, double mMin, pdMaterial
 // §3.3.1 for explicit dampers: the decay time 2 m_min/c_s must not be below Δt_min.
 static void check_pair_decay(double* c1, double* c2, double mMin, pdMaterialParam param, int body1, int body2,
                              double dtmin, pdAdjustmentList* adj) {
-  double cs = series(*c1, *c2);
+  double cs = pd_series(*c1, *c2);
   if (!(cs > 0.0) || !(dtmin > 0.0)) return;
   double tau = 2.0 * mMin / cs;
   if (tau >= dtmin) return;
@@ -362,7 +360,7 @@ static void check_surface_elements(pdContactParams* out, int body1, int body2, d
 // at m_pair), else the explicit values with the derived c/k for a side that gives none.
 static void dampers(double given1, double given2, double k1, double k2, double zeta, double massPair, double* c1,
                     double* c2, bool* modal, bool* proportional) {
-  double ratio = damping_over_stiffness(zeta, series(k1, k2), massPair);
+  double ratio = damping_over_stiffness(zeta, pd_series(k1, k2), massPair);
   derived_dampers(ratio, k1, k2, c1, c2);
   *modal = given1 < 0.0 && given2 < 0.0;
   if (given1 >= 0.0) *c1 = given1;

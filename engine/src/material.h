@@ -34,6 +34,9 @@
 #include "contact_force.h"
 #include "polydyn/vecmath.h"
 
+// Two springs (or dampers) in series: ab/(a + b); 0 when either is 0 (no element).
+static inline double pd_series(double a, double b) { return (a > 0.0 && b > 0.0) ? a * b / (a + b) : 0.0; }
+
 // ---------------------------------------------------------------- restitution (eqs. (12)–(15))
 
 // e⁻²: the smallest restitution reachable with k > 0 (ζ → 1 in eq. (15)).

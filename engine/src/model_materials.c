@@ -166,7 +166,7 @@ static void visit_pairs(struct pdMaterialTable* t) {
         list_adjustment(t, &items[r]);
       }
       if (!periods) continue;
-      double kn = p.k1n * p.k2n / (p.k1n + p.k2n), kt = p.k1t * p.k2t / (p.k1t + p.k2t);
+      double kn = pd_series(p.k1n, p.k2n), kt = pd_series(p.k1t, p.k2t);
       if (kn > 0.0) best = fmin(best, p.massMin / kn);
       if (p.mu > 0.0 && kt > 0.0) best = fmin(best, p.massMin / kt);
     }
@@ -339,16 +339,14 @@ int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int siz
   return len + extra;
 }
 
-static double series(double a, double b) { return (a > 0.0 && b > 0.0) ? a * b / (a + b) : 0.0; }
-
 pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b) {
   pdContactParams p = pd_model_contact_params(model, a, b);
-  double kn = series(p.k1n, p.k2n), kt = series(p.k1t, p.k2t);
+  double kn = pd_series(p.k1n, p.k2n), kt = pd_series(p.k1t, p.k2t);
   pdPairContact pair = {.mu = p.mu,
                         .kn = kn,
                         .kt = kt,
-                        .cn = series(p.c1n, p.c2n),
-                        .ct = series(p.c1t, p.c2t),
+                        .cn = pd_series(p.c1n, p.c2n),
+                        .ct = pd_series(p.c1t, p.c2t),
                         .restitution = sqrt(model->bodies[a].used.restitution * model->bodies[b].used.restitution),
                         .zetaN = p.zetaN,
                         .zetaT = p.zetaT,
