@@ -196,23 +196,57 @@ static bool edge_pair_geometry(const pdPolyhedron* sa, int ea, pdVec3 b0, pdVec3
   return true;
 }
 
-static int find_ee(const pdModel* m, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
+// Edge pruning before the Gauss-map test: an edge whose two ends lie outside one face plane of the other
+// body, by more than PRUNE_OUTSIDE_TOLS boundary tolerances, lies wholly outside that body, so its closest
+// point can never pass find_ee's inside test (which allows one tolerance): its pairs are skipped unseen.
+// The margin of one more tolerance (1e-12 × size) covers the rounding of the closest points (~1e-16 × size),
+// so pruning never changes a result. Masks hold the first 64 faces (a bit per face); vertices beyond
+// PRUNE_VERTICES_MAX are not pruned (correct, only slower).
+#define PRUNE_OUTSIDE_TOLS 2.0
+#define PRUNE_VERTICES_MAX 512
+typedef unsigned long long faceMask;
+
+// mask[i]: the faces (of the first 64) of `faces` whose plane vertex i (given in that body's frame by
+// rel·v + off) lies outside of by more than `margin`.
+static void outside_masks(const pdPolyhedron* vertices, const pdMat3* rel, pdVec3 off, const pdPolyhedron* faces,
+                          double margin, faceMask* mask) {
+  int faceCount = faces->faceCount < 64 ? faces->faceCount : 64;
+  for (int i = 0; i < vertices->vertexCount; ++i) {
+    pdVec3 q = pd_v3_add(off, pd_mat3_mulv(rel, vertices->vertices[i]));
+    faceMask m = 0;
+    for (int f = 0; f < faceCount; ++f)
+      if (face_depth(faces, f, q) < -margin) m |= 1ull << f;
+    mask[i] = m;
+  }
+}
+
+static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
                    int capacity, int n) {
-  const pdPolyhedron* sa = &m->bodies[ia].shape;
-  const pdPolyhedron* sb = &m->bodies[ib].shape;
+  const pdPolyhedron* sa = &model->bodies[ia].shape;
+  const pdPolyhedron* sb = &model->bodies[ib].shape;
   // B in A's frame: rotation R_aᵀ R_b, translation R_aᵀ (x_b − x_a)
   pdMat3 RaT = pd_mat3_transpose(&pa->R);
   pdMat3 rel = pd_mat3_mul(&RaT, &pb->R);
   pdVec3 off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
-  double tolA = BOUNDARY_TOL_REL * m->bodies[ia].size, tolB = BOUNDARY_TOL_REL * m->bodies[ib].size;
+  double tolA = BOUNDARY_TOL_REL * model->bodies[ia].size, tolB = BOUNDARY_TOL_REL * model->bodies[ib].size;
+  faceMask maskA[PRUNE_VERTICES_MAX], maskB[PRUNE_VERTICES_MAX];  // A's vertices against B's faces, and B's against A's
+  bool prune = sa->vertexCount <= PRUNE_VERTICES_MAX && sb->vertexCount <= PRUNE_VERTICES_MAX;
+  if (prune) {
+    // A in B's frame: rotation relᵀ, translation −relᵀ off
+    pdMat3 relT = pd_mat3_transpose(&rel);
+    outside_masks(sa, &relT, pd_v3_scale(pd_mat3_mulv(&relT, off), -1.0), sb, PRUNE_OUTSIDE_TOLS * tolB, maskA);
+    outside_masks(sb, &rel, off, sa, PRUNE_OUTSIDE_TOLS * tolA, maskB);
+  }
   for (int j = 0; j < sb->edgeCount; ++j) {
     const pdEdge* eb = &sb->edges[j];
+    if (prune && (maskB[eb->v[0]] & maskB[eb->v[1]])) continue;
     pdVec3 b0 = pd_v3_add(off, pd_mat3_mulv(&rel, sb->vertices[eb->v[0]]));
     pdVec3 b1 = pd_v3_add(off, pd_mat3_mulv(&rel, sb->vertices[eb->v[1]]));
     pdVec3 c = pd_v3_scale(pd_mat3_mulv(&rel, sb->faces[eb->f[0]].normal), -1.0);
     pdVec3 d = pd_v3_scale(pd_mat3_mulv(&rel, sb->faces[eb->f[1]].normal), -1.0);
     for (int i = 0; i < sa->edgeCount; ++i) {
       const pdEdge* ea = &sa->edges[i];
+      if (prune && (maskA[ea->v[0]] & maskA[ea->v[1]])) continue;
       arcMeeting meet = arcs_meet(sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal, c, d, ARC_TOUCH_TOL);
       if (meet == arcsApart) continue;
       edgeGeom g;
@@ -335,36 +369,47 @@ static bool edge_arcs_meet(const pdModel* model, const pdContactId* id, const pd
   return arcs_meet(a, b, c, d, EE_TRACK_ARC_SLACK) != arcsApart;
 }
 
-bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
-                      pdContactGeom* out) {
-  const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
-  const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
+void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                         pdContactGeom* out) {
   out->id = *id;
   if (id->kind == pd_contactVF) {
+    const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
+    const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
     // (18a) the vertex rides with body 1; (18b) the normal with body 2
     pdVec3 p = to_world(p1, s1->vertices[id->feat1]);
-    pdVec3 q = to_local(p2, p);
     out->point = p;
     out->normal = pd_mat3_mulv(&p2->R, s2->faces[id->feat2].normal);
-    out->depth = face_depth(s2, id->feat2, q);
+    out->depth = face_depth(s2, id->feat2, to_local(p2, p));
+    return;
+  }
+  // where the edge lines are closest; parallel lines have no closest points: normal 0 says so
+  if (!edge_contact(model, id, p1, p2, false, out)) {
+    out->point = p1->x;
+    out->normal = (pdVec3){0, 0, 0};
+    out->depth = 0.0;
+  }
+}
+
+bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                      pdContactGeom* out) {
+  if (id->kind == pd_contactVF) {
+    pd_contact_geometry(model, id, p1, p2, out);
+    const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
+    pdVec3 q = to_local(p2, out->point);
     // still over its face, and not outside the body across another face (it slid past an edge that is
     // not its face's: near a corner the face plane alone can read deep while the vertex is outside)
     double outside = TRACK_INSIDE_TOL_REL * model->settings.deflection * model->bodies[id->body2].size;
     return projects_inside(s2, id->feat2, q, BOUNDARY_TOL_REL * model->bodies[id->body2].size) &&
            inside_body(s2, q, outside);
   }
-  // an edge pair stays a contact while it spans a face of the Minkowski difference (its Gauss-map arcs
-  // still meet): past that, other features carry the contact and the lines' distance means nothing
-  if (edge_contact(model, id, p1, p2, true, out) && edge_arcs_meet(model, id, p1, p2) &&
-      edge_points_inside(model, id, p1, p2, out))
-    return true;
+  // an edge pair stays a contact while its closest points lie inside both edges and it spans a face of
+  // the Minkowski difference (its Gauss-map arcs still meet): past that, other features carry the contact
+  // and the lines' distance means nothing
+  if (edge_contact(model, id, p1, p2, true, out))
+    return edge_arcs_meet(model, id, p1, p2) && edge_points_inside(model, id, p1, p2, out);
   // broken: still report where the edge lines are closest (the caller may integrate on to the end of the
-  // step before it drops the contact); parallel lines have no closest points: normal 0 says so
-  if (!edge_contact(model, id, p1, p2, false, out)) {
-    out->point = p1->x;
-    out->normal = (pdVec3){0, 0, 0};
-    out->depth = 0.0;
-  }
+  // step before it drops the contact)
+  pd_contact_geometry(model, id, p1, p2, out);
   return false;
 }
 

@@ -59,6 +59,12 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
 bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                       pdContactGeom* out);
 
+// The geometry pd_contact_track fills, without deciding whether the contact still holds: what the
+// derivative needs inside a step (a contact is kept or dropped between steps only). Same numbers,
+// bit for bit, as pd_contact_track's `out`.
+void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                         pdContactGeom* out);
+
 // Onset of a contact found at the end of a step (App. C): the fraction δ ∈ [0, 1] of the step at
 // which the features first touched, given the poses of body 1 and body 2 at the start and the end
 // of the step. VF by the quadratic (24)–(25) with linearly interpolated vertex, face point and normal;

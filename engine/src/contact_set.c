@@ -288,8 +288,10 @@ static void poses_from(const pdModel* model, const double* y, pdPose* poses) {
 static void evaluate(const pdModel* model, const contactSlot* c, const double* y, const pdPose* poses,
                      const pdSprings* springs, pdContactGeom* geom, bool* tracked, pdVec3* du, pdContactForce* f) {
   int b1 = c->id.body1, b2 = c->id.body2;
-  bool ok = pd_contact_track(model, &c->id, &poses[b1], &poses[b2], geom);
-  if (tracked) *tracked = ok;
+  if (tracked)
+    *tracked = pd_contact_track(model, &c->id, &poses[b1], &poses[b2], geom);
+  else
+    pd_contact_geometry(model, &c->id, &poses[b1], &poses[b2], geom);
   if (geom->normal.x == 0.0 && geom->normal.y == 0.0 && geom->normal.z == 0.0) {
     // EE edges turned parallel inside a step: keep the last accepted geometry until the step's end drops it
     geom->normal = c->normal;

@@ -285,6 +285,48 @@ static void test_cube_turned_45_degrees_on_a_cube_gives_eight_edge_crossings(voi
   pd_model_free(m);
 }
 
+// The derivative uses pd_contact_geometry (no keep/break decision); it must give the numbers
+// pd_contact_track gives, bit for bit, for VF and EE contacts, tracked or broken, and for parallel edges.
+static void expect_same_geometry(const pdModel* m, const pdContactId* id, const pdPose* p1, const pdPose* p2) {
+  pdContactGeom tracked, geometry;
+  memset(&tracked, 0, sizeof tracked);
+  memset(&geometry, 0, sizeof geometry);
+  (void)pd_contact_track(m, id, p1, p2, &tracked);
+  pd_contact_geometry(m, id, p1, p2, &geometry);
+  assert_memory_equal(&tracked.point, &geometry.point, sizeof tracked.point);
+  assert_memory_equal(&tracked.normal, &geometry.normal, sizeof tracked.normal);
+  assert_memory_equal(&tracked.depth, &geometry.depth, sizeof tracked.depth);
+}
+
+static void test_contact_geometry_is_the_tracked_geometry(void** state) {
+  (void)state;
+  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  pdPose b = pose(0, 0, SIDE - DEPTH, 45, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 8);
+  // at the found poses, turned a little (still tracked), slid far (broken) and turned to parallel edges
+  const pdPose moved[] = {b, pose(0.001, 0.002, SIDE - DEPTH, 44, pd_v3(0.1, 0, 1)), pose(0.3, 0, SIDE, 45, pd_v3(0, 0, 1)),
+                          pose(0, 0, SIDE - DEPTH, 0, pd_v3(0, 0, 1))};
+  for (size_t k = 0; k < sizeof moved / sizeof moved[0]; ++k)
+    for (int i = 0; i < n; ++i) expect_same_geometry(m, &c[i].id, &a, &moved[k]);
+  pd_model_free(m);
+  m = compile(cubeOnFloor);
+  pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
+  pdPose box = pose(0, 0, SIDE / 2 - DEPTH, 10, pd_v3(1, 1, 0));
+  n = pd_contacts_find(m, 0, &floor, 1, &box, NULL, 0, c, CAPACITY);
+  assert_true(n > 0);
+  const pdPose boxes[] = {box, pose(0.7, 0, SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1))};  // the second: off the floor's face
+  for (size_t k = 0; k < 2; ++k)
+    for (int i = 0; i < n; ++i) {
+      const pdPose* p1 = c[i].id.body1 == 0 ? &floor : &boxes[k];
+      const pdPose* p2 = c[i].id.body1 == 0 ? &boxes[k] : &floor;
+      expect_same_geometry(m, &c[i].id, p1, p2);
+    }
+  pd_model_free(m);
+}
+
 static void test_small_capacity_reports_the_needed_count(void** state) {
   (void)state;
   pdModel* m = compile(cubeOnFloor);
@@ -307,6 +349,7 @@ int main(void) {
       cmocka_unit_test(test_ee_onset_interpolates_the_line_distance),
       cmocka_unit_test(test_vertex_on_vertex_and_parallel_edges_give_finite_contacts),
       cmocka_unit_test(test_cube_turned_45_degrees_on_a_cube_gives_eight_edge_crossings),
+      cmocka_unit_test(test_contact_geometry_is_the_tracked_geometry),
       cmocka_unit_test(test_small_capacity_reports_the_needed_count),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
