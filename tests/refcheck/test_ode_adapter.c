@@ -114,7 +114,12 @@ static char* settings(const pdRefWorld* w) {
   assert_non_null(f);
   ode()->settings_json(w, f);
   fclose(f);
-  return text;
+  // a copy: gcc -O3 takes pointers into the stream buffer for pointers into this frame (a false
+  // -Wdangling-pointer in the callers)
+  char* copy = strdup(text);
+  free(text);
+  assert_non_null(copy);
+  return copy;
 }
 
 static const char* variant_name(pdRefVariant v) { return v == pd_refMatched ? "matched" : "native"; }
@@ -138,10 +143,11 @@ static char* temp_dir(void) {
 }
 
 static void remove_run(const char* dir) {
-  char path[512];
+  char path[1100];
   const char* files[] = {"trajectory.csv", "contacts.csv", "summary.json"};
   for (int i = 0; i < 3; ++i) {
-    snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+    int n = snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+    assert_true(n > 0 && (size_t)n < sizeof path);
     unlink(path);
   }
   rmdir(dir);
