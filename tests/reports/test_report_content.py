@@ -269,8 +269,14 @@ class FixtureReport(unittest.TestCase):
             for b in s.get("bodies", []):
                 used = b["material"]["used"]
                 self.assertTrue(any(m["used"]["kn"] == used["kn"] and m["used"]["cn"] == used["cn"] for m in params[ev]["materials"]))
+            # every pair's constants as the run wrote them, listed with the run and the pair's bodies
+            for c in s.get("contact_pairs", []):
+                used = {k: v for k, v in c.items() if k != "bodies"}
+                row = [x for x in params[ev]["pairs"] if x["used"] == used]
+                self.assertEqual(len(row), 1, f"{run_dir}: {c['bodies']}")
+                self.assertTrue(any(b.endswith(": " + " / ".join(c["bodies"])) for b in row[0]["bodies"]))
         self.assertEqual(len(self.table("parameters")), sum(len(x["values"]) for p in self.json["parameters"] for x in p["settings"])
-                         + sum(len(p["materials"]) + len(p["adjustments"]) for p in self.json["parameters"]))
+                         + sum(len(p["materials"]) + len(p["pairs"]) + len(p["adjustments"]) for p in self.json["parameters"]))
 
 
 class CompareReport(unittest.TestCase):

@@ -240,12 +240,13 @@ export function flatten(obj, prefix = '', out = []) {
 
 // Parameters every engine-variant actually used, deduplicated over its runs. For each run with a
 // summary: the reference engines' engine_settings, or polydyn's settings, stepper, materials as used
-// (one row per distinct material, with the bodies that had it) and adjustments. Each distinct value
-// lists the runs that used it.
+// (one row per distinct material, with the bodies that had it), the contact constants of each pair of
+// materials (contact_pairs: springs, dampers, time scales; one row per distinct pair) and adjustments.
+// Each distinct value lists the runs that used it.
 export function parameters(runs) {
   const byEv = new Map();
   for (const run of runs) {
-    if (!byEv.has(run.ev)) byEv.set(run.ev, { ev: run.ev, runs: [], missing: [], settings: new Map(), materials: new Map(), adjustments: new Map() });
+    if (!byEv.has(run.ev)) byEv.set(run.ev, { ev: run.ev, runs: [], missing: [], settings: new Map(), materials: new Map(), pairs: new Map(), adjustments: new Map() });
     const p = byEv.get(run.ev);
     if (!run.summary) { p.missing.push(run.label); continue; }
     p.runs.push(run.label);
@@ -271,6 +272,13 @@ export function parameters(runs) {
         if (!p.materials.has(key)) p.materials.set(key, { used: m, requested: Object.fromEntries(req), bodies: [] });
         p.materials.get(key).bodies.push(`${run.label}: ${b.name}`);
       }
+      for (const c of Array.isArray(s.contact_pairs) ? s.contact_pairs : []) {
+        if (!c || typeof c !== 'object') continue;
+        const { bodies, ...used } = c;
+        const key = JSON.stringify(used);
+        if (!p.pairs.has(key)) p.pairs.set(key, { used, bodies: [] });
+        p.pairs.get(key).bodies.push(`${run.label}: ${Array.isArray(bodies) ? bodies.join(' / ') : '?'}`);
+      }
       for (const a of Array.isArray(s.adjustments) ? s.adjustments : []) add(p.adjustments, String(a), '', run.label);
     }
   }
@@ -280,6 +288,7 @@ export function parameters(runs) {
     missing: p.missing,
     settings: [...p.settings.entries()].map(([key, vs]) => ({ key, values: [...vs.entries()].map(([value, used_by]) => ({ value, used_by })) })),
     materials: [...p.materials.values()],
+    pairs: [...p.pairs.values()],
     adjustments: [...p.adjustments.entries()].map(([text, vs]) => ({ text, used_by: [...vs.values()][0] })),
   }));
 }

@@ -11,8 +11,10 @@ export default {
     const runs = ctx.runs;
     if (!runs || !runs.length) return null;
     const params = parameters(runs).sort((a, b) => ctx.evOrder.indexOf(a.ev) - ctx.evOrder.indexOf(b.ev));
-    let html = '<p>As the runs wrote them (<code>engine_settings</code> of the reference engines; settings, materials as used and ' +
-      'adjustments of polydyn). A value used by only some runs lists them.</p>';
+    let html = '<p>As the runs wrote them (<code>engine_settings</code> of the reference engines; settings, materials as used, ' +
+      'the contact constants of each pair of materials and adjustments of polydyn). A value used by only some runs lists them. ' +
+      'Springs and dampers belong to a pair of bodies (README, contact model): a material’s k and c are shown only where the ' +
+      'scene set them (— otherwise); a modal damper’s c is the one of a single contact at the pair’s reduced mass.</p>';
     const csv = [];
     for (const p of params) {
       const all = p.runs.length;
@@ -31,6 +33,14 @@ export default {
           p.materials.map((m) => [...['mu', 'kn', 'kt', 'cn', 'ct', 'restitution', 'zeta'].map((k) => ({ html: num(m.used[k], 4), cls: 'n', title: String(m.used[k] ?? '') })),
             esc(Object.entries(m.requested).map(([k, v]) => `${k} ${v}`).join(', ') || '—'), shortList(m.bodies, 4)]), 'params');
         for (const m of p.materials) csv.push([...p.ev.split(' '), 'material', JSON.stringify(m.requested), JSON.stringify(m.used), m.bodies.join(' ')]);
+      }
+      if (p.pairs.length) {
+        const keys = ['mu', 'restitution', 'zeta_n', 'zeta_t', 'kn', 'kt', 'cn', 'ct', 'm_pair', 'period', 'delta_max'];
+        html += table(['pair μ', 'e', 'ζ_n', 'ζ_t', 'k_n (N/m)', 'k_t (N/m)', 'c_n (N·s/m)', 'c_t (N·s/m)', 'm_pair (kg)', 'period (s)', 'δ_max (m)',
+          'dampers', 'bodies'],
+          p.pairs.map((c) => [...keys.map((k) => ({ html: num(c.used[k], 4), cls: 'n', title: String(c.used[k] ?? '') })),
+            esc(c.used.damping ? `n ${c.used.damping.n}, t ${c.used.damping.t}` : '—'), shortList(c.bodies, 4)]), 'params');
+        for (const c of p.pairs) csv.push([...p.ev.split(' '), 'pair', c.bodies.join(' '), JSON.stringify(c.used), '']);
       }
       if (p.adjustments.length) {
         html += '<p>Adjustments (§3.3):</p><ul class="adjust">' +
