@@ -209,27 +209,19 @@ int pd_adjustment_describe(const pdAdjustment* a, const char* bodyName, const ch
   }
   const char* unit = (a->param == pd_paramKn || a->param == pd_paramKt) ? "N/m" : "N·s/m";
   const char* name = pd_material_param_name(a->param);
+  // the paper's section, the time scale that fell below dt_min, and what the change means when it is not obvious
+  const char *section = NULL, *scale = NULL, *consequence = "";
   switch (a->rule) {
-    case pd_adjustPairStiffness:
-      return snprintf(buf, (size_t)size,
-                      "%s: %s %.6g -> %.6g %s in contacts with %s (§3.3.1: 1/ω = √(m_min/k_s) = %.3g s < dt_min = "
-                      "%.3g s)",
-                      bodyName, name, a->from, a->to, unit, partnerName, a->tau, a->dtmin);
-    case pd_adjustPairDecay:
-      return snprintf(buf, (size_t)size,
-                      "%s: %s %.6g -> %.6g %s in contacts with %s (§3.3.1: τ = 2 m_min/c_s = %.3g s < dt_min = %.3g s)",
-                      bodyName, name, a->from, a->to, unit, partnerName, a->tau, a->dtmin);
+    case pd_adjustPairStiffness: section = "§3.3.1", scale = "1/ω = √(m_min/k_s)"; break;
+    case pd_adjustPairDecay: section = "§3.3.1", scale = "τ = 2 m_min/c_s"; break;
     case pd_adjustContactNormal:
-      return snprintf(buf, (size_t)size,
-                      "%s: %s %.6g -> %.6g %s in contacts with %s (§3.3.2: τ = (c1n+c2n)/(k1n+k2n) = %.3g s < "
-                      "dt_min = %.3g s: normal dampers off, the impact becomes elastic)",
-                      bodyName, name, a->from, a->to, unit, partnerName, a->tau, a->dtmin);
-    case pd_adjustContactTangential:
-      return snprintf(buf, (size_t)size,
-                      "%s: %s %.6g -> %.6g %s in contacts with %s (§3.3.2: τ = (c1t+c2t)/(k1t+k2t) = %.3g s < "
-                      "dt_min = %.3g s)",
-                      bodyName, name, a->from, a->to, unit, partnerName, a->tau, a->dtmin);
+      section = "§3.3.2", scale = "τ = (c1n+c2n)/(k1n+k2n)", consequence = ": normal dampers off, the impact becomes elastic";
+      break;
+    case pd_adjustContactTangential: section = "§3.3.2", scale = "τ = (c1t+c2t)/(k1t+k2t)"; break;
   }
+  if (section)
+    return snprintf(buf, (size_t)size, "%s: %s %.6g -> %.6g %s in contacts with %s (%s: %s = %.3g s < dt_min = %.3g s%s)",
+                    bodyName, name, a->from, a->to, unit, partnerName, section, scale, a->tau, a->dtmin, consequence);
   return snprintf(buf, (size_t)size, "%s: %s %.6g -> %.6g", bodyName, name, a->from, a->to);
 }
 

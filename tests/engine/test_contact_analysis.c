@@ -97,13 +97,21 @@ static void test_separated_or_just_touching_bodies_have_no_contact(void** state)
   pd_model_free(m);
 }
 
+// Two equal cubes, b resting DEPTH deep on a's top face, turned by turnDeg about the vertical: their
+// contacts into c, the count returned.
+static const char* const twoCubes = "cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n";
+static int cube_on_cube(const pdModel* m, double turnDeg, pdPose* a, pdPose* b, pdContactGeom* c) {
+  *a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  *b = pose(0, 0, SIDE - DEPTH, turnDeg, pd_v3(0, 0, 1));
+  return pd_contacts_find(m, 0, a, 1, b, NULL, 0, c, CAPACITY);
+}
+
 static void test_equal_cubes_face_on_face_count_each_corner_once(void** state) {
   (void)state;
-  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
-  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
-  pdPose b = pose(0, 0, SIDE - DEPTH, 0, pd_v3(0, 0, 1));
+  pdModel* m = compile(twoCubes);
+  pdPose a, b;
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  int n = cube_on_cube(m, 0, &a, &b, c);
   // each corner is a vertex of both cubes: four physical touches, not eight; edges are parallel
   assert_int_equal(n, 4);
   for (int i = 0; i < n; ++i) {
@@ -119,7 +127,7 @@ static void test_equal_cubes_face_on_face_count_each_corner_once(void** state) {
 // bottom edge along y. Crossed, they touch at one point: one EE contact.
 static void test_crossed_edges_give_one_ee_contact_with_the_crossing_depth(void** state) {
   (void)state;
-  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  pdModel* m = compile(twoCubes);
   double h = SIDE / sqrt(2.0);
   pdPose a = pose(0, 0, 0, 45, pd_v3(1, 0, 0));
   pdPose b = pose(0, 0, 2 * h - DEPTH, 45, pd_v3(0, 1, 0));
@@ -222,7 +230,7 @@ static void test_vf_onset_with_a_turning_face_solves_the_quadratic(void** state)
 
 static void test_ee_onset_interpolates_the_line_distance(void** state) {
   (void)state;
-  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  pdModel* m = compile(twoCubes);
   double h = SIDE / sqrt(2.0), gap = 2e-4;
   pdPose a = pose(0, 0, 0, 45, pd_v3(1, 0, 0));
   pdPose bStart = pose(0, 0, 2 * h + gap, 45, pd_v3(0, 1, 0));
@@ -236,7 +244,7 @@ static void test_ee_onset_interpolates_the_line_distance(void** state) {
 
 static void test_vertex_on_vertex_and_parallel_edges_give_finite_contacts(void** state) {
   (void)state;
-  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
+  pdModel* m = compile(twoCubes);
   // b balanced on a corner over a's top corner: b's body diagonal vertical
   pdQuat tilt = pd_quat_mul(pd_quat_from_axis_angle(pd_v3(1, -1, 0), acos(1.0 / sqrt(3.0))), pd_quat_identity());
   pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
@@ -262,11 +270,10 @@ static void test_vertex_on_vertex_and_parallel_edges_give_finite_contacts(void**
 // are parallel), yet each crossing is a contact with the faces' overlap as depth and the vertical normal.
 static void test_cube_turned_45_degrees_on_a_cube_gives_eight_edge_crossings(void** state) {
   (void)state;
-  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
-  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
-  pdPose b = pose(0, 0, SIDE - DEPTH, 45, pd_v3(0, 0, 1));
+  pdModel* m = compile(twoCubes);
+  pdPose a, b;
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  int n = cube_on_cube(m, 45, &a, &b, c);
   assert_int_equal(n, 8);
   double half = SIDE / 2, offset = half * (sqrt(2.0) - 1.0);  // octagon corner: (±half, ±half(√2 − 1))
   for (int i = 0; i < n; ++i) {
@@ -300,11 +307,10 @@ static void expect_same_geometry(const pdModel* m, const pdContactId* id, const 
 
 static void test_contact_geometry_is_the_tracked_geometry(void** state) {
   (void)state;
-  pdModel* m = compile("cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1 0.1\n");
-  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
-  pdPose b = pose(0, 0, SIDE - DEPTH, 45, pd_v3(0, 0, 1));
+  pdModel* m = compile(twoCubes);
+  pdPose a, b;
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  int n = cube_on_cube(m, 45, &a, &b, c);
   assert_int_equal(n, 8);
   // at the found poses, turned a little (still tracked), slid far (broken) and turned to parallel edges
   const pdPose moved[] = {b, pose(0.001, 0.002, SIDE - DEPTH, 44, pd_v3(0.1, 0, 1)), pose(0.3, 0, SIDE, 45, pd_v3(0, 0, 1)),
