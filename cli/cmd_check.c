@@ -14,7 +14,7 @@ static const char* const help =
     "body the material as requested and as used (mu, kn, kt, cn, ct), the mass that sized it, the\n"
     "minimum effective mass and the time constants; then the number of material classes and every\n"
     "time-constant adjustment made to fit dtmin (or \"adjustments: none\").\n"
-    "Refuses (exit 2) what `polydyn run` refuses, including a restitution below e^-2 and bodies that\n"
+    "Refuses (exit 2) what `polydyn run` refuses, including a restitution below 0.01 and bodies that\n"
     "overlap at t = 0. Exit status: 0 ok, 2 bad input.\n";
 
 // -0 prints as "-0"; adding +0 makes it 0, which is what a reader expects to see

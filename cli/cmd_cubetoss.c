@@ -48,7 +48,7 @@ static const char* const help =
     "\n"
     "  --engines LIST   soft, ode, bullet (default: all three; one without an adapter is reported, skipped)\n"
     "  --tosses LIST    all (default), train, test, or toss ids and ranges: 1-20,35\n"
-    "  --params [ENGINE=]FILE  mu/restitution/kn lines over the defaults (mu 0.18, restitution 0.1354,\n"
+    "  --params [ENGINE=]FILE  mu/restitution/kn lines over the defaults (mu 0.18, restitution 0.125,\n"
     "                   kn 2.1e6 N/m on the cube and the board), for ENGINE or every engine; repeatable\n"
     "  --label WORD     the params column of the CSVs (default: default, or params with --params)\n"
     "  --variant V      of ode and bullet: native (default: their own contact) or matched (our k, c)\n"

@@ -205,8 +205,8 @@ const pdGkExperiment pd_gk_d2_slide_to_roll = {
 
 // ---------------------------------------------------------------------------------------------------------
 // D3: a cube pivoting over its bottom edge at 10 rad/s goes over, lands on its next face and settles. The
-// rigid, perfectly plastic, no-slip edge impact gives ω⁺ = ω⁻/4; a soft contact cannot be plastic
-// (e >= e⁻², catalogue A1), and how much the landing edge bounces depends on its effective mass and on the
+// rigid, perfectly plastic, no-slip edge impact gives ω⁺ = ω⁻/4; a soft contact is never perfectly plastic
+// (e >= 0.01), and how much the landing edge bounces depends on its effective mass and on the
 // old edge still touching during the landing. So the check is qualitative: it goes over, the
 // landing takes most of the spin (ω⁺/ω⁻ < 1/2), and the cube settles (drift < 1e-9 m/s over the last
 // second, energy never rises by more than 1e-6 E0). The measured ratio is reported.
@@ -279,7 +279,7 @@ const pdGkExperiment pd_gk_d3_tumbling_cube = {
     .quantity = "omega_ratio",
     .unit = "",
     .formula = "qualitative: goes over the edge, w+/w- < 1/2, settles (drift < 1e-9 m/s, energy gain <= 1e-6 E0); "
-               "rigid plastic theory gives w+/w- = 1/4 (catalogue D3), unreachable with e >= e^-2",
+               "rigid plastic theory gives w+/w- = 1/4 (catalogue D3), never reached by a soft contact (e > 0)",
     .toleranceReason = "catalogue G1/C6 bounds for the settled state; the ratio has no soft-contact closed form",
     .seriesLabel = "spin of the cube about y, rad/s",
     .qualitative = true,

@@ -35,7 +35,7 @@ static double cpu_now(void) {
 
 pdTossParams pd_toss_default_params(void) {
   return (pdTossParams){.mu = TOSS_DEFAULT_MU,
-                        .restitution = PD_TOSS_RESTITUTION_MIN,
+                        .restitution = PD_TOSS_DEFAULT_RESTITUTION,
                         .kn = TOSS_DEFAULT_KN,
                         .tol = TOSS_DEFAULT_TOL,
                         .inertia = PD_TOSS_CUBE_INERTIA};
@@ -448,9 +448,9 @@ bool pd_toss_params_read(const char* path, pdTossParams* params, pdError* err) {
   }
   const pdSceneObject* o = &scene->objects[0];
   bool ok = true;
-  if (keyLine[1] && o->restitution < 0.1353352832366127) {  // e⁻², engine/src/material.h
-    pd_error_set(err, path, keyLine[1], keyCol[1], "restitution %.10g is below e^-2 = 0.1353352832, the model's limit",
-                 o->restitution);
+  if (keyLine[1] && o->restitution < PD_TOSS_RESTITUTION_MIN) {
+    pd_error_set(err, path, keyLine[1], keyCol[1], "restitution %.10g is below %g, the contact model's smallest",
+                 o->restitution, PD_TOSS_RESTITUTION_MIN);
     ok = false;
   } else if (!keyLine[0] && !keyLine[1] && !keyLine[2]) {
     pd_error_set(err, path, 0, 0, "sets none of mu, restitution, kn");

@@ -17,25 +17,33 @@
 
 #define PI 3.14159265358979323846
 
-// Brent's bracket on ζ ∈ [0, 1] shrinks to this width (absolute, ζ is dimensionless and O(1)). The
+// Brent's bracket on ζ shrinks to this width (absolute, ζ is dimensionless and O(1)–O(10)). The
 // catalogue's inverse table is given to 1e-4 and a restitution error of 1e-12 is far below anything a
 // simulation can measure; 1e-13 leaves Brent well clear of roundoff (ζ is known to ~1e-16).
 #define PD_ZETA_TOL_ABS 1e-13
-// Brent converges superlinearly: ~40 iterations reach 1e-13 from [0, 1] even at bisection speed.
+// Brent converges superlinearly: ~50 iterations reach 1e-13 from [1, 50] even at bisection speed.
 #define PD_ZETA_MAX_ITER 200
 
 // ---------------------------------------------------------------- restitution
 
-// h(ζ) = 2ζ arccos ζ/√(1 − ζ²) = −ln e: eq. (15) with atan(√(1−ζ²)/ζ) = arccos ζ for ζ ∈ (0, 1] and
-// ln(E_r) = 2 ln e. Written with θ = arccos ζ as 2ζ θ/sin θ, which stays accurate as ζ → 1 (θ → 0,
-// θ/sin θ → 1, h → 2: e → e⁻²).
+// h(ζ) = −ln e of a Kelvin–Voigt contact that ends when its force reaches zero (eq. (15), with
+// atan(√(1−ζ²)/ζ) = arccos ζ and ln(E_r) = 2 ln e):
+//   underdamped ζ < 1: h = 2ζ arccos ζ/√(1 − ζ²), written with θ = arccos ζ as 2ζ θ/sin θ;
+//   overdamped  ζ > 1: the same function continued, h = 2ζ arccosh ζ/√(ζ² − 1) = 2ζ θ/sinh θ, θ = arccosh ζ.
+// Both forms stay accurate as ζ → 1 (θ → 0, θ/sin θ and θ/sinh θ → 1, h → 2: e → e⁻²). h grows without
+// bound (h > 2 arccosh ζ), so every e in (0, 1] has one ζ: an overdamped contact still ends when its
+// force vanishes, with the slow mode's small exit speed (e → 1/(4ζ²) for large ζ).
 static double neg_log_restitution(double zeta) {
+  if (zeta > 1.0) {
+    double theta = acosh(zeta);
+    return 2.0 * zeta * theta / sinh(theta);
+  }
   double theta = acos(zeta);
   return theta > 0.0 ? 2.0 * zeta * theta / sin(theta) : 2.0 * zeta;
 }
 
 double pd_restitution_from_damping_ratio(double zeta) {
-  PD_ASSERT(zeta >= 0.0 && zeta <= 1.0);
+  PD_ASSERT(zeta >= 0.0 && isfinite(zeta));
   return exp(-neg_log_restitution(zeta));
 }
 
@@ -45,16 +53,17 @@ static double zeta_residual(double zeta, void* params) {
 }
 
 bool pd_damping_ratio_from_restitution(double e, double* zeta, char* why, int whySize) {
-  const double eMin = exp(-2.0);
   if (!(e >= 0.0 && e <= 1.0)) {
     pd_why(why, whySize, "restitution %g is outside [0, 1]", e);
     return false;
   }
-  if (e < eMin) {
+  if (e < PD_RESTITUTION_MIN) {
     pd_why(why, whySize,
-           "restitution %g is unreachable: with a spring (k > 0) the contact model's smallest restitution is "
-           "e^-2 = %.4f (critical damping, paper eq. 15)",
-           e, eMin);
+           "restitution %g is below %g, the smallest the contact model takes: a spring-damper contact always "
+           "returns some energy (e = 0 needs an infinite damper), and below %g the damper (damping ratio above "
+           "%.2f) makes the contact's fast mode, and so the integration step, about %.0fx shorter than the "
+           "spring alone needs",
+           e, PD_RESTITUTION_MIN, PD_RESTITUTION_MIN, PD_DAMPING_RATIO_MAX, 2.0 * PD_DAMPING_RATIO_MAX);
     return false;
   }
   if (e == 1.0) {
@@ -62,11 +71,17 @@ bool pd_damping_ratio_from_restitution(double e, double* zeta, char* why, int wh
     return true;
   }
   double logE = log(e);
-  if (neg_log_restitution(1.0) + logE <= 0.0) {  // e == e⁻² to roundoff: critical damping
+  if (zeta_residual(1.0, &logE) == 0.0) {  // e == e⁻² to roundoff: critical damping
     *zeta = 1.0;
     return true;
   }
-  // h is increasing from h(0) = 0 to h(1) = 2, so [0, 1] brackets the root for e ∈ (e⁻², 1).
+  // h is increasing, h(0) = 0, h(1) = 2 and h(ζ) > 2 arccosh ζ: [0, 1] brackets the root for e > e⁻² and
+  // [1, cosh(−ln e / 2)] for e < e⁻².
+  double lo = 0.0, hi = 1.0;
+  if (zeta_residual(1.0, &logE) < 0.0) {
+    lo = 1.0;
+    hi = cosh(-0.5 * logE);
+  }
   gsl_function f = {.function = zeta_residual, .params = &logE};
   gsl_root_fsolver* solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
   if (!solver) {
@@ -74,7 +89,7 @@ bool pd_damping_ratio_from_restitution(double e, double* zeta, char* why, int wh
     return false;
   }
   gsl_error_handler_t* previous = gsl_set_error_handler_off();
-  int status = gsl_root_fsolver_set(solver, &f, 0.0, 1.0);
+  int status = gsl_root_fsolver_set(solver, &f, lo, hi);
   for (int iter = 0; status == GSL_SUCCESS && iter < PD_ZETA_MAX_ITER; ++iter) {
     status = gsl_root_fsolver_iterate(solver);
     if (status != GSL_SUCCESS) break;
@@ -270,7 +285,7 @@ static double reduced_mass(double m1, double m2) {
 
 bool pd_pair_damping_ratio(const pdMaterialSide* s1, const pdMaterialSide* s2, double* e, double* zeta) {
   *e = sqrt(s1->restitution * s2->restitution);
-  // both factors are >= e⁻², so is their geometric mean (up to the last bit: clamp)
+  // both factors are >= PD_RESTITUTION_MIN, so is their geometric mean (up to the last bit: clamp)
   char why[PD_ERROR_MESSAGE_MAX];
   return pd_damping_ratio_from_restitution(fmax(*e, PD_RESTITUTION_MIN), zeta, why, sizeof why);
 }

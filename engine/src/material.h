@@ -32,6 +32,7 @@
 #include <stdbool.h>
 
 #include "contact_force.h"
+#include "polydyn/model.h"
 #include "polydyn/vecmath.h"
 
 // Two springs (or dampers) in series: ab/(a + b); 0 when either is 0 (no element).
@@ -39,14 +40,17 @@ static inline double pd_series(double a, double b) { return (a > 0.0 && b > 0.0)
 
 // ---------------------------------------------------------------- restitution (eqs. (12)–(15))
 
-// e⁻²: the smallest restitution reachable with k > 0 (ζ → 1 in eq. (15)).
-#define PD_RESTITUTION_MIN 0.1353352832366127
+// PD_RESTITUTION_MIN (polydyn/model.h) is reached at ζ = 4.807: the contact's fast mode,
+// ω(ζ + √(ζ² − 1)) ≈ 2ζω, then bounds the step about ten times below what the spring alone needs
+// (contact_set.c, the stability bound).
+#define PD_DAMPING_RATIO_MAX 4.807  // ζ at PD_RESTITUTION_MIN; for the refusal message
 
-// ζ for a requested restitution e ∈ [e⁻², 1]. Returns false and fills `why` for e outside that range
-// (including e < e⁻², "unreachable with k > 0") or when the root finder fails.
+// ζ for a requested restitution e ∈ [PD_RESTITUTION_MIN, 1]: in [0, 1) for e > e⁻², above 1 (overdamped)
+// below it. Returns false and fills `why` for e outside that range or when the root finder fails.
 bool pd_damping_ratio_from_restitution(double e, double* zeta, char* why, int whySize);
 
-// The forward map of eq. (15): e = exp(−2ζ arccos ζ/√(1−ζ²)) for ζ ∈ [0, 1] (e⁻² at ζ = 1).
+// The forward map of eq. (15): e = exp(−2ζ arccos ζ/√(1−ζ²)) for ζ ∈ [0, 1] (e⁻² at ζ = 1), continued
+// for ζ > 1 as exp(−2ζ arccosh ζ/√(ζ²−1)) (overdamped; the contact ends when its force reaches zero).
 double pd_restitution_from_damping_ratio(double zeta);
 
 // The restitution a body without `restitution` has: a hard, moderately lossy material (wood, plastic,
@@ -124,7 +128,7 @@ typedef struct pdMaterialRequest {
   double mu;
   double kn, kt;        // N/m, > 0 when set
   double cn, ct;        // N·s/m, >= 0 when set
-  double restitution;   // in [e⁻², 1] when set
+  double restitution;   // in [PD_RESTITUTION_MIN, 1] when set
   unsigned setMask;
 } pdMaterialRequest;
 
@@ -147,7 +151,7 @@ typedef struct pdMaterialSide {
   double size;         // m
 } pdMaterialSide;
 
-// One body's side. Returns false and fills `why` for an unreachable restitution (below e⁻²) or invalid
+// One body's side. Returns false and fills `why` for an unreachable restitution (below PD_RESTITUTION_MIN) or invalid
 // inputs.
 bool pd_material_side(const pdMaterialBody* body, const pdMaterialRequest* req, pdMaterialSide* out, char* why,
                       int whySize);

@@ -175,17 +175,17 @@ static void visit_pairs(struct pdMaterialTable* t) {
 
 // ---------------------------------------------------------------- compile
 
-// Below e⁻² no positive stiffness reproduces the restitution (ζ → 1 in eq. (15)): the scene is refused,
-// not silently clamped. The parser accepts [0, 1]; this is the contact model's own limit.
+// A restitution below PD_RESTITUTION_MIN is refused at the object's line (material.h says why), not
+// silently clamped. The parser accepts [0, 1]; this is the contact model's own limit.
 static bool check_restitutions(const pdScene* scene, pdError* err) {
   for (int i = 0; i < scene->objectCount; ++i) {
     const pdSceneObject* o = &scene->objects[i];
     if ((o->setMask & PD_SET_RESTITUTION) && o->restitution < PD_RESTITUTION_MIN) {
       // scene.h keeps no per-property location: the object's line it is
       pd_error_set(err, scene->path, o->where.line, o->where.col,
-                   "object '%s': restitution %.10g is below e^-2 = %.10g, the smallest the contact model can "
-                   "reach (paper §3.2.2, eq. 15: critical damping)",
-                   o->name, o->restitution, PD_RESTITUTION_MIN);
+                   "object '%s': restitution %.10g is below %g, the smallest the contact model takes (e = 0 "
+                   "needs an infinite damper; below %g the overdamped contact forces steps ~10x shorter)",
+                   o->name, o->restitution, PD_RESTITUTION_MIN, PD_RESTITUTION_MIN);
       return false;
     }
   }
@@ -361,7 +361,7 @@ pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b) {
   if (!p.modalN) {
     // explicit dampers: what eq. (15) predicts for one contact carrying the pair's reduced mass
     double zeta = kn > 0.0 ? pair.cn / (2.0 * sqrt(kn * p.massPair)) : 0.0;
-    pair.restitution = zeta >= 1.0 ? 0.0 : pd_restitution_from_damping_ratio(zeta);
+    pair.restitution = pd_restitution_from_damping_ratio(zeta);
     pair.zetaN = zeta;
     pair.restitutionSource = "predicted by eq. (15) from the explicit dampers";
   }

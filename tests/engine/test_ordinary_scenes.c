@@ -1,7 +1,7 @@
 // Scenes as a newcomer writes them (issue 13): a 0.1 m cube on fixed floors and ramps of other sizes,
 // only mu and perhaps restitution set, every other constant left to the defaults (vmax estimated, pair
 // stiffness, modal dampers, critically damped tangential springs). Each test checks a closed form:
-// - restitution of face-, edge- and vertex-first impacts on floors 1×, 10× and 100× the cube's size and of
+// - restitution (0.1 … 0.95) of face-, edge- and vertex-first impacts on floors 1×, 10× and 100× the cube's size and of
 //   two free cubes of different sizes and materials: within 0.01 of the requested e (the pair's √(e₁e₂));
 // - a block below its friction angle on a ramp sticks (speed < 1e-6 m/s after 0.5 s);
 // - a block launched on a floor stops after v²/(2μg) (1 %), at rest within 0.05 s of v/(μg);
@@ -84,7 +84,7 @@ static double cube_on_floor_restitution(landing how, double scale, double e, dou
 
 static void test_cube_on_floors_of_any_size_bounces_with_the_requested_e(void** state) {
   (void)state;
-  const double es[] = {0.3, 0.5, 0.8, 0.95}, scales[] = {1, 10, 100}, mus[] = {0, 0.5};
+  const double es[] = {0.1, 0.3, 0.5, 0.8, 0.95}, scales[] = {1, 10, 100}, mus[] = {0, 0.5};
   double worst = 0.0;
   for (int h = 0; h < 3; ++h)
     for (size_t s = 0; s < sizeof scales / sizeof *scales; ++s)
@@ -96,7 +96,7 @@ static void test_cube_on_floors_of_any_size_bounces_with_the_requested_e(void** 
             fail_msg("%s first on a floor %g× the cube, mu %g: e = %.5f, requested %g", LANDING_NAMES[h], scales[s],
                      mus[f], e, es[i]);
         }
-  print_message("72 landings (face, edge, vertex; floors 1×, 10×, 100×; e 0.3 … 0.95; mu 0, 0.5): worst |e − e_req| "
+  print_message("90 landings (face, edge, vertex; floors 1×, 10×, 100×; e 0.1 … 0.95; mu 0, 0.5): worst |e − e_req| "
                 "%.2e\n",
                 worst);
 }
@@ -132,19 +132,36 @@ static void test_two_free_cubes_collide_with_the_pairs_e(void** state) {
   }
 }
 
-// e below e⁻² = 0.135 cannot be reached by a spring-damper with k > 0: the scene is refused (exit 2 from
-// the CLI), never silently clamped. The issue's e = 0.1 is therefore a refusal, not a bounce.
-static void test_restitution_below_e_minus_2_is_refused(void** state) {
+// e = 0.1 is below e⁻² = 0.135: the normal damper is overdamped (ζ = 1.245), and two free cubes of
+// different sizes reach it too. Below PD_RESTITUTION_MIN (0.01) the scene is refused at the object's line
+// (exit 2 from the CLI), never silently clamped.
+static void test_overdamped_restitution_and_the_smallest_e(void** state) {
   (void)state;
-  const char* text = "cube floor grey 1 1 1\nfixed\nloc 0 0 -0.5\nrestitution 0.1\ncube block red 0.1 0.1 0.1\n"
-                     "loc 0 0 0.1\nrestitution 0.1\n";
+  char text[1024];
+  snprintf(text, sizeof text,
+           "gravity 0 0 0\ntend 0.3\n"
+           "cube a red 0.1 0.1 0.1\nloc -0.2 0 0\nvel 1 0 0\nrestitution 0.1\n"
+           "cube b blue 0.2 0.2 0.2\nspgrav 0.5\nloc 0 0 0  30 1 0 0\nrestitution 0.1\n");
+  pdModel* m = compile_text(text);
+  record* r = run(m, NULL);
+  int k = r->count - 1;
+  double e = r->body[1][k].v.x - r->body[0][k].v.x;
+  print_message("cubes 0.1 m (1 kg) and 0.2 m (4 kg), e 0.1 on both: e = %.5f\n", e);
+  assert_int_equal(r->contacts[k], 0);
+  assert_true(fabs(e - 0.1) <= RESTITUTION_TOL);
+  free(r);
+  pd_model_free(m);
+
+  const char* refused = "cube floor grey 1 1 1\nfixed\nloc 0 0 -0.5\nrestitution 0.005\ncube block red 0.1 0.1 0.1\n"
+                        "loc 0 0 0.1\nrestitution 0.5\n";
   pdError err = {0};
-  pdScene* scene = pd_scene_parse_buffer("e.scene", text, strlen(text), &err);
+  pdScene* scene = pd_scene_parse_buffer("e.scene", refused, strlen(refused), &err);
   assert_non_null(scene);
-  pdModel* m = pd_model_compile(scene, &err);
+  m = pd_model_compile(scene, &err);
   pd_scene_free(scene);
   assert_null(m);
-  assert_non_null(strstr(err.message, "below e^-2"));
+  assert_int_equal(err.line, 1);
+  assert_non_null(strstr(err.message, "restitution 0.005 is below 0.01"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -242,7 +259,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_cube_on_floors_of_any_size_bounces_with_the_requested_e),
       cmocka_unit_test(test_two_free_cubes_collide_with_the_pairs_e),
-      cmocka_unit_test(test_restitution_below_e_minus_2_is_refused),
+      cmocka_unit_test(test_overdamped_restitution_and_the_smallest_e),
       cmocka_unit_test(test_block_below_its_friction_angle_sticks),
       cmocka_unit_test(test_block_on_a_floor_slides_to_rest_where_coulomb_says),
       cmocka_unit_test(test_block_slides_down_a_ramp_at_the_coulomb_rate_on_its_line),

@@ -357,7 +357,7 @@ static void test_parameter_fragment_round_trips_and_refuses_other_lines(void** s
   write_file(path, "# only friction\n  mu 0.3\n");
   q = pd_toss_default_params();
   assert_true(pd_toss_params_read(path, &q, &err));
-  assert_true(q.mu == 0.3 && q.restitution == PD_TOSS_RESTITUTION_MIN && q.kn == pd_toss_default_params().kn);
+  assert_true(q.mu == 0.3 && q.restitution == PD_TOSS_DEFAULT_RESTITUTION && q.kn == pd_toss_default_params().kn);
   // refused, each at its line and column
   struct {
     const char* text;
@@ -366,7 +366,7 @@ static void test_parameter_fragment_round_trips_and_refuses_other_lines(void** s
   } bad[] = {
       {"mu 0.3\n  kt 5\n", 2, 3, "only mu, restitution and kn"},
       {"mu 0.3\ntend 2\n", 2, 1, "only mu"},
-      {"mu 0.3\nrestitution 0.1\n", 2, 1, "below e^-2"},
+      {"mu 0.3\nrestitution 0.005\n", 2, 1, "below 0.01"},
       {"mu 0.3\nkn 0\n", 2, 4, "kn must be > 0"},  // the scene parser's own range check
       {"mu\n", 1, 1, ""},
       {"\nmu zero\n", 2, 4, ""},

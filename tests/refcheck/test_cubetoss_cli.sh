@@ -102,7 +102,7 @@ check "replaced in place: a second run into the same directory works" \
   '"$PD" cubetoss --data "$DATA" --out "$SCRATCH/one" --tosses 2 --engines soft --no-runs >/dev/null 2>&1 && [ ! -e "$SCRATCH/one/runs" ]'
 
 # ---- --params: a fragment with the default values gives the default run's numbers; other values others
-printf '# the defaults, written out\nmu 0.18\nrestitution 0.1354\nkn 2.1e6\n' >"$SCRATCH/same.scene"
+printf '# the defaults, written out\nmu 0.18\nrestitution 0.125\nkn 2.1e6\n' >"$SCRATCH/same.scene"
 "$PD" cubetoss --data "$DATA" --out "$SCRATCH/same" --tosses 1-3 --engines soft --params "$SCRATCH/same.scene" --no-runs >/dev/null 2>&1
 check "--params with the default values: the same errors" \
   '[ "$(cut -d, -f1-4,6-12 "$SCRATCH/same/per_toss.csv")" = "$(grep -v "^[0-9]*,[a-z]*,\(ode\|bullet\)," "$OUT/per_toss.csv" | cut -d, -f1-4,6-12)" ]'
@@ -122,7 +122,7 @@ check "fit: exit 0" '[ $rc -eq 0 ]'
 check "fit.csv: one row for soft, 2 training and 2 test tosses" \
   '[ "$(tail -n +2 "$FIT/fit.csv" | wc -l)" -eq 1 ] && [ "$(tail -n +2 "$FIT/fit.csv" | cut -d, -f1-4,14-16)" = "soft,adaptive,ok,mu;restitution;kn,2,1,2" ]'
 check "fit_trace.csv: the start first, then at least one simplex vertex and the final point" \
-  '[ "$(tail -n +2 "$FIT/fit_trace.csv" | wc -l)" -ge 5 ] && [ "$(sed -n 2p "$FIT/fit_trace.csv" | cut -d, -f1-6)" = "soft,adaptive,1,0.18,0.1354,2100000" ]'
+  '[ "$(tail -n +2 "$FIT/fit_trace.csv" | wc -l)" -ge 5 ] && [ "$(sed -n 2p "$FIT/fit_trace.csv" | cut -d, -f1-6)" = "soft,adaptive,1,0.18,0.125,2100000" ]'
 check "fit: test tosses only, with the default and the fitted parameters" \
   '[ "$(tail -n +2 "$FIT/per_toss.csv" | cut -d, -f1,2,5 | tr "\n" " ")" = "2,test,default 4,test,default 2,test,fitted 4,test,fitted " ]'
 check "fit: the default rows equal cubetoss's own" \

@@ -14,6 +14,12 @@
 #include "polydyn/scene.h"
 #include "polydyn/vecmath.h"
 
+// The smallest restitution a scene may request (pd_model_compile refuses less, at the object's line).
+// Below e⁻² ≈ 0.135 the contact's normal damper is overdamped, which the model reproduces exactly; e = 0
+// would need an infinite damper, and below 0.01 (damping ratio 4.8) the damper's fast mode would force
+// integration steps about ten times shorter than the spring's.
+#define PD_RESTITUTION_MIN 0.01
+
 // Material of a body: as requested by the scene, and as finally used (README "Contact material
 // parameters"). In `requested`, a value the scene did not set is -1 (mu always has a value: its default).
 // In `used`, restitution is the requested e or the default (0.5); kn, kt, cn, ct are the values the scene
@@ -86,7 +92,7 @@ typedef struct pdModel {
 // properties, shifts each body's frame to its centre of mass, sets initial states and settings, derives
 // the contact model's material parameters (paper §3.2, §3.3) and checks that no two bodies overlap.
 // Returns NULL and fills err (at the object's line) on a degenerate polyhedron, an empty scene, an
-// unreachable restitution (below e^-2) or bodies interpenetrating at t = 0 (DESIGN §4.1).
+// unreachable restitution (below PD_RESTITUTION_MIN) or bodies interpenetrating at t = 0 (DESIGN §4.1).
 pdModel* pd_model_compile(const pdScene* scene, pdError* err);
 
 void pd_model_free(pdModel* model);

@@ -59,9 +59,10 @@
 // A recorded quaternion whose norm is farther than this from 1 is refused (they are printed to 9 digits
 // and are within 1e-9); accepted ones are normalised.
 #define PD_TOSS_QUAT_NORM_TOL 1e-6
-// Smallest restitution a toss scene requests: e⁻² ≈ 0.13534 (engine/src/material.h, the model's limit)
-// rounded up so that the scene parser accepts it. The data's authors fitted 0.125 for their own model.
-#define PD_TOSS_RESTITUTION_MIN 0.1354
+// Smallest restitution a toss scene requests: the engine's own (PD_RESTITUTION_MIN, polydyn/model.h).
+#define PD_TOSS_RESTITUTION_MIN PD_RESTITUTION_MIN
+// The default restitution: the data's authors' fit for their own model (Pfrommer et al. 2020).
+#define PD_TOSS_DEFAULT_RESTITUTION 0.125
 
 // ---------------------------------------------------------------- the data
 
@@ -105,8 +106,7 @@ typedef struct pdTossParams {
   double inertia;      // kg·m² about every axis; 0: the uniform-density cube's
 } pdTossParams;
 
-// The parameters without fitting: μ = 0.18 (the data's authors' fit), e = PD_TOSS_RESTITUTION_MIN (their
-// 0.125 is below the model's reach), k_n by the engine's own rule eq. (11) for the cube,
+// The parameters without fitting: μ = 0.18 and e = 0.125 (the data's authors' fit), k_n by the engine's own rule eq. (11) for the cube,
 // m vmax²/(0.01 side)² = 2.105e6 N/m (deflection 0.01, the engine default), tol 1e-6, inertia 8.1e-4.
 pdTossParams pd_toss_default_params(void);
 
