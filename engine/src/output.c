@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "model_contact.h"
+#include "number_format.h"
 
 struct pdRunWriter {
   char* dir;         // final name
@@ -44,10 +45,29 @@ static void remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEP
 
 static void write_number(FILE* out, double x) {
   // the engine never lets a non-finite number reach an output; should one get here, JSON stays valid
-  if (isfinite(x))
-    fprintf(out, "%.17g", x);
-  else
+  if (isfinite(x)) {
+    char text[PD_G17_MAX];
+    fwrite(text, 1, (size_t)pd_format_g17(x, text), out);
+  } else {
     fputs("null", out);
+  }
+}
+
+// ",x,y,…": a row's numbers as write_number writes them, in one fwrite.
+static void write_number_list(FILE* out, const double* x, int count) {
+  char text[16 * (PD_G17_MAX + 1)];
+  PD_ASSERT(count <= 16);
+  size_t n = 0;
+  for (int k = 0; k < count; ++k) {
+    text[n++] = ',';
+    if (isfinite(x[k])) {
+      n += (size_t)pd_format_g17(x[k], text + n);
+    } else {
+      memcpy(text + n, "null", 4);
+      n += 4;
+    }
+  }
+  fwrite(text, 1, n, out);
 }
 
 // CSV field: quoted (RFC 4180) only when it holds a comma, a quote or a line break.
@@ -82,10 +102,7 @@ void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state
     fprintf(out, ",%s,%d,%d", c.edgeEdge ? "EE" : "VF", c.featureA, c.featureB);
     const double row[10] = {c.point.x, c.point.y, c.point.z, c.normal.x, c.normal.y, c.normal.z,
                             c.fn, c.ft.x, c.ft.y, c.ft.z};
-    for (int k = 0; k < 10; ++k) {
-      fputc(',', out);
-      write_number(out, row[k]);
-    }
+    write_number_list(out, row, 10);
     fputs(c.slip ? ",slip\n" : ",stick\n", out);
   }
 }
@@ -100,10 +117,7 @@ void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* st
     write_number(out, state->t);
     fputc(',', out);
     write_csv_text(out, model->bodies[i].name);
-    for (int c = 0; c < 13; ++c) {
-      fputc(',', out);
-      write_number(out, row[c]);
-    }
+    write_number_list(out, row, 13);
     fputc('\n', out);
   }
 }

@@ -1,0 +1,27 @@
+// polydyn — numbers in the outputs: exactly the text of printf's "%.17g", several times faster.
+//
+// Every number polydyn writes (trajectory.csv, contacts.csv, summary.json) is printed with 17 significant
+// digits, so it reads back to the same double. glibc's printf spends ~180 ns on one (multi-precision
+// arithmetic), which made writing the samples up to 40 % of a run (reports/bench/cost.md, the 10-box
+// stack at 1000 samples/s). pd_format_g17 takes the digits from Google's double-conversion library
+// (Debian libdouble-conversion; correctly rounded, ~60 ns) and lays them out as C11 7.21.6.1 says %g
+// does. It differs from double-conversion in one place: an exact tie (the 18th significant digit is the
+// last and is 5) rounds to even, as printf does in the default rounding mode, not away from zero.
+// tests/engine/test_number_format.c compares it with snprintf on millions of doubles, ties included.
+#pragma once
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// The longest text: "-1.2345678901234567e-308" is 24 characters and the terminating NUL.
+#define PD_G17_MAX 32
+
+// Writes finite x as printf("%.17g", x) would into out (at least PD_G17_MAX bytes, NUL-terminated) and
+// returns the length. x must be finite (asserted by the caller's contract: the engine never writes
+// a non-finite number).
+int pd_format_g17(double x, char* out);
+
+#ifdef __cplusplus
+}
+#endif
