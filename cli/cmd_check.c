@@ -80,8 +80,9 @@ static void print_contact_material(const pdModel* m, int i) {
   const pdBody* b = &m->bodies[i];
   pdBodyContactInfo info = pd_model_body_contact_info(m, i);
   print_requested(&b->requested);
-  printf("    material used   mu %.6g, restitution %.6g%s (damping ratio %.4f, eq. 15)", b->used.mu,
-         b->used.restitution, b->requested.restitution >= 0.0 ? "" : " (default)", info.zeta);
+  printf("    material used   mu %.6g, restitution %.6g%s (damping ratio %.4f, %s)", b->used.mu,
+         b->used.restitution, b->requested.restitution >= 0.0 ? "" : " (default)", info.zeta,
+         info.zeta > 1.0 ? "overdamped: eq. 15 continued" : "eq. 15");
   const struct {
     const char* name;
     double value;
