@@ -19,16 +19,129 @@
 //   paired with every edge of A (outer loop over B's edges). No scratch memory at all.
 // - For a Minkowski-face edge pair the two edges are the supporting features along the axis, so the
 //   overlap is u·(p_A − p_B) with one vertex of each edge: O(1), no support search.
+// - Polyhedra with many features carry search structures (pdSatIndex, built with the polyhedron): the
+//   support along a face axis is found by walking downhill over the vertex graph from the previous face's
+//   support (a local minimum of a linear function on a convex polyhedron is the minimum), and the edge
+//   pairs are narrowed to those whose Gauss-map arcs can cross: each arc lies in a spherical cap, A's
+//   caps are sorted by the low end of their z band (A's frame, which is A's body frame here), and an edge
+//   of B meets only the edges of A whose bands overlap its own. The candidates are visited in the same
+//   order as the exhaustive loop (a bit set over A's edges), so results and ties are unchanged.
 // - The cache holds the feature of the last result. In PD_SAT_FIRST_SEPARATING mode it is evaluated
 //   first with the very same helper (bit for bit) as in the full search, and only if it is still a
 //   candidate axis; so a cached separating axis proves exactly what the full search would find, and the
 //   verdict never depends on the cache. Support searches are linear scans over the vertices (the
-//   polyhedra here have at most a few hundred vertices; hill climbing would need adjacency lists).
+//   polyhedra without search structures have at most a few dozen vertices).
 #include "interference.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
 
 #include "polydyn/error.h"
+
+// A z band is widened by this (no unit: z of unit vectors) on each side. Arcs that really cross share a
+// point, so their bands overlap in exact arithmetic; the margin covers rounding (~1e-15) and the arcs the
+// sign tests of edge_pair_overlap might call crossing when they miss by a rounding error, so no pair the
+// exhaustive loop would evaluate is dropped.
+#define PD_SAT_CAP_MARGIN 1e-9
+// Adjacent faces whose normals sum to less than this (nearly opposite: a zero-thickness edge) get a cap
+// over the whole sphere.
+#define PD_SAT_CAP_DEGENERATE 1e-6
+// B's arc is dropped before the full Gauss-map test when both its normals lie on one side of A's edge's
+// great circle by more than this times |e_A| (no unit: normals are unit): the full test computes the same
+// signs in A's frame, where rounding may differ by ~1e-16 |e_A|, so no pair it would accept is dropped.
+#define PD_SAT_STRADDLE_MARGIN 1e-12
+// Edges of A a bit set covers (64 per word, on the stack); past it the exhaustive loop runs.
+#define PD_SAT_BITSET_WORDS 1024
+
+struct pdSatIndex {
+  int* neighbourFirst;  // (V + 1) vertex v's neighbours are neighbours[neighbourFirst[v] .. neighbourFirst[v+1])
+  int* neighbours;      // (2E)
+  int* byZ;             // (E) edge indices sorted by the low end of their arc's z band (arc_band, body frame)
+  double* zLo;          // (E) in byZ order
+  double* zHi;          // (E) in byZ order
+  double zSpanMax;      // the widest band
+};
+
+static void* index_alloc(size_t n, size_t size) {
+  void* p = calloc(n ? n : 1, size);
+  PD_ASSERT(p != NULL);
+  return p;
+}
+
+// The band [lo, hi] of u·axis (axis a unit vector) over the Gauss-map arc from unit n0 to unit n1 (not
+// antipodal), widened by PD_SAT_CAP_MARGIN: the arc lies in the cap of centre c = (n0 + n1)/|n0 + n1| and
+// half-angle r (cos r = c·n0), whose polar angle about the axis spans [θc − r, θc + r], clipped to
+// [0, π] where the cap holds a pole. Nearly antipodal normals get the whole range.
+static void arc_band(pdVec3 n0, pdVec3 n1, pdVec3 axis, double* lo, double* hi) {
+  pdVec3 sum = pd_v3_add(n0, n1);
+  double len = pd_v3_norm(sum);
+  if (len < PD_SAT_CAP_DEGENERATE) {
+    *lo = -1.0 - PD_SAT_CAP_MARGIN;
+    *hi = 1.0 + PD_SAT_CAP_MARGIN;
+    return;
+  }
+  pdVec3 c = pd_v3_scale(sum, 1.0 / len);
+  double cz = pd_v3_dot(c, axis), cosR = fmin(1.0, pd_v3_dot(c, n0));
+  double sinR = sqrt(fmax(0.0, 1.0 - cosR * cosR)), s = sqrt(fmax(0.0, 1.0 - cz * cz));
+  *hi = (cz >= cosR ? 1.0 : cz * cosR + s * sinR) + PD_SAT_CAP_MARGIN;
+  *lo = (-cz >= cosR ? -1.0 : cz * cosR - s * sinR) - PD_SAT_CAP_MARGIN;
+}
+
+static const double* sortKeys;  // qsort has no context argument: set just around the call (build time only)
+static int compare_z(const void* a, const void* b) {
+  double x = sortKeys[*(const int*)a], y = sortKeys[*(const int*)b];
+  if (x != y) return x < y ? -1 : 1;
+  return *(const int*)a - *(const int*)b;
+}
+
+void pd_sat_index_build(pdPolyhedron* p) {
+  p->satIndex = NULL;
+  if (p->edgeCount < PD_SAT_INDEX_MIN_EDGES) return;
+  struct pdSatIndex* x = index_alloc(1, sizeof *x);
+  int V = p->vertexCount, E = p->edgeCount;
+  x->neighbourFirst = index_alloc((size_t)V + 1, sizeof *x->neighbourFirst);
+  x->neighbours = index_alloc(2 * (size_t)E, sizeof *x->neighbours);
+  for (int e = 0; e < E; ++e) ++x->neighbourFirst[p->edges[e].v[0] + 1], ++x->neighbourFirst[p->edges[e].v[1] + 1];
+  for (int v = 0; v < V; ++v) x->neighbourFirst[v + 1] += x->neighbourFirst[v];
+  int* fill = index_alloc((size_t)V, sizeof *fill);
+  for (int e = 0; e < E; ++e)
+    for (int k = 0; k < 2; ++k) {
+      int v = p->edges[e].v[k];
+      x->neighbours[x->neighbourFirst[v] + fill[v]++] = p->edges[e].v[1 - k];
+    }
+  free(fill);
+  double* lo = index_alloc((size_t)E, sizeof *lo);
+  double* hi = index_alloc((size_t)E, sizeof *hi);
+  x->byZ = index_alloc((size_t)E, sizeof *x->byZ);
+  for (int e = 0; e < E; ++e) {
+    arc_band(p->faces[p->edges[e].f[0]].normal, p->faces[p->edges[e].f[1]].normal, (pdVec3){0, 0, 1}, &lo[e], &hi[e]);
+    x->byZ[e] = e;
+  }
+  sortKeys = lo;
+  qsort(x->byZ, (size_t)E, sizeof *x->byZ, compare_z);
+  sortKeys = NULL;
+  x->zLo = index_alloc((size_t)E, sizeof *x->zLo);
+  x->zHi = index_alloc((size_t)E, sizeof *x->zHi);
+  for (int k = 0; k < E; ++k) {
+    x->zLo[k] = lo[x->byZ[k]];
+    x->zHi[k] = hi[x->byZ[k]];
+    x->zSpanMax = fmax(x->zSpanMax, x->zHi[k] - x->zLo[k]);
+  }
+  free(lo);
+  free(hi);
+  p->satIndex = x;
+}
+
+void pd_sat_index_free(struct pdSatIndex* x) {
+  if (!x) return;
+  free(x->neighbourFirst);
+  free(x->neighbours);
+  free(x->byZ);
+  free(x->zLo);
+  free(x->zHi);
+  free(x);
+}
 
 typedef struct relPose {
   pdMat3 R;  // B's body axes in A's frame
@@ -56,8 +169,26 @@ static edgeData edge_of_B(const pdPolyhedron* B, int i, const relPose* f) {
   return d;
 }
 
-// min over the vertices of P of u·p (finite input: a plain comparison rather than a call to fmin)
-static double min_projection(const pdPolyhedron* P, pdVec3 u) {
+// min over the vertices of P of u·p (finite input: a plain comparison rather than a call to fmin). With
+// P's search structures, a steepest-descent walk over the vertex graph from *start (the previous axis's
+// support, usually a few edges away), which ends at the minimum; *start receives the support.
+static double min_projection(const pdPolyhedron* P, pdVec3 u, int* start) {
+  const struct pdSatIndex* x = P->satIndex;
+  if (x) {
+    int v = *start;
+    double lo = pd_v3_dot(u, P->vertices[v]);
+    for (;;) {
+      int next = -1;
+      for (int k = x->neighbourFirst[v]; k < x->neighbourFirst[v + 1]; ++k) {
+        double d = pd_v3_dot(u, P->vertices[x->neighbours[k]]);
+        if (d < lo) lo = d, next = x->neighbours[k];
+      }
+      if (next < 0) break;
+      v = next;
+    }
+    *start = v;
+    return lo;
+  }
   double lo = INFINITY;
   for (int v = 0; v < P->vertexCount; ++v) {
     double d = pd_v3_dot(u, P->vertices[v]);
@@ -66,18 +197,19 @@ static double min_projection(const pdPolyhedron* P, pdVec3 u) {
   return lo;
 }
 
-// Overlap along u = n_A (face i of A).
-static double face_A_overlap(const pdPolyhedron* A, int i, const pdPolyhedron* B, const relPose* f) {
+// Overlap along u = n_A (face i of A). *support: see min_projection.
+static double face_A_overlap(const pdPolyhedron* A, int i, const pdPolyhedron* B, const relPose* f, int* support) {
   pdVec3 n = A->faces[i].normal, m = pd_mat3_tmulv(&f->R, n);  // n in B's frame
-  double lo = min_projection(B, m);
+  double lo = min_projection(B, m, support);
   return A->faces[i].offset - (pd_v3_dot(n, f->t) + lo);
 }
 
-// Overlap along u = −n_B (face i of B); *axis receives u in A's frame.
-static double face_B_overlap(const pdPolyhedron* A, const pdPolyhedron* B, int i, const relPose* f, pdVec3* axis) {
+// Overlap along u = −n_B (face i of B); *axis receives u in A's frame. *support: see min_projection.
+static double face_B_overlap(const pdPolyhedron* A, const pdPolyhedron* B, int i, const relPose* f, pdVec3* axis,
+                             int* support) {
   pdVec3 n = pd_mat3_mulv(&f->R, B->faces[i].normal);  // n_B in A's frame
   double offset = B->faces[i].offset + pd_v3_dot(n, f->t);
-  double lo = min_projection(A, n);
+  double lo = min_projection(A, n, support);
   *axis = pd_v3_scale(n, -1.0);
   return offset - lo;
 }
@@ -125,6 +257,34 @@ typedef struct best {
   int a, b;
 } best;
 
+// Edge i of A against edge j of B (eb): when a candidate axis, counts it and keeps it in *b if deeper.
+// A tie with an earlier edge pair goes to the lower (j, i), as the exhaustive loop (j outer, i inner)
+// visits them, so that the result does not depend on the order of the visits; a tie with a face stays
+// with the face. Returns whether *b changed.
+static inline bool visit_edge_pair(const pdPolyhedron* A, int i, const edgeData* eb, int j, best* b, int* minkowski) {
+  double d;
+  pdVec3 axis;
+  if (!edge_pair_overlap(A, i, eb, &d, &axis)) return false;
+  ++*minkowski;
+  bool earlier = d == b->depth && b->kind == PD_SAT_EDGES && (j < b->b || (j == b->b && i < b->a));
+  if (!(d < b->depth) && !earlier) return false;
+  *b = (best){d, axis, PD_SAT_EDGES, i, j};
+  return true;
+}
+
+// The number of leading entries of the ascending a[0..n) below key (or at most key when inclusive).
+static int count_below(const double* a, int n, double key, bool inclusive) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    int mid = lo + (hi - lo) / 2;
+    if (a[mid] < key || (inclusive && a[mid] == key))
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
 // The cached feature's overlap, when it is still a candidate axis.
 static bool cached_overlap(const pdPolyhedron* A, const pdPolyhedron* B, const relPose* f, const pdSatCache* c,
                            best* out) {
@@ -134,13 +294,16 @@ static bool cached_overlap(const pdPolyhedron* A, const pdPolyhedron* B, const r
   switch (c->kind) {
     case PD_SAT_FACE_A:
       if (c->a < 0 || c->a >= A->faceCount) return false;
-      out->depth = face_A_overlap(A, c->a, B, f);
+      int support = 0;
+      out->depth = face_A_overlap(A, c->a, B, f, &support);
       out->axis = A->faces[c->a].normal;
       return true;
-    case PD_SAT_FACE_B:
+    case PD_SAT_FACE_B: {
       if (c->b < 0 || c->b >= B->faceCount) return false;
-      out->depth = face_B_overlap(A, B, c->b, f, &out->axis);
+      int support = 0;
+      out->depth = face_B_overlap(A, B, c->b, f, &out->axis, &support);
       return true;
+    }
     case PD_SAT_EDGES: {
       if (c->a < 0 || c->a >= A->edgeCount || c->b < 0 || c->b >= B->edgeCount) return false;
       edgeData eb = edge_of_B(B, c->b, f);
@@ -168,8 +331,9 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   if (early && cache && cached_overlap(A, B, &f, cache, &b) && b.depth < 0.0) goto done;
   b = (best){INFINITY, {0, 0, 0}, PD_SAT_NONE, -1, -1};
 
+  int supportB = 0, supportA = 0;
   for (int i = 0; i < A->faceCount; ++i) {
-    double d = face_A_overlap(A, i, B, &f);
+    double d = face_A_overlap(A, i, B, &f, &supportB);
     if (d < b.depth) {
       b = (best){d, A->faces[i].normal, PD_SAT_FACE_A, i, -1};
       if (early && d < 0.0) goto done;
@@ -177,23 +341,70 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   }
   for (int i = 0; i < B->faceCount; ++i) {
     pdVec3 axis;
-    double d = face_B_overlap(A, B, i, &f, &axis);
+    double d = face_B_overlap(A, B, i, &f, &axis, &supportA);
     if (d < b.depth) {
       b = (best){d, axis, PD_SAT_FACE_B, -1, i};
       if (early && d < 0.0) goto done;
     }
   }
-  for (int j = 0; j < B->edgeCount; ++j) {
-    edgeData eb = edge_of_B(B, j, &f);
+  // Edge pairs. With A's search structures: B's edges outer, each meeting the edges of A whose arcs' z
+  // bands (A's frame) meet its own negated arc's, in index order. With B's only: A's (few) edges outer,
+  // each meeting the edges of B whose bands (along B's z) meet its own negated arc's and whose normals
+  // straddle its great circle, tested in B's own frame (no transform) before the full test. Else every
+  // pair, B's edges outer.
+  const struct pdSatIndex* ia = A->satIndex;
+  if (ia && A->edgeCount <= 64 * PD_SAT_BITSET_WORDS) {
+    uint64_t candidates[PD_SAT_BITSET_WORDS];
+    int words = (A->edgeCount + 63) / 64;
+    for (int j = 0; j < B->edgeCount; ++j) {
+      edgeData eb = edge_of_B(B, j, &f);
+      double lo, hi;
+      arc_band(pd_v3_scale(eb.n0, -1.0), pd_v3_scale(eb.n1, -1.0), (pdVec3){0, 0, 1}, &lo, &hi);
+      // A's edges whose bands meet [lo, hi]: byZ positions [first, last) with zHi >= lo
+      int first = count_below(ia->zLo, A->edgeCount, lo - ia->zSpanMax, false);
+      int last = count_below(ia->zLo, A->edgeCount, hi, true);
+      for (int w = 0; w < words; ++w) candidates[w] = 0;
+      for (int k = first; k < last; ++k)
+        if (ia->zHi[k] >= lo) candidates[ia->byZ[k] >> 6] |= (uint64_t)1 << (ia->byZ[k] & 63);
+      for (int w = 0; w < words; ++w)
+        for (uint64_t bits = candidates[w]; bits; bits &= bits - 1)
+          if (visit_edge_pair(A, 64 * w + __builtin_ctzll(bits), &eb, j, &b, &minkowski) && early && b.depth < 0.0)
+            goto done;
+    }
+  } else if (B->satIndex && B->edgeCount <= 64 * PD_SAT_BITSET_WORDS) {
+    const struct pdSatIndex* ib = B->satIndex;
+    uint64_t candidates[PD_SAT_BITSET_WORDS];
+    int words = (B->edgeCount + 63) / 64;
+    pdVec3 zB = {f.R.m[0][2], f.R.m[1][2], f.R.m[2][2]};  // B's z axis in A's frame
     for (int i = 0; i < A->edgeCount; ++i) {
-      double d;
-      pdVec3 axis;
-      if (!edge_pair_overlap(A, i, &eb, &d, &axis)) continue;
-      ++minkowski;
-      if (d < b.depth) {
-        b = (best){d, axis, PD_SAT_EDGES, i, j};
-        if (early && d < 0.0) goto done;
-      }
+      const pdEdge* edge = &A->edges[i];
+      // A's arc against B's negated arcs = A's negated arc against B's arcs, whose bands B's index holds
+      double lo, hi;
+      arc_band(pd_v3_scale(A->faces[edge->f[0]].normal, -1.0), pd_v3_scale(A->faces[edge->f[1]].normal, -1.0), zB,
+               &lo, &hi);
+      int first = count_below(ib->zLo, B->edgeCount, lo - ib->zSpanMax, false);
+      int last = count_below(ib->zLo, B->edgeCount, hi, true);
+      for (int w = 0; w < words; ++w) candidates[w] = 0;
+      for (int k = first; k < last; ++k)
+        if (ib->zHi[k] >= lo) candidates[ib->byZ[k] >> 6] |= (uint64_t)1 << (ib->byZ[k] & 63);
+      pdVec3 eA = pd_v3_sub(A->vertices[edge->v[1]], A->vertices[edge->v[0]]);
+      pdVec3 eAinB = pd_mat3_tmulv(&f.R, eA);
+      double margin = PD_SAT_STRADDLE_MARGIN * pd_v3_norm(eA);
+      for (int w = 0; w < words; ++w)
+        for (uint64_t bits = candidates[w]; bits; bits &= bits - 1) {
+          int j = 64 * w + __builtin_ctzll(bits);
+          const pdEdge* e = &B->edges[j];
+          double s0 = pd_v3_dot(B->faces[e->f[0]].normal, eAinB), s1 = pd_v3_dot(B->faces[e->f[1]].normal, eAinB);
+          if ((s0 > margin && s1 > margin) || (s0 < -margin && s1 < -margin)) continue;
+          edgeData eb = edge_of_B(B, j, &f);
+          if (visit_edge_pair(A, i, &eb, j, &b, &minkowski) && early && b.depth < 0.0) goto done;
+        }
+    }
+  } else {
+    for (int j = 0; j < B->edgeCount; ++j) {
+      edgeData eb = edge_of_B(B, j, &f);
+      for (int i = 0; i < A->edgeCount; ++i)
+        if (visit_edge_pair(A, i, &eb, j, &b, &minkowski) && early && b.depth < 0.0) goto done;
     }
   }
 

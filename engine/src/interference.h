@@ -65,10 +65,21 @@ typedef struct pdSatResult {
   int minkowskiEdgePairs;  // edge pairs that passed the Gauss-map test and were evaluated (work counter)
 } pdSatResult;
 
+// Search structures for polyhedra with many features, built once with the polyhedron (polyhedron.c) so
+// that the test allocates nothing: vertex adjacency, so that each face axis finds the other body's
+// support by walking downhill from the previous one, and every edge's Gauss-map arc enclosed in a
+// spherical cap, the arcs sorted along the body's z axis, so that an edge of B meets only the edges of A
+// whose caps share its z band. Neither changes a result: a downhill walk on a convex polyhedron ends at
+// the minimum, and arcs whose caps' z bands are apart (by PD_SAT_CAP_MARGIN) cannot cross. Polyhedra
+// with fewer than PD_SAT_INDEX_MIN_EDGES edges get none (a cube is searched faster exhaustively).
+#define PD_SAT_INDEX_MIN_EDGES 48
+void pd_sat_index_build(pdPolyhedron* p);
+void pd_sat_index_free(struct pdSatIndex* index);
+
 // Do A (at xA, RA) and B (at xB, RB) interfere? Fills *out and returns !out->separated. Equal-depth
 // ties go to the first axis in the order: faces of A, faces of B, edge pairs (B's edges outer, A's inner),
 // by index; so in PD_SAT_MIN_DEPTH mode the result is a function of the poses alone. `cache` may be
 // NULL; when given it is read first (PD_SAT_FIRST_SEPARATING) and overwritten with the result's feature.
-// No allocation; cost O(F_A·V_B + F_B·V_A + E_A·E_B) at worst.
+// No allocation; cost O(F_A·V_B + F_B·V_A + E_A·E_B) at worst, much less with the search structures.
 bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const pdPolyhedron* B, pdVec3 xB,
                      const pdMat3* RB, pdSatMode mode, pdSatCache* cache, pdSatResult* out);

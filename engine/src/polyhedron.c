@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "interference.h"
 #include "why.h"
 
 
@@ -244,7 +245,12 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
   out->edgeCount = edgeCount;
   out->edges = xcalloc((size_t)edgeCount, sizeof *out->edges);
   pair_edges(out, out->edges, NULL, NULL, 0);
-  return pd_polyhedron_validate(out, why, whySize) || (pd_polyhedron_free(out), false);
+  if (!pd_polyhedron_validate(out, why, whySize)) {
+    pd_polyhedron_free(out);
+    return false;
+  }
+  pd_sat_index_build(out);
+  return true;
 }
 
 // ---------------------------------------------------------------- qhull
@@ -525,6 +531,7 @@ void pd_polyhedron_translate(pdPolyhedron* p, pdVec3 shift) {
 }
 
 void pd_polyhedron_free(pdPolyhedron* p) {
+  pd_sat_index_free(p->satIndex);
   free(p->vertices);
   free(p->edges);
   free(p->faces);

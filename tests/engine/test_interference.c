@@ -591,11 +591,74 @@ static void test_stale_or_foreign_cache_entries_are_harmless(void** state) {
   free_pool(pool);
 }
 
+// The search structures (pdSatIndex: downhill supports, Gauss-map arcs banded along z) change no result:
+// the same pairs with the structures detached (the exhaustive search) give the same depth to the bit, the
+// same feature and axis in PD_SAT_MIN_DEPTH mode and the same verdict in PD_SAT_FIRST_SEPARATING mode.
+// Shapes with many features (spheres of levels 1 and 2, 16- to 64-gon prisms, hulls of 60 points) against
+// each other and against small ones, so that every path (A indexed, B only, both) runs.
+static void test_search_structures_change_no_result(void** state) {
+  (void)state;
+  enum { BIG = 12, PAIRS = 3000 };
+  lcg g = {0xb16ull};
+  shape pool[BIG + SHAPE_KINDS];
+  for (int i = 0; i < BIG; ++i) {
+    char why[128] = "";
+    double scale[3] = {lcg_range(&g, 0.3, 2.0), lcg_range(&g, 0.3, 2.0), lcg_range(&g, 0.3, 2.0)};
+    bool ok;
+    if (i % 3 == 0) {
+      ok = pd_polyhedron_sphere(&pool[i].p, 1 + i / 3 % 2, scale, why, sizeof why);
+      snprintf(pool[i].label, sizeof pool[i].label, "sphere level %d", 1 + i / 3 % 2);
+    } else if (i % 3 == 1) {
+      int sides = 16 + 16 * (i / 3 % 4);
+      ok = pd_polyhedron_prism(&pool[i].p, sides, scale, lcg_range(&g, 0.3, 1.0), why, sizeof why);
+      snprintf(pool[i].label, sizeof pool[i].label, "tprism %d", sides);
+    } else {
+      double pts[3 * 60];
+      for (int k = 0; k < 3 * 60; ++k) pts[k] = scale[k % 3] * lcg_range(&g, -0.5, 0.5);
+      ok = pd_polyhedron_hull(&pool[i].p, pts, 60, why, sizeof why);
+      snprintf(pool[i].label, sizeof pool[i].label, "hull of 60 points");
+    }
+    if (!ok) fail_msg("%s: %s", pool[i].label, why);
+    pd_polyhedron_translate(&pool[i].p, pd_v3_scale(vertex_average(&pool[i].p), -1.0));
+    pool[i].radius = 0.0;
+    for (int v = 0; v < pool[i].p.vertexCount; ++v) pool[i].radius = fmax(pool[i].radius, pd_v3_norm(pool[i].p.vertices[v]));
+  }
+  for (int k = 0; k < SHAPE_KINDS; ++k) make_shape(&g, k, 0, &pool[BIG + k]);
+  int indexed = 0;
+  for (int i = 0; i < BIG + SHAPE_KINDS; ++i) indexed += pool[i].p.satIndex != NULL;
+  assert_true(indexed >= BIG);  // every big shape carries the structures
+  long overlapping = 0;
+  for (int n = 0; n < PAIRS; ++n) {
+    const shape* a = &pool[(int)(lcg_uniform(&g) * (BIG + SHAPE_KINDS))];
+    const shape* b = &pool[(int)(lcg_uniform(&g) * (BIG + SHAPE_KINDS))];
+    pose pa, pb;
+    random_poses(&g, a, &pa, b, &pb);
+    shape plainA = *a, plainB = *b;  // the same polyhedra without their search structures
+    plainA.p.satIndex = NULL;
+    plainB.p.satIndex = NULL;
+    pdSatMode modes[2] = {PD_SAT_MIN_DEPTH, PD_SAT_FIRST_SEPARATING};
+    for (int m = 0; m < 2; ++m) {
+      pdSatResult fast = sat(a, &pa, b, &pb, modes[m], NULL), plain = sat(&plainA, &pa, &plainB, &pb, modes[m], NULL);
+      if (fast.separated != plain.separated)
+        fail_msg("pair %d (%s / %s), mode %d: verdicts differ", n, a->label, b->label, m);
+      if (m == 0 && (fast.depth != plain.depth || fast.kind != plain.kind || fast.a != plain.a || fast.b != plain.b ||
+                     fast.axis.x != plain.axis.x || fast.axis.y != plain.axis.y || fast.axis.z != plain.axis.z))
+        fail_msg("pair %d (%s / %s): depth %.17g (feature %d %d %d) against %.17g (feature %d %d %d) exhaustively", n,
+                 a->label, b->label, fast.depth, fast.kind, fast.a, fast.b, plain.depth, plain.kind, plain.a, plain.b);
+      if (m == 0 && !fast.separated) ++overlapping;
+    }
+  }
+  print_message("%d pairs (%ld overlapping): identical with and without the search structures\n", PAIRS, overlapping);
+  assert_true(overlapping > PAIRS / 10);
+  for (int i = 0; i < BIG + SHAPE_KINDS; ++i) pd_polyhedron_free(&pool[i].p);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_edge_faces_follow_the_convention_the_gauss_map_test_uses),
       cmocka_unit_test(test_closed_cases_face_face_crossed_edges_vertex_face),
       cmocka_unit_test(test_pruned_sat_equals_brute_force_on_20000_random_pairs_near_touching),
+      cmocka_unit_test(test_search_structures_change_no_result),
       cmocka_unit_test(test_cache_changes_no_verdict_and_no_min_depth_along_coherent_motion),
       cmocka_unit_test(test_stale_or_foreign_cache_entries_are_harmless),
   };

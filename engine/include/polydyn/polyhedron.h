@@ -29,12 +29,18 @@ typedef struct pdFace {
   double offset;  // plane: normal · x = offset, m
 } pdFace;
 
+struct pdSatIndex;  // the separating-axis test's search structures (engine/src/interference.c)
+
 typedef struct pdPolyhedron {
   int vertexCount, edgeCount, faceCount;
   pdVec3* vertices;   // (vertexCount) m
   pdEdge* edges;      // (edgeCount)
   pdFace* faces;      // (faceCount)
   int* faceVertices;  // (sum of face counts) vertex indices, CCW seen from outside
+  // Derived by the constructors below for polyhedra with many features (vertex adjacency, the edges'
+  // Gauss-map arcs sorted for the interference test); NULL otherwise and on a polyhedron filled in by
+  // hand, which the test then searches exhaustively. Owned: pd_polyhedron_free releases it.
+  struct pdSatIndex* satIndex;
 } pdPolyhedron;
 
 // Geometric tolerances, relative to the polyhedron's size (largest vertex distance from the
