@@ -285,6 +285,15 @@ static int count_below(const double* a, int n, double key, bool inclusive) {
   return lo;
 }
 
+// The set (one bit per edge, in (edges + 63)/64 words) of the indexed polyhedron's edges whose z bands
+// meet [lo, hi]: byZ positions [first, last), zLo from lo − zSpanMax to hi, with zHi >= lo.
+static void band_candidates(const struct pdSatIndex* x, int edges, double lo, double hi, uint64_t* bits) {
+  int first = count_below(x->zLo, edges, lo - x->zSpanMax, false), last = count_below(x->zLo, edges, hi, true);
+  for (int w = 0; w < (edges + 63) / 64; ++w) bits[w] = 0;
+  for (int k = first; k < last; ++k)
+    if (x->zHi[k] >= lo) bits[x->byZ[k] >> 6] |= (uint64_t)1 << (x->byZ[k] & 63);
+}
+
 // The cached feature's overlap, when it is still a candidate axis.
 static bool cached_overlap(const pdPolyhedron* A, const pdPolyhedron* B, const relPose* f, const pdSatCache* c,
                            best* out) {
@@ -360,12 +369,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
       edgeData eb = edge_of_B(B, j, &f);
       double lo, hi;
       arc_band(pd_v3_scale(eb.n0, -1.0), pd_v3_scale(eb.n1, -1.0), (pdVec3){0, 0, 1}, &lo, &hi);
-      // A's edges whose bands meet [lo, hi]: byZ positions [first, last) with zHi >= lo
-      int first = count_below(ia->zLo, A->edgeCount, lo - ia->zSpanMax, false);
-      int last = count_below(ia->zLo, A->edgeCount, hi, true);
-      for (int w = 0; w < words; ++w) candidates[w] = 0;
-      for (int k = first; k < last; ++k)
-        if (ia->zHi[k] >= lo) candidates[ia->byZ[k] >> 6] |= (uint64_t)1 << (ia->byZ[k] & 63);
+      band_candidates(ia, A->edgeCount, lo, hi, candidates);
       for (int w = 0; w < words; ++w)
         for (uint64_t bits = candidates[w]; bits; bits &= bits - 1)
           if (visit_edge_pair(A, 64 * w + __builtin_ctzll(bits), &eb, j, &b, &minkowski) && early && b.depth < 0.0)
@@ -382,11 +386,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
       double lo, hi;
       arc_band(pd_v3_scale(A->faces[edge->f[0]].normal, -1.0), pd_v3_scale(A->faces[edge->f[1]].normal, -1.0), zB,
                &lo, &hi);
-      int first = count_below(ib->zLo, B->edgeCount, lo - ib->zSpanMax, false);
-      int last = count_below(ib->zLo, B->edgeCount, hi, true);
-      for (int w = 0; w < words; ++w) candidates[w] = 0;
-      for (int k = first; k < last; ++k)
-        if (ib->zHi[k] >= lo) candidates[ib->byZ[k] >> 6] |= (uint64_t)1 << (ib->byZ[k] & 63);
+      band_candidates(ib, B->edgeCount, lo, hi, candidates);
       pdVec3 eA = pd_v3_sub(A->vertices[edge->v[1]], A->vertices[edge->v[0]]);
       pdVec3 eAinB = pd_mat3_tmulv(&f.R, eA);
       double margin = PD_SAT_STRADDLE_MARGIN * pd_v3_norm(eA);
