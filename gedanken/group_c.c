@@ -68,6 +68,7 @@ const pdGkExperiment pd_gk_c1_bounce_apex = {
     .toleranceReason = "catalogue C1 [REC]: within 1 % of the m_eff-corrected prediction; gravity during the "
                        "~1 ms contact lowers e by ~g t_c/v = 0.3 % at 3.1 m/s",
     .seriesLabel = "height of the cube's centre, m",
+    .kind = pd_gkLaw,
     .relative = true,
     .fast = true,
     .inputCount = 1,
@@ -134,6 +135,7 @@ const pdGkExperiment pd_gk_c2_momentum = {
     .formula = "0: contact forces are equal and opposite (catalogue C2); measured |p_end - p_0|/(m v0)",
     .toleranceReason = "catalogue C2: round-off level; 1e-9 of one cube's momentum",
     .seriesLabel = "momentum error relative to m v0",
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = true,
     .inputCount = 1,
@@ -213,6 +215,10 @@ const pdGkExperiment pd_gk_c3_eccentric_bar = {
                "(paper App. A eqs. (19)-(20) and eq. (15); catalogue C3)",
     .toleranceReason = "catalogue C3 [REC]: 1 % for a stiff contact",
     .seriesLabel = "spin of the bar about -y, rad/s",
+    .kind = pd_gkModelPrediction,
+    .appliesTo = PD_GK_SOFT | PD_GK_ODE_MATCHED | PD_GK_BULLET_MATCHED,
+    .notApplicableReason = "ODE and Bullet native: a rigid impact applies the requested e at any effective mass; "
+                           "e_eff(m_eff) is the soft model's",
     .relative = true,
     .fast = true,
     .inputCount = 1,
@@ -266,6 +272,7 @@ const pdGkExperiment pd_gk_c4_velocity_exchange = {
     .formula = "v_b'/v0 = 1: equal masses, e = 1, one dimension (catalogue C4)",
     .toleranceReason = "1e-3: energy is conserved to the integration tolerance over the ~20 ms contact",
     .seriesLabel = "velocity of the struck cube over the launch speed",
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = true,
     .inputCount = 1,
@@ -318,6 +325,7 @@ const pdGkExperiment pd_gk_c6_energy_gain = {
                "measured: largest rise of E (kinetic + gravitational + springs) over E(0)",
     .toleranceReason = "catalogue C6: violations < 1e-6 E0 (integration error only)",
     .seriesLabel = "energy over its initial value",
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = false,
     .inputName = "mu",
@@ -328,3 +336,4 @@ const pdGkExperiment pd_gk_c6_energy_gain = {
     .measure = c6_measure,
     .series = c6_series,
 };
+

@@ -112,6 +112,7 @@ const pdGkExperiment pd_gk_d1_rimless_wheel = {
     .toleranceReason = "catalogue D1 [REC]: steady mean speed within 3 %; the soft impacts are not plastic "
                        "(e >= 0.135): stiff, near-critical contacts approach the rigid value from below",
     .seriesLabel = "speed of the wheel's centre, m/s",
+    .kind = pd_gkLaw,
     .relative = true,
     .fast = false,
     .inputCount = 1,
@@ -194,6 +195,7 @@ const pdGkExperiment pd_gk_d2_slide_to_roll = {
     .toleranceReason = "catalogue D2: 'within a few %' for N >= 40: the ~2 vertex transfers during the slip phase "
                        "lose a little angular momentum (polyhedral caveat); 3 %",
     .seriesLabel = "speed of the prism's centre, m/s",
+    .kind = pd_gkLaw,
     .relative = true,
     .fast = false,
     .inputCount = 1,
@@ -283,6 +285,7 @@ const pdGkExperiment pd_gk_d3_tumbling_cube = {
     .toleranceReason = "catalogue G1/C6 bounds for the settled state; the ratio has no soft-contact closed form",
     .seriesLabel = "spin of the cube about y, rad/s",
     .qualitative = true,
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = false,
     .inputCount = 1,

@@ -136,6 +136,7 @@ const pdGkExperiment pd_gk_f1_top_precession = {
     .toleranceReason = "catalogue F1 [REC]: 2 % for w3 >= 10 sqrt(m g l I1)/I3; started in steady precession, "
                        "the nutation the settling tip spring adds averages out of the fitted rate",
     .seriesLabel = "azimuth of the top's axis, rad",
+    .kind = pd_gkLaw,
     .relative = true,
     .fast = false,
     .inputName = "spin",

@@ -135,6 +135,24 @@ typedef struct pdGkText {
 void pd_gk_text_printf(pdGkText* text, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 void pd_gk_text_free(pdGkText* text);
 
+// What an experiment tests (issue 17 item 4). A law is physics every engine must obey (Coulomb's stop
+// distance, friction-cone isotropy, momentum, a centred impact's restitution): every engine is judged. A model
+// prediction is a consequence of the soft contact model itself (static sinkage, the elastic apex drift,
+// contact duration): it is judged only for the engine variants in `appliesTo`; the others still run and
+// their measurement is recorded, with the status NOT_APPLICABLE and `notApplicableReason` in the note.
+typedef enum pdGkKind { pd_gkLaw, pd_gkModelPrediction } pdGkKind;
+extern const char* const pdGkKindNames[];  // "law", "model_prediction"
+
+// Engine variants, as bits of pdGkExperiment.appliesTo.
+enum {
+  PD_GK_SOFT = 1 << 0,
+  PD_GK_ODE_NATIVE = 1 << 1,
+  PD_GK_ODE_MATCHED = 1 << 2,
+  PD_GK_BULLET_NATIVE = 1 << 3,
+  PD_GK_BULLET_MATCHED = 1 << 4,
+  PD_GK_ALL_VARIANTS = (1 << 5) - 1,
+};
+
 typedef struct pdGkExperiment {
   const char* name;             // unique, lower case: catalogue id + what it measures, e.g. "a1_restitution"
   char group;                   // 'A' … 'G' (catalogue §2)
@@ -144,6 +162,9 @@ typedef struct pdGkExperiment {
   const char* formula;          // the expected value as a formula, with its source
   const char* toleranceReason;  // why the tolerance is what it is
   const char* seriesLabel;      // what series/NAME.csv holds, with its unit
+  pdGkKind kind;
+  unsigned appliesTo;           // model prediction: the PD_GK_* variants judged (law: every variant, 0 here)
+  const char* notApplicableReason;  // model prediction: why the others are not judged (one line)
   bool qualitative;             // every input is a qualitative check (expect gives NAN for each)
   bool relative;                // tolerance and error relative to the expected value
   bool fast;                    // in the CI subset (--fast)
@@ -170,8 +191,21 @@ void pd_gk_input_label(const pdGkExperiment* e, double input, char* buf, int siz
 typedef enum pdGkEngine { pd_gkSoft, pd_gkOde, pd_gkBullet, pd_gkEngineCount } pdGkEngine;
 extern const char* const pdGkEngineNames[pd_gkEngineCount];  // "soft", "ode", "bullet"
 
-typedef enum pdGkStatus { pd_gkPass, pd_gkFail, pd_gkRefused, pd_gkNotBuilt, pd_gkError } pdGkStatus;
-extern const char* const pdGkStatusNames[];  // "PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR"
+// NOT_APPLICABLE: a model prediction measured on a variant it does not apply to (pdGkKind): not judged.
+typedef enum pdGkStatus {
+  pd_gkPass,
+  pd_gkFail,
+  pd_gkRefused,
+  pd_gkNotBuilt,
+  pd_gkError,
+  pd_gkNotApplicable,
+  pd_gkStatusCount
+} pdGkStatus;
+extern const char* const pdGkStatusNames[];  // "PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR", "NOT_APPLICABLE"
+
+// The PD_GK_* bit of an engine variant (soft has one variant), and whether experiment e is judged on it.
+unsigned pd_gk_variant_bit(pdGkEngine engine, bool matched);
+bool pd_gk_applies(const pdGkExperiment* e, pdGkEngine engine, bool matched);
 
 typedef struct pdGkProgress {
   int done, total;
@@ -196,7 +230,7 @@ typedef struct pdGkOptions {
 
 typedef struct pdGkSummary {
   int rows;
-  int count[5];         // rows per status (index pdGkStatus)
+  int count[pd_gkStatusCount];  // rows per status (index pdGkStatus)
   int softFailures;     // soft rows that are FAIL or ERROR: `polydyn gedanken` exits 1 when > 0
   char softFailed[512]; // those rows as "NAME[ INPUT]" separated by ", " (cut short with "..." when long)
   bool interrupted;     // stopped by options.interrupt; nothing was written
