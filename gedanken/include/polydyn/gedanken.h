@@ -96,6 +96,16 @@ double pd_gk_largest_rise(const double* y, int n, double scale);
 // two samples in the window.
 bool pd_gk_drift_speed(const double* t, const pdVec3* x, int n, double t0, double* speed);
 
+// Ratio of the tangential to the normal velocity change of a body over an impact, |vt1 − vt0| / |vn1 − vn0|
+// (catalogue C5): μ for a contact that slides throughout, whatever its stiffness or duration. NAN when the
+// normal velocity did not change.
+double pd_gk_impulse_ratio(double vt0, double vt1, double vn0, double vn1);
+
+// The fraction of the kinetic energy before a landing that the landing took, (E0 − E1)/kinetic0, from the
+// total energies just before (E0) and just after (E1) — gravity does no net work in between then — and the
+// kinetic energy before (> 0).
+double pd_gk_absorbed_fraction(double energyBefore, double energyAfter, double kineticBefore);
+
 // Removes the 2π jumps of an angle series in place, so consecutive samples differ by less than π.
 void pd_gk_unwrap(double* angle, int n);
 
@@ -106,6 +116,13 @@ void pd_gk_unwrap(double* angle, int n);
 // e = exp(−2ζ arccos ζ / √(1−ζ²)) for ζ < 1, e⁻² at ζ = 1, and its continuation exp(−2ζ acosh ζ / √(ζ²−1))
 // for an overdamped contact (ζ > 1). ζ >= 0.
 double pd_gk_restitution_of_damping(double zeta);
+
+// A rigid cube pivoting about one bottom edge lands on the next face (catalogue D3): the impulse at the landing
+// edge leaves it with no tangential velocity (no slip) and a normal velocity −e times the one before
+// (e in [0, 1]). Returns the fraction of the kinetic energy the landing takes, from the impulse balance
+// (angular momentum about the landing edge), and ω⁺/ω⁻ in *spinRatio (nullable): 15/16 and 1/4 when
+// e = 0 (the plastic landing), 0 when e = 1.
+double pd_gk_cube_landing_absorbed(double e, double* spinRatio);
 
 // ---------------------------------------------------------------------------------------------------------
 // Experiments
