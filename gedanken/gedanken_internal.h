@@ -21,7 +21,7 @@ extern const pdGkExperiment pd_gk_c1_bounce_apex, pd_gk_c2_momentum, pd_gk_c3_ec
 extern const pdGkExperiment pd_gk_d1_rimless_wheel, pd_gk_d2_slide_to_roll, pd_gk_d3_tumbling_cube,
     pd_gk_d3_landing_energy;
 extern const pdGkExperiment pd_gk_e1_painleve, pd_gk_e2_side_load_pitch;
-extern const pdGkExperiment pd_gk_f1_top_precession;
+extern const pdGkExperiment pd_gk_f1_top_precession, pd_gk_f2_euler_disk;
 extern const pdGkExperiment pd_gk_g1_stack_drift, pd_gk_g1_stack_sinkage, pd_gk_g2_domino, pd_gk_g3_pushed_load;
 
 // Index of the body called `name` in the model / among the moving bodies (asserts it exists: the scenes

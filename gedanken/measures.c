@@ -176,6 +176,19 @@ double pd_gk_absorbed_fraction(double energyBefore, double energyAfter, double k
   return (energyBefore - energyAfter) / kineticBefore;
 }
 
+bool pd_gk_mean_rate_in_band(const double* t, const double* angle, const double* band, int n, double lo, double hi,
+                             double* rate) {
+  double turned = 0.0, time = 0.0;
+  for (int k = 0; k + 1 < n; ++k)
+    if (band[k] >= lo && band[k] <= hi && band[k + 1] >= lo && band[k + 1] <= hi) {
+      turned += angle[k + 1] - angle[k];
+      time += t[k + 1] - t[k];
+    }
+  if (!(time > 0.0)) return false;
+  *rate = turned / time;
+  return true;
+}
+
 void pd_gk_unwrap(double* angle, int n) {
   const double twoPi = 2.0 * M_PI;
   double offset = 0.0;

@@ -1,7 +1,8 @@
 // The gedanken measures on synthetic series with known answers: the line fit, the first impact with and
 // without gravity, apex heights, the first fall (stop time), the largest rise (energy gain), the drift
 // speed, angle unwrapping, eq. (15)'s restitution of a damping ratio against the catalogue's table, the
-// impulse ratio of an oblique impact (C5) and the energy a cube's landing takes (D3).
+// impulse ratio of an oblique impact (C5), the energy a cube's landing takes (D3) and a rate read within a
+// band of another series (F2's precession).
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -244,6 +245,24 @@ static void test_cube_landing_takes_fifteen_sixteenths_when_plastic(void** state
     assert_true(fabs(pd_gk_cube_landing_absorbed(e, NULL) - 15.0 / 16.0 * (1.0 - e * e)) < ROUND_OFF);
 }
 
+static void test_mean_rate_in_band_reads_each_band_alone(void** state) {
+  (void)state;
+  // a heading turning at 20 rad/s while a tilt falls from 50 to 40, then at 100 rad/s while it falls from 6 to 2
+  double t[N], heading[N], tilt[N];
+  for (int k = 0; k < N; ++k) {
+    t[k] = 0.001 * k;
+    bool early = k <= 200;
+    tilt[k] = early ? 50.0 - 10.0 * k / 200.0 : 6.0 - 4.0 * (k - 201) / 199.0;
+    heading[k] = early ? 20.0 * t[k] : 20.0 * 0.2 + 100.0 * (t[k] - 0.2);
+  }
+  double rate;
+  assert_true(pd_gk_mean_rate_in_band(t, heading, tilt, N, 40.0, 50.0, &rate));
+  assert_true(fabs(rate - 20.0) < ROUND_OFF * 1e3);
+  assert_true(pd_gk_mean_rate_in_band(t, heading, tilt, N, 2.0, 6.0, &rate));
+  assert_true(fabs(rate - 100.0) < ROUND_OFF * 1e3);
+  assert_false(pd_gk_mean_rate_in_band(t, heading, tilt, N, 10.0, 30.0, &rate));  // never in that band
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_line_fit_recovers_the_slope_inside_the_window_only),
@@ -260,6 +279,7 @@ int main(void) {
       cmocka_unit_test(test_impulse_ratio_is_mu_while_the_impact_slides),
       cmocka_unit_test(test_absorbed_fraction_from_total_energies),
       cmocka_unit_test(test_cube_landing_takes_fifteen_sixteenths_when_plastic),
+      cmocka_unit_test(test_mean_rate_in_band_reads_each_band_alone),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -106,6 +106,11 @@ double pd_gk_impulse_ratio(double vt0, double vt1, double vn0, double vn1);
 // kinetic energy before (> 0).
 double pd_gk_absorbed_fraction(double energyBefore, double energyAfter, double kineticBefore);
 
+// The mean rate of change of `angle` (rad, unwrapped) over the sample intervals whose two ends both have
+// lo <= band <= hi: (Σ Δangle)/(Σ Δt) over those intervals. False when there is none.
+bool pd_gk_mean_rate_in_band(const double* t, const double* angle, const double* band, int n, double lo, double hi,
+                             double* rate);
+
 // Removes the 2π jumps of an angle series in place, so consecutive samples differ by less than π.
 void pd_gk_unwrap(double* angle, int n);
 
