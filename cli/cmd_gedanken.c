@@ -174,7 +174,7 @@ int pd_cmd_gedanken(int argc, char** argv) {
     return PD_EXIT_FAILURE;
   }
   printf("polydyn gedanken: %d rows in %.1f s:", summary.rows, summary.wallSeconds);
-  for (int s = 0; s <= pd_gkError; ++s)
+  for (int s = 0; s < pd_gkStatusCount; ++s)
     if (summary.count[s]) printf(" %d %s", summary.count[s], pdGkStatusNames[s]);
   printf("; %s/results.csv\n", options.out);
   if (summary.softFailures > 0) {

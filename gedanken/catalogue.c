@@ -2,16 +2,14 @@
 #include "gedanken_internal.h"
 
 static const pdGkExperiment* const catalogue[] = {
-    &pd_gk_a1_restitution,     &pd_gk_a2_restitution_contacts, &pd_gk_a3_sinkage,
-    &pd_gk_a4_elastic_apex,    &pd_gk_b1_incline_slide,        &pd_gk_b1_incline_stick,
-    &pd_gk_b2_stopping_distance, &pd_gk_b2_stop_time,          &pd_gk_b2_friction_cone,
-    &pd_gk_b3_ramp_onset,      &pd_gk_b4_block_on_block,       &pd_gk_b5_tip_or_slide,
-    &pd_gk_b6_slide_spin,      &pd_gk_c1_bounce_apex,
-    &pd_gk_c2_momentum,        &pd_gk_c3_eccentric_bar,        &pd_gk_c4_velocity_exchange,
-    &pd_gk_c6_energy_gain,     &pd_gk_d1_rimless_wheel,        &pd_gk_d2_slide_to_roll,
-    &pd_gk_d3_tumbling_cube,   &pd_gk_e1_painleve,             &pd_gk_e2_side_load_pitch,
-    &pd_gk_f1_top_precession,  &pd_gk_g1_stack_drift,          &pd_gk_g1_stack_sinkage,
-    &pd_gk_g2_domino,
+    &pd_gk_a1_restitution, &pd_gk_a2_restitution_contacts, &pd_gk_a3_sinkage, &pd_gk_a4_elastic_apex,
+    &pd_gk_b1_incline_slide, &pd_gk_b1_incline_stick, &pd_gk_b2_stopping_distance, &pd_gk_b2_stop_time,
+    &pd_gk_b2_friction_cone, &pd_gk_b3_ramp_onset, &pd_gk_b4_block_on_block, &pd_gk_b5_tip_or_slide,
+    &pd_gk_b6_slide_spin, &pd_gk_c1_bounce_apex, &pd_gk_c2_momentum, &pd_gk_c3_eccentric_bar,
+    &pd_gk_c4_velocity_exchange, &pd_gk_c5_oblique_impact, &pd_gk_c6_energy_gain, &pd_gk_d1_rimless_wheel,
+    &pd_gk_d2_slide_to_roll, &pd_gk_d3_tumbling_cube, &pd_gk_d3_landing_energy, &pd_gk_e1_painleve,
+    &pd_gk_e2_side_load_pitch, &pd_gk_f1_top_precession, &pd_gk_f2_euler_disk, &pd_gk_g1_stack_drift,
+    &pd_gk_g1_stack_sinkage, &pd_gk_g2_domino, &pd_gk_g3_pushed_load,
 };
 
 int pd_gk_experiment_count(void) { return (int)(sizeof catalogue / sizeof catalogue[0]); }

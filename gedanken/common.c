@@ -15,6 +15,35 @@ double pd_gk_restitution_of_damping(double zeta) {
   return exp(-2.0 * zeta * acosh(zeta) / sqrt(zeta * zeta - 1.0));
 }
 
+double pd_gk_cube_landing_absorbed(double e, double* spinRatio) {
+  PD_ASSERT(e >= 0.0 && e <= 1.0);
+  // in the plane of the roll, units m = a = ω⁻ = 1: pivot A at the origin, landing edge B at (1, 0), centre C at
+  // (1/2, 1/2); before, the cube turns about A: ω ŷ × r = ω (r_z, −r_x)
+  const double ic = 1.0 / 6.0;                 // I_c/(m a²)
+  double rho[2] = {0.5, -0.5};                 // B − C
+  double u[2] = {rho[1], -rho[0]};             // v_B = v_C + ω u
+  double vc[2] = {0.5, -0.5};                  // ŷ × (C − A)
+  double vb[2] = {vc[0] + u[0], vc[1] + u[1]};  // (0, −1)
+  double target[2] = {0.0, -e * vb[1]}, dv[2] = {target[0] - vb[0], target[1] - vb[1]};
+  // Δv_B = K P with K = 1/m + u uᵀ/I_c: solve the 2×2 system for the impulse P
+  double k00 = 1.0 + u[0] * u[0] / ic, k01 = u[0] * u[1] / ic, k11 = 1.0 + u[1] * u[1] / ic;
+  double det = k00 * k11 - k01 * k01;
+  double p[2] = {(k11 * dv[0] - k01 * dv[1]) / det, (k00 * dv[1] - k01 * dv[0]) / det};
+  double w = 1.0 + (u[0] * p[0] + u[1] * p[1]) / ic;
+  double v[2] = {vc[0] + p[0], vc[1] + p[1]};
+  double before = 0.5 * (vc[0] * vc[0] + vc[1] * vc[1]) + 0.5 * ic;
+  double after = 0.5 * (v[0] * v[0] + v[1] * v[1]) + 0.5 * ic * w * w;
+  if (spinRatio) *spinRatio = w;
+  return 1.0 - after / before;
+}
+
+double gk_kinetic_energy(const pdModel* model, int body, const pdBodyState* b) {
+  const pdBody* m = &model->bodies[body];
+  pdQuat qc = {b->q.w, -b->q.x, -b->q.y, -b->q.z};
+  pdVec3 w = pd_quat_rotate(qc, b->w);  // body frame, where the inertia is kept
+  return 0.5 * m->mass * pd_v3_dot(b->v, b->v) + 0.5 * pd_v3_dot(w, pd_mat3_mulv(&m->inertia, w));
+}
+
 double gk_effective_mass(const pdModel* model, int body, pdVec3 p, pdVec3 n) {
   const pdBody* b = &model->bodies[body];
   // r × n in the body frame, where the inverse inertia is kept

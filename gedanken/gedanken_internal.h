@@ -17,11 +17,12 @@ extern const pdGkExperiment pd_gk_b1_incline_slide, pd_gk_b1_incline_stick, pd_g
     pd_gk_b2_stop_time, pd_gk_b2_friction_cone, pd_gk_b3_ramp_onset, pd_gk_b4_block_on_block, pd_gk_b5_tip_or_slide,
     pd_gk_b6_slide_spin;
 extern const pdGkExperiment pd_gk_c1_bounce_apex, pd_gk_c2_momentum, pd_gk_c3_eccentric_bar,
-    pd_gk_c4_velocity_exchange, pd_gk_c6_energy_gain;
-extern const pdGkExperiment pd_gk_d1_rimless_wheel, pd_gk_d2_slide_to_roll, pd_gk_d3_tumbling_cube;
+    pd_gk_c4_velocity_exchange, pd_gk_c5_oblique_impact, pd_gk_c6_energy_gain;
+extern const pdGkExperiment pd_gk_d1_rimless_wheel, pd_gk_d2_slide_to_roll, pd_gk_d3_tumbling_cube,
+    pd_gk_d3_landing_energy;
 extern const pdGkExperiment pd_gk_e1_painleve, pd_gk_e2_side_load_pitch;
-extern const pdGkExperiment pd_gk_f1_top_precession;
-extern const pdGkExperiment pd_gk_g1_stack_drift, pd_gk_g1_stack_sinkage, pd_gk_g2_domino;
+extern const pdGkExperiment pd_gk_f1_top_precession, pd_gk_f2_euler_disk;
+extern const pdGkExperiment pd_gk_g1_stack_drift, pd_gk_g1_stack_sinkage, pd_gk_g2_domino, pd_gk_g3_pushed_load;
 
 // Index of the body called `name` in the model / among the moving bodies (asserts it exists: the scenes
 // are generated here, so a missing name is a bug).
@@ -71,6 +72,9 @@ static inline double gk_series_value(const pdGkRecord* rec, int k, int j, gkGett
 // The largest relative energy rise of the run (energy gain; the scale is E(0), positive in scenes whose floor
 // top is z = 0 and whose bodies start above it).
 double gk_energy_gain(const pdGkRecord* rec);
+
+// Kinetic energy of `body` (model index) in state b: translation and rotation (inertia in the body frame).
+double gk_kinetic_energy(const pdModel* model, int body, const pdBodyState* b);
 
 // Effective mass of `body` (model index) for a push along world direction n at world point p, at the
 // body's initial pose (paper eqs. (19)–(20)).

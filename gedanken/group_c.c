@@ -1,4 +1,4 @@
-// polydyn gedanken — group C: impacts (catalogue §2 C1–C4, C6).
+// polydyn gedanken — group C: impacts (catalogue §2 C1–C6).
 #include <stdlib.h>
 
 #include "gedanken_internal.h"
@@ -68,6 +68,7 @@ const pdGkExperiment pd_gk_c1_bounce_apex = {
     .toleranceReason = "catalogue C1 [REC]: within 1 % of the m_eff-corrected prediction; gravity during the "
                        "~1 ms contact lowers e by ~g t_c/v = 0.3 % at 3.1 m/s",
     .seriesLabel = "height of the cube's centre, m",
+    .kind = pd_gkLaw,
     .relative = true,
     .fast = true,
     .inputCount = 1,
@@ -134,6 +135,7 @@ const pdGkExperiment pd_gk_c2_momentum = {
     .formula = "0: contact forces are equal and opposite (catalogue C2); measured |p_end - p_0|/(m v0)",
     .toleranceReason = "catalogue C2: round-off level; 1e-9 of one cube's momentum",
     .seriesLabel = "momentum error relative to m v0",
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = true,
     .inputCount = 1,
@@ -213,6 +215,10 @@ const pdGkExperiment pd_gk_c3_eccentric_bar = {
                "(paper App. A eqs. (19)-(20) and eq. (15); catalogue C3)",
     .toleranceReason = "catalogue C3 [REC]: 1 % for a stiff contact",
     .seriesLabel = "spin of the bar about -y, rad/s",
+    .kind = pd_gkModelPrediction,
+    .appliesTo = PD_GK_SOFT | PD_GK_ODE_MATCHED | PD_GK_BULLET_MATCHED,
+    .notApplicableReason = "ODE and Bullet native: a rigid impact applies the requested e at any effective mass; "
+                           "e_eff(m_eff) is the soft model's",
     .relative = true,
     .fast = true,
     .inputCount = 1,
@@ -266,6 +272,7 @@ const pdGkExperiment pd_gk_c4_velocity_exchange = {
     .formula = "v_b'/v0 = 1: equal masses, e = 1, one dimension (catalogue C4)",
     .toleranceReason = "1e-3: energy is conserved to the integration tolerance over the ~20 ms contact",
     .seriesLabel = "velocity of the struck cube over the launch speed",
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = true,
     .inputCount = 1,
@@ -318,6 +325,7 @@ const pdGkExperiment pd_gk_c6_energy_gain = {
                "measured: largest rise of E (kinetic + gravitational + springs) over E(0)",
     .toleranceReason = "catalogue C6: violations < 1e-6 E0 (integration error only)",
     .seriesLabel = "energy over its initial value",
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = false,
     .inputName = "mu",
@@ -327,4 +335,83 @@ const pdGkExperiment pd_gk_c6_energy_gain = {
     .expect = c6_expect,
     .measure = c6_measure,
     .series = c6_series,
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// C5: oblique impact (the DEM benchmark family of Chung & Ooi 2011, catalogue C5) in gross slip. A regular
+// octahedron (vertex 0.1 m from its centre, m_eff = m along the normal) hits a fixed plate vertex first at
+// 1 m/s down and v_t across, gravity off, μ = 0.3, e = 0.5. While the vertex slides, Coulomb's law holds the
+// tangential force at μ times the normal force, so the impulses are in that ratio: |Δv_t| = μ |Δv_n| for the
+// centre of mass, whatever the contact's stiffness, damping or duration. The vertex keeps sliding when
+// v_t > μ (1 + e) v_n (1 + m r²/I) = 2.7 v_n (I = m r²/5): inputs v_t/v_n = 4 and 8. At lower v_t the
+// tangential spring would stop the slip and rebound (the tangential restitution of Schwager & Pöschel 2008):
+// a prediction of the model, not tested here.
+
+#define C5_MU 0.3
+#define C5_IMPACT_THRESHOLD 1e-6  // m/s: gravity off, so free flight keeps its velocity to round-off
+
+static void c5_scene(double ratio, pdGkText* out) {
+  pd_gk_text_printf(out,
+                    "gravity 0 0 0\ntend 0.2\nsample 2000\ntol 1e-9\nvmax %.17g\n"
+                    "cube plate grey 1 0.3 0.2\nfixed\nloc 0.3 0 -0.1\nmu %g\nrestitution 0.5\n"
+                    "hull oct red 0.1 0 0  -0.1 0 0  0 0.1 0  0 -0.1 0  0 0 0.1  0 0 -0.1\n"
+                    "loc 0 0 0.12\nvel %.17g 0 -1\nmu %g\nrestitution 0.5\n",
+                    hypot(ratio, 1.0), C5_MU, ratio, C5_MU);
+}
+
+static pdGkExpected c5_expect(const pdModel* model, double ratio) {
+  (void)ratio;
+  return (pdGkExpected){pd_model_pair_contact(model, gk_body(model, "oct"), gk_body(model, "plate")).mu, 0.01};
+}
+
+static void c5_measure(const pdModel* model, const pdGkRecord* rec, double ratio, pdGkMeasured* out) {
+  (void)ratio;
+  int j = gk_moving(model, "oct");
+  double* vz = gk_column(rec, j, gk_get_vz);
+  double* vx = gk_column(rec, j, gk_get_vx);
+  pdGkImpact impact;
+  if (pd_gk_first_impact(rec->t, vz, rec->count, 0.0, C5_IMPACT_THRESHOLD, 3, &impact)) {
+    double dvx = vx[rec->count - 1] - vx[0];
+    out->value = pd_gk_impulse_ratio(vx[0], vx[rec->count - 1], impact.vIn, impact.vOut);
+    pdBodyState last = pd_gk_body(rec, rec->count - 1, j);
+    gk_note(out, "impact %.4g..%.4g s: dv_t %.6g m/s, dv_n %.6g m/s (e %.4g); spin after %.4g rad/s", impact.tStart,
+            impact.tEnd, dvx, impact.vOut - impact.vIn, impact.restitution, pd_v3_norm(last.w));
+  } else {
+    gk_note(out, "no complete impact in the run");
+  }
+  free(vz);
+  free(vx);
+}
+
+// v_t against the Coulomb line v_t0 − μ (v_n − v_n0) drawn through the measured normal velocity
+static double c5_series(const pdModel* model, const pdGkRecord* rec, int k, double ratio, double* analytic) {
+  (void)ratio;
+  int j = gk_moving(model, "oct");
+  pdBodyState b0 = pd_gk_body(rec, 0, j), b = pd_gk_body(rec, k, j);
+  *analytic = b0.v.x - c5_expect(model, ratio).value * (b.v.z - b0.v.z);
+  return b.v.x;
+}
+
+const pdGkExperiment pd_gk_c5_oblique_impact = {
+    .name = "c5_oblique_impact",
+    .group = 'C',
+    .title = "Oblique vertex impact in gross slip: tangential impulse = mu x normal impulse",
+    .quantity = "impulse_ratio",
+    .unit = "",
+    .formula = "|dv_t|/|dv_n| = mu (Coulomb's law through a sliding impact; catalogue C5, the oblique-impact "
+               "benchmarks of Chung & Ooi 2011), measured on the centre of mass over the first impact",
+    .toleranceReason = "1 % [REC]: exact for a contact that slides throughout; an engine whose friction is "
+                       "regularised or whose slip stops during the impact falls short of mu",
+    .seriesLabel = "tangential velocity of the octahedron, m/s (analytic: the Coulomb line through the measured "
+                   "normal velocity)",
+    .kind = pd_gkLaw,
+    .relative = true,
+    .fast = false,
+    .inputName = "vt_over_vn",
+    .inputCount = 2,
+    .inputs = {4.0, 8.0},
+    .scene = c5_scene,
+    .expect = c5_expect,
+    .measure = c5_measure,
+    .series = c5_series,
 };

@@ -127,6 +127,7 @@ const pdGkExperiment pd_gk_e1_painleve = {
     .toleranceReason = "10 %: the soft contact needs about one contact period (~2 ms at deflection 0.0025) to "
                        "take up the load the rigid rod feels at once; E1's qualitative check otherwise",
     .seriesLabel = "slip velocity of the rod's foot, m/s",
+    .kind = pd_gkLaw,
     .relative = true,
     .fast = true,
     .inputName = "mu",
@@ -193,6 +194,10 @@ const pdGkExperiment pd_gk_e2_side_load_pitch = {
                "from the static balance of 4 corner springs)",
     .toleranceReason = "1 %: second-order terms in phi (~5e-4 rad) are far smaller; the dampers settle it in 0.1 s",
     .seriesLabel = "pitch of the cube about y, rad",
+    .kind = pd_gkModelPrediction,
+    .appliesTo = PD_GK_SOFT | PD_GK_ODE_MATCHED | PD_GK_BULLET_MATCHED,
+    .notApplicableReason = "ODE and Bullet native: a rigid contact does not deflect, so it does not pitch under the "
+                           "side load (the rigid split is indeterminate)",
     .relative = true,
     .fast = true,
     .inputCount = 1,

@@ -1,4 +1,4 @@
-// polydyn gedanken — group F: gyroscopic motion (catalogue §2 F1).
+// polydyn gedanken — group F: gyroscopic motion (catalogue §2 F1, F2).
 #include <stdlib.h>
 
 #include "gedanken_internal.h"
@@ -136,6 +136,7 @@ const pdGkExperiment pd_gk_f1_top_precession = {
     .toleranceReason = "catalogue F1 [REC]: 2 % for w3 >= 10 sqrt(m g l I1)/I3; started in steady precession, "
                        "the nutation the settling tip spring adds averages out of the fitted rate",
     .seriesLabel = "azimuth of the top's axis, rad",
+    .kind = pd_gkLaw,
     .relative = true,
     .fast = false,
     .inputName = "spin",
@@ -145,4 +146,104 @@ const pdGkExperiment pd_gk_f1_top_precession = {
     .expect = f1_expect,
     .measure = f1_measure,
     .series = f1_series,
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// F2: Euler's disk. A 24-gon disc (circumradius 0.05 m, 1 cm thick) stands on its rim tilted 10° from
+// upright, spinning at 25 rad/s about the vertical, on a floor with μ 0.5. It falls over rolling on its rim
+// and settles flat; the catalogue has no reliable closed form with dissipation (F2: qualitative). What every
+// engine must show (Moffatt 2000; Euler's disk's finite-time singularity): as the disc's angle α to the floor
+// falls, the precession of its rim — the turning rate of its axis' heading — speeds up (Ω² ∝ 1/α for a
+// rolling disc at small α, while the spin about its axis dies), and it ends lying flat at rest. Measured: the
+// mean heading rate while α is 2..6° over the rate while α is 40..50°; the check: that ratio > 2, the disc
+// flat (α < 1°) and still (speed < 1e-3 m/s) at the end. The energy gain is reported (C6 judges it).
+
+#define F2_TILT 80.0  // degrees: axis from the vertical
+#define F2_SPIN 25.0  // rad/s about the vertical
+#define F2_RADIUS 0.05
+#define F2_THICK 0.01
+#define F2_SPEEDUP 2.0
+
+static pdQuat f2_rotation(void) { return pd_quat_from_axis_angle(pd_v3(1.0, 0.0, 0.0), F2_TILT * M_PI / 180.0); }
+
+static void f2_scene(double input, pdGkText* out) {
+  (void)input;
+  double phi = F2_TILT * M_PI / 180.0;
+  // the lowest point of the rim 0.1 mm above the floor; ω about world z in the body's axes
+  double z = F2_RADIUS * sin(phi) + 0.5 * F2_THICK * cos(phi) + 1e-4;
+  pdQuat q = f2_rotation(), qc = {q.w, -q.x, -q.y, -q.z};
+  pdVec3 axis = pd_quat_rotate(qc, pd_v3(0.0, 0.0, 1.0));
+  pd_gk_text_printf(out, "tend 3\nsample 2000\ntol 1e-7\nvmax 1\n");
+  gk_text_floor(out, 1.0, 1.0, 0.2, 0.0, "mu 0.5\nrestitution 0.3\n");
+  pd_gk_text_printf(out, "prism disc red 24 %g %g %g\nloc 0 0 %.17g", 2.0 * F2_RADIUS, 2.0 * F2_RADIUS, F2_THICK, z);
+  gk_text_rotation(out, q);
+  pd_gk_text_printf(out, "\nvel 0 0 0  %.17g %.17g %.17g %.17g\nmu 0.5\nrestitution 0.3\n", F2_SPIN * 180.0 / M_PI,
+                    axis.x, axis.y, axis.z);
+}
+
+static pdGkExpected f2_expect(const pdModel* model, double input) {
+  (void)model, (void)input;
+  return (pdGkExpected){NAN, 0.0};
+}
+
+// the disc's angle to the floor (its axis from the vertical, folded to 0..90°), and its axis' heading
+static double f2_floor_angle(const pdBodyState* b) {
+  double t = gk_get_tilt_deg(b);
+  return t > 90.0 ? 180.0 - t : t;
+}
+static double f2_heading(const pdBodyState* b) {
+  pdVec3 a = pd_quat_rotate(b->q, pd_v3(0.0, 0.0, 1.0));
+  return atan2(a.y, a.x);
+}
+
+static void f2_measure(const pdModel* model, const pdGkRecord* rec, double input, pdGkMeasured* out) {
+  (void)input;
+  int j = gk_moving(model, "disc");
+  double* angle = gk_column(rec, j, f2_floor_angle);
+  double* heading = gk_column(rec, j, f2_heading);
+  pd_gk_unwrap(heading, rec->count);
+  double early, late;
+  pdBodyState last = pd_gk_body(rec, rec->count - 1, j);
+  double speed = pd_v3_norm(last.v), finalAngle = angle[rec->count - 1], gain = gk_energy_gain(rec);
+  bool flat = finalAngle < 1.0 && speed < 1e-3;
+  if (!pd_gk_mean_rate_in_band(rec->t, heading, angle, rec->count, 40.0, 50.0, &early) ||
+      !pd_gk_mean_rate_in_band(rec->t, heading, angle, rec->count, 2.0, 6.0, &late) || early == 0.0) {
+    gk_note(out, "the disc never rolled through 40..50 deg and 2..6 deg to the floor; at the end %.3g deg, %.3g m/s",
+            finalAngle, speed);
+  } else {
+    out->value = fabs(late / early);
+    out->pass = out->value > F2_SPEEDUP && flat;
+    gk_note(out, "heading rate %.4g rad/s at 40..50 deg, %.4g rad/s at 2..6 deg; at the end %.3g deg to the floor, "
+            "%.3g m/s; energy gain %.3g E0", early, late, finalAngle, speed, gain);
+  }
+  free(angle);
+  free(heading);
+}
+
+static double f2_series(const pdModel* model, const pdGkRecord* rec, int k, double input, double* analytic) {
+  (void)input;
+  *analytic = NAN;
+  return gk_series_value(rec, k, gk_moving(model, "disc"), f2_floor_angle);
+}
+
+const pdGkExperiment pd_gk_f2_euler_disk = {
+    .name = "f2_euler_disk",
+    .group = 'F',
+    .title = "Euler's disk: the precession speeds up as the disc falls flat (qualitative)",
+    .quantity = "precession_speedup",
+    .unit = "",
+    .formula = "qualitative: the heading rate of the disc's axis at 2..6 deg to the floor is more than twice that at "
+               "40..50 deg (Euler's disk's finite-time singularity; catalogue F2: no closed form with "
+               "dissipation), and the disc ends flat (< 1 deg) and still (< 1e-3 m/s)",
+    .toleranceReason = "a factor 2: a rolling disc's precession grows as 1/sqrt(angle), about 3x between the two bands",
+    .seriesLabel = "angle of the disc to the floor, deg",
+    .kind = pd_gkLaw,
+    .qualitative = true,
+    .relative = false,
+    .fast = false,
+    .inputCount = 1,
+    .scene = f2_scene,
+    .expect = f2_expect,
+    .measure = f2_measure,
+    .series = f2_series,
 };

@@ -1,4 +1,4 @@
-// polydyn gedanken — group G: several bodies (catalogue §2 G1, G2).
+// polydyn gedanken — group G: several bodies (catalogue §2 G1–G3).
 #include <stdlib.h>
 
 #include "gedanken_internal.h"
@@ -77,6 +77,7 @@ const pdGkExperiment pd_gk_g1_stack_drift = {
     .formula = "0: a stack at rest stays (catalogue G1); measured: largest |x(2 s) - x(1 s)|/1 s over the cubes",
     .toleranceReason = "catalogue G1 [REC]: drift < 1e-9 m/s; contact count constant",
     .seriesLabel = "height of the top cube's centre, m",
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = true,
     .inputCount = 1,
@@ -126,6 +127,9 @@ const pdGkExperiment pd_gk_g1_stack_sinkage = {
                "(catalogue G1; 4 corner contacts on the floor, 8 edge crossings between cubes turned 45 deg)",
     .toleranceReason = "1 %: settled after 2 s (dampers of e = 0.5); the springs' static deflection is exact",
     .seriesLabel = "sinkage of the top cube, m",
+    .kind = pd_gkModelPrediction,
+    .appliesTo = PD_GK_SOFT | PD_GK_ODE_MATCHED | PD_GK_BULLET_MATCHED,
+    .notApplicableReason = "ODE and Bullet native: a rigid contact does not sink",
     .relative = true,
     .fast = false,
     .inputCount = 1,
@@ -187,6 +191,7 @@ const pdGkExperiment pd_gk_g2_domino = {
     .formula = "90 (toppled) when 1/2 I_edge w0^2 >= m g (sqrt((h/2)^2 + (t/2)^2) - h/2), else 0 (catalogue G2)",
     .toleranceReason = "5 deg: the outcome is a resting pose (on its face or its base), exact up to the sinkage",
     .seriesLabel = "tilt of the domino from upright, deg",
+    .kind = pd_gkLaw,
     .relative = false,
     .fast = false,
     .inputName = "omega_ratio",
@@ -196,4 +201,85 @@ const pdGkExperiment pd_gk_g2_domino = {
     .expect = g2_expect,
     .measure = g2_measure,
     .series = g2_series,
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// G3: SimBenchmark's "rolling" test (leggedrobotics/SimBenchmark, catalogue G3) with polyhedral loads: a
+// 0.6 × 0.6 × 0.03 m board (10.8 kg) carrying 25 cubes of 1 kg (0.1 m, 5 × 5, 2 cm apart) is pushed along x by
+// 150 N at its centre of mass over a level floor, μ 0.2 board–floor and 0.4 cube–board (μ² = 0.2 × 0.8: the
+// product rule of √(μ₁μ₂)). The cubes need μ >= a/g = 0.23 to ride along, so they stick and the whole load
+// slides as one body: a = (F − μ_g (M + n m) g)/(M + n m) (catalogue G3, cubes instead of rolling balls).
+
+#define G3_PUSH 150.0   // N
+#define G3_FROM 0.1     // s: after the tangential springs have loaded
+#define G3_TEND 0.6
+#define G3_CUBES 5      // per side
+
+static void g3_scene(double input, pdGkText* out) {
+  (void)input;
+  pd_gk_text_printf(out, "tend %g\nsample 500\ntol 1e-7\nvmax 1.5\n", G3_TEND);
+  gk_text_floor(out, 3.0, 1.0, 0.2, 1.0, "mu 0.2\nrestitution 0.5\n");
+  pd_gk_text_printf(out, "cube board blue 0.6 0.6 0.03\nloc 0 0 0.015\nmu 0.2\nrestitution 0.5\nforce %g 0 0\n",
+                    G3_PUSH);
+  for (int i = 0; i < G3_CUBES; ++i)
+    for (int k = 0; k < G3_CUBES; ++k)
+      pd_gk_text_printf(out, "cube c%d%d red 0.1 0.1 0.1\nloc %g %g 0.08\nmu 0.8\nrestitution 0.5\n", i, k,
+                        0.12 * (i - 2), 0.12 * (k - 2));
+}
+
+// the load's total mass and the board–floor pair's μ
+static double g3_predicted(const pdModel* model) {
+  double mass = 0.0;
+  for (int i = 0; i < model->bodyCount; ++i)
+    if (model->bodies[i].stateIndex >= 0) mass += model->bodies[i].mass;
+  double mu = pd_model_pair_contact(model, gk_body(model, "board"), gk_body(model, "floor")).mu;
+  return (G3_PUSH - mu * mass * pd_v3_norm(model->settings.gravity)) / mass;
+}
+
+static pdGkExpected g3_expect(const pdModel* model, double input) {
+  (void)input;
+  return (pdGkExpected){g3_predicted(model), 0.01};
+}
+
+static void g3_measure(const pdModel* model, const pdGkRecord* rec, double input, pdGkMeasured* out) {
+  (void)input;
+  int board = gk_moving(model, "board");
+  if (!gk_measure_slope(rec, board, gk_get_vx, G3_FROM, G3_TEND, "board's speed", out)) return;
+  // how far the cubes moved on the board (0 when they stick)
+  pdBodyState b0 = pd_gk_body(rec, 0, board), b1 = pd_gk_body(rec, rec->count - 1, board);
+  double slip = 0.0;
+  for (int j = 0; j < rec->bodies; ++j) {
+    if (j == board) continue;
+    pdBodyState c0 = pd_gk_body(rec, 0, j), c1 = pd_gk_body(rec, rec->count - 1, j);
+    slip = fmax(slip, pd_v3_norm(pd_v3_sub(pd_v3_sub(c1.x, c0.x), pd_v3_sub(b1.x, b0.x))));
+  }
+  size_t n = strlen(out->note);
+  snprintf(out->note + n, sizeof out->note - n, "; largest slip of a cube on the board %.3g m", slip);
+}
+
+static double g3_series(const pdModel* model, const pdGkRecord* rec, int k, double input, double* analytic) {
+  (void)input;
+  *analytic = g3_predicted(model) * rec->t[k];
+  return gk_series_value(rec, k, gk_moving(model, "board"), gk_get_vx);
+}
+
+const pdGkExperiment pd_gk_g3_pushed_load = {
+    .name = "g3_pushed_load",
+    .group = 'G',
+    .title = "Board carrying 25 cubes pushed by 150 N over a floor, mu 0.2 (SimBenchmark rolling)",
+    .quantity = "acceleration",
+    .unit = "m/s^2",
+    .formula = "a = (F - mu_g (M + n m) g)/(M + n m): the cubes stick (mu 0.4 >= a/g) and the load slides as one "
+               "body (catalogue G3: SimBenchmark's rolling test with cubes that stick instead of rolling balls)",
+    .toleranceReason = "1 % [REC] (catalogue B4's 0.5 % for two bodies, relaxed for 26 bodies and 104 corner "
+                       "contacts): fitted over 0.1..0.6 s, after the tangential springs have loaded",
+    .seriesLabel = "speed of the board, m/s",
+    .kind = pd_gkLaw,
+    .relative = true,
+    .fast = false,
+    .inputCount = 1,
+    .scene = g3_scene,
+    .expect = g3_expect,
+    .measure = g3_measure,
+    .series = g3_series,
 };

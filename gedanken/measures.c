@@ -167,6 +167,28 @@ bool pd_gk_drift_speed(const double* t, const pdVec3* x, int n, double t0, doubl
   return true;
 }
 
+double pd_gk_impulse_ratio(double vt0, double vt1, double vn0, double vn1) {
+  return vn1 == vn0 ? NAN : fabs(vt1 - vt0) / fabs(vn1 - vn0);
+}
+
+double pd_gk_absorbed_fraction(double energyBefore, double energyAfter, double kineticBefore) {
+  PD_ASSERT(kineticBefore > 0.0);
+  return (energyBefore - energyAfter) / kineticBefore;
+}
+
+bool pd_gk_mean_rate_in_band(const double* t, const double* angle, const double* band, int n, double lo, double hi,
+                             double* rate) {
+  double turned = 0.0, time = 0.0;
+  for (int k = 0; k + 1 < n; ++k)
+    if (band[k] >= lo && band[k] <= hi && band[k + 1] >= lo && band[k + 1] <= hi) {
+      turned += angle[k + 1] - angle[k];
+      time += t[k + 1] - t[k];
+    }
+  if (!(time > 0.0)) return false;
+  *rate = turned / time;
+  return true;
+}
+
 void pd_gk_unwrap(double* angle, int n) {
   const double twoPi = 2.0 * M_PI;
   double offset = 0.0;

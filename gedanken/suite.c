@@ -19,7 +19,21 @@
 #include "polydyn/refcheck.h"
 
 const char* const pdGkEngineNames[pd_gkEngineCount] = {"soft", "ode", "bullet"};
-const char* const pdGkStatusNames[] = {"PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR"};
+const char* const pdGkStatusNames[] = {"PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR", "NOT_APPLICABLE"};
+const char* const pdGkKindNames[] = {"law", "model_prediction"};
+
+unsigned pd_gk_variant_bit(pdGkEngine engine, bool matched) {
+  switch (engine) {
+    case pd_gkSoft: return PD_GK_SOFT;
+    case pd_gkOde: return matched ? PD_GK_ODE_MATCHED : PD_GK_ODE_NATIVE;
+    case pd_gkBullet: return matched ? PD_GK_BULLET_MATCHED : PD_GK_BULLET_NATIVE;
+    default: PD_ASSERT(!"no such engine"); return 0;
+  }
+}
+
+bool pd_gk_applies(const pdGkExperiment* e, pdGkEngine engine, bool matched) {
+  return e->kind == pd_gkLaw || (e->appliesTo & pd_gk_variant_bit(engine, matched)) != 0;
+}
 
 enum { SERIES_MAX_ROWS = 500 };  // per run (RESULT_SCHEMAS.md: "at most ~500 rows per run")
 
@@ -105,10 +119,12 @@ typedef struct gkJob {
   bool done;
 } gkJob;
 
-static const char* variant_name(const gkJob* job) {
-  if (job->engine == pd_gkSoft) return "adaptive";
-  return job->variant == pd_refMatched ? "matched" : "native";
+static const char* variant_of(pdGkEngine engine, bool matched) {
+  if (engine == pd_gkSoft) return "adaptive";
+  return matched ? "matched" : "native";
 }
+
+static const char* variant_name(const gkJob* job) { return variant_of(job->engine, job->variant == pd_refMatched); }
 
 typedef struct gkSuite {
   const pdGkOptions* options;
@@ -167,16 +183,21 @@ static void judge(gkJob* job, const pdGkRecord* rec) {
   job->measured = isfinite(m.value) ? m.value : NAN;
   const char* prefix = e->relative && isfinite(c->expected.value) ? "relative error; " : "";
   job_note(job, "%s%s", prefix, m.note);
-  if (!isfinite(c->expected.value)) {  // a qualitative check: the measure decides
+  if (isfinite(c->expected.value) && !isnan(job->measured))
+    job->error = e->relative ? fabs(job->measured / c->expected.value - 1.0) : fabs(job->measured - c->expected.value);
+  if (!pd_gk_applies(e, job->engine, job->variant == pd_refMatched)) {  // recorded, not judged
+    job->status = pd_gkNotApplicable;
+    char measured[sizeof job->note];
+    snprintf(measured, sizeof measured, "%s", job->note);
+    job_note(job, "not applicable: %s; %s", e->notApplicableReason, measured);
+    return;
+  }
+  if (!isfinite(c->expected.value))  // a qualitative check: the measure decides
     job->status = m.pass ? pd_gkPass : pd_gkFail;
-    return;
-  }
-  if (isnan(job->measured)) {
+  else if (isnan(job->measured))
     job->status = pd_gkFail;
-    return;
-  }
-  job->error = e->relative ? fabs(job->measured / c->expected.value - 1.0) : fabs(job->measured - c->expected.value);
-  job->status = job->error <= c->expected.tolerance ? pd_gkPass : pd_gkFail;
+  else
+    job->status = job->error <= c->expected.tolerance ? pd_gkPass : pd_gkFail;
 }
 
 static void write_series(gkJob* job, const pdGkRecord* rec) {
@@ -343,7 +364,7 @@ static bool write_results(const gkSuite* s, pdError* err) {
   for (int i = 0; i < s->jobCount; ++i) {
     const gkJob* job = &s->jobs[i];
     const pdGkExperiment* e = job->c->experiment;
-    bool judged = job->status == pd_gkPass || job->status == pd_gkFail;
+    bool judged = job->status == pd_gkPass || job->status == pd_gkFail || job->status == pd_gkNotApplicable;
     bool quantitative = isfinite(job->c->expected.value);
     pd_write_csv_text(out, e->name);
     fprintf(out, ",%c,", e->group);
@@ -402,7 +423,16 @@ static bool write_experiments(const gkSuite* s, pdError* err) {
       fprintf(out, "%s\"%s\": ", f ? ", " : "", fields[f].key);
       pd_write_json_string(out, fields[f].value);
     }
-    fprintf(out, ", \"qualitative\": %s, \"scene\": \"generated\", \"series_label\": ", e->qualitative ? "true" : "false");
+    fprintf(out, ", \"qualitative\": %s, \"kind\": \"%s\", \"applies_to\": [", e->qualitative ? "true" : "false",
+            pdGkKindNames[e->kind]);
+    for (int engine = 0, n = 0; engine < pd_gkEngineCount; ++engine)
+      for (int v = 0; v < (engine == pd_gkSoft ? 1 : 2); ++v)
+        if (pd_gk_applies(e, (pdGkEngine)engine, v))
+          fprintf(out, "%s\"%s-%s\"", n++ ? ", " : "", pdGkEngineNames[engine], variant_of((pdGkEngine)engine, v));
+    fputs("], \"not_applicable_reason\": ", out);
+    if (e->kind == pd_gkLaw) fputs("null", out);
+    else pd_write_json_string(out, e->notApplicableReason);
+    fputs(", \"scene\": \"generated\", \"series_label\": ", out);
     pd_write_json_string(out, e->seriesLabel);
     fputc('}', out);
   }

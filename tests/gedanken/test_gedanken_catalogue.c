@@ -49,7 +49,46 @@ static void test_every_experiment_is_complete(void** state) {
     // names are file and directory names (series/NAME.csv, runs/NAME/) and CSV fields
     assert_true(strspn(e->name, "abcdefghijklmnopqrstuvwxyz0123456789_") == strlen(e->name));
     assert_true(e->name[0] == e->group - 'A' + 'a');
+    // issue 17 item 4: a law is judged on every variant; a model prediction on the soft engine at least (its
+    // own model) and not on every variant, with the reason for the others
+    assert_true(e->kind == pd_gkLaw || e->kind == pd_gkModelPrediction);
+    if (e->kind == pd_gkLaw) {
+      assert_int_equal(e->appliesTo, 0);
+      assert_null(e->notApplicableReason);
+    } else {
+      assert_true((e->appliesTo & PD_GK_SOFT) && (e->appliesTo & ~(unsigned)PD_GK_ALL_VARIANTS) == 0);
+      assert_true(e->appliesTo != PD_GK_ALL_VARIANTS);
+      assert_true(e->notApplicableReason && strlen(e->notApplicableReason) > 10);
+    }
   }
+}
+
+// The variants judged: every one for a law; for a model prediction exactly those of appliesTo.
+static void test_applicability_follows_the_kind(void** state) {
+  (void)state;
+  int predictions = 0;
+  for (int i = 0; i < pd_gk_experiment_count(); ++i) {
+    const pdGkExperiment* e = pd_gk_experiment(i);
+    predictions += e->kind == pd_gkModelPrediction;
+    int judged = 0;
+    for (int engine = 0; engine < pd_gkEngineCount; ++engine)
+      for (int matched = 0; matched < 2; ++matched) {
+        bool applies = pd_gk_applies(e, (pdGkEngine)engine, matched);
+        if (e->kind == pd_gkLaw) assert_true(applies);
+        else assert_int_equal(applies, (e->appliesTo & pd_gk_variant_bit((pdGkEngine)engine, matched)) != 0);
+        judged += applies && !(engine == pd_gkSoft && matched);
+      }
+    if (e->kind == pd_gkLaw) assert_int_equal(judged, 5);
+  }
+  // the issue's examples: sinkage is the soft model's, a stop distance and momentum are laws
+  assert_int_equal(pd_gk_find("a3_sinkage")->kind, pd_gkModelPrediction);
+  assert_false(pd_gk_applies(pd_gk_find("a3_sinkage"), pd_gkOde, false));
+  assert_true(pd_gk_applies(pd_gk_find("a3_sinkage"), pd_gkOde, true));
+  assert_int_equal(pd_gk_find("b2_stopping_distance")->kind, pd_gkLaw);
+  assert_int_equal(pd_gk_find("c2_momentum")->kind, pd_gkLaw);
+  assert_true(predictions >= 1 && predictions < pd_gk_experiment_count());
+  assert_string_equal(pdGkStatusNames[pd_gkNotApplicable], "NOT_APPLICABLE");
+  assert_string_equal(pdGkKindNames[pd_gkModelPrediction], "model_prediction");
 }
 
 static void test_every_scene_compiles_with_a_finite_expectation(void** state) {
@@ -90,6 +129,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_catalogue_covers_every_group),
       cmocka_unit_test(test_every_experiment_is_complete),
+      cmocka_unit_test(test_applicability_follows_the_kind),
       cmocka_unit_test(test_every_scene_compiles_with_a_finite_expectation),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -58,7 +58,7 @@ check "restitution rows for several requested e" \
 check "every run directory exists with trajectory, summary and scene" \
   '[ "$(csv_query "$FAST/results.csv" "all(all(__import__(\"os\").path.isfile(\"$FAST/\" + r[\"run_dir\"] + \"/\" + f) for f in (\"trajectory.csv\", \"summary.json\", \"scene.scene\")) for r in rows)")" = True ]'
 check "experiments.json lists the experiments run, with the schema's fields" \
-  '[ "$(python3 -c "import json; d = json.load(open(\"$FAST/experiments.json\")); print(all(set(e) == {\"name\", \"group\", \"title\", \"quantity\", \"unit\", \"formula\", \"tolerance_reason\", \"qualitative\", \"scene\", \"series_label\"} for e in d) and len(d))")" = "$(csv_query "$FAST/results.csv" "len({r[\"experiment\"] for r in rows})")" ]'
+  '[ "$(python3 -c "import json; d = json.load(open(\"$FAST/experiments.json\")); print(all(set(e) == {\"name\", \"group\", \"title\", \"quantity\", \"unit\", \"formula\", \"tolerance_reason\", \"qualitative\", \"kind\", \"applies_to\", \"not_applicable_reason\", \"scene\", \"series_label\"} for e in d) and len(d))")" = "$(csv_query "$FAST/results.csv" "len({r[\"experiment\"] for r in rows})")" ]'
 check "one series file per experiment, with its header and at most 500 rows per run" \
   '[ "$(python3 -c "import csv, glob, collections; fs = glob.glob(\"$FAST/series/*.csv\"); n = [collections.Counter((r[\"engine\"], r[\"variant\"], r[\"input\"]) for r in csv.DictReader(open(f))) for f in fs]; print(len(fs), all(open(f).readline().strip() == \"t,engine,variant,input,value,analytic\" for f in fs), max(max(c.values()) for c in n) <= 500)")" = "$(csv_query "$FAST/results.csv" "len({r[\"experiment\"] for r in rows})") True True" ]'
 check "a run directory replays: its scene.scene gives the same trajectory" \
@@ -83,8 +83,16 @@ run_pd gedanken --only a3_sinkage --out "$REF"
 check "all engines: exit 0 when the soft engine passes" '[ $rc -eq 0 ]'
 check "all engines: one soft row and ode/bullet native and matched rows" \
   '[ "$(csv_query "$REF/results.csv" "[(r[\"engine\"], r[\"variant\"]) for r in rows]")" = "[('"'"'soft'"'"', '"'"'adaptive'"'"'), ('"'"'ode'"'"', '"'"'native'"'"'), ('"'"'ode'"'"', '"'"'matched'"'"'), ('"'"'bullet'"'"', '"'"'native'"'"'), ('"'"'bullet'"'"', '"'"'matched'"'"')]" ]'
-check "all engines: statuses from the schema; a run directory exactly for PASS and FAIL (and some ERRORs)" \
-  '[ "$(csv_query "$REF/results.csv" "all(r[\"status\"] in (\"PASS\", \"FAIL\", \"REFUSED\", \"NOT_BUILT\", \"ERROR\") and (r[\"status\"] == \"ERROR\" or (r[\"run_dir\"] != \"\") == (r[\"status\"] in (\"PASS\", \"FAIL\"))) for r in rows)")" = True ]'
+check "all engines: statuses from the schema; a run directory exactly for PASS, FAIL, NOT_APPLICABLE (and some ERRORs)" \
+  '[ "$(csv_query "$REF/results.csv" "all(r[\"status\"] in (\"PASS\", \"FAIL\", \"REFUSED\", \"NOT_BUILT\", \"ERROR\", \"NOT_APPLICABLE\") and (r[\"status\"] == \"ERROR\" or (r[\"run_dir\"] != \"\") == (r[\"status\"] in (\"PASS\", \"FAIL\", \"NOT_APPLICABLE\"))) for r in rows)")" = True ]'
+# a3_sinkage is a prediction of the soft model (issue 17 item 4): judged on soft and the matched variants; the
+# rigid native variants still run and record their sinkage, not judged, with the reason in the note
+check "model prediction: native rows NOT_APPLICABLE (or NOT_BUILT) with the reason, matched and soft judged" \
+  '[ "$(csv_query "$REF/results.csv" "all((r[\"status\"] == \"NOT_APPLICABLE\" and r[\"measured\"] != \"\" and r[\"note\"].startswith(\"not applicable: \") and \"rigid contact does not sink\" in r[\"note\"]) or r[\"status\"] == \"NOT_BUILT\" if r[\"variant\"] == \"native\" else r[\"status\"] in (\"PASS\", \"FAIL\", \"NOT_BUILT\") for r in rows)")" = True ]'
+check "model prediction: experiments.json names the kind, the judged variants and the reason" \
+  '[ "$(python3 -c "import json; e = json.load(open(\"$REF/experiments.json\"))[0]; print(e[\"kind\"], e[\"applies_to\"], e[\"not_applicable_reason\"])")" = "model_prediction ['"'"'soft-adaptive'"'"', '"'"'ode-matched'"'"', '"'"'bullet-matched'"'"'] ODE and Bullet native: a rigid contact does not sink" ]'
+check "a law: every variant judged, no reason" \
+  '[ "$(python3 -c "import json; e = [x for x in json.load(open(\"$FAST/experiments.json\")) if x[\"name\"] == \"c2_momentum\"][0]; print(e[\"kind\"], len(e[\"applies_to\"]), e[\"not_applicable_reason\"])")" = "law 5 None" ]'
 
 # --- a failing soft experiment exits 1, and still writes its results -----------------------------------
 FAILDIR=$SCRATCH/failing

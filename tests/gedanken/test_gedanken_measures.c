@@ -1,6 +1,8 @@
 // The gedanken measures on synthetic series with known answers: the line fit, the first impact with and
 // without gravity, apex heights, the first fall (stop time), the largest rise (energy gain), the drift
-// speed, angle unwrapping, and eq. (15)'s restitution of a damping ratio against the catalogue's table.
+// speed, angle unwrapping, eq. (15)'s restitution of a damping ratio against the catalogue's table, the
+// impulse ratio of an oblique impact (C5), the energy a cube's landing takes (D3) and a rate read within a
+// band of another series (F2's precession).
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -193,6 +195,74 @@ static void test_restitution_of_damping_matches_the_catalogue_table(void** state
   assert_true(pd_gk_restitution_of_damping(2.0) < exp(-2.0));
 }
 
+// A point mass hits a floor at v_n = −1 m/s, v_t = v_t0, under a half-sine normal force pulse of impulse
+// (1 + e) m (m = 1 kg); while it slides the tangential force is μ times the normal one, and a slip that would
+// reverse sticks at zero. The impulse so far is P(t) = (1 + e) m (1 − cos(π t/T))/2, taken in 100 steps.
+static void sliding_impact(double vt0, double mu, double e, double* vt1, double* vn1) {
+  double vt = vt0, vn = -1.0;
+  const double pi = acos(-1.0);
+  for (int k = 1; k <= 100; ++k) {
+    double p0 = (1.0 + e) * (1.0 - cos(pi * (k - 1) / 100.0)) / 2.0;
+    double p1 = (1.0 + e) * (1.0 - cos(pi * k / 100.0)) / 2.0;
+    vn += p1 - p0;
+    vt = fmax(0.0, vt - mu * (p1 - p0));
+  }
+  *vt1 = vt;
+  *vn1 = vn;
+}
+
+static void test_impulse_ratio_is_mu_while_the_impact_slides(void** state) {
+  (void)state;
+  double vt1, vn1;
+  sliding_impact(4.0, 0.3, 0.5, &vt1, &vn1);  // slides throughout: Δv_t = 0.45 < 4
+  assert_true(fabs(vn1 - 0.5) < ROUND_OFF);
+  assert_true(fabs(pd_gk_impulse_ratio(4.0, vt1, -1.0, vn1) - 0.3) < ROUND_OFF);
+  // a slow slide stops during the impact: the tangential impulse falls short of μ times the normal one
+  sliding_impact(0.2, 0.3, 0.5, &vt1, &vn1);
+  assert_true(fabs(pd_gk_impulse_ratio(0.2, vt1, -1.0, vn1) - 0.2 / 1.5) < ROUND_OFF);
+  assert_true(isnan(pd_gk_impulse_ratio(1.0, 0.5, -1.0, -1.0)));  // no normal impulse: no ratio
+}
+
+static void test_absorbed_fraction_from_total_energies(void** state) {
+  (void)state;
+  // 2 J of kinetic energy at a landing 3 J above the zero of potential energy, 0.5 J of it left after: 3/4 taken
+  assert_true(fabs(pd_gk_absorbed_fraction(5.0, 3.5, 2.0) - 0.75) < ROUND_OFF);
+  assert_true(fabs(pd_gk_absorbed_fraction(5.0, 5.0, 2.0)) < ROUND_OFF);  // elastic: nothing taken
+}
+
+static void test_cube_landing_takes_fifteen_sixteenths_when_plastic(void** state) {
+  (void)state;
+  double spin;
+  // plastic: ω⁺/ω⁻ = (2 + 7 cos(2π/N))/(8 + cos(2π/N)) for an N-gon (catalogue D1), 1/4 for the cube; the
+  // energy about the new edge, whose inertia equals the old one's, is then (1/4)² of what it was
+  assert_true(fabs(pd_gk_cube_landing_absorbed(0.0, &spin) - 15.0 / 16.0) < ROUND_OFF);
+  double n = 4.0, c = cos(2.0 * acos(-1.0) / n);
+  assert_true(fabs(spin - (2.0 + 7.0 * c) / (8.0 + c)) < ROUND_OFF);
+  // elastic normal and no slip: neither impulse does work, nothing is taken
+  assert_true(fabs(pd_gk_cube_landing_absorbed(1.0, &spin)) < ROUND_OFF);
+  // between, the kinetic energy left is (1 + 15 e²)/16 of it (derived by hand from the same impulse balance)
+  for (double e = 0.1; e < 1.0; e += 0.2)
+    assert_true(fabs(pd_gk_cube_landing_absorbed(e, NULL) - 15.0 / 16.0 * (1.0 - e * e)) < ROUND_OFF);
+}
+
+static void test_mean_rate_in_band_reads_each_band_alone(void** state) {
+  (void)state;
+  // a heading turning at 20 rad/s while a tilt falls from 50 to 40, then at 100 rad/s while it falls from 6 to 2
+  double t[N], heading[N], tilt[N];
+  for (int k = 0; k < N; ++k) {
+    t[k] = 0.001 * k;
+    bool early = k <= 200;
+    tilt[k] = early ? 50.0 - 10.0 * k / 200.0 : 6.0 - 4.0 * (k - 201) / 199.0;
+    heading[k] = early ? 20.0 * t[k] : 20.0 * 0.2 + 100.0 * (t[k] - 0.2);
+  }
+  double rate;
+  assert_true(pd_gk_mean_rate_in_band(t, heading, tilt, N, 40.0, 50.0, &rate));
+  assert_true(fabs(rate - 20.0) < ROUND_OFF * 1e3);
+  assert_true(pd_gk_mean_rate_in_band(t, heading, tilt, N, 2.0, 6.0, &rate));
+  assert_true(fabs(rate - 100.0) < ROUND_OFF * 1e3);
+  assert_false(pd_gk_mean_rate_in_band(t, heading, tilt, N, 10.0, 30.0, &rate));  // never in that band
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_line_fit_recovers_the_slope_inside_the_window_only),
@@ -206,6 +276,10 @@ int main(void) {
       cmocka_unit_test(test_drift_speed_of_a_uniform_motion),
       cmocka_unit_test(test_unwrap_restores_a_steadily_turning_angle),
       cmocka_unit_test(test_restitution_of_damping_matches_the_catalogue_table),
+      cmocka_unit_test(test_impulse_ratio_is_mu_while_the_impact_slides),
+      cmocka_unit_test(test_absorbed_fraction_from_total_energies),
+      cmocka_unit_test(test_cube_landing_takes_fifteen_sixteenths_when_plastic),
+      cmocka_unit_test(test_mean_rate_in_band_reads_each_band_alone),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

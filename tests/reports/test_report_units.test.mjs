@@ -4,7 +4,7 @@ import test from 'node:test';
 import assert from 'node:assert/strict';
 import { parseCsv, writeCsv } from '../../reports/generator/lib/csv.mjs';
 import { parseJson, lineOf } from '../../reports/generator/lib/json.mjs';
-import { costToReach, matrix, orderEngineVariants, median } from '../../reports/generator/lib/derive.mjs';
+import { costToReach, matrix, orderEngineVariants, median, verdicts } from '../../reports/generator/lib/derive.mjs';
 import { num } from '../../reports/generator/lib/html.mjs';
 import { parseArgs, outputPaths } from '../../reports/generator/report.mjs';
 
@@ -78,6 +78,27 @@ test('matrix: a cell over several inputs has the worst status, the passing count
   assert.equal(c.error_over_tolerance, 4);
   assert.equal(c.worst_input, 'e=0.5');
   assert.equal(c.wall_seconds, 3);
+});
+
+test('verdict: a model prediction on a variant it does not apply to is n/a, never a pass or a failure', () => {
+  const row = (experiment, ev, status, error, note = '') => ({ experiment, engine: ev.split(' ')[0], variant: ev.split(' ')[1], ev,
+    input: '', inputValue: null, status, error, tolerance: 0.01, relative: true, wall_seconds: 1, line: 2, note });
+  const results = { rows: [
+    row('a3_sinkage', 'soft adaptive', 'PASS', 1e-9), row('a3_sinkage', 'ode native', 'NOT_APPLICABLE', 1, 'not applicable: a rigid contact does not sink; relative'),
+    row('b2_stop_time', 'soft adaptive', 'PASS', 1e-3), row('b2_stop_time', 'ode native', 'FAIL', 0.5)] };
+  const experiments = { list: [{ name: 'a3_sinkage', group: 'A', kind: 'model_prediction', not_applicable_reason: 'rigid: no sinkage' },
+    { name: 'b2_stop_time', group: 'B', kind: 'law' }] };
+  const m = matrix(results, experiments);
+  const na = m.cells.find((c) => c.ev === 'ode native' && c.experiment === 'a3_sinkage');
+  assert.equal(na.status, 'NOT_APPLICABLE');
+  assert.equal(na.not_applicable_reason, 'rigid: no sinkage');
+  assert.equal(matrix(results, null).cells.find((c) => c === na || (c.ev === 'ode native' && c.experiment === 'a3_sinkage')).not_applicable_reason,
+    'a rigid contact does not sink', 'without experiments.json the reason comes from the note');
+  const [soft, ode] = verdicts(m);
+  assert.deepEqual([soft.pass, soft.experiments, soft.not_applicable], [2, 2, []]);
+  // ODE: 0 of 1 applicable; its 100 × tolerance error on the sinkage is not its worst judged error
+  assert.deepEqual([ode.pass, ode.experiments, ode.fail, ode.not_applicable], [0, 1, ['b2_stop_time'], ['a3_sinkage']]);
+  assert.equal(ode.worst.experiment, 'b2_stop_time');
 });
 
 test('engine-variants are ordered soft, ode, bullet, then others; adaptive, native, matched within one', () => {

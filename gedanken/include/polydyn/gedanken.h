@@ -96,6 +96,21 @@ double pd_gk_largest_rise(const double* y, int n, double scale);
 // two samples in the window.
 bool pd_gk_drift_speed(const double* t, const pdVec3* x, int n, double t0, double* speed);
 
+// Ratio of the tangential to the normal velocity change of a body over an impact, |vt1 − vt0| / |vn1 − vn0|
+// (catalogue C5): μ for a contact that slides throughout, whatever its stiffness or duration. NAN when the
+// normal velocity did not change.
+double pd_gk_impulse_ratio(double vt0, double vt1, double vn0, double vn1);
+
+// The fraction of the kinetic energy before a landing that the landing took, (E0 − E1)/kinetic0, from the
+// total energies just before (E0) and just after (E1) — gravity does no net work in between then — and the
+// kinetic energy before (> 0).
+double pd_gk_absorbed_fraction(double energyBefore, double energyAfter, double kineticBefore);
+
+// The mean rate of change of `angle` (rad, unwrapped) over the sample intervals whose two ends both have
+// lo <= band <= hi: (Σ Δangle)/(Σ Δt) over those intervals. False when there is none.
+bool pd_gk_mean_rate_in_band(const double* t, const double* angle, const double* band, int n, double lo, double hi,
+                             double* rate);
+
 // Removes the 2π jumps of an angle series in place, so consecutive samples differ by less than π.
 void pd_gk_unwrap(double* angle, int n);
 
@@ -106,6 +121,13 @@ void pd_gk_unwrap(double* angle, int n);
 // e = exp(−2ζ arccos ζ / √(1−ζ²)) for ζ < 1, e⁻² at ζ = 1, and its continuation exp(−2ζ acosh ζ / √(ζ²−1))
 // for an overdamped contact (ζ > 1). ζ >= 0.
 double pd_gk_restitution_of_damping(double zeta);
+
+// A rigid cube pivoting about one bottom edge lands on the next face (catalogue D3): the impulse at the landing
+// edge leaves it with no tangential velocity (no slip) and a normal velocity −e times the one before
+// (e in [0, 1]). Returns the fraction of the kinetic energy the landing takes, from the impulse balance
+// (angular momentum about the landing edge), and ω⁺/ω⁻ in *spinRatio (nullable): 15/16 and 1/4 when
+// e = 0 (the plastic landing), 0 when e = 1.
+double pd_gk_cube_landing_absorbed(double e, double* spinRatio);
 
 // ---------------------------------------------------------------------------------------------------------
 // Experiments
@@ -135,6 +157,24 @@ typedef struct pdGkText {
 void pd_gk_text_printf(pdGkText* text, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 void pd_gk_text_free(pdGkText* text);
 
+// What an experiment tests (issue 17 item 4). A law is physics every engine must obey (Coulomb's stop
+// distance, friction-cone isotropy, momentum, a centred impact's restitution): every engine is judged. A model
+// prediction is a consequence of the soft contact model itself (static sinkage, the elastic apex drift,
+// contact duration): it is judged only for the engine variants in `appliesTo`; the others still run and
+// their measurement is recorded, with the status NOT_APPLICABLE and `notApplicableReason` in the note.
+typedef enum pdGkKind { pd_gkLaw, pd_gkModelPrediction } pdGkKind;
+extern const char* const pdGkKindNames[];  // "law", "model_prediction"
+
+// Engine variants, as bits of pdGkExperiment.appliesTo.
+enum {
+  PD_GK_SOFT = 1 << 0,
+  PD_GK_ODE_NATIVE = 1 << 1,
+  PD_GK_ODE_MATCHED = 1 << 2,
+  PD_GK_BULLET_NATIVE = 1 << 3,
+  PD_GK_BULLET_MATCHED = 1 << 4,
+  PD_GK_ALL_VARIANTS = (1 << 5) - 1,
+};
+
 typedef struct pdGkExperiment {
   const char* name;             // unique, lower case: catalogue id + what it measures, e.g. "a1_restitution"
   char group;                   // 'A' … 'G' (catalogue §2)
@@ -144,6 +184,9 @@ typedef struct pdGkExperiment {
   const char* formula;          // the expected value as a formula, with its source
   const char* toleranceReason;  // why the tolerance is what it is
   const char* seriesLabel;      // what series/NAME.csv holds, with its unit
+  pdGkKind kind;
+  unsigned appliesTo;           // model prediction: the PD_GK_* variants judged (law: every variant, 0 here)
+  const char* notApplicableReason;  // model prediction: why the others are not judged (one line)
   bool qualitative;             // every input is a qualitative check (expect gives NAN for each)
   bool relative;                // tolerance and error relative to the expected value
   bool fast;                    // in the CI subset (--fast)
@@ -170,8 +213,21 @@ void pd_gk_input_label(const pdGkExperiment* e, double input, char* buf, int siz
 typedef enum pdGkEngine { pd_gkSoft, pd_gkOde, pd_gkBullet, pd_gkEngineCount } pdGkEngine;
 extern const char* const pdGkEngineNames[pd_gkEngineCount];  // "soft", "ode", "bullet"
 
-typedef enum pdGkStatus { pd_gkPass, pd_gkFail, pd_gkRefused, pd_gkNotBuilt, pd_gkError } pdGkStatus;
-extern const char* const pdGkStatusNames[];  // "PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR"
+// NOT_APPLICABLE: a model prediction measured on a variant it does not apply to (pdGkKind): not judged.
+typedef enum pdGkStatus {
+  pd_gkPass,
+  pd_gkFail,
+  pd_gkRefused,
+  pd_gkNotBuilt,
+  pd_gkError,
+  pd_gkNotApplicable,
+  pd_gkStatusCount
+} pdGkStatus;
+extern const char* const pdGkStatusNames[];  // "PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR", "NOT_APPLICABLE"
+
+// The PD_GK_* bit of an engine variant (soft has one variant), and whether experiment e is judged on it.
+unsigned pd_gk_variant_bit(pdGkEngine engine, bool matched);
+bool pd_gk_applies(const pdGkExperiment* e, pdGkEngine engine, bool matched);
 
 typedef struct pdGkProgress {
   int done, total;
@@ -196,7 +252,7 @@ typedef struct pdGkOptions {
 
 typedef struct pdGkSummary {
   int rows;
-  int count[5];         // rows per status (index pdGkStatus)
+  int count[pd_gkStatusCount];  // rows per status (index pdGkStatus)
   int softFailures;     // soft rows that are FAIL or ERROR: `polydyn gedanken` exits 1 when > 0
   char softFailed[512]; // those rows as "NAME[ INPUT]" separated by ", " (cut short with "..." when long)
   bool interrupted;     // stopped by options.interrupt; nothing was written

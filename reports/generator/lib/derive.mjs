@@ -6,7 +6,7 @@ export const TARGET_ERROR = 1e-3;
 
 const ENGINE_ORDER = ['soft', 'ode', 'bullet'];
 const VARIANT_ORDER = ['adaptive', 'fixed', 'native', 'matched'];
-const STATUS_RANK = { PASS: 0, NOT_BUILT: 1, REFUSED: 2, FAIL: 3, ERROR: 4 };
+const STATUS_RANK = { PASS: 0, NOT_APPLICABLE: 1, NOT_BUILT: 2, REFUSED: 3, FAIL: 4, ERROR: 5 };
 
 function rank(list, x) {
   const k = list.indexOf(x);
@@ -64,6 +64,7 @@ export function matrix(results, experiments) {
       const ratios = rows.map(ratio).filter((x) => x !== null);
       cells.push({
         experiment: e.name, ev, engine, variant, status,
+        not_applicable_reason: status === 'NOT_APPLICABLE' ? notApplicableReason(e, rows) : null,
         inputs: rows.length,
         passed: rows.filter((r) => r.status === 'PASS').length,
         error: worst ? worst.error : null,
@@ -79,6 +80,14 @@ export function matrix(results, experiments) {
   return { engine_variants: evs.map((x) => x.ev), experiments: exps.map((e) => e.name), cells };
 }
 
+// Why a model prediction is not judged on a variant: experiments.json's reason, else the row's note
+// ("not applicable: REASON; …").
+function notApplicableReason(e, rows) {
+  if (e.meta && typeof e.meta.not_applicable_reason === 'string') return e.meta.not_applicable_reason;
+  const m = /^not applicable: ([^;]*)/.exec(rows[0].note);
+  return m ? m[1] : '';
+}
+
 function sum(xs) {
   const f = xs.filter((x) => Number.isFinite(x));
   return f.length ? f.reduce((a, b) => a + b, 0) : null;
@@ -91,17 +100,19 @@ export function median(xs) {
   return f.length % 2 ? f[m] : (f[m - 1] + f[m]) / 2;
 }
 
-// Per engine-variant verdict: cells by status, the worst cell by error/tolerance, wall time.
+// Per engine-variant verdict: cells by status, the worst cell by error/tolerance, wall time. Passes are
+// counted over the experiments that apply to the variant (`experiments`); a model prediction measured on a
+// variant it does not apply to is listed in not_applicable and never counts as a pass or a failure.
 export function verdicts(mat) {
   return mat.engine_variants.map((ev) => {
     const cells = mat.cells.filter((c) => c.ev === ev);
     const by = {};
     for (const s of Object.keys(STATUS_RANK)) by[s] = cells.filter((c) => c.status === s).map((c) => c.experiment);
     let worst = null;
-    for (const c of cells) if (c.error_over_tolerance !== null && (!worst || c.error_over_tolerance > worst.error_over_tolerance)) worst = c;
+    for (const c of cells) if (c.status !== 'NOT_APPLICABLE' && c.error_over_tolerance !== null && (!worst || c.error_over_tolerance > worst.error_over_tolerance)) worst = c;
     return {
-      ev, experiments: cells.length, pass: by.PASS.length, fail: by.FAIL, error: by.ERROR, refused: by.REFUSED,
-      not_built: by.NOT_BUILT,
+      ev, experiments: cells.length - by.NOT_APPLICABLE.length, pass: by.PASS.length, fail: by.FAIL, error: by.ERROR,
+      refused: by.REFUSED, not_built: by.NOT_BUILT, not_applicable: by.NOT_APPLICABLE,
       worst: worst ? { experiment: worst.experiment, input: worst.worst_input, error_over_tolerance: worst.error_over_tolerance } : null,
       total_wall_seconds: sum(cells.map((c) => c.wall_seconds)),
       median_wall_seconds_per_experiment: median(cells.map((c) => c.wall_seconds)),

@@ -15,7 +15,7 @@ export const SWEEP_HEADER = ['scene', 'engine', 'variant', 'setting', 'value', '
 export const METRICS_HEADER = ['scene', 'engine', 'variant', 'reference', 'pos_err_final', 'pos_err_rms',
   'rot_err_final_rad', 'rot_err_rms_rad', 'energy_drift_rel', 'momentum_drift_rel', 'max_penetration_over_size',
   'wall_per_sim_second', 'steps', 'restitution_impacts'];
-export const STATUSES = ['PASS', 'FAIL', 'REFUSED', 'NOT_BUILT', 'ERROR'];
+export const STATUSES = ['PASS', 'FAIL', 'REFUSED', 'NOT_BUILT', 'ERROR', 'NOT_APPLICABLE'];
 
 const NUMBER = /^[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?$/;
 const NONFINITE = { nan: NaN, '-nan': NaN, inf: Infinity, '+inf': Infinity, '-inf': -Infinity, infinity: Infinity,
@@ -155,6 +155,13 @@ export function readExperiments(dir) {
       if (!(k in e)) throw new InputError(src.file, line, `experiment${typeof e.name === 'string' ? ` "${e.name}"` : ''}: missing "${k}"`);
       if (typeof e[k] !== type) throw new InputError(src.file, line, `"${k}" must be a ${type}`);
     }
+    // what the experiment tests (FORMATS): optional, an experiment without a kind is a law
+    if ('kind' in e && !['law', 'model_prediction'].includes(e.kind))
+      throw new InputError(src.file, line, `"kind" must be "law" or "model_prediction"`);
+    if ('applies_to' in e && !(Array.isArray(e.applies_to) && e.applies_to.every((x) => typeof x === 'string')))
+      throw new InputError(src.file, line, '"applies_to" must be an array of "ENGINE-VARIANT" strings');
+    if (e.kind === 'model_prediction' && typeof e.not_applicable_reason !== 'string')
+      throw new InputError(src.file, line, `experiment "${e.name}": a model prediction needs "not_applicable_reason" (a string)`);
     if (names.has(e.name)) throw new InputError(src.file, line, `duplicate experiment "${e.name}" (first at line ${names.get(e.name)})`);
     names.set(e.name, line);
   }

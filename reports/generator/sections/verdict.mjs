@@ -11,7 +11,8 @@ export default {
     if (!v && !costs) return null;
     const sentences = [];
     for (const x of v || []) {
-      let s = `<b>${esc(x.ev)}</b> passes ${x.pass} of ${x.experiments} experiment${x.experiments === 1 ? '' : 's'}`;
+      let s = `<b>${esc(x.ev)}</b> passes ${x.pass} of the ${x.experiments} experiment${x.experiments === 1 ? '' : 's'} that apply to it`;
+      if (x.not_applicable.length) s += ` (${x.not_applicable.length} prediction${x.not_applicable.length === 1 ? '' : 's'} of the soft model not applicable: ${esc(x.not_applicable.join(', '))})`;
       const parts = [];
       if (x.fail.length) parts.push(`fails ${esc(x.fail.join(', '))}`);
       if (x.error.length) parts.push(`stopped with an error in ${esc(x.error.join(', '))}`);
@@ -39,13 +40,15 @@ export default {
     html += '<p class="note">ODE and Bullet solve a different (rigid, LCP) contact model: every engine is judged against ' +
       'the analytic answer of each experiment, never against polydyn’s own runs.</p>';
     if (v) {
-      html += table(['engine variant', 'PASS', 'FAIL', 'other', 'largest error / tolerance', 'wall time, total (s)', 'wall time, median per experiment (s)'],
+      html += table(['engine variant', 'PASS (of the experiments that apply)', 'FAIL', 'other', 'largest error / tolerance', 'wall time, total (s)', 'wall time, median per experiment (s)'],
         v.map((x) => [
           esc(x.ev),
           { html: `${x.pass} / ${x.experiments}`, cls: 'n' },
           { html: x.fail.length ? String(x.fail.length) : '0', cls: 'n' + (x.fail.length ? ' bad' : '') },
           { html: esc([x.error.length ? `${x.error.length} error` : '', x.refused.length ? `${x.refused.length} refused` : '',
-            x.not_built.length ? `${x.not_built.length} not built` : ''].filter(Boolean).join(', ') || '—') },
+            x.not_built.length ? `${x.not_built.length} not built` : '',
+            x.not_applicable.length ? `${x.not_applicable.length} n/a` : ''].filter(Boolean).join(', ') || '—'),
+          title: x.not_applicable.length ? `not applicable (model predictions): ${x.not_applicable.join(', ')}` : '' },
           { html: x.worst ? `${num(x.worst.error_over_tolerance)}× <span class="muted">(${esc(x.worst.experiment)})</span>` : '—', cls: 'n' },
           { html: num(x.total_wall_seconds), cls: 'n' },
           { html: num(x.median_wall_seconds_per_experiment), cls: 'n' },
@@ -54,10 +57,10 @@ export default {
     return {
       html,
       data: { sentences: sentences.map((s) => s.replace(/<[^>]+>/g, '')), engine_variants: v },
-      csv: v ? [{ name: 'verdict', header: ['engine', 'variant', 'experiments', 'pass', 'fail', 'error', 'refused', 'not_built',
+      csv: v ? [{ name: 'verdict', header: ['engine', 'variant', 'experiments', 'pass', 'fail', 'error', 'refused', 'not_built', 'not_applicable',
         'worst_experiment', 'worst_error_over_tolerance', 'total_wall_seconds', 'median_wall_seconds_per_experiment'],
       rows: v.map((x) => [...x.ev.split(' '), x.experiments, x.pass, x.fail.length, x.error.length, x.refused.length, x.not_built.length,
-        x.worst ? x.worst.experiment : '', x.worst ? x.worst.error_over_tolerance : null, x.total_wall_seconds, x.median_wall_seconds_per_experiment]) }] : [],
+        x.not_applicable.length, x.worst ? x.worst.experiment : '', x.worst ? x.worst.error_over_tolerance : null, x.total_wall_seconds, x.median_wall_seconds_per_experiment]) }] : [],
     };
   },
 };
