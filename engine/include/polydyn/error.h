@@ -6,6 +6,8 @@
 // - bad input (scene files, CLI arguments): a pdError with `FILE:LINE:COL: message`, never an assert.
 #pragma once
 
+#include "polydyn/api.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -19,11 +21,11 @@ typedef struct pdError {
 } pdError;
 
 // Fills err (if not NULL) with a location and a printf-style message.
-void pd_error_set(pdError* err, const char* file, int line, int col, const char* fmt, ...)
+PD_API void pd_error_set(pdError* err, const char* file, int line, int col, const char* fmt, ...)
     __attribute__((format(printf, 5, 6)));
 
 // Writes `FILE:LINE:COL: message\n` (or `FILE: message` when the line is unknown) to `out`.
-void pd_error_print(const pdError* err, FILE* out);
+PD_API void pd_error_print(const pdError* err, FILE* out);
 
 #define PD_ASSERT(cond)                                                                         \
   do {                                                                                          \

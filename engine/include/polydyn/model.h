@@ -7,6 +7,8 @@
 // - A body's pose maps that frame to the world: x_world = x + R(q) · x_body.
 #pragma once
 
+#include "polydyn/api.h"
+
 #include <stdbool.h>
 
 #include "polydyn/error.h"
@@ -87,23 +89,23 @@ typedef struct pdModel {
 // the contact model's material parameters (paper §3.2, §3.3) and checks that no two bodies overlap.
 // Returns NULL and fills err (at the object's line) on a degenerate polyhedron, an empty scene, an
 // unreachable restitution (below e^-2) or bodies interpenetrating at t = 0 (DESIGN §4.1).
-pdModel* pd_model_compile(const pdScene* scene, pdError* err);
+PD_API pdModel* pd_model_compile(const pdScene* scene, pdError* err);
 
-void pd_model_free(pdModel* model);
+PD_API void pd_model_free(pdModel* model);
 
 // Total mechanical energy contributions of one moving body in a given state (J).
-double pd_body_kinetic_energy(const pdBody* body, pdVec3 v, pdVec3 w, pdQuat q);
+PD_API double pd_body_kinetic_energy(const pdBody* body, pdVec3 v, pdVec3 w, pdQuat q);
 
 // ---------------------------------------------------------------- applied loads (engine/src/applied_force.c)
 
 // The applied force on `body` at time t: force0 + t·forceRate, N, world frame (zero without a force).
-pdVec3 pd_body_applied_force(const pdBody* body, double t);
+PD_API pdVec3 pd_body_applied_force(const pdBody* body, double t);
 // The torque about the centre of mass of the applied force `force` (N, world) acting at the body's
 // forcePoint, with `r` the body's rotation (body → world): (r · forcePoint) × force, N·m, world frame.
-pdVec3 pd_body_applied_torque(const pdBody* body, const pdMat3* r, pdVec3 force);
+PD_API pdVec3 pd_body_applied_torque(const pdBody* body, const pdMat3* r, pdVec3 force);
 // True when at least one body carries an applied force. Its work is not part of the state's energy
 // (pd_state_energy), so an energy balance of such a run does not close.
-bool pd_model_has_applied_force(const pdModel* model);
+PD_API bool pd_model_has_applied_force(const pdModel* model);
 
 // ---------------------------------------------------------------- contact material (paper §3.2, §3.3)
 
@@ -114,22 +116,22 @@ typedef struct pdBodyContactInfo {
   double zeta;  // damping ratio of the body's own restitution (eq. (15)); a pair uses that of √(e₁e₂)
 } pdBodyContactInfo;
 
-pdBodyContactInfo pd_model_body_contact_info(const pdModel* model, int body);
+PD_API pdBodyContactInfo pd_model_body_contact_info(const pdModel* model, int body);
 
 // Bodies whose side of a contact (material as used, mass, minimum effective mass, size) is identical
 // share a material class; contact-pair constants are derived once per pair of classes.
-int pd_model_material_class_count(const pdModel* model);
+PD_API int pd_model_material_class_count(const pdModel* model);
 // The pairs of classes that can touch (one body moving), each named by two bodies (a moving one first):
 // writes up to `capacity` into bodyA[], bodyB[] and returns how many there are.
-int pd_model_contact_class_pairs(const pdModel* model, int* bodyA, int* bodyB, int capacity);
+PD_API int pd_model_contact_class_pairs(const pdModel* model, int* bodyA, int* bodyB, int capacity);
 
 // The time-constant adjustments of §3.3.1 and §3.3.2 made at compile time, per pair of material classes
 // (naming the first body of each class). Adjustments past the list's capacity are not listed but counted
 // (pd_model_adjustments_dropped).
-int pd_model_adjustment_count(const pdModel* model);
-int pd_model_adjustments_dropped(const pdModel* model);
+PD_API int pd_model_adjustment_count(const pdModel* model);
+PD_API int pd_model_adjustments_dropped(const pdModel* model);
 // One line describing adjustment i (0 <= i < count) into buf (UTF-8, no newline); returns snprintf's count.
-int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int size);
+PD_API int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int size);
 
 // ---------------------------------------------------------------- one pair, as a reference engine sees it
 // A reference engine (refcheck: ODE, Bullet) takes one spring, one damper, one μ and one e per contact.
@@ -155,4 +157,4 @@ typedef struct pdPairContact {
 } pdPairContact;
 
 // The pair constants of bodies a and b (model body indices, a != b, not both fixed), as used.
-pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b);
+PD_API pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b);

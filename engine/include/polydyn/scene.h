@@ -9,6 +9,8 @@
 // `FILE:LINE:COL: message` in a pdError. The parser never asserts or aborts on file content.
 #pragma once
 
+#include "polydyn/api.h"
+
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -129,9 +131,9 @@ typedef struct pdScene {
 // unknown command, arity, non-number, non-finite, out of range, property before any object,
 // duplicate name, a file that cannot be opened or is not text, a token or file over the limits).
 // Memory use is bounded by the scene's content, not by the length of junk lines.
-pdScene* pd_scene_parse_file(const char* path, pdError* err);
+PD_API pdScene* pd_scene_parse_file(const char* path, pdError* err);
 
 // Parses a scene held in memory; `name` is used in messages. Same contract as pd_scene_parse_file.
-pdScene* pd_scene_parse_buffer(const char* name, const char* text, size_t length, pdError* err);
+PD_API pdScene* pd_scene_parse_buffer(const char* name, const char* text, size_t length, pdError* err);
 
-void pd_scene_free(pdScene* scene);
+PD_API void pd_scene_free(pdScene* scene);

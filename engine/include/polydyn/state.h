@@ -14,6 +14,8 @@
 // Memory: pd_state_create allocates everything the step needs; pd_advance allocates nothing.
 #pragma once
 
+#include "polydyn/api.h"
+
 #include <stdbool.h>
 
 #include "polydyn/model.h"
@@ -32,7 +34,7 @@ typedef enum pdStage {
   pd_stageObserve,          // calls to the observer (output)
   pd_stageCount
 } pdStage;
-extern const char* const pdStageNames[pd_stageCount];
+PD_API extern const char* const pdStageNames[pd_stageCount];
 
 // Counted warnings: numerical trouble that was recovered from.
 typedef enum pdWarning {
@@ -42,7 +44,7 @@ typedef enum pdWarning {
                          // added deeper than the onset tolerance (its springs start at 0 there)
   pd_warnCount
 } pdWarning;
-extern const char* const pdWarningNames[pd_warnCount];
+PD_API extern const char* const pdWarningNames[pd_warnCount];
 
 // Which stepper advances the state. Adaptive RK4 is the paper's; the fixed one is for sweeps.
 typedef enum pdStepper {
@@ -91,16 +93,16 @@ typedef struct pdBodyState {
   pdVec3 w;  // rad/s, world
 } pdBodyState;
 
-pdState* pd_state_create(const pdModel* model);
+PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters and timers cleared.
-void pd_state_reset(const pdModel* model, pdState* state);
-void pd_state_free(pdState* state);
+PD_API void pd_state_reset(const pdModel* model, pdState* state);
+PD_API void pd_state_free(pdState* state);
 
-pdBodyState pd_state_body(const pdModel* model, const pdState* state, int bodyIndex);
+PD_API pdBodyState pd_state_body(const pdModel* model, const pdState* state, int bodyIndex);
 
 // Kinetic + gravitational potential energy of all moving bodies plus the energy stored in the contact
 // springs (½ k s² each), J (gravitational potential zero at the origin).
-double pd_state_energy(const pdModel* model, const pdState* state);
+PD_API double pd_state_energy(const pdModel* model, const pdState* state);
 
 // One active contact at the state's time, for output (DESIGN §4.2 contacts.csv).
 typedef struct pdContactReport {
@@ -115,8 +117,8 @@ typedef struct pdContactReport {
   bool slip;            // the friction limit is active
 } pdContactReport;
 
-int pd_state_contact_count(const pdState* state);
-pdContactReport pd_state_contact(const pdState* state, int i);
+PD_API int pd_state_contact_count(const pdState* state);
+PD_API pdContactReport pd_state_contact(const pdState* state, int i);
 
 // Called at every output sample, with state->t exactly k / sampleRate. Returning false asks
 // pd_advance to stop after this sample (state->stopped is set).
@@ -126,8 +128,8 @@ typedef bool pdObserverFcn(const pdModel* model, const pdState* state, void* use
 // (nullable) at every output sample t = k / sampleRate <= tEnd, including t = 0 when the state is
 // there. Returns false if the run had to stop (state->failed; the state stays finite) or the
 // observer asked to stop (state->stopped).
-bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
+PD_API bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
 
 // The state derivative dy/dt at (t, y), y laid out for the state's current contact list (its length is
 // state->n). Uses the state's scratch and stage timers. Exposed for tests and alternative steppers.
-void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt);
+PD_API void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt);

@@ -7,6 +7,8 @@
 // - Angles in these helpers are radians; the scene language uses degrees and converts on input.
 #pragma once
 
+#include "polydyn/api.h"
+
 #include <math.h>
 #include <stdbool.h>
 
@@ -96,4 +98,4 @@ static inline pdVec3 pd_quat_rotate(pdQuat q, pdVec3 v) {
   return pd_mat3_mulv(&r, v);
 }
 // Quaternion of a proper rotation matrix (Shepperd's method; sign chosen so w >= 0).
-pdQuat pd_quat_from_mat3(const pdMat3* r);
+PD_API pdQuat pd_quat_from_mat3(const pdMat3* r);
