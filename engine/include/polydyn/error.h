@@ -20,7 +20,8 @@ typedef struct pdError {
   char message[PD_ERROR_MESSAGE_MAX];  // one line, no trailing newline
 } pdError;
 
-// Fills err (if not NULL) with a location and a printf-style message.
+// Fills err (if not NULL) with a location (file "" or NULL when none; line, col 0 when unknown) and a
+// printf-style message (one line: control characters become spaces; a message too long ends in "...").
 PD_API void pd_error_set(pdError* err, const char* file, int line, int col, const char* fmt, ...)
     __attribute__((format(printf, 5, 6)));
 

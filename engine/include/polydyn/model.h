@@ -89,11 +89,15 @@ typedef struct pdModel {
 // the contact model's material parameters (paper §3.2, §3.3) and checks that no two bodies overlap.
 // Returns NULL and fills err (at the object's line) on a degenerate polyhedron, an empty scene, an
 // unreachable restitution (below e^-2) or bodies interpenetrating at t = 0 (DESIGN §4.1).
+// The model copies what it needs: the scene may be freed right after. The caller owns the model
+// (pd_model_free); it is read-only from then on (any number of states and threads may share it).
 PD_API pdModel* pd_model_compile(const pdScene* scene, pdError* err);
 
+// Frees the model and everything it holds; NULL is allowed. Free its states first.
 PD_API void pd_model_free(pdModel* model);
 
-// Total mechanical energy contributions of one moving body in a given state (J).
+// Kinetic energy of one moving body with velocity v (m/s, world), angular velocity w (rad/s, world) and
+// orientation q (body → world): ½ m v² + ½ wᵀ R I Rᵀ w, J.
 PD_API double pd_body_kinetic_energy(const pdBody* body, pdVec3 v, pdVec3 w, pdQuat q);
 
 // ---------------------------------------------------------------- applied loads (engine/src/applied_force.c)
@@ -116,6 +120,7 @@ typedef struct pdBodyContactInfo {
   double zeta;  // damping ratio of the body's own restitution (eq. (15)); a pair uses that of √(e₁e₂)
 } pdBodyContactInfo;
 
+// The derived contact quantities of body `body` (0 <= body < model->bodyCount; asserts otherwise).
 PD_API pdBodyContactInfo pd_model_body_contact_info(const pdModel* model, int body);
 
 // Bodies whose side of a contact (material as used, mass, minimum effective mass, size) is identical
@@ -130,7 +135,8 @@ PD_API int pd_model_contact_class_pairs(const pdModel* model, int* bodyA, int* b
 // (pd_model_adjustments_dropped).
 PD_API int pd_model_adjustment_count(const pdModel* model);
 PD_API int pd_model_adjustments_dropped(const pdModel* model);
-// One line describing adjustment i (0 <= i < count) into buf (UTF-8, no newline); returns snprintf's count.
+// One line describing adjustment i (0 <= i < count) into buf (UTF-8, no newline, truncated to size - 1
+// bytes); returns snprintf's count (the length it needed).
 PD_API int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int size);
 
 // ---------------------------------------------------------------- one pair, as a reference engine sees it

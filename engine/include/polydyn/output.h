@@ -21,7 +21,9 @@
 
 typedef struct pdRunWriter pdRunWriter;
 
-// Starts a run directory for `dir`. Returns NULL and fills err on failure (nothing left behind).
+// Starts a run directory for `dir`: creates the temporary directory and opens trajectory.csv and
+// contacts.csv in it. The caller owns the writer: pd_run_finish or pd_run_abort frees it. Returns NULL
+// and fills err on failure (nothing left behind).
 PD_API pdRunWriter* pd_run_open(const char* dir, pdError* err);
 
 // Observer that appends the current sample to trajectory.csv; `user` is the pdRunWriter.
@@ -49,12 +51,12 @@ typedef struct pdRunInfo {
   const char* engineSettingsJson;  // nullable: one JSON object written as "engine_settings" (refcheck)
 } pdRunInfo;
 
-// Writes summary.json, closes every file and renames the directory into place. Returns false and
-// fills err on an I/O failure (then the temporary directory is removed).
+// Writes summary.json, closes every file and renames the directory into place; frees `run` in every
+// case. Returns false and fills err on an I/O failure (then the temporary directory is removed).
 PD_API bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state, const pdRunInfo* info,
                    pdError* err);
 
-// Removes the temporary directory and frees the writer.
+// Removes the temporary directory and frees the writer (an interrupted or failed run); NULL is allowed.
 PD_API void pd_run_abort(pdRunWriter* run);
 
 // Writes `s` (UTF-8) as a JSON string: quoted, with the quote, the backslash and control characters escaped.

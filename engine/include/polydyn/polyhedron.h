@@ -49,6 +49,8 @@ typedef struct pdPolyhedron {
 // Builds the convex hull of `count` points (xyz triples) with qhull. Returns false and fills
 // `why` (a short phrase, e.g. "the points are coplanar") when the hull is degenerate (fewer than 4
 // non-coplanar points) or qhull fails. Interior points are dropped; coplanar facets are merged.
+// On success `out` holds arrays the caller frees with pd_polyhedron_free; on failure it holds none.
+// `why` receives at most whySize bytes, NUL included (every function below with `why` does the same).
 PD_API bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char* why, int whySize);
 
 // The scene primitives of DESIGN §4.1, already scaled by (sx, sy, sz), in the primitive's own frame
@@ -71,6 +73,7 @@ PD_API bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize
 // Moves every vertex and plane by `shift` (x → x + shift).
 PD_API void pd_polyhedron_translate(pdPolyhedron* p, pdVec3 shift);
 
+// Frees the arrays of *p (not p itself) and zeroes it.
 PD_API void pd_polyhedron_free(pdPolyhedron* p);
 
 // Exact mass properties of a uniform-density convex polyhedron (divergence theorem, evaluated as a

@@ -133,7 +133,9 @@ typedef struct pdScene {
 // Memory use is bounded by the scene's content, not by the length of junk lines.
 PD_API pdScene* pd_scene_parse_file(const char* path, pdError* err);
 
-// Parses a scene held in memory; `name` is used in messages. Same contract as pd_scene_parse_file.
+// Parses a scene held in memory: `length` bytes of `text` (no terminating NUL needed); `name` is used in
+// messages. Same contract as pd_scene_parse_file.
 PD_API pdScene* pd_scene_parse_buffer(const char* name, const char* text, size_t length, pdError* err);
 
+// Frees the scene and everything it holds; NULL is allowed.
 PD_API void pd_scene_free(pdScene* scene);
