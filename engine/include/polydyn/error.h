@@ -6,10 +6,10 @@
 // - bad input (scene files, CLI arguments): a pdError with `FILE:LINE:COL: message`, never an assert.
 #pragma once
 
-#include "polydyn/api.h"
-
 #include <stdio.h>
 #include <stdlib.h>
+
+#include "polydyn/api.h"
 
 enum { PD_ERROR_MESSAGE_MAX = 512 };
 

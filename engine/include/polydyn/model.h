@@ -7,10 +7,9 @@
 // - A body's pose maps that frame to the world: x_world = x + R(q) · x_body.
 #pragma once
 
-#include "polydyn/api.h"
-
 #include <stdbool.h>
 
+#include "polydyn/api.h"
 #include "polydyn/error.h"
 #include "polydyn/polyhedron.h"
 #include "polydyn/scene.h"

@@ -10,11 +10,10 @@
 // sample, bodies in scene order; numbers printed with %.17g so they round-trip exactly.
 #pragma once
 
-#include "polydyn/api.h"
-
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "polydyn/api.h"
 #include "polydyn/error.h"
 #include "polydyn/model.h"
 #include "polydyn/state.h"

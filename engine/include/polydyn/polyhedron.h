@@ -12,10 +12,9 @@
 //   facets are merged into one face when the polyhedron is built).
 #pragma once
 
-#include "polydyn/api.h"
-
 #include <stdbool.h>
 
+#include "polydyn/api.h"
 #include "polydyn/error.h"
 #include "polydyn/vecmath.h"
 

@@ -9,12 +9,11 @@
 // `FILE:LINE:COL: message` in a pdError. The parser never asserts or aborts on file content.
 #pragma once
 
-#include "polydyn/api.h"
-
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
 
+#include "polydyn/api.h"
 #include "polydyn/error.h"
 
 typedef enum pdPrimitiveKind {

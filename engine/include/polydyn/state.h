@@ -20,10 +20,9 @@
 // pd_advance grows the state's vectors (doubling) only when the contact list outgrows them.
 #pragma once
 
-#include "polydyn/api.h"
-
 #include <stdbool.h>
 
+#include "polydyn/api.h"
 #include "polydyn/model.h"
 #include "polydyn/vecmath.h"
 

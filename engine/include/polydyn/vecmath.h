@@ -7,10 +7,10 @@
 // - Angles in these helpers are radians; the scene language uses degrees and converts on input.
 #pragma once
 
-#include "polydyn/api.h"
-
 #include <math.h>
 #include <stdbool.h>
+
+#include "polydyn/api.h"
 
 typedef struct pdVec3 {
   double x, y, z;
