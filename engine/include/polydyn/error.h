@@ -9,6 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "polydyn/api.h"
+
 enum { PD_ERROR_MESSAGE_MAX = 512 };
 
 typedef struct pdError {
@@ -18,12 +20,13 @@ typedef struct pdError {
   char message[PD_ERROR_MESSAGE_MAX];  // one line, no trailing newline
 } pdError;
 
-// Fills err (if not NULL) with a location and a printf-style message.
-void pd_error_set(pdError* err, const char* file, int line, int col, const char* fmt, ...)
+// Fills err (if not NULL) with a location (file "" or NULL when none; line, col 0 when unknown) and a
+// printf-style message (one line: control characters become spaces; a message too long ends in "...").
+PD_API void pd_error_set(pdError* err, const char* file, int line, int col, const char* fmt, ...)
     __attribute__((format(printf, 5, 6)));
 
 // Writes `FILE:LINE:COL: message\n` (or `FILE: message` when the line is unknown) to `out`.
-void pd_error_print(const pdError* err, FILE* out);
+PD_API void pd_error_print(const pdError* err, FILE* out);
 
 #define PD_ASSERT(cond)                                                                         \
   do {                                                                                          \

@@ -9,6 +9,7 @@
 
 #include <stdbool.h>
 
+#include "polydyn/api.h"
 #include "polydyn/error.h"
 #include "polydyn/polyhedron.h"
 #include "polydyn/scene.h"
@@ -93,23 +94,27 @@ typedef struct pdModel {
 // the contact model's material parameters (paper §3.2, §3.3) and checks that no two bodies overlap.
 // Returns NULL and fills err (at the object's line) on a degenerate polyhedron, an empty scene, an
 // unreachable restitution (below PD_RESTITUTION_MIN) or bodies interpenetrating at t = 0 (DESIGN §4.1).
-pdModel* pd_model_compile(const pdScene* scene, pdError* err);
+// The model copies what it needs: the scene may be freed right after. The caller owns the model
+// (pd_model_free); it is read-only from then on (any number of states and threads may share it).
+PD_API pdModel* pd_model_compile(const pdScene* scene, pdError* err);
 
-void pd_model_free(pdModel* model);
+// Frees the model and everything it holds; NULL is allowed. Free its states first.
+PD_API void pd_model_free(pdModel* model);
 
-// Total mechanical energy contributions of one moving body in a given state (J).
-double pd_body_kinetic_energy(const pdBody* body, pdVec3 v, pdVec3 w, pdQuat q);
+// Kinetic energy of one moving body with velocity v (m/s, world), angular velocity w (rad/s, world) and
+// orientation q (body → world): ½ m v² + ½ wᵀ R I Rᵀ w, J.
+PD_API double pd_body_kinetic_energy(const pdBody* body, pdVec3 v, pdVec3 w, pdQuat q);
 
 // ---------------------------------------------------------------- applied loads (engine/src/applied_force.c)
 
 // The applied force on `body` at time t: force0 + t·forceRate, N, world frame (zero without a force).
-pdVec3 pd_body_applied_force(const pdBody* body, double t);
+PD_API pdVec3 pd_body_applied_force(const pdBody* body, double t);
 // The torque about the centre of mass of the applied force `force` (N, world) acting at the body's
 // forcePoint, with `r` the body's rotation (body → world): (r · forcePoint) × force, N·m, world frame.
-pdVec3 pd_body_applied_torque(const pdBody* body, const pdMat3* r, pdVec3 force);
+PD_API pdVec3 pd_body_applied_torque(const pdBody* body, const pdMat3* r, pdVec3 force);
 // True when at least one body carries an applied force. Its work is not part of the state's energy
 // (pd_state_energy), so an energy balance of such a run does not close.
-bool pd_model_has_applied_force(const pdModel* model);
+PD_API bool pd_model_has_applied_force(const pdModel* model);
 
 // ---------------------------------------------------------------- contact material (paper §3.2, §3.3)
 
@@ -120,22 +125,24 @@ typedef struct pdBodyContactInfo {
   double zeta;  // damping ratio of the body's own restitution (eq. (15)); a pair uses that of √(e₁e₂)
 } pdBodyContactInfo;
 
-pdBodyContactInfo pd_model_body_contact_info(const pdModel* model, int body);
+// The derived contact quantities of body `body` (0 <= body < model->bodyCount; asserts otherwise).
+PD_API pdBodyContactInfo pd_model_body_contact_info(const pdModel* model, int body);
 
 // Bodies whose side of a contact (material as used, mass, minimum effective mass, size) is identical
 // share a material class; contact-pair constants are derived once per pair of classes.
-int pd_model_material_class_count(const pdModel* model);
+PD_API int pd_model_material_class_count(const pdModel* model);
 // The pairs of classes that can touch (one body moving), each named by two bodies (a moving one first):
 // writes up to `capacity` into bodyA[], bodyB[] and returns how many there are.
-int pd_model_contact_class_pairs(const pdModel* model, int* bodyA, int* bodyB, int capacity);
+PD_API int pd_model_contact_class_pairs(const pdModel* model, int* bodyA, int* bodyB, int capacity);
 
 // The time-constant adjustments of §3.3.1 and §3.3.2 made at compile time, per pair of material classes
 // (naming the first body of each class). Adjustments past the list's capacity are not listed but counted
 // (pd_model_adjustments_dropped).
-int pd_model_adjustment_count(const pdModel* model);
-int pd_model_adjustments_dropped(const pdModel* model);
-// One line describing adjustment i (0 <= i < count) into buf (UTF-8, no newline); returns snprintf's count.
-int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int size);
+PD_API int pd_model_adjustment_count(const pdModel* model);
+PD_API int pd_model_adjustments_dropped(const pdModel* model);
+// One line describing adjustment i (0 <= i < count) into buf (UTF-8, no newline, truncated to size - 1
+// bytes); returns snprintf's count (the length it needed).
+PD_API int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int size);
 
 // ---------------------------------------------------------------- one pair, as a reference engine sees it
 // A reference engine (refcheck: ODE, Bullet) takes one spring, one damper, one μ and one e per contact.
@@ -161,4 +168,4 @@ typedef struct pdPairContact {
 } pdPairContact;
 
 // The pair constants of bodies a and b (model body indices, a != b, not both fixed), as used.
-pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b);
+PD_API pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b);

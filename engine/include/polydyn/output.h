@@ -13,29 +13,32 @@
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "polydyn/api.h"
 #include "polydyn/error.h"
 #include "polydyn/model.h"
 #include "polydyn/state.h"
 
 typedef struct pdRunWriter pdRunWriter;
 
-// Starts a run directory for `dir`. Returns NULL and fills err on failure (nothing left behind).
-pdRunWriter* pd_run_open(const char* dir, pdError* err);
+// Starts a run directory for `dir`: creates the temporary directory and opens trajectory.csv and
+// contacts.csv in it. The caller owns the writer: pd_run_finish or pd_run_abort frees it. Returns NULL
+// and fills err on failure (nothing left behind).
+PD_API pdRunWriter* pd_run_open(const char* dir, pdError* err);
 
 // Observer that appends the current sample to trajectory.csv; `user` is the pdRunWriter.
-bool pd_run_observe(const pdModel* model, const pdState* state, void* user);
+PD_API bool pd_run_observe(const pdModel* model, const pdState* state, void* user);
 
 // Writes one trajectory row per moving body at the state's time.
-void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state);
-void pd_write_trajectory_header(FILE* out);
+PD_API void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state);
+PD_API void pd_write_trajectory_header(FILE* out);
 // contacts.csv (DESIGN §4.2): header `t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode`;
 // one row per active contact per sample, in contact-id order; kind VF or EE; body_a carries the vertex
 // (VF) or the first edge (EE); n points from body_b into body_a; (fn, ft) is the force on body_a, N;
 // mode stick or slip.
-void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state);
-void pd_write_contacts_header(FILE* out);
+PD_API void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state);
+PD_API void pd_write_contacts_header(FILE* out);
 // Writes `s` as one CSV field: as it is, or quoted (RFC 4180) when it holds a comma, a quote or a line break.
-void pd_write_csv_text(FILE* out, const char* s);
+PD_API void pd_write_csv_text(FILE* out, const char* s);
 
 typedef struct pdRunInfo {
   const char* engine;     // e.g. "polydyn-soft"
@@ -47,16 +50,16 @@ typedef struct pdRunInfo {
   const char* engineSettingsJson;  // nullable: one JSON object written as "engine_settings" (refcheck)
 } pdRunInfo;
 
-// Writes summary.json, closes every file and renames the directory into place. Returns false and
-// fills err on an I/O failure (then the temporary directory is removed).
-bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state, const pdRunInfo* info,
+// Writes summary.json, closes every file and renames the directory into place; frees `run` in every
+// case. Returns false and fills err on an I/O failure (then the temporary directory is removed).
+PD_API bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state, const pdRunInfo* info,
                    pdError* err);
 
-// Removes the temporary directory and frees the writer.
-void pd_run_abort(pdRunWriter* run);
+// Removes the temporary directory and frees the writer (an interrupted or failed run); NULL is allowed.
+PD_API void pd_run_abort(pdRunWriter* run);
 
 // Writes `s` (UTF-8) as a JSON string: quoted, with the quote, the backslash and control characters escaped.
-void pd_write_json_string(FILE* out, const char* s);
+PD_API void pd_write_json_string(FILE* out, const char* s);
 
 // Writes the summary JSON object to `out` (also used by `polydyn check --json` later).
-void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state, const pdRunInfo* info);
+PD_API void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state, const pdRunInfo* info);

@@ -14,6 +14,7 @@
 
 #include <stdbool.h>
 
+#include "polydyn/api.h"
 #include "polydyn/error.h"
 #include "polydyn/vecmath.h"
 
@@ -53,7 +54,9 @@ typedef struct pdPolyhedron {
 // Builds the convex hull of `count` points (xyz triples) with qhull. Returns false and fills
 // `why` (a short phrase, e.g. "the points are coplanar") when the hull is degenerate (fewer than 4
 // non-coplanar points) or qhull fails. Interior points are dropped; coplanar facets are merged.
-bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char* why, int whySize);
+// On success `out` holds arrays the caller frees with pd_polyhedron_free; on failure it holds none.
+// `why` receives at most whySize bytes, NUL included (every function below with `why` does the same).
+PD_API bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char* why, int whySize);
 
 // The scene primitives of DESIGN §4.1, already scaled by (sx, sy, sz), in the primitive's own frame
 // (origin at its geometric centre, before the shift to the centre of mass):
@@ -64,18 +67,19 @@ bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char
 // - sphere: geodesic polyhedron of diameter 1: an icosahedron subdivided `level` times (each
 //   triangle into four), new vertices pushed onto the sphere.
 // Return false with `why` only on a degenerate result (cannot happen for valid arguments).
-bool pd_polyhedron_cube(pdPolyhedron* out, const double scale[3], char* why, int whySize);
-bool pd_polyhedron_prism(pdPolyhedron* out, int sides, const double scale[3], double taper, char* why, int whySize);
-bool pd_polyhedron_sphere(pdPolyhedron* out, int level, const double scale[3], char* why, int whySize);
+PD_API bool pd_polyhedron_cube(pdPolyhedron* out, const double scale[3], char* why, int whySize);
+PD_API bool pd_polyhedron_prism(pdPolyhedron* out, int sides, const double scale[3], double taper, char* why, int whySize);
+PD_API bool pd_polyhedron_sphere(pdPolyhedron* out, int level, const double scale[3], char* why, int whySize);
 
 // Checks every invariant listed at the top of this header. Returns false and fills `why` with the
 // first violation found.
-bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize);
+PD_API bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize);
 
 // Moves every vertex and plane by `shift` (x → x + shift).
-void pd_polyhedron_translate(pdPolyhedron* p, pdVec3 shift);
+PD_API void pd_polyhedron_translate(pdPolyhedron* p, pdVec3 shift);
 
-void pd_polyhedron_free(pdPolyhedron* p);
+// Frees the arrays of *p (not p itself) and zeroes it.
+PD_API void pd_polyhedron_free(pdPolyhedron* p);
 
 // Exact mass properties of a uniform-density convex polyhedron (divergence theorem, evaluated as a
 // sum of tetrahedra from the vertex average so that results do not depend on the frame's origin).
@@ -90,4 +94,4 @@ typedef struct pdMassProperties {
 
 // `density` in kg/m³ (> 0). Returns false with `why` if the volume is not positive or the inertia
 // is not positive definite.
-bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties* out, char* why, int whySize);
+PD_API bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties* out, char* why, int whySize);

@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "polydyn/api.h"
 #include "polydyn/error.h"
 
 typedef enum pdPrimitiveKind {
@@ -129,9 +130,11 @@ typedef struct pdScene {
 // unknown command, arity, non-number, non-finite, out of range, property before any object,
 // duplicate name, a file that cannot be opened or is not text, a token or file over the limits).
 // Memory use is bounded by the scene's content, not by the length of junk lines.
-pdScene* pd_scene_parse_file(const char* path, pdError* err);
+PD_API pdScene* pd_scene_parse_file(const char* path, pdError* err);
 
-// Parses a scene held in memory; `name` is used in messages. Same contract as pd_scene_parse_file.
-pdScene* pd_scene_parse_buffer(const char* name, const char* text, size_t length, pdError* err);
+// Parses a scene held in memory: `length` bytes of `text` (no terminating NUL needed); `name` is used in
+// messages. Same contract as pd_scene_parse_file.
+PD_API pdScene* pd_scene_parse_buffer(const char* name, const char* text, size_t length, pdError* err);
 
-void pd_scene_free(pdScene* scene);
+// Frees the scene and everything it holds; NULL is allowed.
+PD_API void pd_scene_free(pdScene* scene);

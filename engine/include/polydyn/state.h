@@ -11,11 +11,18 @@
 // body B into body A; the force reported is the one B applies to A; penetration depth > 0 when overlapping.
 // One model can drive many states (sweeps, threads): the model is never written to.
 //
-// Memory: pd_state_create allocates everything the step needs; pd_advance allocates nothing.
+// Reading a state: t, count, warnings, failed and stopped directly; poses with pd_state_body, contacts with
+// pd_state_contact_count and pd_state_contact (not from y, whose layout is internal to the stepper). The
+// fields are written by pd_advance and pd_state_reset; a caller writes only `stepper` (and `h`, the first
+// step to try), between pd_state_create or pd_state_reset and the first pd_advance.
+//
+// Memory: pd_state_create allocates everything a step needs. A step never allocates; between two steps,
+// pd_advance grows the state's vectors (doubling) only when the contact list outgrows them.
 #pragma once
 
 #include <stdbool.h>
 
+#include "polydyn/api.h"
 #include "polydyn/model.h"
 #include "polydyn/vecmath.h"
 
@@ -32,7 +39,8 @@ typedef enum pdStage {
   pd_stageObserve,          // calls to the observer (output)
   pd_stageCount
 } pdStage;
-extern const char* const pdStageNames[pd_stageCount];
+// Names of the stages (e.g. "broad_phase"), as summary.json writes them.
+PD_API extern const char* const pdStageNames[pd_stageCount];
 
 // Counted warnings: numerical trouble that was recovered from.
 typedef enum pdWarning {
@@ -42,7 +50,8 @@ typedef enum pdWarning {
                          // added deeper than the onset tolerance (its springs start at 0 there)
   pd_warnCount
 } pdWarning;
-extern const char* const pdWarningNames[pd_warnCount];
+// Names of the warnings (e.g. "step_at_minimum"), as summary.json writes them.
+PD_API extern const char* const pdWarningNames[pd_warnCount];
 
 // Which stepper advances the state. Adaptive RK4 is the paper's; the fixed one is for sweeps.
 typedef enum pdStepper {
@@ -91,16 +100,23 @@ typedef struct pdBodyState {
   pdVec3 w;  // rad/s, world
 } pdBodyState;
 
-pdState* pd_state_create(const pdModel* model);
-// Back to t = 0 with the model's initial conditions; counters and timers cleared.
-void pd_state_reset(const pdModel* model, pdState* state);
-void pd_state_free(pdState* state);
+// A new state of `model` at t = 0: the scene's initial poses and velocities, no contacts, the adaptive
+// stepper with first step settings.dt. The caller owns it (pd_state_free). `model` must outlive the state
+// and be the model passed with it to every other call.
+PD_API pdState* pd_state_create(const pdModel* model);
+// Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
+// to the adaptive one (set state->stepper after this call for the fixed one).
+PD_API void pd_state_reset(const pdModel* model, pdState* state);
+// Frees the state and everything it holds; NULL is allowed.
+PD_API void pd_state_free(pdState* state);
 
-pdBodyState pd_state_body(const pdModel* model, const pdState* state, int bodyIndex);
+// Pose and velocity of body `bodyIndex` (a model body index, 0 <= bodyIndex < model->bodyCount, fixed
+// bodies included) at the state's time t. Asserts on an index out of range.
+PD_API pdBodyState pd_state_body(const pdModel* model, const pdState* state, int bodyIndex);
 
 // Kinetic + gravitational potential energy of all moving bodies plus the energy stored in the contact
 // springs (½ k s² each), J (gravitational potential zero at the origin).
-double pd_state_energy(const pdModel* model, const pdState* state);
+PD_API double pd_state_energy(const pdModel* model, const pdState* state);
 
 // One active contact at the state's time, for output (DESIGN §4.2 contacts.csv).
 typedef struct pdContactReport {
@@ -115,19 +131,29 @@ typedef struct pdContactReport {
   bool slip;            // the friction limit is active
 } pdContactReport;
 
-int pd_state_contact_count(const pdState* state);
-pdContactReport pd_state_contact(const pdState* state, int i);
+// The active contacts at the state's time t (in an observer, or after pd_advance returned): their number,
+// and contact i (0 <= i < count, in contact-id order; asserts otherwise) as a copy. Its force is the one the
+// springs carry at t; a contact whose normal springs would pull reports no force (it is dropped after the
+// step). The sum over contacts of ±(fn·normal + ft) (+ when the body is A, − when it is B) is the total
+// contact force on a body (examples/embed/main.c).
+PD_API int pd_state_contact_count(const pdState* state);
+PD_API pdContactReport pd_state_contact(const pdState* state, int i);
 
 // Called at every output sample, with state->t exactly k / sampleRate. Returning false asks
-// pd_advance to stop after this sample (state->stopped is set).
+// pd_advance to stop after this sample (state->stopped is set). The observer reads the state (it is
+// const) and may do anything else, but must not call pd_advance or pd_state_reset on this state.
 typedef bool pdObserverFcn(const pdModel* model, const pdState* state, void* user);
 
-// Advances the state to tEnd (clamped to settings.tend is the caller's choice), calling `observer`
-// (nullable) at every output sample t = k / sampleRate <= tEnd, including t = 0 when the state is
-// there. Returns false if the run had to stop (state->failed; the state stays finite) or the
-// observer asked to stop (state->stopped).
-bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
+// Advances the state to tEnd, s (tEnd >= state->t, asserted; clamping to settings.tend is the caller's
+// choice), calling `observer` (nullable) with `user` at every output sample t = k / sampleRate <= tEnd,
+// including t = 0 when the state is there. Call it again with a later tEnd to go on: the samples continue
+// where they stopped. Returns true when state->t == tEnd; false if the run had to stop (state->failed,
+// with the reason counted in state->warnings; the state stays finite and later calls return false at once)
+// or the observer asked to stop (state->stopped; state->t is then that sample's time).
+PD_API bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
 
 // The state derivative dy/dt at (t, y), y laid out for the state's current contact list (its length is
-// state->n). Uses the state's scratch and stage timers. Exposed for tests and alternative steppers.
-void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt);
+// state->n; layout at the top of this header), written to dydt (state->n numbers). Uses the state's
+// scratch and stage timers, so it changes what pd_state_contact reports until the next step. Exposed for
+// tests and alternative steppers.
+PD_API void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt);

@@ -10,6 +10,8 @@
 #include <math.h>
 #include <stdbool.h>
 
+#include "polydyn/api.h"
+
 typedef struct pdVec3 {
   double x, y, z;
 } pdVec3;
@@ -96,4 +98,4 @@ static inline pdVec3 pd_quat_rotate(pdQuat q, pdVec3 v) {
   return pd_mat3_mulv(&r, v);
 }
 // Quaternion of a proper rotation matrix (Shepperd's method; sign chosen so w >= 0).
-pdQuat pd_quat_from_mat3(const pdMat3* r);
+PD_API pdQuat pd_quat_from_mat3(const pdMat3* r);

@@ -1,0 +1,34 @@
+// polydyn — the public API: what every header of include/polydyn shares.
+//
+// Headers (C11; include the ones you use, each compiles on its own):
+//   scene.h       parse a scene file or a scene held in memory (pdScene)
+//   model.h       compile a scene into a read-only model: bodies, mass properties, contact material (pdModel)
+//   state.h       the mutable state of a run, stepping it (pd_advance), reading poses and contacts (pdState)
+//   output.h      run directories (trajectory.csv, contacts.csv, summary.json), as `polydyn run` writes them
+//   polyhedron.h  convex polyhedra and exact mass properties
+//   vecmath.h     vectors, quaternions, 3×3 matrices (mostly static inline)
+//   error.h       pdError (bad input) and PD_ASSERT (misuse)
+// examples/embed/main.c uses them end to end: scene → model → state → pd_advance with an observer.
+//
+// Conventions of every function:
+// - Units SI (m, kg, s, N, rad) except where a comment says otherwise (the scene language's degrees).
+// - Ownership: a function named *_create, *_compile, *_parse_* or *_open returns an object the caller owns
+//   and frees with the matching *_free (or pd_run_finish / pd_run_abort), which accepts NULL. Pointers
+//   inside a returned struct are owned by that struct; a caller reads them and never frees them.
+//   pd_polyhedron_* fill a pdPolyhedron the caller holds; pd_polyhedron_free frees its arrays.
+// - Errors: bad input (a scene file, a path) is reported through a pdError and a NULL/false return, never an
+//   abort. Misuse by the caller (an index out of range, a NULL where one is not allowed) and running out of
+//   memory abort through PD_ASSERT with a message on stderr.
+// - Threads: no global mutable state. A pdModel is never written after pd_model_compile, so one model may
+//   drive many states in as many threads; a pdState belongs to one thread at a time.
+//
+// PD_API marks the functions and data of the API. The engine is compiled with hidden symbol visibility:
+// libpolydyn.so exports exactly the PD_API declarations of these headers, so an embedding program cannot
+// come to depend on an internal function (engine/src) by accident. libpolydyn.a holds the same objects.
+#pragma once
+
+#if defined(__GNUC__)
+#define PD_API __attribute__((visibility("default")))
+#else
+#define PD_API
+#endif
