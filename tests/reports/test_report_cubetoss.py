@@ -114,9 +114,14 @@ class CubetossReport(unittest.TestCase):
         self.assertTrue(all(float(r["pos_err"]) >= 0 and 0 <= float(r["rot_err_rad"]) <= math.pi for r in over))
 
     def test_replay_payload_is_the_record_then_every_engines_run(self):
-        blocks = re.findall(r'<details class="replay"[^>]*>.*?<script type="application/json" class="pd-run">(.*?)</script></details>', self.html, re.S)
+        blocks = re.findall(r'<details class="replay" data-run="[^"]*" data-replay="([^"]*)">', self.html)
         self.assertEqual(len(blocks), 1)
-        payload = json.loads(blocks[0])
+        # the block's data: a script of report-replays/ calling polydynReplay(NAME, PAYLOAD)
+        with open(os.path.join(self.ct, "report-replays", blocks[0]), encoding="utf-8") as f:
+            script = f.read()
+        head = f"polydynReplay({json.dumps(blocks[0])}, "
+        self.assertTrue(script.startswith(head) and script.endswith(");\n"), script[:80])
+        payload = json.loads(script[len(head):-3])
         typ = self.json["cubetoss"]["typical"]
         self.assertEqual([r["run"] for r in payload["runs"]],
                          [f'runs/{typ["toss"]}/record'] + [r["run_dir"] for r in typ["runs"]])

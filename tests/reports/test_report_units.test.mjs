@@ -107,8 +107,10 @@ test('arguments: DIR, -o, --viewer, --no-viewer; outputs beside the page', () =>
   assert.throws(() => parseArgs([]), /DIR is missing/);
   assert.throws(() => parseArgs(['a', 'b']), /one directory expected/);
   assert.throws(() => parseArgs(['a', '--bogus']), /unknown option/);
-  assert.deepEqual(outputPaths('d', null, ['matrix']), { page: 'd/report.html', json: 'd/report.json', csv: { matrix: 'd/report-matrix.csv' } });
+  assert.deepEqual(outputPaths('d', null, ['matrix']), { page: 'd/report.html', json: 'd/report.json', csv: { matrix: 'd/report-matrix.csv' },
+    replays: 'd/report-replays' });
   assert.equal(outputPaths('d', 'out/x.html', []).json, 'out/x.json');
+  assert.equal(outputPaths('d', 'out/x.html').replays, 'out/x-replays');
 });
 
 import { rotationAngle, errorsOverTime, ecdf, typicalToss, paramsOrder } from '../../reports/generator/lib/cubetoss.mjs';
