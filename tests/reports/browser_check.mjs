@@ -1,7 +1,8 @@
 // Browser smoke test of a generated report, in Debian's Chromium (never a downloaded browser) through
 // playwright-core: the page loads from file:// without a single network request or console error,
-// every chart has drawn (a non-empty SVG with marks), and every replay, once opened, loads its data
-// from the folder beside the page and draws it (its canvas has drawn pixels).
+// the charts far below the first screen wait until scrolled to, then every chart has drawn (a non-empty
+// SVG with marks), and every replay, once opened, loads its data from the folder beside the page and
+// draws it (its canvas has drawn pixels).
 // --missing-replays PAGE: a page whose replay folder is gone: every opened replay says that its data is
 // missing, and the only console errors are the failed loads of those files.
 // usage: node browser_check.mjs REPORT.html... [--missing-replays PAGE] [--screenshot PNG [--until SECTION_ID]] [--width W] [--height H]
@@ -55,6 +56,15 @@ try {
     await page.goto(pathToFileURL(path.resolve(file)).href, { waitUntil: 'load' });
     await page.waitForTimeout(300);
 
+    // charts are drawn as they come near the screen: those far below wait; scrolled to, each draws
+    const waiting = await page.evaluate(() => Array.from(document.querySelectorAll('.chart'))
+      .filter((el) => el.getBoundingClientRect().top > window.innerHeight + 1600).map((el) => !!el.querySelector('svg')));
+    if (waiting.length) check(waiting.every((drawn) => !drawn), `the ${waiting.length} charts far below the first screen are not drawn at load`);
+    for (const id of await page.evaluate(() => Array.from(document.querySelectorAll('.chart')).map((el) => el.id))) {
+      await page.locator(`#${id}`).scrollIntoViewIfNeeded();
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    }
+    await page.evaluate(() => window.scrollTo(0, 0));
     const charts = await page.evaluate(() => Array.from(document.querySelectorAll('.chart')).map((el) => {
       const svg = el.querySelector('svg');
       const r = el.getBoundingClientRect();
