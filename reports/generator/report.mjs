@@ -19,6 +19,7 @@ import { fileURLToPath } from 'node:url';
 import { InputError, UsageError, SetupError } from './lib/errors.mjs';
 import { readResults, readExperiments, readSeries, readSweep, readMetrics, readSummary, readCubetoss } from './lib/inputs.mjs';
 import { loadTypical } from './lib/cubetoss.mjs';
+import { compactTrajectory, compactContacts } from './lib/replay.mjs';
 import * as derive from './lib/derive.mjs';
 import { esc, colorOf } from './lib/html.mjs';
 import { writeCsv } from './lib/csv.mjs';
@@ -181,7 +182,8 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
       const contacts = read('contacts.csv');
       const summary = read('summary.json');
       if (trajectory.length + (contacts || '').length + (summary || '').length > REPLAY_MAX_BYTES) return null;
-      return { run: runDir, summary: summary === null ? null : JSON.parse(summary), trajectory, contacts };
+      return { run: runDir, summary: summary === null ? null : JSON.parse(summary), trajectory: compactTrajectory(trajectory),
+        contacts: compactContacts(contacts) };
     },
     // A closed replay block whose data (what PolydynViewer.mount takes) is written to its own file
     // in replayFolder, a script the page loads when the block is first opened. The file's name ends

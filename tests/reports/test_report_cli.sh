@@ -62,18 +62,19 @@ runs=$(grep -o '<details class="replay" data-run="[^"]*" data-replay="[^"]*"' "$
 files=$(find "$work/o/v-replays" -name '*.js' | wc -l)
 [[ $runs -eq 2 && $files -eq 2 && $(grep -c 'id="pd-viewer-bundle"' "$work/o/v.html") -eq 1 ]] &&
   ok "-o v.html with a viewer: 2 replay blocks, their 2 data files in v-replays/, the bundle once" || bad "replays: $runs blocks, $files files"
-# each block names a file that holds that run's trajectory.csv as it is
-python3 - "$work/o/v.html" "$work/o/v-replays" "$fixture" <<'EOF' && ok "each replay file holds its run's trajectory.csv and summary.json" || bad "replay files"
+# each block names a file that holds that run's summary.json and trajectory.csv (numbers shortened to the
+# values the viewer keeps), and is smaller than the run's files
+python3 - "$work/o/v.html" "$work/o/v-replays" "$fixture" "$src/tests/reports" <<'EOF' && ok "each replay file holds its run's trajectory.csv and summary.json, in fewer bytes" || bad "replay files"
 import json, os, re, sys
-page, folder, fixture = sys.argv[1:]
+page, folder, fixture, here = sys.argv[1:]
+sys.path.insert(0, here)
+from replay_files import read_replay, same_trajectory
 blocks = re.findall(r'<details class="replay" data-run="([^"]*)" data-replay="([^"]*)"', open(page, encoding="utf-8").read())
 for run, name in blocks:
-    text = open(os.path.join(folder, name), encoding="utf-8").read()
-    head = f"polydynReplay({json.dumps(name)}, "
-    assert text.startswith(head) and text.endswith(");\n"), name
-    files = json.loads(text[len(head):-3])
+    files = read_replay(folder, name)
     assert files["run"] == run, (files["run"], run)
-    assert files["trajectory"] == open(os.path.join(fixture, run, "trajectory.csv"), encoding="utf-8").read(), run
+    full = open(os.path.join(fixture, run, "trajectory.csv"), encoding="utf-8").read()
+    assert same_trajectory(files["trajectory"], full) and len(files["trajectory"]) < len(full), run
     assert files["summary"] == json.load(open(os.path.join(fixture, run, "summary.json"), encoding="utf-8")), run
 EOF
 cp -r "$work/o/v-replays" "$work/first-replays"
