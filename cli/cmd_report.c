@@ -5,7 +5,8 @@
 // arguments, finds the script and runs it with posix_spawnp — an argument vector, no shell, so any
 // file name is passed as it is. The script reads and checks every input (a malformed file is
 // `polydyn report: FILE:LINE: message` and exit status 2, before anything is written) and writes
-// the page, report.json and report-*.csv, each under a temporary name renamed when complete.
+// the page, report.json, report-*.csv and the replays' folder report-replays/, each under a temporary
+// name renamed when complete.
 //
 // Where the script is: $PD_REPORT_GENERATOR when set, else PD_SOURCE_DIR/reports/generator/report.mjs
 // (PD_SOURCE_DIR is the source tree this binary was built from, a compile definition). Which node:
@@ -47,7 +48,9 @@ static const char* const help =
     "  -o FILE         the page (default DIR/report.html); FILE.json (FILE without .html) and\n"
     "                  FILE-TABLE.csv are written beside it\n"
     "  --viewer FILE   inline this replay bundle once and add a 3-D replay of each run (default:\n"
-    "                  viewer/dist/viewer.js of the source tree, when it exists)\n"
+    "                  viewer/dist/viewer.js of the source tree, when it exists); each replay's data\n"
+    "                  is a file of FILE-replays/ (FILE without .html), loaded when its block is\n"
+    "                  opened: keep that folder beside the page\n"
     "  --no-viewer     no replays\n"
     "\n"
     "Needs Node.js and `npm ci --prefix reports/generator` (scripts/setup does it). Exit status:\n"

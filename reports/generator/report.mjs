@@ -5,17 +5,21 @@
 // (any subset: results.csv, experiments.json, series/*.csv, runs/*/*/summary.json, sweep.csv, metrics.csv,
 // cubetoss/ — or DIR itself being a cubetoss directory) and
 // writes one self-contained HTML page (Apache ECharts and the page script inlined: no network at view
-// time), the numbers it shows as JSON beside it, and its derived tables as CSV:
-//   FILE (default DIR/report.html), FILE without .html + .json, FILE without .html + -TABLE.csv.
+// time), the numbers it shows as JSON beside it, its derived tables as CSV, and with a viewer bundle
+// each replay's data as a script of its own, which the page loads when the replay is opened:
+//   FILE (default DIR/report.html), FILE without .html + .json, FILE without .html + -TABLE.csv,
+//   FILE without .html + -replays/RUN-HASH.js.
 // Each file is written under a temporary name and renamed when complete.
 // Exit status: 0 written; 1 failure (e.g. the charting library is not installed); 2 bad input
 // (`polydyn report: FILE:LINE: message` on stderr, nothing written); 130 interrupted.
+import crypto from 'node:crypto';
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { InputError, UsageError, SetupError } from './lib/errors.mjs';
 import { readResults, readExperiments, readSeries, readSweep, readMetrics, readSummary, readCubetoss } from './lib/inputs.mjs';
 import { loadTypical } from './lib/cubetoss.mjs';
+import { compactTrajectory, compactContacts } from './lib/replay.mjs';
 import * as derive from './lib/derive.mjs';
 import { esc, colorOf } from './lib/html.mjs';
 import { writeCsv } from './lib/csv.mjs';
@@ -24,7 +28,7 @@ import { sections } from './sections/index.mjs';
 const HERE = path.dirname(fileURLToPath(import.meta.url));
 const REPO = path.resolve(HERE, '..', '..');
 export const DEFAULT_VIEWER = path.join(REPO, 'viewer', 'dist', 'viewer.js');
-const REPLAY_MAX_BYTES = 8 << 20;  // a run whose files are larger is not embedded for replay
+const REPLAY_MAX_BYTES = 8 << 20;  // a run whose files are larger gets no replay
 
 const GROUP_NAMES = { A: 'contact-model calibration', B: 'friction', C: 'impacts', D: 'rolling, pivoting, polyhedral wheels',
   E: 'paradoxes and indeterminacy', F: 'gyroscopic', G: 'multi-body' };
@@ -44,7 +48,9 @@ plus the numbers it shows as JSON and CSV beside it. Sections appear when their 
   -o FILE         the page (default DIR/report.html); FILE.json (without .html) and FILE-TABLE.csv
                   are written beside it
   --viewer FILE   inline this replay bundle (one copy) and add a 3-D replay of each run
-                  (default: viewer/dist/viewer.js of the source tree, when it exists)
+                  (default: viewer/dist/viewer.js of the source tree, when it exists); each replay's
+                  data is a file of FILE-replays/ (FILE without .html), loaded when its block is
+                  opened: keep that folder beside the page
   --no-viewer     no replays
 
 Exit status: 0 written, 1 failure, 2 bad input (FILE:LINE: message), 130 interrupted.
@@ -131,8 +137,10 @@ function slug(name) {
 }
 
 // Builds the page, report.json and the CSV tables in memory.
-export function generate(dir, inputs, { viewerSource = null, echartsSource = readEcharts() } = {}) {
+// replayFolder: the name of the folder beside the page that holds each replay's data (FILE-replays).
+export function generate(dir, inputs, { viewerSource = null, echartsSource = readEcharts(), replayFolder = 'report-replays' } = {}) {
   const charts = [];
+  const replays = new Map();  // file name in replayFolder → its text
   const lazy = (f) => { let done = false, v; return () => (done ? v : (done = true, v = f())); };
   const results = inputs.results;
   const matrix = lazy(() => (results && results.rows.length ? derive.matrix(results, inputs.experiments) : null));
@@ -153,7 +161,6 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
     evOrder,
     groupNames: GROUP_NAMES,
     slug,
-    scriptJson,
     experimentList: derive.orderExperiments(results, inputs.experiments),
     get matrix() { return matrix(); },
     get verdicts() { return matrix() ? derive.verdicts(matrix()) : null; },
@@ -175,7 +182,19 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
       const contacts = read('contacts.csv');
       const summary = read('summary.json');
       if (trajectory.length + (contacts || '').length + (summary || '').length > REPLAY_MAX_BYTES) return null;
-      return { run: runDir, summary: summary === null ? null : JSON.parse(summary), trajectory, contacts };
+      return { run: runDir, summary: summary === null ? null : JSON.parse(summary), trajectory: compactTrajectory(trajectory),
+        contacts: compactContacts(contacts) };
+    },
+    // A closed replay block whose data (what PolydynViewer.mount takes) is written to its own file
+    // in replayFolder, a script the page loads when the block is first opened. The file's name ends
+    // in a hash of its data, so that a folder written with another page is never taken for this one's.
+    replay(runDir, summaryHtml, files) {
+      const data = scriptJson(files);
+      const hash = crypto.createHash('sha256').update(data).digest('hex').slice(0, 12);
+      const name = `${slug(runDir)}-${hash}.js`;
+      replays.set(name, `polydynReplay(${JSON.stringify(name)}, ${data});\n`);
+      return `<details class="replay" data-run="${esc(runDir)}" data-replay="${esc(name)}"><summary>${summaryHtml}</summary>` +
+        '<div class="pd-replay"></div></details>';
     },
   };
 
@@ -212,9 +231,10 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
 <style>
 ${css}</style>
 </head>
-<body>
+<body${replays.size ? ` data-replays="${esc(replayFolder)}"` : ''}>
 <header><h1>polydyn report <span class="muted">${esc(path.basename(path.resolve(dir)))}</span></h1>
-<p class="muted">From ${esc(shortInputs(inputs))}. The numbers shown are in report.json and report-*.csv beside this page.</p></header>
+<p class="muted">From ${esc(shortInputs(inputs))}. The numbers shown are in report.json and report-*.csv beside this page.${replays.size ?
+    ` The data of the ${replays.size} 3-D replays is in the folder ${esc(replayFolder)}/ beside it (keep the two together).` : ''}</p></header>
 <nav>${nav}</nav>
 <main>
 ${body}
@@ -228,7 +248,7 @@ ${scriptSource(pageJs)}</script>
 </body>
 </html>
 `;
-  return { html, json: JSON.stringify(json, finiteReplacer, 1) + '\n', csvs };
+  return { html, json: JSON.stringify(json, finiteReplacer, 1) + '\n', csvs, replays: [...replays].sort(([a], [b]) => (a < b ? -1 : 1)) };
 }
 
 function inputList(inputs) {
@@ -257,31 +277,44 @@ function shortInputs(inputs) {
   return list.join(', ');
 }
 
-// Output paths: the page, its JSON and CSVs beside it.
-export function outputPaths(dir, out, csvNames) {
+// Output paths: the page, its JSON, CSVs and replay folder beside it.
+export function outputPaths(dir, out, csvNames = []) {
   const page = out || path.join(dir, 'report.html');
   const stem = page.endsWith('.html') ? page.slice(0, -5) : page;
-  return { page, json: stem + '.json', csv: Object.fromEntries(csvNames.map((n) => [n, `${stem}-${n}.csv`])) };
+  return { page, json: stem + '.json', csv: Object.fromEntries(csvNames.map((n) => [n, `${stem}-${n}.csv`])), replays: stem + '-replays' };
 }
 
 const temporaries = new Set();
+const removeTree = (p) => fs.rmSync(p, { recursive: true, force: true });
 
-// Writes every file under a temporary name, then renames them all (the page last).
-function writeAll(files) {
+// Writes every file under a temporary name, and the replay folder (replays: [name, text] pairs, or
+// null for none) as a temporary folder, then renames them all, the page last. The folder replaces the
+// one there; a page without replays removes it, so that the page and its folder always belong together.
+function writeAll(files, folder, replays) {
   const pending = [];
+  const tmp = (p) => { const t = `${p}.tmp-${process.pid}`; temporaries.add(t); return t; };
   try {
-    for (const [file, text] of files) {
-      const tmp = `${file}.tmp-${process.pid}`;
-      temporaries.add(tmp);
-      fs.writeFileSync(tmp, text);
-      pending.push([tmp, file]);
+    if (replays) {
+      const t = tmp(folder);
+      removeTree(t);
+      fs.mkdirSync(t);
+      for (const [name, text] of replays) fs.writeFileSync(path.join(t, name), text);
+      pending.push([t, folder]);
     }
-    for (const [tmp, file] of pending) {
-      fs.renameSync(tmp, file);
-      temporaries.delete(tmp);
+    for (const [file, text] of files) {
+      const t = tmp(file);
+      fs.writeFileSync(t, text);
+      pending.push([t, file]);
+    }
+    const old = `${folder}.old-${process.pid}`;
+    temporaries.add(old);
+    if (fs.existsSync(folder)) fs.renameSync(folder, old);
+    for (const [t, file] of pending) {
+      fs.renameSync(t, file);
+      temporaries.delete(t);
     }
   } finally {
-    for (const tmp of temporaries) try { fs.unlinkSync(tmp); } catch { /* already gone */ }
+    for (const t of temporaries) removeTree(t);
     temporaries.clear();
   }
 }
@@ -303,17 +336,20 @@ export function main(argv) {
   if (viewerPath) {
     try { viewerSource = fs.readFileSync(viewerPath, 'utf8'); } catch (e) { throw new InputError(viewerPath, 0, `cannot read the viewer bundle: ${e.code || e.message}`); }
   }
-  const { html, json, csvs } = generate(dir, inputs, { viewerSource });
+  const replayFolder = outputPaths(dir, opts.out).replays;
+  const { html, json, csvs, replays } = generate(dir, inputs, { viewerSource, replayFolder: path.basename(replayFolder) });
   const out = outputPaths(dir, opts.out, csvs.map((c) => c.name));
-  writeAll([[out.json, json], ...csvs.map((c) => [out.csv[c.name], c.text]), [out.page, html]]);
-  process.stderr.write(`polydyn report: wrote ${out.page} (${(html.length / 1e6).toFixed(1)} MB), ${path.basename(out.json)} and ${csvs.length} CSV table${csvs.length === 1 ? '' : 's'}\n`);
+  writeAll([[out.json, json], ...csvs.map((c) => [out.csv[c.name], c.text]), [out.page, html]], out.replays, replays.length ? replays : null);
+  const mb = (n) => `${(n / 1e6).toFixed(1)} MB`;
+  process.stderr.write(`polydyn report: wrote ${out.page} (${mb(html.length)}), ${path.basename(out.json)}, ${csvs.length} CSV table${csvs.length === 1 ? '' : 's'}` +
+    `${replays.length ? ` and ${replays.length} replays in ${path.basename(out.replays)}/ (${mb(replays.reduce((n, [, t]) => n + t.length, 0))})` : ''}\n`);
   return 0;
 }
 
 if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.meta.url)) {
   for (const sig of ['SIGINT', 'SIGTERM']) {
     process.on(sig, () => {
-      for (const tmp of temporaries) try { fs.unlinkSync(tmp); } catch { /* gone */ }
+      for (const tmp of temporaries) removeTree(tmp);
       process.exit(130);
     });
   }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Browser smoke test: the fixture report with cube-toss results (and a stand-in viewer bundle for the
 # replay hook) and a sweep-only report load in headless Debian Chromium with no console error and no network request,
-# every chart draws, and every embedded replay mounts (one of them the cube toss's record with each engine's run).
+# every chart draws, and every replay loads its data from full-replays/ when opened and draws it (one of them the cube
+# toss's record with each engine's run); the page copied without that folder says, in each replay, that the data is missing.
 # usage: test_report_browser.sh POLYDYN SOURCE_DIR
 set -euo pipefail
 polydyn=$1
@@ -21,4 +22,7 @@ echo "ok - the fixture report embeds 3 replays (one of a cube toss) and the view
 mkdir "$work/s"
 cp "$fixtures/gedanken/sweep.csv" "$work/s/"
 "$polydyn" report "$work/s" --no-viewer 2>/dev/null
-node "$src/tests/reports/browser_check.mjs" "$work/full.html" "$work/s/report.html"
+# the same page without its replay folder (full-replays/)
+mkdir "$work/alone"
+cp "$work/full.html" "$work/alone/"
+node "$src/tests/reports/browser_check.mjs" "$work/full.html" "$work/s/report.html" --missing-replays "$work/alone/full.html"

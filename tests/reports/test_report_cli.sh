@@ -55,6 +55,37 @@ mkdir "$work/o"
   bad "-o: $(ls "$work/o")"
 [[ -z $(find "$fixture" -name 'report*' -o -name '*.tmp-*') ]] && ok "-o leaves the input directory untouched" || bad "files written into the fixture"
 
+# --- replays: the viewer bundle once in the page, each run's data in its own file of FILE-replays/
+fake=$src/tests/reports/fixtures/fake-viewer.js
+"$polydyn" report "$fixture" -o "$work/o/v.html" --viewer "$fake" 2>/dev/null
+runs=$(grep -o '<details class="replay" data-run="[^"]*" data-replay="[^"]*"' "$work/o/v.html" | wc -l)
+files=$(find "$work/o/v-replays" -name '*.js' | wc -l)
+[[ $runs -eq 2 && $files -eq 2 && $(grep -c 'id="pd-viewer-bundle"' "$work/o/v.html") -eq 1 ]] &&
+  ok "-o v.html with a viewer: 2 replay blocks, their 2 data files in v-replays/, the bundle once" || bad "replays: $runs blocks, $files files"
+# each block names a file that holds that run's summary.json and trajectory.csv (numbers shortened to the
+# values the viewer keeps), and is smaller than the run's files
+python3 - "$work/o/v.html" "$work/o/v-replays" "$fixture" "$src/tests/reports" <<'EOF' && ok "each replay file holds its run's trajectory.csv and summary.json, in fewer bytes" || bad "replay files"
+import json, os, re, sys
+page, folder, fixture, here = sys.argv[1:]
+sys.path.insert(0, here)
+from replay_files import read_replay, same_trajectory
+blocks = re.findall(r'<details class="replay" data-run="([^"]*)" data-replay="([^"]*)"', open(page, encoding="utf-8").read())
+for run, name in blocks:
+    files = read_replay(folder, name)
+    assert files["run"] == run, (files["run"], run)
+    full = open(os.path.join(fixture, run, "trajectory.csv"), encoding="utf-8").read()
+    assert same_trajectory(files["trajectory"], full) and len(files["trajectory"]) < len(full), run
+    assert files["summary"] == json.load(open(os.path.join(fixture, run, "summary.json"), encoding="utf-8")), run
+EOF
+cp -r "$work/o/v-replays" "$work/first-replays"
+echo stale >"$work/o/v-replays/stale.js"
+"$polydyn" report "$fixture" -o "$work/o/v.html" --viewer "$fake" 2>/dev/null
+diff -r "$work/first-replays" "$work/o/v-replays" >/dev/null && [[ -z $(find "$work/o" -name '*.tmp-*' -o -name '*.old-*') ]] &&
+  ok "a second run replaces the replay folder with identical bytes (no stale file, no temporary)" || bad "the replay folder differs between two runs"
+"$polydyn" report "$fixture" -o "$work/o/v.html" --no-viewer 2>/dev/null
+[[ ! -e $work/o/v-replays ]] && ! grep -q 'data-replays=' "$work/o/v.html" && ok "a page without replays removes its replay folder" ||
+  bad "--no-viewer left $work/o/v-replays"
+
 # --- sections are pluggable: a directory with only sweep.csv gets the sweep's sections only
 mkdir "$work/s"
 cp "$fixture/sweep.csv" "$work/s/"

@@ -1,12 +1,20 @@
 // Unit tests of the report generator's parts (node --test): the CSV and JSON readers keep line
-// numbers, the cost-to-target interpolation, the matrix aggregation, the number formatting.
+// numbers, the cost-to-target interpolation, the matrix aggregation, the number formatting, the replay
+// data shortened without changing what the viewer reads.
 import test from 'node:test';
 import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
 import { parseCsv, writeCsv } from '../../reports/generator/lib/csv.mjs';
 import { parseJson, lineOf } from '../../reports/generator/lib/json.mjs';
 import { costToReach, matrix, orderEngineVariants, median, verdicts } from '../../reports/generator/lib/derive.mjs';
 import { num } from '../../reports/generator/lib/html.mjs';
 import { parseArgs, outputPaths } from '../../reports/generator/report.mjs';
+import { shortDouble, shortFloat32, compactTrajectory, compactContacts } from '../../reports/generator/lib/replay.mjs';
+import { readRunFiles } from '../../viewer/src/data.js';
+
+const HERE = path.dirname(fileURLToPath(import.meta.url));
 
 test('csv: quoted fields keep commas, quotes and line breaks, and records keep their first line', () => {
   const recs = parseCsv('a,b\n1,"x, ""y""\nz"\r\n2,\n', 'f.csv');
@@ -128,8 +136,10 @@ test('arguments: DIR, -o, --viewer, --no-viewer; outputs beside the page', () =>
   assert.throws(() => parseArgs([]), /DIR is missing/);
   assert.throws(() => parseArgs(['a', 'b']), /one directory expected/);
   assert.throws(() => parseArgs(['a', '--bogus']), /unknown option/);
-  assert.deepEqual(outputPaths('d', null, ['matrix']), { page: 'd/report.html', json: 'd/report.json', csv: { matrix: 'd/report-matrix.csv' } });
+  assert.deepEqual(outputPaths('d', null, ['matrix']), { page: 'd/report.html', json: 'd/report.json', csv: { matrix: 'd/report-matrix.csv' },
+    replays: 'd/report-replays' });
   assert.equal(outputPaths('d', 'out/x.html', []).json, 'out/x.json');
+  assert.equal(outputPaths('d', 'out/x.html').replays, 'out/x-replays');
 });
 
 import { rotationAngle, errorsOverTime, ecdf, typicalToss, paramsOrder } from '../../reports/generator/lib/cubetoss.mjs';
@@ -162,4 +172,43 @@ test('cube tosses: the typical toss is nearest the median, among tosses with a r
   assert.equal(none.replay, false);
   assert.deepEqual(ecdf([3, 1, 2, NaN]), [[1, 1 / 3], [2, 2 / 3], [3, 1]]);
   assert.deepEqual(paramsOrder([{ params: 'x' }, { params: 'fitted' }, { params: 'default' }]), ['default', 'fitted', 'x']);
+});
+
+test('replay data: each number shortened to the shortest text of the value the viewer keeps, other fields as they are', () => {
+  assert.equal(shortDouble('0.55000000000000004'), '0.55');
+  assert.equal(shortDouble('-5.5511151231257827e-17'), '-5.551115123125783e-17');
+  assert.equal(shortDouble('-0'), '-0');
+  for (const field of ['', ' 1', 'nan', 'inf', 'box', '1e999']) {
+    assert.equal(shortDouble(field), field);
+    assert.equal(shortFloat32(field), field);
+  }
+  assert.equal(shortFloat32('-0.0098100000000000001'), '-0.00981');  // float32(-0.00981) is the same float32
+  assert.equal(shortFloat32('0.10000000149011612'), '0.1');
+  assert.equal(shortFloat32('16777217'), '16777216');  // 2^24 + 1 is not a float32
+});
+
+test('replay data: the viewer reads the shortened files of a run into the very same arrays, to the bit', () => {
+  const dir = path.join(HERE, 'fixtures', 'gedanken', 'runs', 'A1', 'soft-adaptive-e=0.5');
+  // the bodies of the run (floor, box) as summary.json describes them today (the fixture's is older)
+  const cube = { vertices: [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]],
+    faces: [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 4, 7, 3]] };
+  const body = (name, fixed) => ({ name, color: 'grey', fixed, mass: 1, size: 2, inertia: [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+    initial: { x: [0, 0, 0], q: [1, [0, 0, 0]] }, shape: cube });
+  const summary = { engine: 'soft', scene: 's', settings: { gravity: [0, 0, -9.81] }, bodies: [body('floor', true), body('box', false)] };
+  const trajectory = fs.readFileSync(path.join(dir, 'trajectory.csv'), 'utf8');
+  // contacts at three sample times, numbers written as polydyn does (%.17g), from a fixed generator
+  const times = trajectory.split('\n').slice(1, 4).map((l) => l.split(',')[0]);
+  let seed = 7;
+  const random = () => { seed = (seed * 16807) % 2147483647; return (seed / 2147483647 - 0.5) * 10 ** ((seed % 9) - 4); };
+  const g17 = (x) => x.toPrecision(17);
+  const contacts = 't,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode\n' +
+    times.map((t, k) => [t, 'box', 'floor', k ? 'EE' : 'VF', 3, 1, ...Array.from({ length: 10 }, () => g17(random())), k ? 'slip' : 'stick'].join(',') + '\n').join('');
+  const full = { run: 'r', summary, trajectory, contacts };
+  const short = { ...full, trajectory: compactTrajectory(trajectory), contacts: compactContacts(contacts) };
+  assert.ok(short.trajectory.length < 0.8 * trajectory.length && short.contacts.length < contacts.length,
+    `${trajectory.length} → ${short.trajectory.length}, ${contacts.length} → ${short.contacts.length} bytes`);
+  const [a, b] = [readRunFiles(full).runs[0], readRunFiles(short).runs[0]];
+  assert.equal(a.contacts, 3);
+  const bytes = (v) => Buffer.from(v.buffer, v.byteOffset, v.byteLength);
+  for (const k of ['t', 'pose', 'vel', 'contactStart', 'contactFloat', 'contactInt']) assert.ok(bytes(a[k]).equals(bytes(b[k])), k);
 });

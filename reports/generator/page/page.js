@@ -1,5 +1,6 @@
 // polydyn report: draws the charts (Apache ECharts, inlined above) from the JSON specifications the
-// generator wrote into #pd-charts, and mounts the 3-D replays when a viewer bundle is inlined.
+// generator wrote into #pd-charts as they come into view, and mounts the 3-D replays (their data
+// loaded on demand) when a viewer bundle is inlined.
 (function () {
   'use strict';
   // a number for axis labels and tooltips: 3 significant digits, scientific outside [1e-3, 1e5)
@@ -45,23 +46,53 @@
     }
     return o;
   }
+  // Each chart is drawn when it comes near the screen (a report has tens of charts, which would take
+  // about a second to draw at once); all of them before printing.
   var specs = JSON.parse(document.getElementById('pd-charts').textContent);
   var charts = [];
-  specs.forEach(function (s) {
-    var el = document.getElementById(s.id);
-    var chart = echarts.init(el, null, { renderer: 'svg' });
+  function draw(s) {
+    if (s.drawn) return;
+    s.drawn = true;
+    var chart = echarts.init(document.getElementById(s.id), null, { renderer: 'svg' });
     var option = decorate(s.option);
     option.animation = false;
     option.textStyle = { fontFamily: 'system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans", sans-serif' };
     chart.setOption(option);
     charts.push(chart);
-  });
+  }
+  function drawAll() { specs.forEach(draw); }
+  if (typeof IntersectionObserver === 'function') {
+    var specOf = {};
+    var near = new IntersectionObserver(function (entries) {
+      entries.forEach(function (e) {
+        if (!e.isIntersecting) return;
+        near.unobserve(e.target);
+        draw(specOf[e.target.id]);
+      });
+    }, { rootMargin: '800px 0px' });
+    specs.forEach(function (s) {
+      specOf[s.id] = s;
+      near.observe(document.getElementById(s.id));
+    });
+  } else {
+    drawAll();
+  }
+  window.addEventListener('beforeprint', drawAll);
   window.addEventListener('resize', function () { charts.forEach(function (c) { c.resize(); }); });
-  window.polydynReport = { charts: charts };
+  window.polydynReport = { charts: charts, drawAll: drawAll };
 
-  // replays: the inlined viewer bundle defines PolydynViewer.mount(element, run); each run is
-  // mounted when its <details> is first opened (one WebGL context per open replay)
+  // replays: the inlined viewer bundle defines PolydynViewer.mount(element, files); each replay's
+  // files are in a script of the folder beside the page (body's data-replays), which calls
+  // polydynReplay(NAME, files). It is added when the replay's <details> is first opened: a script
+  // loads from file:// where fetch() does not. One WebGL context per open replay.
   var viewer = window.PolydynViewer;
+  var folder = document.body.dataset.replays;
+  var waiting = {};  // file name → mounts its files
+  window.polydynReplay = function (name, files) {
+    var mount = waiting[name];
+    delete waiting[name];
+    if (mount) mount(files);
+  };
   Array.prototype.forEach.call(document.querySelectorAll('details.replay'), function (d) {
     d.addEventListener('toggle', function () {
       if (!d.open || d.dataset.mounted) return;
@@ -71,7 +102,26 @@
         target.textContent = 'The inlined viewer bundle does not define PolydynViewer.mount.';
         return;
       }
-      viewer.mount(target, JSON.parse(d.querySelector('script.pd-run').textContent));
+      var name = d.dataset.replay, src = folder + '/' + name;
+      var missing = 'The replay data is missing: this page loads it from ' + src + ', which is not there. polydyn report writes ' +
+        'the folder ' + folder + '/ beside the page; keep it there (copy both together).';
+      target.textContent = 'Loading the replay data from ' + src + ' …';
+      waiting[name] = function (files) {
+        target.textContent = '';
+        viewer.mount(target, files);
+      };
+      var script = document.createElement('script');
+      script.src = encodeURIComponent(folder) + '/' + encodeURIComponent(name);
+      function fail(message) {
+        delete waiting[name];
+        target.textContent = message;
+        target.classList.add('pd-missing');
+      }
+      script.onerror = function () { fail(missing); };
+      script.onload = function () {
+        if (waiting[name]) fail(src + ' does not hold the replay data (it does not call polydynReplay for ' + name + ').');
+      };
+      document.head.appendChild(script);
     });
   });
 })();

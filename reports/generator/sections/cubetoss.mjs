@@ -186,9 +186,8 @@ function typicalBlock(ctx, ct, typ) {
     const files = typ.runs.map((run) => ctx.runData(run.run_dir));
     if (files.every(Boolean)) {
       const payload = { title: `toss ${typ.toss}: the record and ${typ.runs.slice(1).map((r) => r.label).join(', ')}`, runs: files };
-      html += `<details class="replay" data-run="${esc(typ.runs[0].run_dir)}"><summary>3-D replay: the record of toss ${typ.toss} ` +
-        `(solid) with ${esc(typ.runs.slice(1).map((r) => r.label).join(', '))} overlaid</summary>` +
-        `<div class="pd-replay"></div><script type="application/json" class="pd-run">${ctx.scriptJson(payload)}</script></details>`;
+      html += ctx.replay(typ.runs[0].run_dir, `3-D replay: the record of toss ${typ.toss} ` +
+        `(solid) with ${esc(typ.runs.slice(1).map((r) => r.label).join(', '))} overlaid`, payload);
     }
   }
   return { html, data, csv: [{ name: 'cubetoss-typical', header: ['toss', 'engine', 'variant', 't', 'pos_err', 'rot_err_rad'], rows: csvRows }] };

@@ -84,14 +84,13 @@ function inputNumber(input) {
   return Number.isFinite(x) ? x : Infinity;
 }
 
-// The replay hook: each run with a trajectory gets a <details> that mounts the viewer when opened.
+// The replay hook: each run with a trajectory gets a <details> that loads its data and mounts the viewer when opened.
 function replays(ctx, rows) {
   let html = '';
   for (const r of rows) {
     const run = r.run_dir && ctx.runData(r.run_dir);
     if (!run) continue;
-    html += `<details class="replay" data-run="${esc(r.run_dir)}"><summary>3-D replay: ${esc(r.ev)}${r.input ? ' ' + esc(r.input) : ''}</summary>` +
-      `<div class="pd-replay"></div><script type="application/json" class="pd-run">${ctx.scriptJson(run)}</script></details>`;
+    html += ctx.replay(r.run_dir, `3-D replay: ${esc(r.ev)}${r.input ? ' ' + esc(r.input) : ''}`, run);
   }
   return html;
 }
