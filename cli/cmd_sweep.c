@@ -6,6 +6,7 @@
 // engine at the tightest tolerance, checked against one 10× tighter; both are written.
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
