@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "polydyn/batch.h"
 #include "polydyn/gedanken.h"
 
 static const char* const help =
@@ -168,8 +169,10 @@ int pd_cmd_gedanken(int argc, char** argv) {
     return 130;
   }
   if (!ok) {
-    fprintf(stderr, "polydyn gedanken: ");
-    pd_error_print(&err, stderr);
+    if (pd_batch_is_root()) {
+      fprintf(stderr, "polydyn gedanken: ");
+      pd_error_print(&err, stderr);
+    }
     return PD_EXIT_FAILURE;
   }
   printf("polydyn gedanken: %d rows in %.1f s:", summary.rows, summary.wallSeconds);
@@ -177,7 +180,8 @@ int pd_cmd_gedanken(int argc, char** argv) {
     if (summary.count[s]) printf(" %d %s", summary.count[s], pdGkStatusNames[s]);
   printf("; %s/results.csv\n", options.out);
   if (summary.softFailures > 0) {
-    fprintf(stderr, "polydyn gedanken: %d soft-engine row%s failed: %s\n", summary.softFailures,
+    if (pd_batch_is_root())  // MPI: every rank has the rows; rank 0 says it
+      fprintf(stderr, "polydyn gedanken: %d soft-engine row%s failed: %s\n", summary.softFailures,
             summary.softFailures > 1 ? "s" : "", summary.softFailed);
     return PD_EXIT_FAILURE;
   }
