@@ -58,7 +58,11 @@ check "$COMMAND --jobs 2: exit 0" '[ $rc -eq 0 ]'
 check "$COMMAND --jobs 2: the serial run's files and bytes but the measured times" \
   'python3 "$HERE/same_outputs.py" "$SCRATCH/serial" "$SCRATCH/jobs2"'
 if [ -n "$MPIEXEC" ]; then
+  # Under ASan: OpenMPI never frees what MPI_Init allocates, much of it in components it unloads at
+  # MPI_Finalize (their frames cannot be suppressed by name), so the leak check is off for these runs only;
+  # the serial and --jobs runs above leak-check the same code of polydyn.
   # shellcheck disable=SC2086
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
   "$MPIEXEC" --oversubscribe -np 3 "$PD" $ARGS --out "$SCRATCH/mpi3" >"$SCRATCH/mpi3.out" 2>"$SCRATCH/mpi3.err"; rc=$?
   check "$COMMAND under mpirun -np 3: exit 0" '[ $rc -eq 0 ]' || cat "$SCRATCH/mpi3.err"
   check "$COMMAND under mpirun -np 3: the serial run's files and bytes but the measured times" \
