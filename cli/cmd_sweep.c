@@ -305,13 +305,6 @@ int pd_cmd_sweep(int argc, char** argv) {
     pd_model_free(refModel);
     return PD_EXIT_BAD_INPUT;
   }
-  // DIR under a temporary name (refused now, before the work, when it is not a sweep directory)
-  char tmp[4096];
-  if (!pd_cli_out_open("sweep", out, "sweep.csv", tmp, sizeof tmp)) {
-    pd_model_free(refModel);
-    pd_model_free(checkModel);
-    return PD_EXIT_BAD_INPUT;
-  }
   if (progress) fprintf(stderr, "\rpolydyn sweep: reference (tol %g) and its check (tol %g)\033[K", SWEEP_REFERENCE_TOL,
                         SWEEP_REFERENCE_CHECK_TOL);
   referenceRun references[2] = {{.model = refModel}, {.model = checkModel}};
@@ -330,7 +323,6 @@ int pd_cmd_sweep(int argc, char** argv) {
     if (progress) fputs("\r\033[K", stderr);
     if (why[0]) fprintf(stderr, "polydyn sweep: %s\n", why);
     fprintf(stderr, "polydyn sweep: the reference run (soft at tol %g) did not complete\n", SWEEP_REFERENCE_TOL);
-    pd_cli_remove_tree(tmp);
     pd_trajectory_free(ref);
     pd_trajectory_free(check);
     pd_model_free(refModel);
@@ -375,17 +367,19 @@ int pd_cmd_sweep(int argc, char** argv) {
   }
   free(measured);
   if (progress) fputs("\r\033[K", stderr);
-  if (!pointsOk || !pd_batch_is_root()) {  // MPI: rank 0 writes and reports
+  // DIR under a temporary name, made only now (an interrupted sweep leaves nothing); MPI: rank 0 writes
+  char tmp[4096];
+  bool opened = pointsOk && pd_cli_out_open("sweep", out, "sweep.csv", tmp, sizeof tmp);
+  if (!opened || !pd_batch_is_root()) {
     if (!pointsOk) fprintf(stderr, "polydyn sweep: %s\n", why);
-    pd_cli_remove_tree(tmp);
     pd_trajectory_free(ref);
     pd_trajectory_free(check);
     pd_model_free(refModel);
     pd_model_free(checkModel);
-    return pointsOk ? PD_EXIT_OK : PD_EXIT_FAILURE;
+    return !pointsOk ? PD_EXIT_FAILURE : opened ? PD_EXIT_OK : PD_EXIT_BAD_INPUT;
   }
 
-  // write DIR under a temporary name, then rename
+  // write DIR's files, then rename
   char path[4400];
   int status = PD_EXIT_OK;
   {
