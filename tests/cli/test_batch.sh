@@ -23,6 +23,8 @@ trap 'rm -rf "$SCRATCH"' EXIT
 . "$HERE/../lib.sh"  # check, no_partial
 # CI runs as root: OpenMPI refuses that unless told it is meant
 if [ "$(id -u)" -eq 0 ]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
+# containers often forbid the cross-process memory reads OpenMPI's shared-memory transport tries first
+export OMPI_MCA_btl_vader_single_copy_mechanism=none
 
 # the command's arguments but --out DIR; $ARGS is split on purpose
 case $COMMAND in
