@@ -20,7 +20,8 @@ int pd_cmd_cubetoss(int argc, char** argv);
 int pd_cmd_gedanken(int argc, char** argv);
 int pd_cmd_oracle(int argc, char** argv);
 
-// Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr; returns 2.
+// Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr (on MPI rank 0 only:
+// every rank sees the same arguments); returns 2.
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 
 // Output directories (cli/out_dir.c): mkdir -p of the directories above `path`; out/NAME for scene path
@@ -32,8 +33,17 @@ void pd_cli_remove_tree(const char* path);
 // pd_cli_out_open refuses (message, false) an existing OUT without `marker` in it — not a directory of
 // this command — and makes tmp. pd_cli_out_close moves tmp into place, replacing a previous OUT; on
 // failure it prints why, removes tmp and returns false.
+// Under MPI (refcheck/include/polydyn/batch.h) both are collective: rank 0 makes, moves and removes the
+// directories, every rank gets tmp's name (or false), and the others' pd_cli_out_close does nothing.
 bool pd_cli_out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize);
 bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out);
+
+// --jobs N of the batch commands (README, Batch runs): a whole number 1..PD_CLI_MAX_JOBS; false when not.
+#define PD_CLI_MAX_JOBS 64
+bool pd_cli_jobs(const char* text, int* jobs);
+// The worker processes of this process: `given` when --jobs was given (> 0), else `serialDefault`, or 1
+// under MPI (the ranks already fill the cores).
+int pd_cli_default_jobs(int given, int serialDefault);
 
 // Seconds of CLOCK_MONOTONIC (wall time of runs and progress displays).
 double pd_cli_wall_seconds(void);

@@ -1,6 +1,9 @@
-// polydyn compare — one scene in every engine, metrics against a tighter soft run (DESIGN §5).
+// polydyn compare — one scene (or every scene of a directory) in every engine, metrics against a tighter
+// soft run (DESIGN §5). Each scene is one task of a batch (refcheck/include/polydyn/batch.h).
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "polydyn/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
@@ -20,8 +24,8 @@
 #define COMPARE_PATH_MAX 3000
 
 static const char* const help =
-    "usage: polydyn compare SCENE --out DIR [--engines soft,ode,bullet] [--variants native,matched]\n"
-    "                             [--step H] [--tend T] [--sample HZ]\n"
+    "usage: polydyn compare SCENE|SCENE_DIR --out DIR [--engines soft,ode,bullet] [--variants native,matched]\n"
+    "                             [--step H] [--tend T] [--sample HZ] [--jobs N]\n"
     "\n"
     "Runs SCENE in polydyn's soft engine and in the reference engines (each variant), and a reference run\n"
     "of the soft engine at a 100x tighter tolerance. Writes DIR/metrics.csv (one row per run: pose error\n"
@@ -33,9 +37,16 @@ static const char* const help =
     "  --variants LIST  of the reference engines: native, matched (default: both)\n"
     "  --step H         the reference engines' step, s (default 1e-3)\n"
     "  --tend T, --sample HZ   override the scene's settings for every run\n"
+    "  --jobs N         compare N scenes at a time in worker processes (default 1); under mpirun or srun the\n"
+    "                   scenes are split over the ranks (README, Batch runs). Scenes compared side by side\n"
+    "                   share the machine: wall_per_sim_second then measures a loaded machine\n"
+    "\n"
+    "With SCENE_DIR, every SCENE_DIR/NAME.scene (in byte order of the names) is compared into DIR/NAME/\n"
+    "(the directory `polydyn compare SCENE_DIR/NAME.scene --out DIR/NAME` writes), and DIR/metrics.csv holds\n"
+    "the rows of all of them, in that order. Every scene is read first: one bad scene, nothing written.\n"
     "\n"
     "An engine that is not built, or that cannot represent the scene, is reported and skipped.\n"
-    "Exit status: 0 ok, 1 the soft engine's run failed, 2 bad input.\n";
+    "Exit status: 0 ok, 1 the soft engine's run of a scene failed, 2 bad input.\n";
 
 typedef struct compareRun {
   char name[32];  // ENGINE-VARIANT
@@ -150,19 +161,14 @@ static void write_json_text(FILE* out, const char* s) {
   fputc('"', out);
 }
 
-// metrics.csv (schema: reports/FORMATS.md) and compare.json; false on an I/O error.
-static bool write_results(const char* dir, const char* scene, const pdModel* model, const compareRun* runs,
-                          int count, double tolReference) {
-  char path[8192];
-  snprintf(path, sizeof path, "%s/metrics.csv", dir);
-  FILE* out = fopen(path, "w");
-  if (!out) return false;
-  fputs("scene,engine,variant,reference,pos_err_final,pos_err_rms,rot_err_final_rad,rot_err_rms_rad,"
-        "energy_drift_rel,momentum_drift_rel,max_penetration_over_size,wall_per_sim_second,steps,"
-        "restitution_impacts\n",
-        out);
-  char refName[64];
-  snprintf(refName, sizeof refName, "soft tol=%g", tolReference);
+static const char* const metricsHeader =
+    "scene,engine,variant,reference,pos_err_final,pos_err_rms,rot_err_final_rad,rot_err_rms_rad,"
+    "energy_drift_rel,momentum_drift_rel,max_penetration_over_size,wall_per_sim_second,steps,"
+    "restitution_impacts\n";
+
+// The rows of metrics.csv (schema: reports/FORMATS.md), one per run that completed.
+static void write_metric_rows(FILE* out, const char* scene, const pdModel* model, const compareRun* runs, int count,
+                              const char* refName) {
   double simulated = model->settings.tend;
   for (int i = 0; i < count; ++i) {
     const compareRun* r = &runs[i];
@@ -180,6 +186,17 @@ static bool write_results(const char* dir, const char* scene, const pdModel* mod
       fprintf(out, "%s%s:%.4f", k ? ";" : "", model->bodies[m.impactBody[k]].name, m.restitution[k]);
     fputc('\n', out);
   }
+}
+
+// metrics.csv and compare.json; false on an I/O error.
+static bool write_results(const char* dir, const char* scene, const pdModel* model, const compareRun* runs,
+                          int count, const char* refName) {
+  char path[8192];
+  snprintf(path, sizeof path, "%s/metrics.csv", dir);
+  FILE* out = fopen(path, "w");
+  if (!out) return false;
+  fputs(metricsHeader, out);
+  write_metric_rows(out, scene, model, runs, count, refName);
   bool ok = !ferror(out);
   ok = fclose(out) == 0 && ok;
   snprintf(path, sizeof path, "%s/compare.json", dir);
@@ -200,20 +217,278 @@ static bool write_results(const char* dir, const char* scene, const pdModel* mod
   return fclose(out) == 0 && ok;
 }
 
+// The table a person reads first (stdout).
+static void write_table(FILE* out, const pdModel* model, const compareRun* runs, int count) {
+  fprintf(out, "%-16s %-8s %12s %12s %12s %14s\n", "run", "status", "pos err end", "rot err end", "energy drift",
+          "wall/sim s");
+  for (int i = 0; i < count; ++i) {
+    const compareRun* r = &runs[i];
+    if (strcmp(r->status, "ok") != 0) {
+      fprintf(out, "%-16s %-8s\n", r->name, r->status);
+      continue;
+    }
+    const pdCompareMetrics m = r->metrics;
+    fprintf(out, "%-16s %-8s %12.3g %12.3g %12.3g %14.3g\n", r->name, r->status, m.posErrFinal, m.rotErrFinal,
+            m.energyDriftRel, r->wallSeconds / model->settings.tend);
+  }
+}
+
+typedef struct compareSettings {
+  const char* engines;
+  const char* variants;
+  pdCliOverrides overrides;
+  pdRefOptions refOptions;
+  bool progress;
+} compareSettings;
+
+// What one scene's task returns: its status, then its metrics rows and its table (texts with their sizes).
+typedef struct sceneHeader {
+  int32_t status;
+  int32_t written;  // its metrics.csv and compare.json are complete
+  uint64_t rowsSize, tableSize;
+} sceneHeader;
+
+// Compares one scene into `dir` (which exists): its run directories, metrics.csv and compare.json.
+static void compare_scene(const char* scene, const pdModel* model, const compareSettings* c, const char* dir,
+                          pdBatchBuffer* result) {
+  char runsDir[4500];
+  snprintf(runsDir, sizeof runsDir, "%s/runs", dir);
+  sceneHeader h = {.status = PD_EXIT_OK, .written = true};
+  if (mkdir(runsDir, 0777) != 0) {
+    fprintf(stderr, "polydyn compare: cannot create %s: %s\n", runsDir, strerror(errno));
+    h = (sceneHeader){.status = PD_EXIT_FAILURE};
+    pd_batch_append(result, &h, sizeof h);
+    return;
+  }
+  compareRun runs[8];
+  int count = 0;
+  pdCliOverrides tighter = c->overrides;
+  tighter.tolScale = COMPARE_REFERENCE_TOL_SCALE;
+  double tolReference = model->settings.tol * COMPARE_REFERENCE_TOL_SCALE;
+  // the reference first: every other run is measured against it
+  runs[count] = (compareRun){.engine = "soft", .variant = "reference", .isReference = true, .status = "failed"};
+  snprintf(runs[count].name, sizeof runs[count].name, "soft-reference");
+  ++count;
+  if (pd_cli_list_has(c->engines, "soft")) {
+    runs[count] = (compareRun){.engine = "soft", .variant = "adaptive", .status = "failed"};
+    snprintf(runs[count].name, sizeof runs[count].name, "soft-adaptive");
+    ++count;
+  }
+  static const char* const refEngines[] = {"ode", "bullet"};
+  static const char* const refVariants[] = {"native", "matched"};
+  for (int e = 0; e < 2; ++e)
+    for (int v = 0; v < 2; ++v)
+      if (pd_cli_list_has(c->engines, refEngines[e]) && pd_cli_list_has(c->variants, refVariants[v])) {
+        runs[count] = (compareRun){.engine = refEngines[e], .variant = refVariants[v], .status = "failed"};
+        snprintf(runs[count].name, sizeof runs[count].name, "%s-%s", refEngines[e], refVariants[v]);
+        ++count;
+      }
+
+  for (int i = 0; i < count; ++i) {
+    compareRun* r = &runs[i];
+    char runDir[4600];
+    snprintf(runDir, sizeof runDir, "%s/%s", runsDir, r->name);
+    if (c->progress) fprintf(stderr, "\rpolydyn compare: %s %s (%d/%d)\033[K", scene, r->name, i + 1, count);
+    if (strcmp(r->engine, "soft") == 0) {
+      run_soft(scene, r->isReference ? &tighter : &c->overrides, runDir, r);
+      continue;
+    }
+    const pdRefAdapter* adapter = pd_ref_adapter(r->engine);
+    if (!adapter) {
+      r->status = "not built";
+      snprintf(r->message, sizeof r->message, "this build of polydyn has no %s adapter", r->engine);
+      continue;
+    }
+    pdRefOptions o = c->refOptions;
+    o.variant = strcmp(r->variant, "matched") == 0 ? pd_refMatched : pd_refNative;
+    run_reference_engine(model, adapter, &o, runDir, r);
+  }
+  if (c->progress) fputs("\r\033[K", stderr);
+
+  for (int i = 0; i < count; ++i) {
+    compareRun* r = &runs[i];
+    if (strcmp(r->status, "ok") != 0) {
+      fprintf(stderr, "polydyn compare: %s: %s %s: %s\n", scene, r->name, r->status, r->message);
+      if (strcmp(r->engine, "soft") == 0) h.status = PD_EXIT_FAILURE;
+    }
+  }
+  const compareRun* reference = strcmp(runs[0].status, "ok") == 0 ? &runs[0] : NULL;
+  for (int i = 0; i < count; ++i)
+    if (strcmp(runs[i].status, "ok") == 0)
+      runs[i].metrics = pd_compare_metrics(model, runs[i].trajectory,
+                                           reference && reference != &runs[i] ? reference->trajectory : NULL);
+  char refName[64];
+  snprintf(refName, sizeof refName, "soft tol=%g", tolReference);
+  char* rows = NULL;
+  char* table = NULL;
+  size_t rowsSize = 0, tableSize = 0;
+  FILE* rowsOut = open_memstream(&rows, &rowsSize);
+  FILE* tableOut = open_memstream(&table, &tableSize);
+  if (!rowsOut || !tableOut) abort();
+  if (write_results(dir, scene, model, runs, count, refName)) {
+    write_metric_rows(rowsOut, scene, model, runs, count, refName);
+    write_table(tableOut, model, runs, count);
+  } else {
+    fprintf(stderr, "polydyn compare: cannot write %s: %s\n", dir, strerror(errno));
+    h = (sceneHeader){.status = PD_EXIT_FAILURE};
+  }
+  fclose(rowsOut);
+  fclose(tableOut);
+  h.rowsSize = rowsSize;
+  h.tableSize = tableSize;
+  pd_batch_append(result, &h, sizeof h);
+  pd_batch_append(result, rows, rowsSize);
+  pd_batch_append(result, table, tableSize);
+  free(rows);
+  free(table);
+  for (int i = 0; i < count; ++i) pd_trajectory_free(runs[i].trajectory);
+}
+
+// The scenes of one command: one file, or every NAME.scene of a directory (in byte order of the names).
+typedef struct sceneList {
+  bool directory;
+  int count;
+  char** paths;   // (count)
+  char** names;   // (count) NAME, the sub-directory of the output
+  pdModel** models;
+  const compareSettings* settings;
+  const char* tmp;
+} sceneList;
+
+static int compare_names(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
+
+static bool is_scene_name(const char* name) {
+  size_t n = strlen(name);
+  return n > 6 && name[0] != '.' && strcmp(name + n - 6, ".scene") == 0;
+}
+
+// Fills the list from `arg`; false (message printed) when the directory cannot be read or has no scene.
+static bool list_scenes(const char* arg, sceneList* list) {
+  struct stat st;
+  list->directory = stat(arg, &st) == 0 && S_ISDIR(st.st_mode);
+  if (!list->directory) {
+    list->count = 1;
+    list->paths = calloc(1, sizeof *list->paths);
+    list->names = calloc(1, sizeof *list->names);
+    if (!list->paths || !list->names || !(list->paths[0] = strdup(arg)) || !(list->names[0] = strdup(""))) abort();
+    return true;
+  }
+  DIR* d = opendir(arg);
+  if (!d) {
+    fprintf(stderr, "polydyn compare: %s: cannot read the directory: %s\n", arg, strerror(errno));
+    return false;
+  }
+  int capacity = 0;
+  for (struct dirent* e; (e = readdir(d));) {
+    if (!is_scene_name(e->d_name)) continue;
+    if (list->count == capacity) {
+      capacity = capacity ? 2 * capacity : 16;
+      list->names = realloc(list->names, (size_t)capacity * sizeof *list->names);
+      if (!list->names) abort();
+    }
+    if (!(list->names[list->count++] = strdup(e->d_name))) abort();
+  }
+  closedir(d);
+  if (list->count == 0) {
+    fprintf(stderr, "polydyn compare: %s: no NAME.scene in the directory\n", arg);
+    return false;
+  }
+  qsort(list->names, (size_t)list->count, sizeof *list->names, compare_names);
+  list->paths = calloc((size_t)list->count, sizeof *list->paths);
+  if (!list->paths) abort();
+  for (int i = 0; i < list->count; ++i) {
+    size_t n = strlen(arg) + strlen(list->names[i]) + 2;
+    list->paths[i] = malloc(n);
+    if (!list->paths[i]) abort();
+    snprintf(list->paths[i], n, "%s/%s", arg, list->names[i]);
+    list->names[i][strlen(list->names[i]) - 6] = '\0';  // NAME.scene -> NAME
+  }
+  return true;
+}
+
+static void free_scenes(sceneList* list) {
+  for (int i = 0; i < list->count; ++i) {
+    if (list->paths) free(list->paths[i]);
+    if (list->names) free(list->names[i]);
+    if (list->models && list->models[i]) pd_model_free(list->models[i]);
+  }
+  free(list->paths);
+  free(list->names);
+  free(list->models);
+}
+
+static void scene_task(int task, pdBatchBuffer* result, void* user) {
+  const sceneList* list = user;
+  char dir[4400];
+  snprintf(dir, sizeof dir, "%s%s%s", list->tmp, list->directory ? "/" : "", list->names[task]);
+  if (list->directory && mkdir(dir, 0777) != 0) {
+    fprintf(stderr, "polydyn compare: cannot create %s: %s\n", dir, strerror(errno));
+    sceneHeader h = {.status = PD_EXIT_FAILURE};
+    pd_batch_append(result, &h, sizeof h);
+    return;
+  }
+  compare_scene(list->paths[task], list->models[task], list->settings, dir, result);
+}
+
+// Rank 0 after the batch: the aggregated metrics.csv of a directory, the tables; the exit status. False
+// when a scene's files or the aggregate could not be written (then nothing is kept).
+static bool report_scenes(const sceneList* list, const pdBatchBuffer* results, const char* out, int* status) {
+  *status = PD_EXIT_OK;
+  for (int i = 0; i < list->count; ++i) {
+    sceneHeader h;
+    size_t at = 0;
+    if (!pd_batch_read(&results[i], &at, &h, sizeof h) || !h.written) return false;
+  }
+  FILE* metrics = NULL;
+  char path[4300];
+  if (list->directory) {
+    snprintf(path, sizeof path, "%s/metrics.csv", list->tmp);
+    metrics = fopen(path, "w");
+    if (!metrics) {
+      fprintf(stderr, "polydyn compare: cannot write %s: %s\n", path, strerror(errno));
+      return false;
+    }
+    fputs(metricsHeader, metrics);
+  }
+  for (int i = 0; i < list->count; ++i) {
+    sceneHeader h;
+    size_t at = 0;
+    bool whole = pd_batch_read(&results[i], &at, &h, sizeof h);
+    PD_ASSERT(whole && results[i].size - at == h.rowsSize + h.tableSize);
+    if (h.status > *status) *status = h.status;
+    if (metrics) fwrite(results[i].data + at, 1, (size_t)h.rowsSize, metrics);
+    if (list->directory) printf("%s:\n", list->paths[i]);
+    fwrite(results[i].data + at + h.rowsSize, 1, (size_t)h.tableSize, stdout);
+    printf("metrics: %s%s%s/metrics.csv (reference: soft at tol %g)\n", out, list->directory ? "/" : "", list->names[i],
+           list->models[i]->settings.tol * COMPARE_REFERENCE_TOL_SCALE);
+  }
+  if (metrics) {
+    bool ok = !ferror(metrics);
+    ok = fclose(metrics) == 0 && ok;
+    if (!ok) {
+      fprintf(stderr, "polydyn compare: cannot write %s\n", path);
+      return false;
+    }
+    printf("all scenes: %s/metrics.csv\n", out);
+  }
+  return true;
+}
+
 int pd_cmd_compare(int argc, char** argv) {
   const char* scene = NULL;
   const char* out = NULL;
-  const char* engines = "soft,ode,bullet";
-  const char* variants = "native,matched";
-  pdCliOverrides overrides = {0};
-  pdRefOptions refOptions = {pd_refNative, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid};
+  int jobs = 0;
+  compareSettings c = {.engines = "soft,ode,bullet",
+                       .variants = "native,matched",
+                       .refOptions = {pd_refNative, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid}};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     if (pd_cli_is_help(a)) {
       fputs(help, stdout);
       return PD_EXIT_OK;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--engines") == 0 || strcmp(a, "--variants") == 0 ||
-               strcmp(a, "--step") == 0 || strcmp(a, "--tend") == 0 || strcmp(a, "--sample") == 0) {
+               strcmp(a, "--step") == 0 || strcmp(a, "--tend") == 0 || strcmp(a, "--sample") == 0 ||
+               strcmp(a, "--jobs") == 0) {
       if (i + 1 >= argc) return pd_cli_usage_error("compare", "%s needs a value", a);
       const char* v = argv[++i];
       char bad[64];
@@ -224,23 +499,25 @@ int pd_cmd_compare(int argc, char** argv) {
         static const char* const known[] = {"soft", "ode", "bullet", NULL};
         if (!list_valid(v, known, bad, sizeof bad))
           return pd_cli_usage_error("compare", "--engines: unknown engine '%s' (soft, ode, bullet)", bad);
-        engines = v;
+        c.engines = v;
       } else if (strcmp(a, "--variants") == 0) {
         static const char* const known[] = {"native", "matched", NULL};
         if (!list_valid(v, known, bad, sizeof bad))
           return pd_cli_usage_error("compare", "--variants: unknown variant '%s' (native, matched)", bad);
-        variants = v;
+        c.variants = v;
       } else if (strcmp(a, "--step") == 0) {
-        if (!pd_cli_positive(v, &refOptions.step)) return pd_cli_usage_error("compare", "--step needs a number > 0");
+        if (!pd_cli_positive(v, &c.refOptions.step)) return pd_cli_usage_error("compare", "--step needs a number > 0");
       } else if (strcmp(a, "--tend") == 0) {
-        if (!pd_cli_positive(v, &overrides.tend)) return pd_cli_usage_error("compare", "--tend needs a number > 0");
-      } else if (!pd_cli_positive(v, &overrides.sample)) {
+        if (!pd_cli_positive(v, &c.overrides.tend)) return pd_cli_usage_error("compare", "--tend needs a number > 0");
+      } else if (strcmp(a, "--jobs") == 0) {
+        if (!pd_cli_jobs(v, &jobs)) return pd_cli_usage_error("compare", "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
+      } else if (!pd_cli_positive(v, &c.overrides.sample)) {
         return pd_cli_usage_error("compare", "--sample needs a number > 0");
       }
     } else if (a[0] == '-' && a[1] != '\0') {
       return pd_cli_usage_error("compare", "unknown option '%s'", a);
     } else if (scene) {
-      return pd_cli_usage_error("compare", "one scene at a time ('%s' and '%s')", scene, a);
+      return pd_cli_usage_error("compare", "one scene or one directory of scenes ('%s' and '%s')", scene, a);
     } else {
       scene = a;
     }
@@ -248,107 +525,50 @@ int pd_cmd_compare(int argc, char** argv) {
   if (!scene) return pd_cli_usage_error("compare", "no scene given");
   if (!out) return pd_cli_usage_error("compare", "--out DIR is required");
   if (strlen(out) > COMPARE_PATH_MAX) return pd_cli_usage_error("compare", "--out: path longer than %d bytes", COMPARE_PATH_MAX);
+  jobs = pd_cli_default_jobs(jobs, 1);  // one at a time unless asked: wall_per_sim_second is a measurement
 
-  pdModel* model = pd_cli_load_model(scene, &overrides, NULL);
-  if (!model) return PD_EXIT_BAD_INPUT;
-  char tmp[4096];
-  if (!pd_cli_out_open("compare", out, "metrics.csv", tmp, sizeof tmp)) {
-    pd_model_free(model);
+  // every scene read first: a bad one is refused before anything is written
+  sceneList list = {.settings = &c};
+  if (!list_scenes(scene, &list)) {
+    free_scenes(&list);
     return PD_EXIT_BAD_INPUT;
   }
-  char runsDir[4200];
-  snprintf(runsDir, sizeof runsDir, "%s/runs", tmp);
-  if (mkdir(runsDir, 0777) != 0) {
-    fprintf(stderr, "polydyn compare: cannot create %s: %s\n", runsDir, strerror(errno));
-    pd_cli_remove_tree(tmp);
-    pd_model_free(model);
-    return PD_EXIT_FAILURE;
-  }
-  bool progress = isatty(STDERR_FILENO) == 1;
-
-  compareRun runs[8];
-  int count = 0;
-  pdCliOverrides tighter = overrides;
-  tighter.tolScale = COMPARE_REFERENCE_TOL_SCALE;
-  double tolReference = model->settings.tol * COMPARE_REFERENCE_TOL_SCALE;
-  // the reference first: every other run is measured against it
-  runs[count] = (compareRun){.engine = "soft", .variant = "reference", .isReference = true, .status = "failed"};
-  snprintf(runs[count].name, sizeof runs[count].name, "soft-reference");
-  ++count;
-  if (pd_cli_list_has(engines, "soft")) {
-    runs[count] = (compareRun){.engine = "soft", .variant = "adaptive", .status = "failed"};
-    snprintf(runs[count].name, sizeof runs[count].name, "soft-adaptive");
-    ++count;
-  }
-  static const char* const refEngines[] = {"ode", "bullet"};
-  static const char* const refVariants[] = {"native", "matched"};
-  for (int e = 0; e < 2; ++e)
-    for (int v = 0; v < 2; ++v)
-      if (pd_cli_list_has(engines, refEngines[e]) && pd_cli_list_has(variants, refVariants[v])) {
-        runs[count] = (compareRun){.engine = refEngines[e], .variant = refVariants[v], .status = "failed"};
-        snprintf(runs[count].name, sizeof runs[count].name, "%s-%s", refEngines[e], refVariants[v]);
-        ++count;
-      }
-
-  for (int i = 0; i < count; ++i) {
-    compareRun* r = &runs[i];
-    char dir[4300];
-    snprintf(dir, sizeof dir, "%s/%s", runsDir, r->name);
-    if (progress) fprintf(stderr, "\rpolydyn compare: %s (%d/%d)\033[K", r->name, i + 1, count);
-    if (strcmp(r->engine, "soft") == 0) {
-      run_soft(scene, r->isReference ? &tighter : &overrides, dir, r);
-      continue;
+  list.models = calloc((size_t)list.count, sizeof *list.models);
+  if (!list.models) abort();
+  for (int i = 0; i < list.count; ++i)
+    if (!(list.models[i] = pd_cli_load_model(list.paths[i], &c.overrides, NULL))) {
+      free_scenes(&list);
+      return PD_EXIT_BAD_INPUT;
     }
-    const pdRefAdapter* adapter = pd_ref_adapter(r->engine);
-    if (!adapter) {
-      r->status = "not built";
-      snprintf(r->message, sizeof r->message, "this build of polydyn has no %s adapter", r->engine);
-      continue;
-    }
-    pdRefOptions o = refOptions;
-    o.variant = strcmp(r->variant, "matched") == 0 ? pd_refMatched : pd_refNative;
-    run_reference_engine(model, adapter, &o, dir, r);
+  char tmp[4096];
+  if (!pd_cli_out_open("compare", out, "metrics.csv", tmp, sizeof tmp)) {
+    free_scenes(&list);
+    return PD_EXIT_BAD_INPUT;
   }
-  if (progress) fputs("\r\033[K", stderr);
+  list.tmp = tmp;
+  // progress of a scene's runs when they run here, one after the other
+  c.progress = isatty(STDERR_FILENO) == 1 && jobs == 1 && pd_batch_ranks() == 1;
 
+  pdBatchBuffer* results = calloc((size_t)list.count, sizeof *results);
+  if (!results) abort();
+  pdBatchOptions batch = {.workers = jobs};
+  char why[256] = "";
   int status = PD_EXIT_OK;
-  for (int i = 0; i < count; ++i) {
-    compareRun* r = &runs[i];
-    if (strcmp(r->status, "ok") != 0) {
-      fprintf(stderr, "polydyn compare: %s %s: %s\n", r->name, r->status, r->message);
-      if (strcmp(r->engine, "soft") == 0) status = PD_EXIT_FAILURE;
-    }
-  }
-  const compareRun* reference = strcmp(runs[0].status, "ok") == 0 ? &runs[0] : NULL;
-  for (int i = 0; i < count; ++i)
-    if (strcmp(runs[i].status, "ok") == 0)
-      runs[i].metrics = pd_compare_metrics(model, runs[i].trajectory,
-                                           reference && reference != &runs[i] ? reference->trajectory : NULL);
-  bool written = write_results(tmp, scene, model, runs, count, tolReference);
-  if (!written) {
-    fprintf(stderr, "polydyn compare: cannot write %s: %s\n", tmp, strerror(errno));
+  if (!pd_batch_run(list.count, scene_task, &list, &batch, results, why, sizeof why)) {
+    fprintf(stderr, "polydyn compare: %s\n", why);
     pd_cli_remove_tree(tmp);
-  }
-  written = written && pd_cli_out_close("compare", tmp, out);
-  if (!written) {
     status = PD_EXIT_FAILURE;
-  } else {
-    // the table on stdout: what a person reads first
-    printf("%-16s %-8s %12s %12s %12s %14s\n", "run", "status", "pos err end", "rot err end", "energy drift",
-           "wall/sim s");
-    for (int i = 0; i < count; ++i) {
-      compareRun* r = &runs[i];
-      if (strcmp(r->status, "ok") != 0) {
-        printf("%-16s %-8s\n", r->name, r->status);
-        continue;
-      }
-      const pdCompareMetrics m = r->metrics;
-      printf("%-16s %-8s %12.3g %12.3g %12.3g %14.3g\n", r->name, r->status, m.posErrFinal, m.rotErrFinal,
-             m.energyDriftRel, r->wallSeconds / model->settings.tend);
+  } else if (pd_batch_is_root()) {  // MPI: rank 0 writes and reports
+    // a scene whose soft run failed is kept (exit 1, as one scene); a write error keeps nothing
+    if (!report_scenes(&list, results, out, &status)) {
+      pd_cli_remove_tree(tmp);
+      status = PD_EXIT_FAILURE;
+    } else if (!pd_cli_out_close("compare", tmp, out)) {
+      status = PD_EXIT_FAILURE;
     }
-    printf("metrics: %s/metrics.csv (reference: soft at tol %g)\n", out, tolReference);
   }
-  for (int i = 0; i < count; ++i) pd_trajectory_free(runs[i].trajectory);
-  pd_model_free(model);
+  for (int i = 0; i < list.count; ++i) pd_batch_buffer_free(&results[i]);
+  free(results);
+  free_scenes(&list);
   return status;
 }

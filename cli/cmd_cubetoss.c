@@ -11,8 +11,9 @@
 #include <unistd.h>
 
 #include "cli.h"
-#include "polydyn/output.h"
+#include "polydyn/batch.h"
 #include "polydyn/cubetoss.h"
+#include "polydyn/output.h"
 
 // Longest --out path: the run directories' paths below it fit the fixed buffers.
 #define CUBETOSS_PATH_MAX 3000
@@ -55,7 +56,8 @@ static const char* const help =
     "  --step H         the reference engines' step, s (default 1e-3)\n"
     "  --tol T          the soft engine's integration tolerance (default 1e-6)\n"
     "  --inertia I      the cube's moment of inertia, kg m^2 (default 8.1e-4, the data's), or uniform\n"
-    "  --jobs N         worker processes (default 2)\n"
+    "  --jobs N         worker processes (default 2; 1 per rank under mpirun or srun, where the tosses\n"
+    "                   are split over the ranks: README, Batch runs)\n"
     "  --no-runs        keep no run directories (only the CSVs)\n"
     "  --train-every K  fit on every K-th training toss (default 1: all)\n"
     "  --max-evals N    objective evaluations per engine (default 100); --size-tol S simplex size (0.01)\n"
@@ -202,7 +204,7 @@ static int parse_options(int argc, char** argv, options* o) {
         else if (!pd_cli_positive(v, &o->inertia)) return pd_cli_usage_error(cmd, "--inertia needs a number > 0 (kg m^2) or uniform");
         break;
       case 10:
-        if (!positive_int(v, &o->jobs) || o->jobs > 64) return pd_cli_usage_error(cmd, "--jobs needs an integer in 1..64");
+        if (!pd_cli_jobs(v, &o->jobs)) return pd_cli_usage_error(cmd, "--jobs needs an integer in 1..%d", PD_CLI_MAX_JOBS);
         break;
       case 11:
         if (!positive_int(v, &o->trainEvery)) return pd_cli_usage_error(cmd, "--train-every needs an integer >= 1");
@@ -545,12 +547,13 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   char tmp[4200], runsDir[4300];
   if (!pd_cli_out_open("cubetoss", o->out, "per_toss.csv", tmp, sizeof tmp)) return PD_EXIT_BAD_INPUT;
   snprintf(runsDir, sizeof runsDir, "%s/runs", tmp);
-  if (o->runs && mkdir(runsDir, 0777) != 0) {
+  // every rank makes it (MPI: all see the same directory), so every rank knows whether it is there
+  if (o->runs && mkdir(runsDir, 0777) != 0 && errno != EEXIST) {
     fprintf(stderr, "polydyn cubetoss: cannot create %s: %s\n", runsDir, strerror(errno));
     pd_cli_remove_tree(tmp);
     return PD_EXIT_FAILURE;
   }
-  for (int e = 0; e < engineCount; ++e)
+  for (int e = 0; e < engineCount && pd_batch_is_root(); ++e)
     if (!specs[e].built)
       fprintf(stderr, "polydyn cubetoss: %s: this build of polydyn has no %s adapter; reported as not built\n",
               specs[e].label, specs[e].name);
@@ -567,6 +570,10 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   bool ok = pd_toss_parallel(count, o->jobs, sizeof *results, results, toss_job, &ctx, show_progress, &progress, why,
                              sizeof why);
   if (progress.terminal) fputs("\r\033[K", stderr);
+  if (ok && !pd_batch_is_root()) {  // MPI: rank 0 writes and reports
+    free(results);
+    return PD_EXIT_OK;
+  }
   if (!ok) {
     free(results);
     if (interrupted) return finish_interrupted("cubetoss", tmp);
@@ -645,15 +652,17 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   }
   char path[4400];
   snprintf(path, sizeof path, "%s/fit_trace.csv", tmp);
-  FILE* trace = fopen(path, "w");
-  if (!trace) {
+  FILE* trace = pd_batch_is_root() ? fopen(path, "w") : NULL;  // MPI: every rank fits, rank 0 writes
+  int traceOpen = trace != NULL;
+  pd_batch_share(&traceOpen, sizeof traceOpen);
+  if (!traceOpen) {
     fprintf(stderr, "polydyn cubetoss fit: cannot write %s: %s\n", path, strerror(errno));
     pd_cli_remove_tree(tmp);
     free(train);
     free(test);
     return PD_EXIT_FAILURE;
   }
-  pd_toss_fit_trace_header(trace);
+  if (trace) pd_toss_fit_trace_header(trace);
 
   pdTossFitResult fits[ENGINES_MAX] = {0};
   pdTossParams fitted[ENGINES_MAX];
@@ -662,11 +671,11 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   progressState progress = {.terminal = isatty(STDERR_FILENO) == 1, .start = pd_cli_wall_seconds(), .fitting = true};
   for (int e = 0; e < engineCount && ok; ++e) {
     fitted[e] = specs[e].params;
-    if (!specs[e].built) {
+    if (!specs[e].built && pd_batch_is_root()) {
       fprintf(stderr, "polydyn cubetoss fit: %s: this build of polydyn has no %s adapter; not fitted\n", specs[e].label,
               specs[e].name);
-      continue;
     }
+    if (!specs[e].built) continue;
     progress.what = specs[e].label;
     progress.evaluation = 0;
     pdTossFitOptions fo = {.set = set,
@@ -684,8 +693,8 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
     ok = pd_toss_fit(&fo, &fits[e], why, sizeof why);
     if (ok) fitted[e] = fits[e].params;
   }
-  bool traceOk = !ferror(trace);
-  traceOk = fclose(trace) == 0 && traceOk;
+  bool traceOk = !trace || !ferror(trace);
+  traceOk = (!trace || fclose(trace) == 0) && traceOk;
 
   // the test tosses with the starting and with the fitted parameters
   tossJobResult* results[2] = {calloc((size_t)testCount, sizeof(tossJobResult)),
@@ -702,6 +711,13 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
                           &progress, why, sizeof why);
   }
   if (progress.terminal) fputs("\r\033[K", stderr);
+  if (ok && !pd_batch_is_root()) {  // MPI: rank 0 writes and reports
+    free(results[0]);
+    free(results[1]);
+    free(train);
+    free(test);
+    return PD_EXIT_OK;
+  }
   if (!ok) {
     free(results[0]);
     free(results[1]);
@@ -794,7 +810,6 @@ int pd_cmd_cubetoss(int argc, char** argv) {
                .variant = pd_refNative,
                .step = PD_REF_DEFAULT_STEP,
                .tol = pd_toss_default_params().tol,
-               .jobs = DEFAULT_JOBS,
                .runs = true,
                .trainEvery = 1,
                .maxEvals = FIT_DEFAULT_MAX_EVALUATIONS,
@@ -807,6 +822,7 @@ int pd_cmd_cubetoss(int argc, char** argv) {
   const char* cmd = o.fit ? "cubetoss fit" : "cubetoss";
   int parsed = parse_options(argc, argv, &o);
   if (parsed >= 0) return parsed;
+  o.jobs = pd_cli_default_jobs(o.jobs, DEFAULT_JOBS);
   if (!o.label && !o.fit) o.label = o.paramCount > 0 ? "params" : "default";
 
   pdError err = {0};

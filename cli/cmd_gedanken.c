@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "polydyn/batch.h"
 #include "polydyn/gedanken.h"
 
 static const char* const help =
@@ -27,7 +28,9 @@ static const char* const help =
     "  --engines ENGINES    soft, ode, bullet (default: all three); ode and bullet run in their native and\n"
     "                       matched variants; an engine this build has no adapter for gives NOT_BUILT rows\n"
     "  --fast               only the fast subset that CI runs\n"
-    "  --jobs N             soft-engine runs in N threads (default 2); reference engines run on one thread\n"
+    "  --jobs N             runs in N worker processes (default 2; 1 per rank under mpirun or srun, where the\n"
+    "                       runs are split over the ranks: README, Batch runs); the files are the same bytes\n"
+    "                       whatever N, except the measured wall times\n"
     "  --tolerance-scale F  multiply every tolerance by F > 0 (default 1: the catalogue's); only to check that\n"
     "                       failures are reported, the verdicts are then not the catalogue's\n"
     "\n"
@@ -35,7 +38,7 @@ static const char* const help =
     "engines may fail some: see results.csv), 1 a soft-engine experiment failed or the results could not be\n"
     "written, 2 bad input, 130 interrupted (nothing written).\n";
 
-enum { MAX_ONLY = 64, MAX_JOBS = 64 };
+enum { MAX_ONLY = 64 };
 
 static volatile sig_atomic_t interrupted = 0;
 static void on_signal(int sig) {
@@ -77,7 +80,7 @@ static int split(char* text, char** items, int max) {
 }
 
 int pd_cmd_gedanken(int argc, char** argv) {
-  pdGkOptions options = {.jobs = 2, .toleranceScale = 1.0};
+  pdGkOptions options = {.toleranceScale = 1.0};
   bool listOnly = false, enginesGiven = false;
   char* onlyText = NULL;
   char* onlyNames[MAX_ONLY];
@@ -114,12 +117,8 @@ int pd_cmd_gedanken(int argc, char** argv) {
           options.engines[e] = true;
         }
       } else if (strcmp(a, "--jobs") == 0) {
-        char* end = NULL;
-        errno = 0;
-        long n = strtol(v, &end, 10);
-        if (end == v || *end != '\0' || errno || n < 1 || n > MAX_JOBS)
-          return pd_cli_usage_error("gedanken", "--jobs needs a whole number from 1 to %d", MAX_JOBS);
-        options.jobs = (int)n;
+        if (!pd_cli_jobs(v, &options.jobs))
+          return pd_cli_usage_error("gedanken", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);
       } else if (!pd_cli_positive(v, &options.toleranceScale)) {
         return pd_cli_usage_error("gedanken", "--tolerance-scale needs a number > 0");
       }
@@ -127,6 +126,7 @@ int pd_cmd_gedanken(int argc, char** argv) {
       return pd_cli_usage_error("gedanken", "unknown argument '%s'", a);
     }
   }
+  options.jobs = pd_cli_default_jobs(options.jobs, 2);
   if (listOnly) {
     list(options.fast);
     return PD_EXIT_OK;
@@ -169,8 +169,10 @@ int pd_cmd_gedanken(int argc, char** argv) {
     return 130;
   }
   if (!ok) {
-    fprintf(stderr, "polydyn gedanken: ");
-    pd_error_print(&err, stderr);
+    if (pd_batch_is_root()) {
+      fprintf(stderr, "polydyn gedanken: ");
+      pd_error_print(&err, stderr);
+    }
     return PD_EXIT_FAILURE;
   }
   printf("polydyn gedanken: %d rows in %.1f s:", summary.rows, summary.wallSeconds);
@@ -178,7 +180,8 @@ int pd_cmd_gedanken(int argc, char** argv) {
     if (summary.count[s]) printf(" %d %s", summary.count[s], pdGkStatusNames[s]);
   printf("; %s/results.csv\n", options.out);
   if (summary.softFailures > 0) {
-    fprintf(stderr, "polydyn gedanken: %d soft-engine row%s failed: %s\n", summary.softFailures,
+    if (pd_batch_is_root())  // MPI: every rank has the rows; rank 0 says it
+      fprintf(stderr, "polydyn gedanken: %d soft-engine row%s failed: %s\n", summary.softFailures,
             summary.softFailures > 1 ? "s" : "", summary.softFailed);
     return PD_EXIT_FAILURE;
   }

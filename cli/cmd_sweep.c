@@ -6,6 +6,7 @@
 // engine at the tightest tolerance, checked against one 10× tighter; both are written.
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +15,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "polydyn/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/refcheck.h"
 #include "polydyn/state.h"
@@ -25,7 +27,7 @@
 #define SWEEP_MAX_REPEATS 21
 
 static const char* const help =
-    "usage: polydyn sweep SCENE --out DIR [--repeats R] [--engines soft,ode,bullet] [--tend T]\n"
+    "usage: polydyn sweep SCENE --out DIR [--repeats R] [--engines soft,ode,bullet] [--tend T] [--jobs N]\n"
     "\n"
     "Work-precision sweep of SCENE: polydyn's adaptive RK4 at tol 1e-2 ... 1e-10 (decades) and its fixed-step\n"
     "RK4 at dt 1e-3 ... 1e-5, ODE and Bullet (native and matched) at steps 1/60 ... 1/16000 s. The error of\n"
@@ -33,6 +35,12 @@ static const char* const help =
     "rad) against the soft engine at tol 1e-12 (whose own error, against tol 1e-13, is reported as the\n"
     "reference's). Wall time: median of R runs (default 3), no output files written during the runs.\n"
     "Writes DIR/sweep.csv (reports/FORMATS.md) and DIR/reference.json; DIR is replaced atomically.\n"
+    "\n"
+    "  --jobs N   run N points at a time in worker processes (default 1); under mpirun or srun the points are\n"
+    "             split over the ranks (README, Batch runs). Every point's repeats stay in one process, one\n"
+    "             after the other, but points running side by side share the machine: the wall times then\n"
+    "             measure a loaded machine. Everything but the wall times is the same bytes whatever N.\n"
+    "\n"
     "Progress goes to stderr on a terminal. Exit status: 0 ok, 1 the reference run failed, 2 bad input.\n";
 
 static int compare_doubles(const void* a, const void* b) {
@@ -63,16 +71,25 @@ static double pose_error(const pdModel* model, const pdTrajectory* run, const pd
   return count ? sqrt(sum / (double)count) : 0.0;
 }
 
+// One point of the sweep: what it runs (the same list on every rank) and what it measured.
 typedef struct point {
   const char* engine;
   const char* variant;
   const char* setting;  // tol | step
   double value;
+  // measured: travels between processes as these bytes (pointMeasure)
   bool completed;
   double error;         // NAN when the run did not complete
   double wall;          // median over repeats, s
   long steps;
 } point;
+
+typedef struct pointMeasure {
+  int32_t completed;
+  int32_t unused;
+  double error, wall;
+  int64_t steps;
+} pointMeasure;
 
 // One soft run: trajectory (when wanted), wall time, steps, completed.
 static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* trajectory, double* wall, long* steps) {
@@ -86,14 +103,15 @@ static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* traj
   return ok;
 }
 
-static void measure_soft(const char* scene, const pdCliOverrides* base, const char* variant, double value,
-                         int repeats, const pdTrajectory* ref, point* p) {
+static void measure_soft(const char* scene, const pdCliOverrides* base, int repeats, const pdTrajectory* ref, point* p) {
   pdCliOverrides o = *base;
-  bool fixed = strcmp(variant, "fixed") == 0;
-  if (fixed) o.dt = value;
-  else o.tol = value;
+  bool fixed = strcmp(p->variant, "fixed") == 0;
+  if (fixed) o.dt = p->value;
+  else o.tol = p->value;
   pdModel* model = pd_cli_load_model(scene, &o, NULL);
-  *p = (point){"soft", variant, fixed ? "step" : "tol", value, false, NAN, NAN, 0};
+  p->completed = false;
+  p->error = p->wall = NAN;
+  p->steps = 0;
   if (!model) return;
   double walls[SWEEP_MAX_REPEATS];
   pdTrajectory* tr = pd_trajectory_create(model);
@@ -110,12 +128,15 @@ static void measure_soft(const char* scene, const pdCliOverrides* base, const ch
   pd_model_free(model);
 }
 
-static void measure_reference_engine(const pdModel* model, const pdRefAdapter* adapter, pdRefVariant variant,
-                                     double step, int repeats, const pdTrajectory* ref, point* p) {
-  *p = (point){adapter->name, variant == pd_refMatched ? "matched" : "native", "step", step, false, NAN, NAN, 0};
+static void measure_reference_engine(const pdModel* model, int repeats, const pdTrajectory* ref, point* p) {
+  const pdRefAdapter* adapter = pd_ref_adapter(p->engine);
+  PD_ASSERT(adapter != NULL);
+  p->completed = false;
+  p->error = p->wall = NAN;
+  p->steps = 0;
   double walls[SWEEP_MAX_REPEATS];
   pdTrajectory* tr = pd_trajectory_create(model);
-  pdRefOptions o = {variant, step, pd_odeFrictionPyramid};
+  pdRefOptions o = {strcmp(p->variant, "matched") == 0 ? pd_refMatched : pd_refNative, p->value, pd_odeFrictionPyramid};
   for (int r = 0; r < repeats; ++r) {
     pdRefRunStats stats;
     pdError err = {0};
@@ -133,11 +154,99 @@ static void measure_reference_engine(const pdModel* model, const pdRefAdapter* a
   pd_trajectory_free(tr);
 }
 
+// ---------------------------------------------------------------- the runs as batch tasks
+
+// The reference or its check: a soft run at a tight tolerance whose trajectory every rank gets.
+typedef struct referenceRun {
+  const pdModel* model;
+  pdTrajectory* trajectory;
+  double wall;
+  long steps;
+} referenceRun;
+
+typedef struct referenceHeader {
+  int32_t completed, movingCount;
+  int64_t samples, steps;
+  double wall;
+} referenceHeader;
+
+static void reference_task(int task, pdBatchBuffer* result, void* user) {
+  const referenceRun* r = &((const referenceRun*)user)[task];
+  pdTrajectory* tr = pd_trajectory_create(r->model);
+  double wall;
+  long steps;
+  bool completed = soft_run(r->model, pd_stepperRK4Adaptive, tr, &wall, &steps);
+  referenceHeader h = {completed, tr->movingCount, tr->samples, steps, wall};
+  pd_batch_append(result, &h, sizeof h);
+  pd_batch_append(result, tr->t, (size_t)tr->samples * sizeof *tr->t);
+  pd_batch_append(result, tr->bodies, (size_t)tr->samples * (size_t)tr->movingCount * sizeof *tr->bodies);
+  pd_trajectory_free(tr);
+}
+
+// Fills r->trajectory (made empty), wall and steps from a reference_task's bytes; false when the run failed.
+static bool take_reference(const pdBatchBuffer* bytes, referenceRun* r) {
+  referenceHeader h;
+  size_t at = 0;
+  if (!pd_batch_read(bytes, &at, &h, sizeof h) || !h.completed || h.movingCount != r->trajectory->movingCount)
+    return false;
+  pdTrajectory* tr = r->trajectory;
+  size_t bodies = (size_t)h.samples * (size_t)h.movingCount;
+  tr->t = malloc((size_t)h.samples * sizeof *tr->t + 1);
+  tr->bodies = malloc(bodies * sizeof *tr->bodies + 1);
+  if (!tr->t || !tr->bodies) abort();
+  tr->samples = tr->capacity = (long)h.samples;
+  r->wall = h.wall;
+  r->steps = (long)h.steps;
+  return pd_batch_read(bytes, &at, tr->t, (size_t)h.samples * sizeof *tr->t) &&
+         pd_batch_read(bytes, &at, tr->bodies, bodies * sizeof *tr->bodies);
+}
+
+typedef struct pointRuns {
+  const char* scene;
+  const pdCliOverrides* base;
+  int repeats;
+  const pdModel* refModel;
+  const pdTrajectory* ref;
+  point* points;
+  bool progress;
+} pointRuns;
+
+static void point_task(int task, pdBatchBuffer* result, void* user) {
+  const pointRuns* r = user;
+  point p = r->points[task];
+  if (strcmp(p.engine, "soft") == 0) measure_soft(r->scene, r->base, r->repeats, r->ref, &p);
+  else measure_reference_engine(r->refModel, r->repeats, r->ref, &p);
+  pointMeasure m = {p.completed, 0, p.error, p.wall, p.steps};
+  pd_batch_append(result, &m, sizeof m);
+}
+
+static void take_point(const pdBatchBuffer* bytes, point* p) {
+  pointMeasure m;
+  size_t at = 0;
+  bool whole = pd_batch_read(bytes, &at, &m, sizeof m);
+  PD_ASSERT(whole);
+  p->completed = m.completed;
+  p->error = m.error;
+  p->wall = m.wall;
+  p->steps = (long)m.steps;
+}
+
+static bool point_progress(int task, int done, int total, void* user) {
+  const pointRuns* r = user;
+  if (task >= 0) {
+    const point* p = &r->points[task];
+    fprintf(stderr, "\rpolydyn sweep: %s %s %s %.3g (%d/%d)\033[K", p->engine, p->variant, p->setting, p->value,
+            done, total);
+  }
+  return true;
+}
+
 int pd_cmd_sweep(int argc, char** argv) {
   const char* scene = NULL;
   const char* out = NULL;
   const char* engines = "soft,ode,bullet";
   long repeats = 3;
+  int jobs = 0;
   pdCliOverrides base = {0};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
@@ -145,7 +254,7 @@ int pd_cmd_sweep(int argc, char** argv) {
       fputs(help, stdout);
       return PD_EXIT_OK;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--repeats") == 0 || strcmp(a, "--engines") == 0 ||
-               strcmp(a, "--tend") == 0) {
+               strcmp(a, "--tend") == 0 || strcmp(a, "--jobs") == 0) {
       if (i + 1 >= argc) return pd_cli_usage_error("sweep", "%s needs a value", a);
       const char* v = argv[++i];
       if (strcmp(a, "--out") == 0) {
@@ -166,6 +275,8 @@ int pd_cmd_sweep(int argc, char** argv) {
           q = comma ? comma + 1 : q + len;
         }
         engines = v;
+      } else if (strcmp(a, "--jobs") == 0) {
+        if (!pd_cli_jobs(v, &jobs)) return pd_cli_usage_error("sweep", "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
       } else if (!pd_cli_positive(v, &base.tend)) {
         return pd_cli_usage_error("sweep", "--tend needs a number > 0");
       }
@@ -181,7 +292,9 @@ int pd_cmd_sweep(int argc, char** argv) {
   if (!out) return pd_cli_usage_error("sweep", "--out DIR is required");
   bool progress = isatty(STDERR_FILENO) == 1;
 
-  // the reference and its check
+  jobs = pd_cli_default_jobs(jobs, 1);  // one at a time unless asked: the wall times are the measurement
+
+  // the reference and its check: two tasks, their trajectories on every rank (every point needs the reference)
   pdCliOverrides refO = base, checkO = base;
   refO.tol = SWEEP_REFERENCE_TOL;
   checkO.tol = SWEEP_REFERENCE_CHECK_TOL;
@@ -192,15 +305,23 @@ int pd_cmd_sweep(int argc, char** argv) {
     pd_model_free(refModel);
     return PD_EXIT_BAD_INPUT;
   }
-  if (progress) fprintf(stderr, "\rpolydyn sweep: reference (tol %g)\033[K", SWEEP_REFERENCE_TOL);
-  pdTrajectory* ref = pd_trajectory_create(refModel);
-  pdTrajectory* check = pd_trajectory_create(checkModel);
-  double refWall, checkWall;
-  long refSteps, checkSteps;
-  bool refOk = soft_run(refModel, pd_stepperRK4Adaptive, ref, &refWall, &refSteps) &&
-               soft_run(checkModel, pd_stepperRK4Adaptive, check, &checkWall, &checkSteps);
+  if (progress) fprintf(stderr, "\rpolydyn sweep: reference (tol %g) and its check (tol %g)\033[K", SWEEP_REFERENCE_TOL,
+                        SWEEP_REFERENCE_CHECK_TOL);
+  referenceRun references[2] = {{.model = refModel}, {.model = checkModel}};
+  pdBatchBuffer referenceBytes[2];
+  char why[256] = "";
+  pdBatchOptions batch = {.workers = jobs, .everywhere = true};
+  bool refOk = pd_batch_run(2, reference_task, references, &batch, referenceBytes, why, sizeof why);
+  for (int k = 0; k < 2; ++k) {
+    references[k].trajectory = pd_trajectory_create(references[k].model);
+    refOk = refOk && take_reference(&referenceBytes[k], &references[k]);
+    pd_batch_buffer_free(&referenceBytes[k]);
+  }
+  pdTrajectory* ref = references[0].trajectory;
+  pdTrajectory* check = references[1].trajectory;
   if (!refOk) {
     if (progress) fputs("\r\033[K", stderr);
+    if (why[0]) fprintf(stderr, "polydyn sweep: %s\n", why);
     fprintf(stderr, "polydyn sweep: the reference run (soft at tol %g) did not complete\n", SWEEP_REFERENCE_TOL);
     pd_trajectory_free(ref);
     pd_trajectory_free(check);
@@ -209,52 +330,59 @@ int pd_cmd_sweep(int argc, char** argv) {
     return PD_EXIT_FAILURE;
   }
   double refError = pose_error(refModel, ref, check);
+  double refWall = references[0].wall;
+  long refSteps = references[0].steps;
 
+  // the points: one task each, in the order of sweep.csv
   enum { MAX_POINTS = 64 };
   point points[MAX_POINTS];
   int count = 0;
   static const double tols[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
   static const double fixedSteps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};
   static const double refSteps_[] = {1.0 / 60, 1.0 / 250, 1.0 / 1000, 1.0 / 4000, 1.0 / 16000};
-  int total = 0;
-  if (pd_cli_list_has(engines, "soft")) total += 14;
-  if (pd_cli_list_has(engines, "ode") && pd_ref_adapter("ode")) total += 10;
-  if (pd_cli_list_has(engines, "bullet") && pd_ref_adapter("bullet")) total += 10;
   if (pd_cli_list_has(engines, "soft")) {
-    for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i) {
-      if (progress) fprintf(stderr, "\rpolydyn sweep: soft tol %g (%d/%d)\033[K", tols[i], count + 1, total);
-      measure_soft(scene, &base, "adaptive", tols[i], (int)repeats, ref, &points[count++]);
-    }
-    for (size_t i = 0; i < sizeof fixedSteps / sizeof fixedSteps[0]; ++i) {
-      if (progress) fprintf(stderr, "\rpolydyn sweep: soft fixed dt %g (%d/%d)\033[K", fixedSteps[i], count + 1, total);
-      measure_soft(scene, &base, "fixed", fixedSteps[i], (int)repeats, ref, &points[count++]);
-    }
+    for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i) points[count++] = (point){.engine = "soft", .variant = "adaptive", .setting = "tol", .value = tols[i]};
+    for (size_t i = 0; i < sizeof fixedSteps / sizeof fixedSteps[0]; ++i)
+      points[count++] = (point){.engine = "soft", .variant = "fixed", .setting = "step", .value = fixedSteps[i]};
   }
   static const char* const refNames[] = {"ode", "bullet"};
   for (int e = 0; e < 2; ++e) {
-    const pdRefAdapter* adapter = pd_ref_adapter(refNames[e]);
     if (!pd_cli_list_has(engines, refNames[e])) continue;
-    if (!adapter) {
-      fprintf(stderr, "polydyn sweep: this build has no %s adapter; skipped\n", refNames[e]);
+    if (!pd_ref_adapter(refNames[e])) {
+      if (pd_batch_is_root()) fprintf(stderr, "polydyn sweep: this build has no %s adapter; skipped\n", refNames[e]);
       continue;
     }
     for (int v = 0; v < 2; ++v)
-      for (size_t i = 0; i < sizeof refSteps_ / sizeof refSteps_[0]; ++i) {
-        if (progress)
-          fprintf(stderr, "\rpolydyn sweep: %s %s h %.3g (%d/%d)\033[K", refNames[e], v ? "matched" : "native",
-                  refSteps_[i], count + 1, total);
-        measure_reference_engine(refModel, adapter, v ? pd_refMatched : pd_refNative, refSteps_[i], (int)repeats,
-                                 ref, &points[count++]);
-      }
+      for (size_t i = 0; i < sizeof refSteps_ / sizeof refSteps_[0]; ++i)
+        points[count++] = (point){.engine = refNames[e], .variant = v ? "matched" : "native", .setting = "step", .value = refSteps_[i]};
   }
+  pointRuns runs = {scene, &base, (int)repeats, refModel, ref, points, progress};
+  pdBatchBuffer* measured = calloc((size_t)count + 1, sizeof *measured);
+  if (!measured) abort();
+  batch = (pdBatchOptions){.workers = jobs, .progress = progress ? point_progress : NULL, .progressUser = &runs};
+  bool pointsOk = pd_batch_run(count, point_task, &runs, &batch, measured, why, sizeof why);
+  for (int i = 0; i < count; ++i) {
+    if (pointsOk && pd_batch_is_root()) take_point(&measured[i], &points[i]);
+    pd_batch_buffer_free(&measured[i]);
+  }
+  free(measured);
   if (progress) fputs("\r\033[K", stderr);
+  // DIR under a temporary name, made only now (an interrupted sweep leaves nothing); MPI: rank 0 writes
+  char tmp[4096];
+  bool opened = pointsOk && pd_cli_out_open("sweep", out, "sweep.csv", tmp, sizeof tmp);
+  if (!opened || !pd_batch_is_root()) {
+    if (!pointsOk) fprintf(stderr, "polydyn sweep: %s\n", why);
+    pd_trajectory_free(ref);
+    pd_trajectory_free(check);
+    pd_model_free(refModel);
+    pd_model_free(checkModel);
+    return !pointsOk ? PD_EXIT_FAILURE : opened ? PD_EXIT_OK : PD_EXIT_BAD_INPUT;
+  }
 
-  // write DIR under a temporary name, then rename
-  char tmp[4096], path[4400];
+  // write DIR's files, then rename
+  char path[4400];
   int status = PD_EXIT_OK;
-  if (!pd_cli_out_open("sweep", out, "sweep.csv", tmp, sizeof tmp)) {
-    status = PD_EXIT_BAD_INPUT;
-  } else {
+  {
     char refName[128];
     snprintf(refName, sizeof refName, "soft tol=%g", SWEEP_REFERENCE_TOL);
     double tend = refModel->settings.tend;

@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "polydyn/batch.h"
 
 static const char* const usage =
     "usage: polydyn COMMAND [ARGS]\n"
@@ -34,6 +35,7 @@ static const char* const usage =
     "Every command takes --help. Exit status: 0 ok, 1 failure, 2 bad input.\n";
 
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) {
+  if (!pd_batch_is_root()) return PD_EXIT_BAD_INPUT;
   va_list ap;
   va_start(ap, fmt);
   fprintf(stderr, "polydyn %s: ", subcommand);
@@ -71,9 +73,23 @@ bool pd_cli_list_has(const char* list, const char* word) {
   return false;
 }
 
+bool pd_cli_jobs(const char* text, int* jobs) {
+  char* end = NULL;
+  errno = 0;
+  long n = strtol(text, &end, 10);
+  if (end == text || *end != '\0' || errno || n < 1 || n > PD_CLI_MAX_JOBS) return false;
+  *jobs = (int)n;
+  return true;
+}
+
+int pd_cli_default_jobs(int given, int serialDefault) {
+  if (given > 0) return given;
+  return pd_batch_ranks() > 1 ? 1 : serialDefault;
+}
+
 bool pd_cli_is_help(const char* arg) { return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0; }
 
-int main(int argc, char** argv) {
+static int dispatch(int argc, char** argv) {
   if (argc < 2) {
     fputs(usage, stderr);
     return PD_EXIT_BAD_INPUT;
@@ -98,4 +114,18 @@ int main(int argc, char** argv) {
   }
   fprintf(stderr, "polydyn: unknown command '%s'\n\n%s", cmd, usage);
   return PD_EXIT_BAD_INPUT;
+}
+
+// Under mpirun or srun every rank runs the same command: the batch commands split their tasks over the
+// ranks (refcheck/include/polydyn/batch.h) and rank 0 alone prints and writes the results.
+int main(int argc, char** argv) {
+  char why[512];
+  if (!pd_batch_mpi_start(&argc, &argv, why, sizeof why)) {
+    fprintf(stderr, "polydyn: %s\n", why);
+    return PD_EXIT_BAD_INPUT;
+  }
+  if (!pd_batch_is_root() && !freopen("/dev/null", "w", stdout)) return PD_EXIT_FAILURE;
+  int status = dispatch(argc, argv);
+  pd_batch_mpi_stop();
+  return status;
 }

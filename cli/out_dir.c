@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "polydyn/batch.h"
 
 // mkdir -p of the directories above `path`; a real failure shows when the run directory is made
 void pd_cli_make_parents(const char* path) {
@@ -40,9 +41,21 @@ static int remove_entry(const char* path, const struct stat* st, int flag, struc
   return remove(path);
 }
 
-void pd_cli_remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
+// Only rank 0 removes: the directories are rank 0's (pd_cli_out_open)
+void pd_cli_remove_tree(const char* path) {
+  if (pd_batch_is_root()) nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
 
+static bool out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize);
+
+// Under MPI rank 0 makes the directory and every rank learns its name ("" when it could not).
 bool pd_cli_out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize) {
+  if (pd_batch_is_root() && !out_open(cmd, out, marker, tmp, tmpSize)) tmp[0] = '\0';
+  pd_batch_share(tmp, tmpSize);
+  return tmp[0] != '\0';
+}
+
+static bool out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize) {
   struct stat st;
   char path[4200];
   snprintf(path, sizeof path, "%s/%s", out, marker);
@@ -59,6 +72,7 @@ bool pd_cli_out_open(const char* cmd, const char* out, const char* marker, char*
 }
 
 bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out) {
+  if (!pd_batch_is_root()) return true;
   struct stat st;
   char old[4200];
   snprintf(old, sizeof old, "%s.old-%ld", out, (long)getpid());

@@ -1,20 +1,20 @@
 // polydyn gedanken — the suite: every selected experiment on every selected engine, and its output files
 // (gedanken/RESULT_SCHEMAS.md: results.csv, experiments.json, series/NAME.csv, runs/NAME/ENGINE-VARIANT[-INPUT]).
 //
-// Order of work: the scenes are generated and compiled on the calling thread (compiling touches GSL's global
-// error handler), one model per (experiment, input), shared read-only by that case's runs. Soft-engine runs
-// then go to `jobs` threads; reference-engine runs stay on the calling thread (ODE keeps per-thread data;
-// polydyn run calls it from the main thread too). Every job owns its row, record and series text, so the
-// files are the same bytes whatever the number of threads, except wall times.
+// Order of work: the scenes are generated and compiled first (compiling touches GSL's global error
+// handler), one model per (experiment, input), shared read-only by that case's runs. Every run is then one
+// task of a batch (refcheck/include/polydyn/batch.h: `jobs` worker processes, or MPI ranks): it writes its
+// run directory and returns its row and series text, which land in task order, so the files are the same
+// bytes whatever the number of processes, except wall times.
 #include <errno.h>
 #include <ftw.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "gedanken_internal.h"
+#include "polydyn/batch.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
 
@@ -133,11 +133,6 @@ typedef struct gkSuite {
   int caseCount;
   gkJob* jobs;
   int jobCount;
-  int* softQueue;         // job indices of soft runs, in order
-  int softCount, softNext;
-  int doneCount;
-  pthread_mutex_t lock;   // softNext, doneCount, progress
-  pthread_mutex_t fileLock;  // file creation: pd_run_open briefly sets the process umask to 0 (output.c)
 } gkSuite;
 
 static bool interrupted(const gkSuite* s) { return s->options->interrupt && *s->options->interrupt; }
@@ -244,9 +239,7 @@ static void run_job(gkSuite* s, gkJob* job) {
   snprintf(job->runDir, sizeof job->runDir, "runs/%s/%s", c->experiment->name, name);
   char* dir = path_join(s->root, job->runDir);
   pdError err = {0};
-  pthread_mutex_lock(&s->fileLock);
   pdRunWriter* writer = pd_run_open(dir, &err);
-  pthread_mutex_unlock(&s->fileLock);
   if (!writer) {
     job->status = pd_gkError;
     job->runDir[0] = '\0';
@@ -268,20 +261,15 @@ static void run_job(gkSuite* s, gkJob* job) {
     } else {
       pdRunInfo info = {.engine = "polydyn-soft", .energyStart = energyStart, .energyEnd = pd_state_energy(model, state),
                         .wallSeconds = job->wallSeconds, .completed = completed};
-      pthread_mutex_lock(&s->fileLock);
-      written = pd_run_finish(writer, model, state, &info, &err);
-      pthread_mutex_unlock(&s->fileLock);
-      if (!completed) job_note(job, "the run stopped at t = %.6g s", state->t);
+          written = pd_run_finish(writer, model, state, &info, &err);
+          if (!completed) job_note(job, "the run stopped at t = %.6g s", state->t);
     }
     pd_state_free(state);
   } else {
     pdRefOptions options = {.variant = job->variant, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
     pdRefRunStats stats;
-    // the whole run under the file lock: pd_ref_run creates summary.json itself
-    pthread_mutex_lock(&s->fileLock);
-    written = pd_ref_run(model, adapter, &options, writer, observe_ref, &observer, &stats, &err);
-    pthread_mutex_unlock(&s->fileLock);
-    job->wallSeconds = stats.wallSeconds;
+      written = pd_ref_run(model, adapter, &options, writer, observe_ref, &observer, &stats, &err);
+      job->wallSeconds = stats.wallSeconds;
     completed = stats.completed;
     if (!written && stats.refused) {
       job->status = pd_gkRefused;
@@ -300,10 +288,8 @@ static void run_job(gkSuite* s, gkJob* job) {
     job->runDir[0] = '\0';
     job_note(job, "the run directory could not be written: %s", err.message[0] ? err.message : "a write failed");
   } else {
-    pthread_mutex_lock(&s->fileLock);
-    bool copied = write_scene_copy(dir, c->sceneText);
-    pthread_mutex_unlock(&s->fileLock);
-    if (!completed) {
+      bool copied = write_scene_copy(dir, c->sceneText);
+      if (!completed) {
       job->status = pd_gkFail;
     } else if (!copied) {
       job->status = pd_gkError;
@@ -317,34 +303,57 @@ static void run_job(gkSuite* s, gkJob* job) {
   free(dir);
 }
 
-static void finish_job(gkSuite* s, gkJob* job) {
-  pthread_mutex_lock(&s->lock);
+// A run as one task of the batch: its row and series text travel as bytes (taskRow, then the series).
+typedef struct taskRow {
+  int32_t status;
+  double measured, error, wallSeconds;
+  char runDir[sizeof((gkJob*)0)->runDir];
+  char note[sizeof((gkJob*)0)->note];
+} taskRow;
+
+static void run_task(int task, pdBatchBuffer* result, void* user) {
+  gkSuite* s = user;
+  gkJob* job = &s->jobs[task];
+  run_job(s, job);
+  taskRow row;
+  memset(&row, 0, sizeof row);  // no uninitialised padding in the bytes
+  row.status = (int32_t)job->status;
+  row.measured = job->measured;
+  row.error = job->error;
+  row.wallSeconds = job->wallSeconds;
+  memcpy(row.runDir, job->runDir, sizeof row.runDir);
+  memcpy(row.note, job->note, sizeof row.note);
+  pd_batch_append(result, &row, sizeof row);
+  pd_batch_append(result, job->series.data, job->series.length);
+}
+
+static void take_result(gkJob* job, const pdBatchBuffer* result) {
+  taskRow row;
+  size_t at = 0;
+  bool whole = pd_batch_read(result, &at, &row, sizeof row);
+  PD_ASSERT(whole);
+  job->status = (pdGkStatus)row.status;
+  job->measured = row.measured;
+  job->error = row.error;
+  job->wallSeconds = row.wallSeconds;
+  memcpy(job->runDir, row.runDir, sizeof row.runDir);
+  memcpy(job->note, row.note, sizeof row.note);
+  pd_gk_text_free(&job->series);
+  if (result->size > at) pd_gk_text_printf(&job->series, "%.*s", (int)(result->size - at), (const char*)result->data + at);
   job->done = true;
-  ++s->doneCount;
-  if (s->options->progress) {
+}
+
+static bool task_progress(int task, int done, int total, void* user) {
+  const gkSuite* s = user;
+  if (task >= 0 && s->options->progress) {
+    const gkJob* job = &s->jobs[task];
     char engine[32];
     snprintf(engine, sizeof engine, "%s%s%s", pdGkEngineNames[job->engine], job->engine == pd_gkSoft ? "" : "-",
              job->engine == pd_gkSoft ? "" : variant_name(job));
-    pdGkProgress p = {s->doneCount, s->jobCount, job->c->experiment->name, engine, job->c->label};
+    pdGkProgress p = {done, total, job->c->experiment->name, engine, job->c->label};
     s->options->progress(&p, s->options->progressUser);
   }
-  pthread_mutex_unlock(&s->lock);
-}
-
-static gkJob* next_soft_job(gkSuite* s) {
-  pthread_mutex_lock(&s->lock);
-  gkJob* job = !interrupted(s) && s->softNext < s->softCount ? &s->jobs[s->softQueue[s->softNext++]] : NULL;
-  pthread_mutex_unlock(&s->lock);
-  return job;
-}
-
-static void* soft_worker(void* user) {
-  gkSuite* s = user;
-  for (gkJob* job; (job = next_soft_job(s));) {
-    run_job(s, job);
-    finish_job(s, job);
-  }
-  return NULL;
+  return !interrupted(s);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -542,13 +551,10 @@ static void free_suite(gkSuite* s) {
   for (int i = 0; i < s->jobCount; ++i) pd_gk_text_free(&s->jobs[i].series);
   free(s->cases);
   free(s->jobs);
-  free(s->softQueue);
   if (s->root) {
-    remove_tree(s->root);  // nothing when it was installed (renamed away)
+    if (pd_batch_is_root()) remove_tree(s->root);  // nothing when it was installed (renamed away)
     free(s->root);
   }
-  pthread_mutex_destroy(&s->lock);
-  pthread_mutex_destroy(&s->fileLock);
 }
 
 bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* err) {
@@ -563,13 +569,10 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
   if (!pd_gk_out_replaceable(options->out, err)) return false;
 
   gkSuite s = {.options = options};
-  pthread_mutex_init(&s.lock, NULL);
-  pthread_mutex_init(&s.fileLock, NULL);
   int maxCases = pd_gk_experiment_count() * PD_GK_MAX_INPUTS;
   s.cases = calloc((size_t)maxCases, sizeof *s.cases);
   s.jobs = calloc((size_t)maxCases * 5, sizeof *s.jobs);
-  s.softQueue = calloc((size_t)maxCases, sizeof *s.softQueue);
-  PD_ASSERT(s.cases && s.jobs && s.softQueue);
+  PD_ASSERT(s.cases && s.jobs);
   bool ok = true;
   for (int i = 0; ok && i < pd_gk_experiment_count(); ++i) {
     const pdGkExperiment* e = pd_gk_experiment(i);
@@ -582,7 +585,6 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
         for (int v = 0; v < (engine == pd_gkSoft ? 1 : 2); ++v) {
           gkJob* job = &s.jobs[s.jobCount];
           *job = (gkJob){.c = c, .engine = (pdGkEngine)engine, .variant = v ? pd_refMatched : pd_refNative};
-          if (engine == pd_gkSoft) s.softQueue[s.softCount++] = s.jobCount;
           ++s.jobCount;
         }
       }
@@ -592,57 +594,64 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
     pd_error_set(err, options->out, 0, 0, "no experiment selected");
     ok = false;
   }
-  if (ok) {
-    size_t n = strlen(options->out) + 24;
-    s.root = malloc(n);
-    PD_ASSERT(s.root != NULL);
-    snprintf(s.root, n, "%s.partial-XXXXXX", options->out);
+  // rank 0 makes the temporary directory and its runs/NAME/ directories; every rank learns its name
+  enum { ROOT_MAX = 4200 };
+  char root[ROOT_MAX] = "";
+  if (ok && pd_batch_is_root() && strlen(options->out) + 24 < ROOT_MAX) {
+    snprintf(root, sizeof root, "%s.partial-XXXXXX", options->out);
     make_parents(options->out);
-    if (!mkdtemp(s.root)) {
+    if (!mkdtemp(root)) {
       pd_error_set(err, options->out, 0, 0, "cannot create the output directory: %s", strerror(errno));
-      free(s.root);
-      s.root = NULL;
-      ok = false;
+      root[0] = '\0';
     } else {
       mode_t mask = umask(0);  // mkdtemp makes the directory private; the results get the usual permissions
       umask(mask);
-      chmod(s.root, 0777 & ~mask);
+      chmod(root, 0777 & ~mask);
+      s.root = strdup(root);
+      PD_ASSERT(s.root != NULL);
+      char* runs = path_join(s.root, "runs");
+      bool made = make_dir(runs, err);
+      for (int i = 0; made && i < s.caseCount; ++i) {
+        if (i > 0 && s.cases[i].experiment == s.cases[i - 1].experiment) continue;
+        char* dir = path_join(runs, s.cases[i].experiment->name);
+        made = make_dir(dir, err);
+        free(dir);
+      }
+      free(runs);
+      if (!made) root[0] = '\0';
     }
   }
   if (ok) {
-    char* runs = path_join(s.root, "runs");
-    ok = make_dir(runs, err);
-    for (int i = 0; ok && i < s.caseCount; ++i) {
-      if (i > 0 && s.cases[i].experiment == s.cases[i - 1].experiment) continue;
-      char* dir = path_join(runs, s.cases[i].experiment->name);
-      ok = make_dir(dir, err);
-      free(dir);
+    pd_batch_share(root, sizeof root);
+    if (!root[0]) {
+      if (!err->message[0]) pd_error_set(err, options->out, 0, 0, "rank 0 could not create the output directory");
+      ok = false;
+    } else if (!s.root) {
+      s.root = strdup(root);
+      PD_ASSERT(s.root != NULL);
     }
-    free(runs);
   }
   if (ok) {
-    // workers take the soft runs; this thread runs the reference engines first, then helps with the rest
-    int workers = options->jobs - 1;
-    pthread_t* threads = calloc((size_t)(workers > 0 ? workers : 1), sizeof *threads);
-    PD_ASSERT(threads != NULL);
-    int started = 0;
-    for (; started < workers; ++started)
-      if (pthread_create(&threads[started], NULL, soft_worker, &s) != 0) break;
-    for (int i = 0; i < s.jobCount && !interrupted(&s); ++i) {
-      if (s.jobs[i].engine == pd_gkSoft) continue;
-      run_job(&s, &s.jobs[i]);
-      finish_job(&s, &s.jobs[i]);
+    pdBatchBuffer* results = calloc((size_t)s.jobCount, sizeof *results);
+    PD_ASSERT(results != NULL);
+    pdBatchOptions batch = {.workers = options->jobs, .everywhere = true, .progress = task_progress, .progressUser = &s};
+    char why[256] = "";
+    ok = pd_batch_run(s.jobCount, run_task, &s, &batch, results, why, sizeof why);
+    for (int i = 0; i < s.jobCount; ++i) {
+      if (ok) take_result(&s.jobs[i], &results[i]);
+      pd_batch_buffer_free(&results[i]);
     }
-    soft_worker(&s);
-    for (int i = 0; i < started; ++i) pthread_join(threads[i], NULL);
-    free(threads);
+    free(results);
     if (interrupted(&s)) {
       summary->interrupted = true;
       pd_error_set(err, options->out, 0, 0, "interrupted; nothing written");
-      ok = false;
+    } else if (!ok) {
+      pd_error_set(err, options->out, 0, 0, "%s", why);
     }
   }
-  ok = ok && write_results(&s, err) && write_experiments(&s, err) && write_series_files(&s, err) && install(&s, err);
+  // rank 0 writes the files; every rank has every row (the same summary, the same exit status)
+  if (pd_batch_is_root())
+    ok = ok && write_results(&s, err) && write_experiments(&s, err) && write_series_files(&s, err) && install(&s, err);
   if (ok) {
     free(s.root);
     s.root = NULL;

@@ -4,5 +4,4 @@
 target_sources(polydyn_refcheck PRIVATE
   ${CMAKE_CURRENT_SOURCE_DIR}/cubetoss_data.c
   ${CMAKE_CURRENT_SOURCE_DIR}/cubetoss_sim.c
-  ${CMAKE_CURRENT_SOURCE_DIR}/cubetoss_pool.c
   ${CMAKE_CURRENT_SOURCE_DIR}/cubetoss_fit.c)

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "polydyn/batch.h"
 #include "polydyn/cubetoss.h"
 #include "polydyn/output.h"
 #include "polydyn/scene.h"
@@ -488,4 +489,50 @@ void pd_toss_params_write(FILE* out, const pdTossParams* p, const char* comment)
     write_exact(out, values[k]);
     fputc('\n', out);
   }
+}
+
+// ---------------------------------------------------------------- parallel runs (batch.h)
+
+typedef struct tossBatch {
+  size_t resultSize;
+  pdTossJobFcn* job;
+  void* user;
+  pdTossProgressFcn* progress;
+  void* progressUser;
+} tossBatch;
+
+static void toss_task(int task, pdBatchBuffer* result, void* user) {
+  const tossBatch* b = user;
+  unsigned char* slot = calloc(1, b->resultSize);
+  if (!slot) abort();
+  b->job(task, slot, b->user);
+  pd_batch_append(result, slot, b->resultSize);
+  free(slot);
+}
+
+static bool toss_progress(int task, int done, int total, void* user) {
+  (void)task;
+  const tossBatch* b = user;
+  return b->progress(done, total, b->progressUser);
+}
+
+bool pd_toss_parallel(int count, int workers, size_t resultSize, void* results, pdTossJobFcn* job, void* user,
+                      pdTossProgressFcn* progress, void* progressUser, char* why, size_t whySize) {
+  PD_ASSERT(count >= 0 && workers >= 1 && resultSize > 0 && (results || count == 0) && job);
+  tossBatch b = {resultSize, job, user, progress, progressUser};
+  // every rank gets every result: the fit's simplex steps on all ranks alike
+  pdBatchOptions options = {.workers = workers, .everywhere = true, .progress = progress ? toss_progress : NULL,
+                            .progressUser = &b};
+  pdBatchBuffer* buffers = calloc((size_t)count + 1, sizeof *buffers);
+  if (!buffers) abort();
+  bool ok = pd_batch_run(count, toss_task, &b, &options, buffers, why, whySize);
+  for (int i = 0; i < count; ++i) {
+    if (ok) {
+      PD_ASSERT(buffers[i].size == resultSize);
+      memcpy((unsigned char*)results + (size_t)i * resultSize, buffers[i].data, resultSize);
+    }
+    pd_batch_buffer_free(&buffers[i]);
+  }
+  free(buffers);
+  return ok;
 }

@@ -2,7 +2,7 @@
 # End-to-end tests of polydyn gedanken (gedanken/RESULT_SCHEMAS.md): the fast subset passes on the soft
 # engine, the output files have the fixed schema, an engine without an adapter gives NOT_BUILT rows and no
 # failure, a failing soft experiment exits 1, bad arguments exit 2 with nothing written, the results do not
-# depend on the number of threads, a previous result directory is replaced, an interrupt leaves nothing.
+# depend on the number of worker processes, a previous result directory is replaced, an interrupt leaves nothing.
 #
 # usage: test_gedanken_cli.sh POLYDYN_BINARY
 set -u
@@ -101,14 +101,14 @@ check "a soft FAIL exits 1" '[ $rc -eq 1 ]'
 check "a soft FAIL is named on stderr" 'grep -q "a3_sinkage" "$ERR"'
 check "a soft FAIL is written as FAIL" '[ "$(csv_query "$FAILDIR/results.csv" "rows[0][\"status\"]")" = FAIL ]'
 
-# --- determinism: same bytes whatever the number of threads, except wall times ------------------------
+# --- determinism: same bytes whatever the number of worker processes, except wall times ------------------------
 strip_wall() { python3 -c 'import csv, sys
 for r in csv.reader(open(sys.argv[1], newline="")): print(r[:13] + r[14:])' "$1"; }
 run_pd gedanken --only a1_restitution,c2_momentum,e1_painleve --engines soft --jobs 1 --out "$SCRATCH/det1"
 run_pd gedanken --only a1_restitution,c2_momentum,e1_painleve --engines soft --jobs 3 --out "$SCRATCH/det3"
-check "results.csv identical with 1 and 3 threads (but wall times)" \
+check "results.csv identical with 1 and 3 worker processes (but wall times)" \
   '[ "$(strip_wall "$SCRATCH/det1/results.csv")" = "$(strip_wall "$SCRATCH/det3/results.csv")" ]'
-check "series and trajectories identical with 1 and 3 threads" \
+check "series and trajectories identical with 1 and 3 worker processes" \
   'diff -r -q -x summary.json -x results.csv "$SCRATCH/det1" "$SCRATCH/det3" >/dev/null'
 
 # --- replacing a previous result directory ----------------------------------------------------------------

@@ -60,5 +60,23 @@ awk -F, 'NR == 2 { ok = ($4 == "self") } END { exit !ok }' "$OUT/metrics.csv"; r
 check "with ode: exit 0 and the compare directory replaced" '[ $rc -eq 0 ] && [ -f "$OUT/metrics.csv" ] && [ -z "$(ls -d "$SCRATCH"/cmp.old-* 2>/dev/null)" ]'
 check "ode's row or its reason is there" 'grep -q "^\"[^\"]*\",ode,native" "$OUT/metrics.csv" || grep -q "ode-native" "$SCRATCH/err"'
 
+# a directory of scenes: DIR/NAME/ per scene, DIR/metrics.csv = the header and every scene's rows in name order
+SCENES=$SCRATCH/scenes
+mkdir "$SCENES"
+cp "$SCENE" "$SCENES/b_slide.scene"
+sed 's/^vel 2 0 0/vel 1 0 0/' "$SCENE" >"$SCENES/a_slow.scene"
+"$PD" compare "$SCENES" --out "$SCRATCH/many" --engines soft --tend 0.2 >"$SCRATCH/stdout" 2>"$SCRATCH/err"; rc=$?
+check "a directory of scenes: exit 0, one sub-directory per scene" \
+  '[ $rc -eq 0 ] && [ -f "$SCRATCH/many/a_slow/compare.json" ] && [ -f "$SCRATCH/many/b_slide/runs/soft-adaptive/trajectory.csv" ]'
+check "a directory of scenes: metrics.csv is the header, then a_slow's rows, then b_slide's" \
+  '[ "$(cat "$SCRATCH/many/metrics.csv")" = "$(head -n 1 "$SCRATCH/many/a_slow/metrics.csv"; tail -n +2 "$SCRATCH/many/a_slow/metrics.csv"; tail -n +2 "$SCRATCH/many/b_slide/metrics.csv")" ] && [ "$(wc -l <"$SCRATCH/many/metrics.csv")" -eq 5 ]'
+printf 'cube c red 1 1 1\nloc 0 0 zero\n' >"$SCENES/c_bad.scene"
+"$PD" compare "$SCENES" --out "$SCRATCH/bad" --engines soft >/dev/null 2>"$SCRATCH/err"; rc=$?
+check "one bad scene in the directory: exit 2 at its line, nothing written" \
+  '[ $rc -eq 2 ] && grep -q "c_bad.scene:2:" "$SCRATCH/err" && [ ! -e "$SCRATCH/bad" ] && no_partial "$SCRATCH/bad"'
+mkdir "$SCRATCH/empty"
+"$PD" compare "$SCRATCH/empty" --out "$SCRATCH/none" >/dev/null 2>"$SCRATCH/err"; rc=$?
+check "a directory without scenes: exit 2, says so" '[ $rc -eq 2 ] && grep -q "no NAME.scene" "$SCRATCH/err" && [ ! -e "$SCRATCH/none" ]'
+
 echo "test_compare_cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -243,7 +243,7 @@ typedef struct pdGkOptions {
   const char* const* only;    // experiment names to run (NULL: all)
   int onlyCount;
   bool fast;                  // only the experiments marked fast
-  int jobs;                   // >= 1: soft-engine runs in parallel (reference engines stay on this thread)
+  int jobs;                   // >= 1: worker processes of this process (or MPI rank) for the runs
   double toleranceScale;      // > 0: every tolerance is multiplied by it (1 = the catalogue's); for tests
   volatile sig_atomic_t* interrupt;  // nullable: non-zero stops the suite (nothing is written)
   pdGkProgressFcn* progress;  // nullable

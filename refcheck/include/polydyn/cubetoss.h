@@ -193,10 +193,11 @@ typedef void pdTossJobFcn(int job, void* result, void* user);
 // Called in the calling process as jobs finish (done of total); returning false stops the work.
 typedef bool pdTossProgressFcn(int done, int total, void* user);
 
-// Runs jobs 0 .. count-1 in `workers` processes (fork; jobs handed out one at a time, so the results do
-// not depend on which worker ran which job) and leaves job i's result at results + i·resultSize. With
-// one worker (or one job) runs them in this process. Returns false with a message in `why` when a worker
-// died or progress asked to stop.
+// Runs jobs 0 .. count-1 as a batch (batch.h): in `workers` processes (fork; jobs handed out one at a
+// time, so the results do not depend on which worker ran which job), and under MPI split over the ranks,
+// every rank getting every result (collective: every rank calls it alike). Leaves job i's result at
+// results + i·resultSize. With one worker (or one job) runs them in this process. Returns false with a
+// message in `why` when a worker died or progress asked to stop.
 bool pd_toss_parallel(int count, int workers, size_t resultSize, void* results, pdTossJobFcn* job, void* user,
                       pdTossProgressFcn* progress, void* progressUser, char* why, size_t whySize);
 
