@@ -66,6 +66,37 @@ static bool inside_body(const pdPolyhedron* s, pdVec3 q, double tol) {
   return true;
 }
 
+// Tolerance of "flush", as a fraction of the pair's δ_max (deflection × the smaller size): a face plane
+// of one body that the other body does not cross by more than this is a plane both bodies share (bricks
+// side by side, a box on a box of the same width): a vertex lying on it has crossed another face, not
+// that one, and edges crossing inside it have no depth. A contact on such a plane would carry at most
+// this fraction of the deflection an impact at vmax makes; the bodies rock by 1e-6 rad and more while
+// they settle (1e-7 m on a 0.1 m brick), which a roundoff-sized tolerance would not absorb.
+#define FLUSH_TOL_DEFLECTIONS 1e-3
+
+// Does body sv (at pv) cross face f's plane of body sf (at pf) by more than tol, i.e. lie partly outside it?
+static bool crosses_face_plane(const pdPolyhedron* sv, const pdPose* pv, const pdPolyhedron* sf, const pdPose* pf,
+                               int f, double tol) {
+  for (int i = 0; i < sv->vertexCount; ++i)
+    if (face_depth(sf, f, to_local(pf, to_world(pv, sv->vertices[i]))) < -tol) return true;
+  return false;
+}
+
+// The face plane of sf a vertex crossed last on its way from q0 (step start) to q (now), both in sf's
+// frame: the vertex entered the body when it crossed the last of the planes it was outside of (a straight
+// path through a convex body). -1 when it was inside every plane already (a contact found again, or at t = 0).
+static int face_crossed(const pdPolyhedron* sf, pdVec3 q0, pdVec3 q, double tol) {
+  int face = -1;
+  double latest = -1.0;
+  for (int f = 0; f < sf->faceCount; ++f) {
+    double d0 = face_depth(sf, f, q0), d = face_depth(sf, f, q);
+    if (!(d0 < -tol && d > tol)) continue;
+    double fraction = d0 / (d0 - d);
+    if (fraction > latest) latest = fraction, face = f;
+  }
+  return face;
+}
+
 // The face a vertex keeps from the previous contact state, or -1.
 static int previous_face(const pdContactId* previous, int count, int vertexBody, int vertex, int faceBody) {
   for (int i = 0; i < count; ++i) {
@@ -76,35 +107,42 @@ static int previous_face(const pdContactId* previous, int count, int vertexBody,
 }
 
 // VF contacts of the vertices of body iv inside body jf.
-static int find_vf(const pdModel* m, int iv, const pdPose* pv, int jf, const pdPose* pf, const pdContactId* previous,
-                   int previousCount, pdContactGeom* out, int capacity, int n) {
+static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0, int jf, const pdPose* pf,
+                   const pdPose* pf0, const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity,
+                   int n) {
   const pdPolyhedron* sv = &m->bodies[iv].shape;
   const pdPolyhedron* sf = &m->bodies[jf].shape;
   double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
+  double flushTol = FLUSH_TOL_DEFLECTIONS * m->settings.deflection * fmin(m->bodies[iv].size, m->bodies[jf].size);
   for (int i = 0; i < sv->vertexCount; ++i) {
     pdVec3 p = to_world(pv, sv->vertices[i]);
     pdVec3 q = to_local(pf, p);
-    // penetration: the distance to the nearest face plane. A face whose plane the vertex lies on, at
-    // the edge of that face's polygon, does not count: the vertex sits on an edge of the other body
-    // (a corner resting exactly on a corner of an equal cube lies on the side planes) and what it
-    // presses on is the face it is behind. A vertex on a face's interior only touches: no contact.
+    // penetration: the distance to the nearest face plane the vertex can have crossed. A face plane
+    // the vertex lies on but its own body does not cross is not one: the two bodies share that plane
+    // (a corner resting on the corner of an equal cube, a brick on two bricks of its width, a box on a
+    // box with one side aligned), the vertex slides along it and presses on the face it did cross. A
+    // vertex on a plane its body crosses lies on that face from outside: it only touches, no contact.
     double penetration = INFINITY;
     bool outside = false;
     for (int f = 0; f < sf->faceCount && !outside; ++f) {
       double d = face_depth(sf, f, q);
       outside = d < -tol;
-      if (fabs(d) <= tol && !projects_inside(sf, f, q, -tol)) continue;
+      if (d <= flushTol && !crosses_face_plane(sv, pv, sf, pf, f, flushTol)) continue;
       penetration = fmin(penetration, d);
     }
     if (outside || !(penetration > tol)) continue;
     int face = previous_face(previous, previousCount, iv, i, jf);
+    // a new contact: the face whose plane it crossed during the step. Depth alone misleads where the
+    // vertex also lies just inside another plane (a brick's corner a roundoff inside the side plane of
+    // the brick below, which it slides along, while it sinks into the top face).
+    if (face < 0 && pv0) face = face_crossed(sf, to_local(pf0, to_world(pv0, sv->vertices[i])), q, tol);
     if (face < 0) {
-      // the face it crossed: the shallowest one with positive depth whose polygon is over the vertex
+      // no crossing seen: the shallowest face with positive depth whose polygon is over the vertex
       double best = INFINITY, bestAny = INFINITY;
       int any = 0;
       for (int f = 0; f < sf->faceCount; ++f) {
         double d = face_depth(sf, f, q);
-        if (!(d > tol)) continue;
+        if (!(d > tol) || (d <= flushTol && !crosses_face_plane(sv, pv, sf, pf, f, flushTol))) continue;
         if (d < bestAny) bestAny = d, any = f;
         if (d < best && projects_inside(sf, f, q, tol)) best = d, face = f;
       }
@@ -144,7 +182,10 @@ typedef enum arcMeeting { arcsApart = 0, arcsCross, arcsTouch } arcMeeting;
 static arcMeeting arcs_meet(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d, double slack) {
   pdVec3 bxa = pd_v3_cross(b, a), dxc = pd_v3_cross(d, c);
   double cba = pd_v3_dot(c, bxa), dba = pd_v3_dot(d, bxa), adc = pd_v3_dot(a, dxc), bdc = pd_v3_dot(b, dxc);
-  if (cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0) return arcsCross;
+  // a crossing by a roundoff (an end of one arc within ARC_TOUCH_TOL of the other's great circle, as
+  // when two faces are parallel) is a touch: it gets the touch's depth check, whatever the roundoff's sign
+  bool nearEnd = fmin(fmin(fabs(cba), fabs(dba)), fmin(fabs(adc), fabs(bdc))) <= ARC_TOUCH_TOL;
+  if (!nearEnd && cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0) return arcsCross;
   pdVec3 n1 = pd_v3_normalize(pd_v3_cross(a, b)), n2 = pd_v3_normalize(pd_v3_cross(c, d));
   pdVec3 line = pd_v3_cross(n1, n2);
   double len = pd_v3_norm(line);
@@ -220,6 +261,21 @@ static void outside_masks(const pdPolyhedron* vertices, const pdMat3* rel, pdVec
   }
 }
 
+// Does B's edge b0–b1 (A's frame) lie in the plane of a face of A around A's edge ea, a plane that B does
+// not cross (B's rotation rel and offset off in A's frame): a plane both bodies share (FLUSH_TOL_DEFLECTIONS)?
+static bool in_shared_plane(const pdPolyhedron* sa, const pdEdge* ea, pdVec3 b0, pdVec3 b1, const pdPolyhedron* sb,
+                            const pdMat3* rel, pdVec3 off, double flushTol) {
+  for (int k = 0; k < 2; ++k) {
+    int f = ea->f[k];
+    if (fabs(face_depth(sa, f, b0)) > flushTol || fabs(face_depth(sa, f, b1)) > flushTol) continue;
+    bool crosses = false;
+    for (int v = 0; v < sb->vertexCount && !crosses; ++v)
+      crosses = face_depth(sa, f, pd_v3_add(off, pd_mat3_mulv(rel, sb->vertices[v]))) < -flushTol;
+    if (!crosses) return true;
+  }
+  return false;
+}
+
 static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
                    int capacity, int n) {
   const pdPolyhedron* sa = &model->bodies[ia].shape;
@@ -229,6 +285,8 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   pdMat3 rel = pd_mat3_mul(&RaT, &pb->R);
   pdVec3 off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
   double tolA = BOUNDARY_TOL_REL * model->bodies[ia].size, tolB = BOUNDARY_TOL_REL * model->bodies[ib].size;
+  double flushTol =
+      FLUSH_TOL_DEFLECTIONS * model->settings.deflection * fmin(model->bodies[ia].size, model->bodies[ib].size);
   faceMask maskA[PRUNE_VERTICES_MAX], maskB[PRUNE_VERTICES_MAX];  // A's vertices against B's faces, and B's against A's
   bool prune = sa->vertexCount <= PRUNE_VERTICES_MAX && sb->vertexCount <= PRUNE_VERTICES_MAX;
   if (prune) {
@@ -258,6 +316,10 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
         for (int k = 0; k < 4; ++k) shallowest = fmin(shallowest, overlap_along(sa, sb, &rel, off, axes[k]));
         if (g.depth > shallowest + tolA + tolB) continue;
       }
+      // edges crossing inside a plane both bodies share (the flush sides of a brick on a brick of its
+      // width, one tilted a little on the other): the normal, their cross product, lies in the faces
+      // that press and the depth along it is nil; the VF contacts at the overlap's corners carry it
+      if (in_shared_plane(sa, ea, b0, b1, sb, &rel, off, flushTol)) continue;
       // a crossing, not an antipodal Minkowski face: each edge's closest point is inside the other body
       pdVec3 onA = pd_v3_sub(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on A's edge
       pdVec3 onB = pd_v3_add(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on B's edge
@@ -289,18 +351,21 @@ static int drop_coincident(pdContactGeom* c, int count, int lowBody) {
   return kept;
 }
 
-int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
-                     const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity) {
+int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, const pdPose* pa0,
+                     const pdPose* pb0, const pdContactId* previous, int previousCount, pdContactGeom* out,
+                     int capacity) {
   PD_ASSERT(ia != ib && ia >= 0 && ib >= 0 && ia < model->bodyCount && ib < model->bodyCount);
+  PD_ASSERT((pa0 == NULL) == (pb0 == NULL));
   if (ia > ib) {
     const pdPose* tp = pa;
     pa = pb, pb = tp;
+    tp = pa0, pa0 = pb0, pb0 = tp;
     int ti = ia;
     ia = ib, ib = ti;
   }
   int n = 0;
-  n = find_vf(model, ia, pa, ib, pb, previous, previousCount, out, capacity, n);
-  n = find_vf(model, ib, pb, ia, pa, previous, previousCount, out, capacity, n);
+  n = find_vf(model, ia, pa, pa0, ib, pb, pb0, previous, previousCount, out, capacity, n);
+  n = find_vf(model, ib, pb, pb0, ia, pa, pa0, previous, previousCount, out, capacity, n);
   n = find_ee(model, ia, pa, ib, pb, out, capacity, n);
   if (n > capacity) return n;
   n = drop_coincident(out, n, ia);

@@ -46,10 +46,13 @@ int pd_contact_id_compare(const pdContactId* a, const pdContactId* b);
 // Appends to out[] (at most capacity) the contacts between bodies ia and ib in the given poses, and
 // returns how many there are (which may exceed capacity: the caller grows its buffer and retries).
 // A vertex already in contact with a face of the other body in `previous` (sorted, nullable) keeps
-// that face (face continuity, §4.4.3). Equal-feature duplicates (a vertex of each body at the same
-// point, as when equal cubes meet face to face) are reported once.
-int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
-                     const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity);
+// that face (face continuity, §4.4.3); a new one takes the face whose plane it crossed between the
+// poses pa0, pb0 (the step's start; both NULL: unknown) and pa, pb, else the shallowest face over it.
+// Equal-feature duplicates (a vertex of each body at the same point, as when equal cubes meet face to
+// face) are reported once.
+int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, const pdPose* pa0,
+                     const pdPose* pb0, const pdContactId* previous, int previousCount, pdContactGeom* out,
+                     int capacity);
 
 // Geometry of one known contact at the given poses (tracking, §4.4.2): VF by (18), EE by the
 // closest points of the two edge lines. Returns false when the contact must break for geometric

@@ -704,13 +704,13 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
     while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) == 0)
       set->previous[previousCount++] = set->items[listed++].id;
     if (!touching) continue;
-    int n = pd_contacts_find(model, a, &poses1[a], b, &poses1[b], set->previous, previousCount, set->found,
-                             set->foundCapacity);
+    int n = pd_contacts_find(model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], set->previous,
+                             previousCount, set->found, set->foundCapacity);
     if (n > set->foundCapacity) {
       set->foundCapacity = 2 * n;
       set->found = grow(set->found, set->foundCapacity, sizeof *set->found);
-      n = pd_contacts_find(model, a, &poses1[a], b, &poses1[b], set->previous, previousCount, set->found,
-                           set->foundCapacity);
+      n = pd_contacts_find(model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], set->previous,
+                           previousCount, set->found, set->foundCapacity);
     }
     // found[] and C0's contacts of this pair are both sorted by id: merge
     int j = first;

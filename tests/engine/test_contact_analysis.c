@@ -66,7 +66,7 @@ static void test_cube_resting_on_floor_gives_four_vf_contacts_with_the_floor_nor
   pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
   pdPose box = pose(0.2, -0.1, SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &floor, 1, &box, NULL, 0, c, CAPACITY);
+  int n = pd_contacts_find(m, 0, &floor, 1, &box, NULL, NULL, NULL, 0, c, CAPACITY);
   assert_int_equal(n, 4);
   for (int i = 0; i < n; ++i) {
     assert_int_equal(c[i].id.kind, pd_contactVF);
@@ -80,7 +80,7 @@ static void test_cube_resting_on_floor_gives_four_vf_contacts_with_the_floor_nor
   }
   // the same pair asked the other way round gives the same contacts
   pdContactGeom d[CAPACITY];
-  assert_int_equal(pd_contacts_find(m, 1, &box, 0, &floor, NULL, 0, d, CAPACITY), 4);
+  assert_int_equal(pd_contacts_find(m, 1, &box, 0, &floor, NULL, NULL, NULL, 0, d, CAPACITY), 4);
   for (int i = 0; i < 4; ++i) assert_int_equal(pd_contact_id_compare(&c[i].id, &d[i].id), 0);
   pd_model_free(m);
 }
@@ -91,9 +91,9 @@ static void test_separated_or_just_touching_bodies_have_no_contact(void** state)
   pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
   pdContactGeom c[CAPACITY];
   pdPose above = pose(0, 0, SIDE / 2 + 1e-9, 0, pd_v3(0, 0, 1));
-  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &above, NULL, 0, c, CAPACITY), 0);
+  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &above, NULL, NULL, NULL, 0, c, CAPACITY), 0);
   pdPose touching = pose(0, 0, SIDE / 2, 0, pd_v3(0, 0, 1));
-  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &touching, NULL, 0, c, CAPACITY), 0);
+  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &touching, NULL, NULL, NULL, 0, c, CAPACITY), 0);
   pd_model_free(m);
 }
 
@@ -103,7 +103,7 @@ static const char* const twoCubes = "cube a red 0.1 0.1 0.1\ncube b blue 0.1 0.1
 static int cube_on_cube(const pdModel* m, double turnDeg, pdPose* a, pdPose* b, pdContactGeom* c) {
   *a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
   *b = pose(0, 0, SIDE - DEPTH, turnDeg, pd_v3(0, 0, 1));
-  return pd_contacts_find(m, 0, a, 1, b, NULL, 0, c, CAPACITY);
+  return pd_contacts_find(m, 0, a, 1, b, NULL, NULL, NULL, 0, c, CAPACITY);
 }
 
 static void test_equal_cubes_face_on_face_count_each_corner_once(void** state) {
@@ -123,6 +123,62 @@ static void test_equal_cubes_face_on_face_count_each_corner_once(void** state) {
   pd_model_free(m);
 }
 
+// Cube b rests DEPTH deep on cube a, shifted half a side along x: their y faces are flush (in one plane).
+// The overlap is a rectangle whose four corners lie on those shared planes: two of b's bottom vertices
+// over a's top face and two of a's top vertices under b's bottom face. Each presses on the face it
+// crossed (top or bottom), at the full depth — not "touching" a side face it slides along.
+static void test_flush_side_faces_give_the_overlap_corners_on_the_faces_crossed(void** state) {
+  (void)state;
+  pdModel* m = compile(twoCubes);
+  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  pdPose b = pose(SIDE / 2, 0, SIDE - DEPTH, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, NULL, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 4);
+  int aVertices = 0;
+  for (int i = 0; i < n; ++i) {
+    assert_int_equal(c[i].id.kind, pd_contactVF);
+    expect_near(c[i].depth, DEPTH, GEOM_TOL, "depth");
+    expect_near(fabs(c[i].normal.z), 1.0, GEOM_TOL, "normal along z (the face crossed, not a flush side face)");
+    expect_near(fabs(c[i].point.y), SIDE / 2, GEOM_TOL, "corner on the flush planes");
+    aVertices += c[i].id.body1 == 0;
+    // a's vertex (x = s/2) in b's bottom face; b's vertex (x = 0) on a's top face
+    expect_near(c[i].point.x, c[i].id.body1 == 0 ? SIDE / 2 : 0.0, GEOM_TOL, "corner x");
+  }
+  assert_int_equal(aVertices, 2);
+  // a body lying on another's face from outside only touches, flush or not: lift b to touching
+  b = pose(SIDE / 2, 0, SIDE, 0, pd_v3(0, 0, 1));
+  assert_int_equal(pd_contacts_find(m, 0, &a, 1, &b, NULL, NULL, NULL, 0, c, CAPACITY), 0);
+  pd_model_free(m);
+}
+
+// A new contact takes the face whose plane its vertex crossed during the step, not the nearest plane:
+// b's corner, sinking DEPTH into a's top face over the step, also ends 1e-7 m inside a's side plane
+// x = s/2 (it was 2e-7 inside at the start), closer than the top. Without the step's start the nearest
+// face wins.
+static void test_new_vf_contact_takes_the_face_crossed_during_the_step(void** state) {
+  (void)state;
+  pdModel* m = compile(twoCubes);
+  double slide = 1e-7;
+  pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  pdPose b0 = pose(SIDE - 2 * slide, SIDE / 2, SIDE + DEPTH, 0, pd_v3(0, 0, 1));  // above the top face
+  pdPose b = pose(SIDE - slide, SIDE / 2, SIDE - DEPTH, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &a, 1, &b, &a, &b0, NULL, 0, c, CAPACITY);
+  int found = 0;
+  for (int i = 0; i < n; ++i) {
+    if (c[i].id.kind != pd_contactVF || c[i].id.body1 != 1) continue;
+    ++found;
+    expect_near(c[i].normal.z, 1.0, GEOM_TOL, "b's corner presses on a's top face");
+    expect_near(c[i].depth, DEPTH, GEOM_TOL, "at the depth below the top face");
+  }
+  assert_int_equal(found, 1);
+  n = pd_contacts_find(m, 0, &a, 1, &b, NULL, NULL, NULL, 0, c, CAPACITY);
+  for (int i = 0; i < n; ++i)
+    if (c[i].id.kind == pd_contactVF && c[i].id.body1 == 1) expect_near(c[i].depth, slide, GEOM_TOL, "nearest face");
+  pd_model_free(m);
+}
+
 // Cube a turned 45° about x has a top edge along x at height s/√2; cube b turned 45° about y has a
 // bottom edge along y. Crossed, they touch at one point: one EE contact.
 static void test_crossed_edges_give_one_ee_contact_with_the_crossing_depth(void** state) {
@@ -132,7 +188,7 @@ static void test_crossed_edges_give_one_ee_contact_with_the_crossing_depth(void*
   pdPose a = pose(0, 0, 0, 45, pd_v3(1, 0, 0));
   pdPose b = pose(0, 0, 2 * h - DEPTH, 45, pd_v3(0, 1, 0));
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, NULL, NULL, 0, c, CAPACITY);
   assert_int_equal(n, 1);
   assert_int_equal(c[0].id.kind, pd_contactEE);
   assert_int_equal(c[0].id.body1, 0);
@@ -154,7 +210,7 @@ static void test_sliding_vertex_keeps_its_face_and_breaks_past_the_face_edge(voi
   pdPose base = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
   pdPose box = pose(0, 0, 0.1 + SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &base, 1, &box, NULL, 0, c, CAPACITY);
+  int n = pd_contacts_find(m, 0, &base, 1, &box, NULL, NULL, NULL, 0, c, CAPACITY);
   assert_int_equal(n, 4);
   pdContactId ids[4];
   for (int i = 0; i < 4; ++i) ids[i] = c[i].id;
@@ -162,7 +218,7 @@ static void test_sliding_vertex_keeps_its_face_and_breaks_past_the_face_edge(voi
 
   // the vertex keeps its face while it stays over the face polygon
   pdPose slid = pose(0.04, 0, 0.1 + SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
-  n = pd_contacts_find(m, 0, &base, 1, &slid, ids, 4, c, CAPACITY);
+  n = pd_contacts_find(m, 0, &base, 1, &slid, NULL, NULL, ids, 4, c, CAPACITY);
   assert_int_equal(n, 4);
   for (int i = 0; i < 4; ++i) assert_int_equal(c[i].id.feat2, topFace);
   pdContactGeom g;
@@ -184,7 +240,7 @@ static void test_vf_onset_interpolates_the_crossing_time(void** state) {
   pdPose start = pose(0, 0, SIDE / 2 + gap, 0, pd_v3(0, 0, 1));
   pdPose end = pose(0, 0, SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &floor, 1, &end, NULL, 0, c, CAPACITY);
+  int n = pd_contacts_find(m, 0, &floor, 1, &end, NULL, NULL, NULL, 0, c, CAPACITY);
   assert_int_equal(n, 4);
   // straight-line motion: the crossing is at gap / (gap + depth) of the step
   double t = pd_contact_onset(m, &c[0].id, &start, &end, &floor, &floor);
@@ -204,7 +260,7 @@ static void test_vf_onset_with_a_turning_face_solves_the_quadratic(void** state)
   pdPose boxStart = pose(0.05, 0.12, 0.05 + 1e-3, 0, pd_v3(0, 0, 1));
   pdPose boxEnd = pose(0.05, 0.12, 0.05 + 2e-4, 0, pd_v3(0, 0, 1));
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &plateEnd, 1, &boxEnd, NULL, 0, c, CAPACITY);
+  int n = pd_contacts_find(m, 0, &plateEnd, 1, &boxEnd, NULL, NULL, NULL, 0, c, CAPACITY);
   assert_true(n >= 1);
   const pdContactGeom* vf = NULL;
   for (int i = 0; i < n; ++i)
@@ -236,7 +292,7 @@ static void test_ee_onset_interpolates_the_line_distance(void** state) {
   pdPose bStart = pose(0, 0, 2 * h + gap, 45, pd_v3(0, 1, 0));
   pdPose bEnd = pose(0, 0, 2 * h - DEPTH, 45, pd_v3(0, 1, 0));
   pdContactGeom c[CAPACITY];
-  assert_int_equal(pd_contacts_find(m, 0, &a, 1, &bEnd, NULL, 0, c, CAPACITY), 1);
+  assert_int_equal(pd_contacts_find(m, 0, &a, 1, &bEnd, NULL, NULL, NULL, 0, c, CAPACITY), 1);
   double t = pd_contact_onset(m, &c[0].id, &a, &a, &bStart, &bEnd);
   expect_near(t, gap / (gap + DEPTH), 1e-12, "onset fraction");
   pd_model_free(m);
@@ -250,13 +306,13 @@ static void test_vertex_on_vertex_and_parallel_edges_give_finite_contacts(void**
   pdPose a = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
   pdPose b = {{0.05, 0.05, 0.05 + SIDE * sqrt(3.0) / 2 - DEPTH}, pd_quat_to_mat3(tilt)};
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, 0, c, CAPACITY);
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, NULL, NULL, 0, c, CAPACITY);
   assert_true(n >= 1 && n <= CAPACITY);
   for (int i = 0; i < n; ++i)
     assert_true(isfinite(c[i].depth) && pd_v3_isfinite(c[i].normal) && pd_v3_isfinite(c[i].point));
   // edge on edge, parallel: two cubes side by side, one lifted to share an edge line
   pdPose side = pose(SIDE - DEPTH, 0, SIDE - DEPTH, 0, pd_v3(0, 0, 1));
-  n = pd_contacts_find(m, 0, &a, 1, &side, NULL, 0, c, CAPACITY);
+  n = pd_contacts_find(m, 0, &a, 1, &side, NULL, NULL, NULL, 0, c, CAPACITY);
   for (int i = 0; i < n; ++i) {
     assert_int_equal(c[i].id.kind, pd_contactVF);
     assert_true(isfinite(c[i].depth) && pd_v3_isfinite(c[i].normal));
@@ -287,7 +343,7 @@ static void test_cube_turned_45_degrees_on_a_cube_gives_eight_edge_crossings(voi
   // two cubes side by side sharing an edge line: their front faces are parallel too, but 0.1 m apart
   // across an overlap that is only DEPTH deep sideways: no edge crossing there may count as a contact
   pdPose side = pose(SIDE - DEPTH, 0, SIDE - DEPTH, 0, pd_v3(0, 0, 1));
-  n = pd_contacts_find(m, 0, &a, 1, &side, NULL, 0, c, CAPACITY);
+  n = pd_contacts_find(m, 0, &a, 1, &side, NULL, NULL, NULL, 0, c, CAPACITY);
   for (int i = 0; i < n; ++i) assert_true(c[i].depth <= DEPTH * (1 + 1e-9));
   pd_model_free(m);
 }
@@ -321,7 +377,7 @@ static void test_contact_geometry_is_the_tracked_geometry(void** state) {
   m = compile(cubeOnFloor);
   pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
   pdPose box = pose(0, 0, SIDE / 2 - DEPTH, 10, pd_v3(1, 1, 0));
-  n = pd_contacts_find(m, 0, &floor, 1, &box, NULL, 0, c, CAPACITY);
+  n = pd_contacts_find(m, 0, &floor, 1, &box, NULL, NULL, NULL, 0, c, CAPACITY);
   assert_true(n > 0);
   const pdPose boxes[] = {box, pose(0.7, 0, SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1))};  // the second: off the floor's face
   for (size_t k = 0; k < 2; ++k)
@@ -339,7 +395,7 @@ static void test_small_capacity_reports_the_needed_count(void** state) {
   pdPose floor = pose(0, 0, -0.05, 0, pd_v3(0, 0, 1));
   pdPose box = pose(0, 0, SIDE / 2 - DEPTH, 0, pd_v3(0, 0, 1));
   pdContactGeom c[2];
-  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &box, NULL, 0, c, 2), 4);
+  assert_int_equal(pd_contacts_find(m, 0, &floor, 1, &box, NULL, NULL, NULL, 0, c, 2), 4);
   pd_model_free(m);
 }
 
@@ -348,6 +404,8 @@ int main(void) {
       cmocka_unit_test(test_cube_resting_on_floor_gives_four_vf_contacts_with_the_floor_normal),
       cmocka_unit_test(test_separated_or_just_touching_bodies_have_no_contact),
       cmocka_unit_test(test_equal_cubes_face_on_face_count_each_corner_once),
+      cmocka_unit_test(test_flush_side_faces_give_the_overlap_corners_on_the_faces_crossed),
+      cmocka_unit_test(test_new_vf_contact_takes_the_face_crossed_during_the_step),
       cmocka_unit_test(test_crossed_edges_give_one_ee_contact_with_the_crossing_depth),
       cmocka_unit_test(test_sliding_vertex_keeps_its_face_and_breaks_past_the_face_edge),
       cmocka_unit_test(test_vf_onset_interpolates_the_crossing_time),
