@@ -19,6 +19,7 @@ int pd_cmd_view(int argc, char** argv);
 int pd_cmd_cubetoss(int argc, char** argv);
 int pd_cmd_gedanken(int argc, char** argv);
 int pd_cmd_oracle(int argc, char** argv);
+int pd_cmd_soak(int argc, char** argv);
 
 // Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr (on MPI rank 0 only:
 // every rank sees the same arguments); returns 2.

@@ -29,6 +29,7 @@ static const char* const usage =
     "  cubetoss [fit] --data FILE.csv --out DIR [--engines soft,ode,bullet]\n"
     "                 real cube tosses in every engine against the record; fit each engine's parameters\n"
     "  oracle (SCENE | --random N --seed S | --replay FILE)  interference test vs libccd\n"
+    "  soak --out DIR [--scenes N] [--seed S]             random scenes, invariants checked\n"
     "  help           this text\n"
     "  --version      print the version\n"
     "\n"
@@ -104,6 +105,7 @@ static int dispatch(int argc, char** argv) {
   if (strcmp(cmd, "cubetoss") == 0) return pd_cmd_cubetoss(argc - 1, argv + 1);
   if (strcmp(cmd, "gedanken") == 0) return pd_cmd_gedanken(argc - 1, argv + 1);
   if (strcmp(cmd, "oracle") == 0) return pd_cmd_oracle(argc - 1, argv + 1);
+  if (strcmp(cmd, "soak") == 0) return pd_cmd_soak(argc - 1, argv + 1);
   if (strcmp(cmd, "help") == 0 || pd_cli_is_help(cmd)) {
     fputs(usage, stdout);
     return PD_EXIT_OK;

@@ -82,17 +82,17 @@ static bool crosses_face_plane(const pdPolyhedron* sv, const pdPose* pv, const p
   return false;
 }
 
-// The face plane of sf a vertex crossed last on its way from q0 (step start) to q (now), both in sf's
-// frame: the vertex entered the body when it crossed the last of the planes it was outside of (a straight
-// path through a convex body). -1 when it was inside every plane already (a contact found again, or at t = 0).
+// The face plane of sf a vertex crossed on its way from q0 (step start) to q (now), both in sf's frame:
+// one it was on or outside of at the start and is inside of now. Of several (a vertex entering near an
+// edge, or one that started on two planes: a corner set down flush), the one it moved into most, which is
+// the one it presses on. -1 when it was inside every plane already (a contact found again).
 static int face_crossed(const pdPolyhedron* sf, pdVec3 q0, pdVec3 q, double tol) {
   int face = -1;
-  double latest = -1.0;
+  double most = 0.0;
   for (int f = 0; f < sf->faceCount; ++f) {
     double d0 = face_depth(sf, f, q0), d = face_depth(sf, f, q);
-    if (!(d0 < -tol && d > tol)) continue;
-    double fraction = d0 / (d0 - d);
-    if (fraction > latest) latest = fraction, face = f;
+    if (!(d0 <= tol && d > tol)) continue;
+    if (d - d0 > most) most = d - d0, face = f;
   }
   return face;
 }
@@ -285,8 +285,8 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   pdMat3 rel = pd_mat3_mul(&RaT, &pb->R);
   pdVec3 off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
   double tolA = BOUNDARY_TOL_REL * model->bodies[ia].size, tolB = BOUNDARY_TOL_REL * model->bodies[ib].size;
-  double flushTol =
-      FLUSH_TOL_DEFLECTIONS * model->settings.deflection * fmin(model->bodies[ia].size, model->bodies[ib].size);
+  double deltaMax = model->settings.deflection * fmin(model->bodies[ia].size, model->bodies[ib].size);
+  double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
   faceMask maskA[PRUNE_VERTICES_MAX], maskB[PRUNE_VERTICES_MAX];  // A's vertices against B's faces, and B's against A's
   bool prune = sa->vertexCount <= PRUNE_VERTICES_MAX && sb->vertexCount <= PRUNE_VERTICES_MAX;
   if (prune) {
@@ -320,10 +320,23 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
       // width, one tilted a little on the other): the normal, their cross product, lies in the faces
       // that press and the depth along it is nil; the VF contacts at the overlap's corners carry it
       if (in_shared_plane(sa, ea, b0, b1, sb, &rel, off, flushTol)) continue;
-      // a crossing, not an antipodal Minkowski face: each edge's closest point is inside the other body
+      // a crossing, not an antipodal Minkowski face: each edge's closest point is inside the other body.
+      // A thin body's sharp edge (a sliver, a plate's rim) is a wedge of a few degrees: the other edge's
+      // point, the depth away along the pair's normal, leaves it through a face at once although the edge
+      // is pressed into the other body. Such a pair is kept when its points are within the depth (at
+      // most the pair's δ_max) of inside and the depth is no more than the bodies' overlap along the
+      // normal: a bogus pair whose lines pass a body's width apart reads a depth of that width, its
+      // points that far outside.
       pdVec3 onA = pd_v3_sub(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on A's edge
       pdVec3 onB = pd_v3_add(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on B's edge
-      if (!inside_body(sa, onB, tolA) || !inside_body(sb, pd_mat3_tmulv(&rel, pd_v3_sub(onA, off)), tolB)) continue;
+      pdVec3 onAinB = pd_mat3_tmulv(&rel, pd_v3_sub(onA, off));
+      if (!inside_body(sa, onB, tolA) || !inside_body(sb, onAinB, tolB)) {
+        double slack = fmin(g.depth, deltaMax);
+        if (!inside_body(sa, onB, slack) || !inside_body(sb, onAinB, slack)) continue;
+        pdVec3 u = pd_v3_scale(g.normal, -1.0);  // from A to B
+        double overlap = fmin(overlap_along(sa, sb, &rel, off, u), overlap_along(sa, sb, &rel, off, g.normal));
+        if (g.depth > overlap + tolA + tolB) continue;
+      }
       if (n < capacity)
         out[n] = (pdContactGeom){{ia, ib, pd_contactEE, i, j}, to_world(pa, g.point), pd_mat3_mulv(&pa->R, g.normal),
                                  g.depth};
@@ -464,8 +477,12 @@ bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose*
     // still over its face, and not outside the body across another face (it slid past an edge that is
     // not its face's: near a corner the face plane alone can read deep while the vertex is outside)
     double outside = TRACK_INSIDE_TOL_REL * model->settings.deflection * model->bodies[id->body2].size;
-    return projects_inside(s2, id->feat2, q, BOUNDARY_TOL_REL * model->bodies[id->body2].size) &&
-           inside_body(s2, q, outside);
+    // over its face polygon within the flush tolerance: a corner resting on a shared side plane wanders
+    // across it by roundoff and must not break and be found again on the side face
+    double over = fmax(BOUNDARY_TOL_REL * model->bodies[id->body2].size,
+                       FLUSH_TOL_DEFLECTIONS * model->settings.deflection *
+                           fmin(model->bodies[id->body1].size, model->bodies[id->body2].size));
+    return projects_inside(s2, id->feat2, q, over) && inside_body(s2, q, outside);
   }
   // an edge pair stays a contact while its closest points lie inside both edges and it spans a face of
   // the Minkowski difference (its Gauss-map arcs still meet): past that, other features carry the contact

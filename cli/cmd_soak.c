@@ -1,0 +1,243 @@
+// polydyn soak — the random-scene soak (refcheck/include/polydyn/soak.h; README, Reliability). Each scene
+// is one task of a batch (refcheck/include/polydyn/batch.h); its runs go through child processes.
+#include <errno.h>
+#include <signal.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "polydyn/batch.h"
+#include "polydyn/soak.h"
+
+static const char* const help =
+    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--engines soft,ode,bullet]\n"
+    "                    [--budget SECONDS] [--jobs N]\n"
+    "\n"
+    "Generates N random scenes (campaign S: scene i is the same text on every machine) and runs each in\n"
+    "every engine, in a child process per run, checking at every output sample: no NaN or Inf; for the soft\n"
+    "engine also penetration below 3 delta_max of the pair, no energy gained beyond 1e-3 of E(0) in a\n"
+    "dissipative scene, the momentum kept in a scene without gravity or fixed bodies; and that the run\n"
+    "reaches its end. Scenes of two overlapping boxes must be refused. A run over its wall-time budget is\n"
+    "stopped and counted as over budget (a cost finding, not a failure).\n"
+    "Writes DIR/summary.csv (one row per scene and engine), DIR/failures/SCENE-ENGINE.scene (every failed\n"
+    "run's scene, replayable with `polydyn run`) and DIR/over-budget/SCENE-ENGINE.scene; prints the counts.\n"
+    "DIR is written under a temporary name and renamed when complete.\n"
+    "\n"
+    "  --scenes N       how many scenes (default 100)\n"
+    "  --seed S         the campaign (default 1)\n"
+    "  --first I        start at scene I (default 0): scenes I .. I+N-1\n"
+    "  --engines LIST   soft, ode, bullet (default soft)\n"
+    "  --budget SECONDS wall-time budget of one run (default 20)\n"
+    "  --jobs N         scenes in N worker processes (default 1; under mpirun or srun split over the ranks)\n"
+    "\n"
+    "Exit status: 0 no failure, 1 a run failed (or the results could not be written), 2 bad input,\n"
+    "130 interrupted (nothing written).\n";
+
+enum { ENGINES_MAX = 3 };
+static const char* const engineNames[ENGINES_MAX] = {"soft", "ode", "bullet"};
+
+typedef struct soakJob {
+  unsigned long seed;
+  long first;
+  const char* engines[ENGINES_MAX];
+  int engineCount;
+  double budget;
+} soakJob;
+
+static void soak_task(int task, pdBatchBuffer* result, void* user) {
+  const soakJob* job = user;
+  pdSoakScene scene = pd_soak_scene(job->seed, job->first + task);
+  for (int e = 0; e < job->engineCount; ++e) {
+    pdSoakResult r;
+    pd_soak_run(&scene, job->engines[e], job->budget, &r);
+    pd_batch_append(result, &r, sizeof r);
+  }
+  pd_soak_scene_free(&scene);
+}
+
+static volatile sig_atomic_t interrupted = 0;
+static void on_signal(int sig) {
+  (void)sig;
+  interrupted = 1;
+}
+static bool keep_going(int task, int done, int total, void* user) {
+  (void)task, (void)user;
+  if (isatty(2)) fprintf(stderr, "\r\033[Kpolydyn soak: %d/%d", done, total);
+  return !interrupted;
+}
+
+static void csv_text(FILE* out, const char* s) {
+  fputc('"', out);
+  for (; *s; ++s) {
+    if (*s == '"') fputc('"', out);
+    fputc(*s, out);
+  }
+  fputc('"', out);
+}
+
+// The scene file of a run that did not pass: the scene, headed by what happened.
+static bool write_scene_file(const char* dir, const char* sub, long index, const char* engine,
+                             const pdSoakScene* scene, const pdSoakResult* r) {
+  char path[8192];
+  snprintf(path, sizeof path, "%s/%s", dir, sub);
+  if (mkdir(path, 0777) != 0 && errno != EEXIST) return false;
+  snprintf(path, sizeof path, "%s/%s/%06ld-%s.scene", dir, sub, index, engine);
+  FILE* f = fopen(path, "w");
+  if (!f) return false;
+  fprintf(f, "# %s: %s\n# replay: polydyn run %06ld-%s.scene --engine %s\n%s", pdSoakStatusNames[r->status],
+          r->message, index, engine, engine, scene->text);
+  bool ok = !ferror(f);
+  return fclose(f) == 0 && ok;
+}
+
+int pd_cmd_soak(int argc, char** argv) {
+  soakJob job = {.seed = 1, .budget = 20.0};
+  long scenes = 100;
+  int jobs = 0;
+  const char* out = NULL;
+  const char* engines = "soft";
+  for (int i = 1; i < argc; ++i) {
+    const char* a = argv[i];
+    if (pd_cli_is_help(a)) {
+      fputs(help, stdout);
+      return PD_EXIT_OK;
+    }
+    if (i + 1 >= argc) return pd_cli_usage_error("soak", "unknown argument '%s' or %s without a value", a, a);
+    const char* v = argv[++i];
+    char* end = NULL;
+    errno = 0;
+    if (strcmp(a, "--out") == 0) {
+      if (!v[0]) return pd_cli_usage_error("soak", "--out needs a directory name");
+      out = v;
+    } else if (strcmp(a, "--scenes") == 0 || strcmp(a, "--first") == 0) {
+      long n = strtol(v, &end, 10);
+      bool isScenes = strcmp(a, "--scenes") == 0;
+      if (end == v || *end || errno || n < (isScenes ? 1 : 0) || n > 100000000)
+        return pd_cli_usage_error("soak", "%s needs a whole number from %d to 100000000", a, isScenes ? 1 : 0);
+      if (isScenes) scenes = n;
+      else job.first = n;
+    } else if (strcmp(a, "--seed") == 0) {
+      unsigned long long s = strtoull(v, &end, 10);
+      if (end == v || *end || errno || v[0] == '-' || s > 0xffffffffull)
+        return pd_cli_usage_error("soak", "--seed needs a whole number from 0 to 4294967295");
+      job.seed = (unsigned long)s;
+    } else if (strcmp(a, "--engines") == 0) {
+      engines = v;
+    } else if (strcmp(a, "--budget") == 0) {
+      if (!pd_cli_positive(v, &job.budget) || job.budget > 86400)
+        return pd_cli_usage_error("soak", "--budget needs seconds > 0 (at most a day)");
+    } else if (strcmp(a, "--jobs") == 0) {
+      if (!pd_cli_jobs(v, &jobs))
+        return pd_cli_usage_error("soak", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);
+    } else {
+      return pd_cli_usage_error("soak", "unknown argument '%s'", a);
+    }
+  }
+  if (!out) return pd_cli_usage_error("soak", "--out DIR is required");
+  if (job.first + scenes > 2000000000L) return pd_cli_usage_error("soak", "--first + --scenes is too large");
+  // the engines, in the order given, each once
+  for (const char* p = engines; *p;) {
+    const char* comma = strchr(p, ',');
+    size_t len = comma ? (size_t)(comma - p) : strlen(p);
+    int e = 0;
+    while (e < ENGINES_MAX && !(strlen(engineNames[e]) == len && strncmp(p, engineNames[e], len) == 0)) ++e;
+    if (e == ENGINES_MAX) return pd_cli_usage_error("soak", "--engines: unknown engine '%.*s'", (int)len, p);
+    for (int k = 0; k < job.engineCount; ++k)
+      if (job.engines[k] == engineNames[e]) return pd_cli_usage_error("soak", "--engines: %s twice", engineNames[e]);
+    job.engines[job.engineCount++] = engineNames[e];
+    if (!comma) break;
+    p = comma + 1;
+    if (!*p) return pd_cli_usage_error("soak", "--engines: an empty name");
+  }
+  if (job.engineCount == 0) return pd_cli_usage_error("soak", "--engines needs a list like soft,ode,bullet");
+
+  char tmp[4096];
+  if (!pd_cli_out_open("soak", out, "summary.csv", tmp, sizeof tmp)) return PD_EXIT_BAD_INPUT;
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+
+  pdBatchBuffer* results = calloc((size_t)scenes, sizeof *results);
+  if (!results) abort();
+  pdBatchOptions options = {.workers = pd_cli_default_jobs(jobs, 1), .progress = keep_going};
+  char why[512] = "";
+  bool ran = pd_batch_run((int)scenes, soak_task, &job, &options, results, why, sizeof why);
+  if (isatty(2)) fputs("\r\033[K", stderr);
+  int status = PD_EXIT_OK;
+  if (!ran) {
+    if (pd_batch_is_root()) fprintf(stderr, "polydyn soak: %s\n", interrupted ? "interrupted; nothing written" : why);
+    pd_cli_remove_tree(tmp);
+    status = interrupted ? 130 : PD_EXIT_FAILURE;
+  } else if (pd_batch_is_root()) {
+    long counts[ENGINES_MAX][pd_soakStatusCount] = {{0}};
+    long kinds[pd_soakKindCount][pd_soakStatusCount] = {{0}};
+    char path[8192];
+    snprintf(path, sizeof path, "%s/summary.csv", tmp);
+    FILE* csv = fopen(path, "w");
+    bool ok = csv != NULL;
+    if (ok)
+      fputs("seed,scene,kind,objects,dissipative,engine,status,wall_seconds,simulated,steps,penetration_over_delta_max,"
+            "energy_gain_rel,momentum_error_rel,message\n",
+            csv);
+    for (long s = 0; s < scenes && ok; ++s) {
+      long index = job.first + s;
+      pdSoakScene scene = pd_soak_scene(job.seed, index);
+      size_t offset = 0;
+      for (int e = 0; e < job.engineCount && ok; ++e) {
+        pdSoakResult r;
+        if (!pd_batch_read(&results[s], &offset, &r, sizeof r)) {
+          ok = false;
+          break;
+        }
+        r.message[sizeof r.message - 1] = '\0';
+        int engine = 0;
+        while (engineNames[engine] != job.engines[e]) ++engine;
+        ++counts[engine][r.status];
+        if (e == 0) ++kinds[scene.kind][r.status];
+        fprintf(csv, "%lu,%ld,%s,%d,%d,%s,%s,%.4g,%.6g,%ld,%.4g,%.4g,%.4g,", job.seed, index, pdSoakKindNames[scene.kind],
+                scene.objects, scene.dissipative, job.engines[e], pdSoakStatusNames[r.status], r.wallSeconds,
+                r.simulated, r.steps, r.penetration, r.energyGain, r.momentumError);
+        csv_text(csv, r.message);
+        fputc('\n', csv);
+        if (r.status == pd_soakFailed) ok = write_scene_file(tmp, "failures", index, job.engines[e], &scene, &r);
+        if (r.status == pd_soakOverBudget) ok = write_scene_file(tmp, "over-budget", index, job.engines[e], &scene, &r);
+        if (r.status == pd_soakFailed) {
+          status = PD_EXIT_FAILURE;
+          printf("FAILED scene %ld (%s) in %s: %s\n", index, pdSoakKindNames[scene.kind], job.engines[e], r.message);
+        }
+      }
+      pd_soak_scene_free(&scene);
+    }
+    if (csv) ok = !ferror(csv) && fclose(csv) == 0 && ok;
+    printf("polydyn soak: seed %lu, scenes %ld .. %ld\n", job.seed, job.first, job.first + scenes - 1);
+    printf("%-8s %8s %8s %12s %8s %10s\n", "engine", "ok", "refused", "over-budget", "failed", "not-built");
+    for (int e = 0; e < ENGINES_MAX; ++e) {
+      bool used = false;
+      for (int k = 0; k < job.engineCount; ++k) used = used || job.engines[k] == engineNames[e];
+      if (!used) continue;
+      printf("%-8s %8ld %8ld %12ld %8ld %10ld\n", engineNames[e], counts[e][pd_soakOk], counts[e][pd_soakRefused],
+             counts[e][pd_soakOverBudget], counts[e][pd_soakFailed], counts[e][pd_soakNotBuilt]);
+    }
+    printf("%s by kind (%s):", job.engines[0], "ok/refused/over-budget/failed");
+    for (int k = 0; k < pd_soakKindCount; ++k)
+      printf(" %s %ld/%ld/%ld/%ld", pdSoakKindNames[k], kinds[k][pd_soakOk], kinds[k][pd_soakRefused],
+             kinds[k][pd_soakOverBudget], kinds[k][pd_soakFailed]);
+    putchar('\n');
+    if (!ok) {
+      fprintf(stderr, "polydyn soak: cannot write the results in %s\n", tmp);
+      pd_cli_remove_tree(tmp);
+      status = PD_EXIT_FAILURE;
+    } else if (!pd_cli_out_close("soak", tmp, out)) {
+      status = PD_EXIT_FAILURE;
+    }
+  }
+  for (long s = 0; s < scenes; ++s) pd_batch_buffer_free(&results[s]);
+  free(results);
+  return status;
+}

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# The random-scene soak (README, Reliability; cli/cmd_soak.c, refcheck/soak.c).
+# - CI's campaign: seed 1, scenes 0..SCENES-1 (500; 100 in the ASan + UBSan build, ten times slower), in
+#   the soft engine, ODE and Bullet: every run ok, or refused where
+#   it must be (the overlap scenes), no failure, no run over its budget; summary.csv has a row per scene and
+#   engine; the same command again gives the same rows but the measured times (scene i of campaign S is a
+#   function of S and i alone, and the runs are deterministic);
+# - regressions the soak found and that are fixed (README, Reliability): seed 2 scene 2945 (a stack of eight
+#   flush boxes sank 29 delta_max), seed 1 scenes 4, 7, 19 (inside the campaign: a sliver's sharp rim pressed
+#   into a box found no edge-edge contact);
+# - a run stopped at its budget writes its scene under over-budget/, and that file replays with polydyn run;
+# - bad arguments: exit 2 with a message, nothing written.
+#
+# usage: test_soak.sh POLYDYN_BINARY [SCENES]
+set -u
+PD=$1
+SCENES=${2:-500}
+HERE=$(dirname "${BASH_SOURCE[0]}")
+SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_soak.XXXXXX") || exit 1
+trap 'rm -rf "$SCRATCH"' EXIT
+. "$HERE/../lib.sh"
+
+run_pd "$SCRATCH/ci.out" "$SCRATCH/ci.err" soak --seed 1 --scenes "$SCENES" --engines soft,ode,bullet --jobs 2 --out "$SCRATCH/ci"
+check "seed 1, scenes 0..$((SCENES - 1)): exit 0" '[ $rc -eq 0 ]' || cat "$SCRATCH/ci.out" "$SCRATCH/ci.err"
+check "a row per scene and engine" '[ "$(tail -n +2 "$SCRATCH/ci/summary.csv" | wc -l)" -eq $((3 * SCENES)) ]'
+check "no failure" '! grep -q ",failed," "$SCRATCH/ci/summary.csv" && [ ! -e "$SCRATCH/ci/failures" ]'
+check "no run over its budget" '! grep -q ",over-budget," "$SCRATCH/ci/summary.csv"'
+check "only overlap scenes refused" '! grep ",refused," "$SCRATCH/ci/summary.csv" | grep -vq ",overlap,"'
+check "every overlap scene refused" '! grep ",overlap," "$SCRATCH/ci/summary.csv" | grep -vq ",refused,"'
+check "the counts are printed" 'grep -q "^soft  *[0-9]" "$SCRATCH/ci.out"'
+# the same scenes again (a slice, serially): the same rows but wall_seconds (column 8)
+run_pd "$SCRATCH/again.out" "$SCRATCH/again.err" soak --seed 1 --first 60 --scenes 40 --out "$SCRATCH/again"
+check "a slice again: exit 0" '[ $rc -eq 0 ]'
+check "the same rows but the measured times" \
+  'diff <(grep -E "^1,([6-9][0-9]),[^,]*,[^,]*,[^,]*,soft," "$SCRATCH/ci/summary.csv" | cut -d, -f1-7,9-) \
+        <(tail -n +2 "$SCRATCH/again/summary.csv" | cut -d, -f1-7,9-)'
+
+run_pd "$SCRATCH/stack.out" "$SCRATCH/stack.err" soak --seed 2 --first 2945 --scenes 1 --out "$SCRATCH/stack"
+check "regression: seed 2 scene 2945 (flush stack) passes" '[ $rc -eq 0 ] && grep -q "^2,2945,stack,.*,soft,ok," "$SCRATCH/stack/summary.csv"'
+
+run_pd "$SCRATCH/budget.out" "$SCRATCH/budget.err" soak --seed 1 --first 13 --scenes 1 --budget 0.001 --out "$SCRATCH/budget"
+check "over budget: exit 0 (a cost finding, not a failure)" '[ $rc -eq 0 ]'
+check "over budget: counted" 'grep -q ",over-budget," "$SCRATCH/budget/summary.csv"'
+check "over budget: the scene is written" '[ -f "$SCRATCH/budget/over-budget/000013-soft.scene" ]'
+check "over budget: it says why" 'head -1 "$SCRATCH/budget/over-budget/000013-soft.scene" | grep -q "^# over-budget: stopped at t = "'
+run_pd "$SCRATCH/replay.out" "$SCRATCH/replay.err" run "$SCRATCH/budget/over-budget/000013-soft.scene" --out "$SCRATCH/replay"
+check "over budget: the scene replays with polydyn run" '[ $rc -eq 0 ] && [ -f "$SCRATCH/replay/trajectory.csv" ]'
+
+for bad in "--scenes 0" "--scenes x" "--seed -1" "--engines soft,box" "--engines soft,soft" "--budget 0" "--jobs 0" "--frobnicate 1"; do
+  # shellcheck disable=SC2086
+  run_pd "$SCRATCH/bad.out" "$SCRATCH/bad.err" soak $bad --out "$SCRATCH/bad"
+  check "bad argument '$bad': exit 2 with a message, nothing written" \
+    '[ $rc -eq 2 ] && grep -q "polydyn soak: " "$SCRATCH/bad.err" && [ ! -e "$SCRATCH/bad" ] && no_partial "$SCRATCH/bad"'
+done
+run_pd "$SCRATCH/bad.out" "$SCRATCH/bad.err" soak --scenes 3
+check "no --out: exit 2" '[ $rc -eq 2 ] && grep -q "\-\-out DIR is required" "$SCRATCH/bad.err"'
+check_interrupted "$SCRATCH/int.out" "$SCRATCH/int.err" "$SCRATCH/int" soak --seed 1 --scenes 100000 --out "$SCRATCH/int"
+
+echo "test_soak: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
