@@ -276,6 +276,10 @@ static bool in_shared_plane(const pdPolyhedron* sa, const pdEdge* ea, pdVec3 b0,
   return false;
 }
 
+// Deepest a new EE contact may be, in the pair's δ_max: contacts are found as they start (onsets are
+// interpolated to 10⁻³ δ_max), so a deeper one was missed for several δ_max of travel or is not a contact.
+#define EE_NEW_DEPTH_MAX_DEFLECTIONS 3.0
+
 static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
                    int capacity, int n) {
   const pdPolyhedron* sa = &model->bodies[ia].shape;
@@ -320,6 +324,10 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
       // width, one tilted a little on the other): the normal, their cross product, lies in the faces
       // that press and the depth along it is nil; the VF contacts at the overlap's corners carry it
       if (in_shared_plane(sa, ea, b0, b1, sb, &rel, off, flushTol)) continue;
+      // a new edge pair deeper than this is not where the bodies just met: its lines pass each other a
+      // body's width away (two flush boxes rocking a little on each other cross their antipodal edges,
+      // lying on the shared planes, inside within any tolerance)
+      if (g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax) continue;
       // a crossing, not an antipodal Minkowski face: each edge's closest point is inside the other body.
       // A thin body's sharp edge (a sliver, a plate's rim) is a wedge of a few degrees: the other edge's
       // point, the depth away along the pair's normal, leaves it through a face at once although the edge
