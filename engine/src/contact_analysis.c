@@ -438,8 +438,12 @@ static bool edge_points_inside(const pdModel* model, const pdContactId* id, cons
   pdVec3 on2 = pd_v3_muladd(g->point, 0.5 * g->depth, g->normal);   // on body 2's edge
   const pdBody* b1 = &model->bodies[id->body1];
   const pdBody* b2 = &model->bodies[id->body2];
-  double tol1 = TRACK_INSIDE_TOL_REL * model->settings.deflection * b1->size;
-  double tol2 = TRACK_INSIDE_TOL_REL * model->settings.deflection * b2->size;
+  // as the search accepts a sharp edge's pair (find_ee): the points within the pair's depth of inside,
+  // up to the deepest a new pair may be; else a pair found again every step would break at every commit
+  double deltaMax = model->settings.deflection * fmin(b1->size, b2->size);
+  double sharp = fmin(fmax(g->depth, 0.0), EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax);
+  double tol1 = fmax(TRACK_INSIDE_TOL_REL * model->settings.deflection * b1->size, sharp);
+  double tol2 = fmax(TRACK_INSIDE_TOL_REL * model->settings.deflection * b2->size, sharp);
   return inside_body(&b1->shape, to_local(p1, on2), tol1) && inside_body(&b2->shape, to_local(p2, on1), tol2);
 }
 
