@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The random-scene soak (README, Reliability; cli/cmd_soak.c, refcheck/soak.c).
-# - CI's campaign: seed 1, scenes 0..SCENES-1 (500; 100 in the ASan + UBSan build, ten times slower), in
+# - CI's campaign: seed 1, scenes 0..SCENES-1 (500; 100 in the ASan + UBSan build, 10-40 times slower, whose
+#   runs get a budget of 300 s instead of 20), in
 #   the soft engine, ODE and Bullet: every run ok, or refused where
 #   it must be (the overlap scenes), no failure, no run over its budget; summary.csv has a row per scene and
 #   engine; the same command again gives the same rows but the measured times (scene i of campaign S is a
@@ -11,16 +12,17 @@
 # - a run stopped at its budget writes its scene under over-budget/, and that file replays with polydyn run;
 # - bad arguments: exit 2 with a message, nothing written.
 #
-# usage: test_soak.sh POLYDYN_BINARY [SCENES]
+# usage: test_soak.sh POLYDYN_BINARY [SCENES [BUDGET]]   (BUDGET: seconds per run, polydyn soak --budget)
 set -u
 PD=$1
 SCENES=${2:-500}
+BUDGET=${3:-20}
 HERE=$(dirname "${BASH_SOURCE[0]}")
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_soak.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
 . "$HERE/../lib.sh"
 
-run_pd "$SCRATCH/ci.out" "$SCRATCH/ci.err" soak --seed 1 --scenes "$SCENES" --engines soft,ode,bullet --jobs 2 --out "$SCRATCH/ci"
+run_pd "$SCRATCH/ci.out" "$SCRATCH/ci.err" soak --seed 1 --scenes "$SCENES" --engines soft,ode,bullet --jobs 2 --budget "$BUDGET" --out "$SCRATCH/ci"
 check "seed 1, scenes 0..$((SCENES - 1)): exit 0" '[ $rc -eq 0 ]' || cat "$SCRATCH/ci.out" "$SCRATCH/ci.err"
 check "a row per scene and engine" '[ "$(tail -n +2 "$SCRATCH/ci/summary.csv" | wc -l)" -eq $((3 * SCENES)) ]'
 check "no failure" '! grep -q ",failed," "$SCRATCH/ci/summary.csv" && [ ! -e "$SCRATCH/ci/failures" ]'
@@ -29,13 +31,13 @@ check "only overlap scenes refused" '! grep ",refused," "$SCRATCH/ci/summary.csv
 check "every overlap scene refused" '! grep ",overlap," "$SCRATCH/ci/summary.csv" | grep -vq ",refused,"'
 check "the counts are printed" 'grep -q "^soft  *[0-9]" "$SCRATCH/ci.out"'
 # the same scenes again (a slice, serially): the same rows but wall_seconds (column 8)
-run_pd "$SCRATCH/again.out" "$SCRATCH/again.err" soak --seed 1 --first 60 --scenes 40 --out "$SCRATCH/again"
+run_pd "$SCRATCH/again.out" "$SCRATCH/again.err" soak --seed 1 --first 60 --scenes 40 --budget "$BUDGET" --out "$SCRATCH/again"
 check "a slice again: exit 0" '[ $rc -eq 0 ]'
 check "the same rows but the measured times" \
   'diff <(grep -E "^1,([6-9][0-9]),[^,]*,[^,]*,[^,]*,soft," "$SCRATCH/ci/summary.csv" | cut -d, -f1-7,9-) \
         <(tail -n +2 "$SCRATCH/again/summary.csv" | cut -d, -f1-7,9-)'
 
-run_pd "$SCRATCH/stack.out" "$SCRATCH/stack.err" soak --seed 2 --first 2945 --scenes 1 --out "$SCRATCH/stack"
+run_pd "$SCRATCH/stack.out" "$SCRATCH/stack.err" soak --seed 2 --first 2945 --scenes 1 --budget "$BUDGET" --out "$SCRATCH/stack"
 check "regression: seed 2 scene 2945 (flush stack) passes" '[ $rc -eq 0 ] && grep -q "^2,2945,stack,.*,soft,ok," "$SCRATCH/stack/summary.csv"'
 
 run_pd "$SCRATCH/budget.out" "$SCRATCH/budget.err" soak --seed 1 --first 13 --scenes 1 --budget 0.001 --out "$SCRATCH/budget"
