@@ -12,6 +12,7 @@
 #include "polydyn/cubetoss.h"
 #include "polydyn/output.h"
 #include "polydyn/scene.h"
+#include "text_buffer.h"
 
 // Default stiffness of each side, N/m: eq. (11) for the cube, m vmax²/δ_max² with δ_max = 0.01 × side
 // (the engine's default deflection): 0.37 × 2.5² / (0.01 × 0.1048)² = 2.105e6, rounded.
@@ -54,66 +55,42 @@ const char* pd_toss_status_name(pdTossStatus status) {
 
 // ---------------------------------------------------------------- the scene
 
-// Appends to a growing string (aborts when memory runs out, as the rest of the CLI).
-typedef struct textBuf {
-  char* s;
-  size_t len, cap;
-} textBuf;
-
-static void append(textBuf* b, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
-static void append(textBuf* b, const char* fmt, ...) {
-  for (;;) {
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(b->s ? b->s + b->len : NULL, b->s ? b->cap - b->len : 0, fmt, ap);
-    va_end(ap);
-    PD_ASSERT(n >= 0);
-    if (b->s && b->len + (size_t)n < b->cap) {
-      b->len += (size_t)n;
-      return;
-    }
-    b->cap = 2 * (b->cap + (size_t)n) + 256;
-    b->s = realloc(b->s, b->cap);
-    if (!b->s) abort();
-  }
-}
-
-static void append_material(textBuf* b, const pdTossParams* p) {
-  append(b, "mu %.17g\nrestitution %.17g\nkn %.17g\n", p->mu, p->restitution, p->kn);
+static void append_material(pdTextBuffer* b, const pdTossParams* p) {
+  pd_text_appendf(b, "mu %.17g\nrestitution %.17g\nkn %.17g\n", p->mu, p->restitution, p->kn);
 }
 
 char* pd_toss_scene(const pdToss* toss, const pdTossParams* p) {
   PD_ASSERT(toss && p && toss->sampleCount >= 2);
   const pdBodyState* s0 = &toss->samples[0];
-  textBuf b = {0};
-  append(&b, "# polydyn cubetoss: toss %ld from its first sample (generated)\n", toss->id);
-  append(&b, "tend %.17g\nsample %.17g\ntol %.17g\nvmax %.17g\n", (double)(toss->sampleCount - 1) / PD_TOSS_RATE,
-         PD_TOSS_RATE, p->tol, PD_TOSS_VMAX);
-  append(&b, "cube board grey %.17g %.17g %.17g\nfixed\nloc 0 0 %.17g\n", PD_TOSS_BOARD_WIDTH, PD_TOSS_BOARD_WIDTH,
-         PD_TOSS_BOARD_THICKNESS, PD_TOSS_BOARD_TOP - 0.5 * PD_TOSS_BOARD_THICKNESS);
+  pdTextBuffer b = {0};
+  pd_text_appendf(&b, "# polydyn cubetoss: toss %ld from its first sample (generated)\n", toss->id);
+  pd_text_appendf(&b, "tend %.17g\nsample %.17g\ntol %.17g\nvmax %.17g\n",
+                  (double)(toss->sampleCount - 1) / PD_TOSS_RATE, PD_TOSS_RATE, p->tol, PD_TOSS_VMAX);
+  pd_text_appendf(&b, "cube board grey %.17g %.17g %.17g\nfixed\nloc 0 0 %.17g\n", PD_TOSS_BOARD_WIDTH,
+                  PD_TOSS_BOARD_WIDTH, PD_TOSS_BOARD_THICKNESS, PD_TOSS_BOARD_TOP - 0.5 * PD_TOSS_BOARD_THICKNESS);
   append_material(&b, p);
   const double side = PD_TOSS_CUBE_SIDE;
-  append(&b, "cube cube red %.17g %.17g %.17g\nspgrav %.17g\n", side, side, side,
-         PD_TOSS_CUBE_MASS / (side * side * side) / 1000.0);
+  pd_text_appendf(&b, "cube cube red %.17g %.17g %.17g\nspgrav %.17g\n", side, side, side,
+                  PD_TOSS_CUBE_MASS / (side * side * side) / 1000.0);
   // orientation as an angle about a world axis: q = (cos θ/2, sin θ/2 u), θ ∈ [0, 2π] keeps q's sign
   pdVec3 qv = {s0->q.x, s0->q.y, s0->q.z};
   double qvNorm = pd_v3_norm(qv);
-  append(&b, "loc %.17g %.17g %.17g", s0->x.x, s0->x.y, s0->x.z);
+  pd_text_appendf(&b, "loc %.17g %.17g %.17g", s0->x.x, s0->x.y, s0->x.z);
   if (qvNorm > 0.0) {
     double angle = 2.0 * atan2(qvNorm, s0->q.w);
-    append(&b, " %.17g %.17g %.17g %.17g", angle * 180.0 / kPi, qv.x / qvNorm, qv.y / qvNorm, qv.z / qvNorm);
+    pd_text_appendf(&b, " %.17g %.17g %.17g %.17g", angle * 180.0 / kPi, qv.x / qvNorm, qv.y / qvNorm, qv.z / qvNorm);
   }
   // angular velocity: `vel` takes a spin about an axis of the object's own frame, so ω_body = Rᵀ ω
-  append(&b, "\nvel %.17g %.17g %.17g", s0->v.x, s0->v.y, s0->v.z);
+  pd_text_appendf(&b, "\nvel %.17g %.17g %.17g", s0->v.x, s0->v.y, s0->v.z);
   double spin = pd_v3_norm(s0->w);
   if (spin > 0.0) {
     pdMat3 r = pd_quat_to_mat3(s0->q);
     pdVec3 axis = pd_v3_scale(pd_mat3_tmulv(&r, s0->w), 1.0 / spin);
-    append(&b, " %.17g %.17g %.17g %.17g", spin * 180.0 / kPi, axis.x, axis.y, axis.z);
+    pd_text_appendf(&b, " %.17g %.17g %.17g %.17g", spin * 180.0 / kPi, axis.x, axis.y, axis.z);
   }
-  append(&b, "\n");
+  pd_text_appendf(&b, "\n");
   append_material(&b, p);
-  return b.s;
+  return b.data;
 }
 
 pdModel* pd_toss_model(const pdToss* toss, const pdTossParams* p, pdError* err) {

@@ -5,7 +5,6 @@
 #include <gsl/gsl_rng.h>
 #include <math.h>
 #include <signal.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,6 +17,7 @@
 #include "polydyn/refcheck.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
+#include "text_buffer.h"
 
 const char* const pdSoakKindNames[pd_soakKindCount] = {"drop", "stack", "throw", "free", "overlap"};
 const char* const pdSoakStatusNames[pd_soakStatusCount] = {"ok", "refused", "over-budget", "failed", "not-built"};
@@ -25,29 +25,6 @@ const char* const pdSoakStatusNames[pd_soakStatusCount] = {"ok", "refused", "ove
 #define PI 3.14159265358979323846
 
 // ---------------------------------------------------------------- scene text
-
-typedef struct text {
-  char* data;
-  size_t size, capacity;
-} text;
-
-static void put(text* t, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
-static void put(text* t, const char* fmt, ...) {
-  for (;;) {
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(t->data ? t->data + t->size : NULL, t->data ? t->capacity - t->size : 0, fmt, ap);
-    va_end(ap);
-    if (n < 0) abort();
-    if (t->data && t->size + (size_t)n < t->capacity) {
-      t->size += (size_t)n;
-      return;
-    }
-    t->capacity = 2 * (t->capacity + (size_t)n + 256);
-    t->data = realloc(t->data, t->capacity);
-    if (!t->data) abort();
-  }
-}
 
 static double uniform(gsl_rng* r, double lo, double hi) { return lo + (hi - lo) * gsl_rng_uniform(r); }
 static double log_uniform(gsl_rng* r, double lo, double hi) { return lo * pow(hi / lo, gsl_rng_uniform(r)); }
@@ -60,7 +37,7 @@ static void unit_vector(gsl_rng* r, double u[3]) {
 }
 
 // One body's shape line; returns the radius of a sphere about its centre that holds it (for spacing).
-static double shape_line(gsl_rng* r, text* t, const char* name, double size, bool flatEnds) {
+static double shape_line(gsl_rng* r, pdTextBuffer* t, const char* name, double size, bool flatEnds) {
   static const char* const colors[] = {"red", "blue", "green", "orange", "tan", "grey", "brown", "purple"};
   const char* color = colors[gsl_rng_uniform_int(r, sizeof colors / sizeof colors[0])];
   int choice = flatEnds ? (int)gsl_rng_uniform_int(r, 2) : (int)gsl_rng_uniform_int(r, 5);
@@ -68,43 +45,45 @@ static double shape_line(gsl_rng* r, text* t, const char* name, double size, boo
   if (choice == 0 && chance(r, 0.15)) sz = fmax(sx, sy) / 100.0;  // a 100:1 plate
   switch (choice) {
     case 0:
-      put(t, "cube %s %s %.17g %.17g %.17g\n", name, color, sx, sy, sz);
+      pd_text_appendf(t, "cube %s %s %.17g %.17g %.17g\n", name, color, sx, sy, sz);
       return 0.5 * sqrt(sx * sx + sy * sy + sz * sz);
     case 1:
-      put(t, "prism %s %s %d %.17g %.17g %.17g\n", name, color, 3 + (int)gsl_rng_uniform_int(r, 6), sx, sy, sz);
+      pd_text_appendf(t, "prism %s %s %d %.17g %.17g %.17g\n", name, color, 3 + (int)gsl_rng_uniform_int(r, 6), sx, sy,
+                      sz);
       return 0.5 * sqrt(sx * sx + sy * sy + sz * sz);
     case 2:
-      put(t, "tprism %s %s %d %.17g %.17g %.17g %.17g\n", name, color, 3 + (int)gsl_rng_uniform_int(r, 6), sx, sy, sz,
-          uniform(r, 0.3, 1.0));
+      pd_text_appendf(t, "tprism %s %s %d %.17g %.17g %.17g %.17g\n", name, color, 3 + (int)gsl_rng_uniform_int(r, 6),
+                      sx, sy, sz, uniform(r, 0.3, 1.0));
       return 0.5 * sqrt(sx * sx + sy * sy + sz * sz);
     case 3:
-      put(t, "sphere %s %s %d %.17g %.17g %.17g\n", name, color, (int)gsl_rng_uniform_int(r, 2), sx, sy, sz);
+      pd_text_appendf(t, "sphere %s %s %d %.17g %.17g %.17g\n", name, color, (int)gsl_rng_uniform_int(r, 2), sx, sy,
+                      sz);
       return 0.5 * fmax(sx, fmax(sy, sz));
     default: {
       // a hull of 6 … 12 random points in a box, sometimes squashed to a sliver (20:1)
       int n = 6 + (int)gsl_rng_uniform_int(r, 7);
       double squash = chance(r, 0.2) ? 0.05 : 1.0, far = 0.0;
-      put(t, "hull %s %s", name, color);
+      pd_text_appendf(t, "hull %s %s", name, color);
       for (int i = 0; i < n; ++i) {
         double p[3] = {uniform(r, -0.5, 0.5) * sx, uniform(r, -0.5, 0.5) * sy, uniform(r, -0.5, 0.5) * sz * squash};
         far = fmax(far, sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]));
-        put(t, " %.17g %.17g %.17g", p[0], p[1], p[2]);
+        pd_text_appendf(t, " %.17g %.17g %.17g", p[0], p[1], p[2]);
       }
-      put(t, "\n");
+      pd_text_appendf(t, "\n");
       return 2.0 * far;  // the centre of mass lies inside the hull: its distance to any point is < 2 far
     }
   }
 }
 
 // The material lines of a body; *elastic set when it asks for restitution 1.
-static void material_lines(gsl_rng* r, text* t, bool* elastic) {
-  if (chance(r, 0.85)) put(t, "mu %.17g\n", chance(r, 0.15) ? 0.0 : uniform(r, 0.05, 1.5));
+static void material_lines(gsl_rng* r, pdTextBuffer* t, bool* elastic) {
+  if (chance(r, 0.85)) pd_text_appendf(t, "mu %.17g\n", chance(r, 0.15) ? 0.0 : uniform(r, 0.05, 1.5));
   if (chance(r, 0.7)) {
     double e = chance(r, 0.1) ? 1.0 : uniform(r, 0.1, 0.95);
     if (e >= 1.0) *elastic = true;
-    put(t, "restitution %.17g\n", e);
+    pd_text_appendf(t, "restitution %.17g\n", e);
   }
-  put(t, "spgrav %.17g\n", log_uniform(r, 0.3, 10.0));
+  pd_text_appendf(t, "spgrav %.17g\n", log_uniform(r, 0.3, 10.0));
 }
 
 static void turn(gsl_rng* r, double* angle, double axis[3]) {
@@ -113,24 +92,24 @@ static void turn(gsl_rng* r, double* angle, double axis[3]) {
 }
 
 // Settings lines shared by every kind: sometimes vmax, deflection and tol are set.
-static void settings_lines(gsl_rng* r, text* t, double tend) {
-  put(t, "tend %.17g\nsample 100\n", tend);
-  if (chance(r, 0.2)) put(t, "tol %.17g\n", log_uniform(r, 1e-7, 1e-5));
-  if (chance(r, 0.2)) put(t, "deflection %.17g\n", log_uniform(r, 0.005, 0.05));
+static void settings_lines(gsl_rng* r, pdTextBuffer* t, double tend) {
+  pd_text_appendf(t, "tend %.17g\nsample 100\n", tend);
+  if (chance(r, 0.2)) pd_text_appendf(t, "tol %.17g\n", log_uniform(r, 1e-7, 1e-5));
+  if (chance(r, 0.2)) pd_text_appendf(t, "deflection %.17g\n", log_uniform(r, 0.005, 0.05));
 }
 
 // A fixed floor whose top face is the plane z = 0, `half` wide each way.
-static void floor_lines(text* t, double half) {
-  put(t, "cube floor grey %.17g %.17g %.17g\nfixed\nloc 0 0 %.17g\nmu 0.5\n", 2 * half, 2 * half, 0.1 * half,
-      -0.05 * half);
+static void floor_lines(pdTextBuffer* t, double half) {
+  pd_text_appendf(t, "cube floor grey %.17g %.17g %.17g\nfixed\nloc 0 0 %.17g\nmu 0.5\n", 2 * half, 2 * half,
+                  0.1 * half, -0.05 * half);
 }
 
-static int drop_scene(gsl_rng* r, text* t, double L, bool* elastic) {
+static int drop_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   int n = 1 + (int)gsl_rng_uniform_int(r, 30);
   settings_lines(r, t, 0.5);
   // pitch from the largest body: every body's sphere fits in its cell
   double sizes[30], radii[30];
-  text bodies = {0};
+  pdTextBuffer bodies = {0};
   double pitch = 0.0;
   for (int i = 0; i < n; ++i) {
     sizes[i] = L * log_uniform(r, 0.3, 3.0);
@@ -139,7 +118,7 @@ static int drop_scene(gsl_rng* r, text* t, double L, bool* elastic) {
     radii[i] = shape_line(r, &bodies, name, sizes[i], false);
     pitch = fmax(pitch, 2.2 * radii[i]);
     // placeholder: the loc line is written below, once the pitch is known
-    put(&bodies, "@LOC%d\n", i);
+    pd_text_appendf(&bodies, "@LOC%d\n", i);
     material_lines(r, &bodies, elastic);
   }
   int side = (int)ceil(sqrt((double)n));
@@ -150,25 +129,25 @@ static int drop_scene(gsl_rng* r, text* t, double L, bool* elastic) {
     char mark[16];
     snprintf(mark, sizeof mark, "@LOC%d\n", i);
     const char* at = strstr(p, mark);
-    put(t, "%.*s", (int)(at - p), p);
+    pd_text_appendf(t, "%.*s", (int)(at - p), p);
     int layer = i / (side * side), row = (i / side) % side, col = i % side;
     double x = (col - 0.5 * (side - 1)) * pitch, y = (row - 0.5 * (side - 1)) * pitch;
     double z = 0.5 * pitch + layer * pitch + uniform(r, 0.0, 2.0 * L), angle, axis[3], dir[3], spin[3];
     turn(r, &angle, axis);
-    put(t, "loc %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", x, y, z, angle, axis[0], axis[1], axis[2]);
+    pd_text_appendf(t, "loc %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", x, y, z, angle, axis[0], axis[1], axis[2]);
     double speed = uniform(r, 0.0, 3.0), omega = uniform(r, 0.0, 360.0);
     unit_vector(r, dir);
     unit_vector(r, spin);
-    put(t, "vel %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", speed * dir[0], speed * dir[1], speed * dir[2], omega,
-        spin[0], spin[1], spin[2]);
+    pd_text_appendf(t, "vel %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", speed * dir[0], speed * dir[1],
+                    speed * dir[2], omega, spin[0], spin[1], spin[2]);
     p = at + strlen(mark);
   }
-  put(t, "%s", p);
+  pd_text_appendf(t, "%s", p);
   free(bodies.data);
   return n + 1;
 }
 
-static int stack_scene(gsl_rng* r, text* t, double L, bool* elastic) {
+static int stack_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   int n = 2 + (int)gsl_rng_uniform_int(r, 7);
   settings_lines(r, t, 0.5);
   floor_lines(t, 20.0 * L);
@@ -177,22 +156,22 @@ static int stack_scene(gsl_rng* r, text* t, double L, bool* elastic) {
   for (int i = 0; i < n; ++i) {
     double h = L * log_uniform(r, 0.3, 1.5);
     double sx = flush ? w : L * log_uniform(r, 0.5, 2.0), sy = flush ? d : L * log_uniform(r, 0.5, 2.0);
-    put(t, "cube s%d tan %.17g %.17g %.17g\n", i, sx, sy, h);
+    pd_text_appendf(t, "cube s%d tan %.17g %.17g %.17g\n", i, sx, sy, h);
     double angle = flush ? 0.0 : uniform(r, 0.0, 90.0);
-    put(t, "loc 0 0 %.17g %.17g 0 0 1\n", z + 0.5 * h, angle);
+    pd_text_appendf(t, "loc 0 0 %.17g %.17g 0 0 1\n", z + 0.5 * h, angle);
     material_lines(r, t, elastic);
     z += h;
   }
   return n + 1;
 }
 
-static int throw_scene(gsl_rng* r, text* t, double L, bool* elastic) {
+static int throw_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   int n = 1 + (int)gsl_rng_uniform_int(r, 10);
   settings_lines(r, t, 0.3);
   floor_lines(t, 40.0 * L);
   double wallX = 8.0 * L;
-  put(t, "cube wall grey %.17g %.17g %.17g\nfixed\nloc %.17g 0 %.17g\nmu 0.5\n", L, 40.0 * L, 20.0 * L, wallX + 0.5 * L,
-      10.0 * L);
+  pd_text_appendf(t, "cube wall grey %.17g %.17g %.17g\nfixed\nloc %.17g 0 %.17g\nmu 0.5\n", L, 40.0 * L, 20.0 * L,
+                  wallX + 0.5 * L, 10.0 * L);
   for (int i = 0; i < n; ++i) {
     char name[16];
     snprintf(name, sizeof name, "t%d", i);
@@ -201,21 +180,21 @@ static int throw_scene(gsl_rng* r, text* t, double L, bool* elastic) {
     turn(r, &angle, axis);
     // a column along y, spaced by the largest possible sphere: thrown towards +x and down
     double y = (i - 0.5 * (n - 1)) * 3.0 * (2.0 * L), z = fmax(radius * 1.05, uniform(r, 1.0, 4.0) * L);
-    put(t, "loc %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", uniform(r, -4.0, 0.0) * L, y, z, angle, axis[0],
-        axis[1], axis[2]);
+    pd_text_appendf(t, "loc %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", uniform(r, -4.0, 0.0) * L, y, z, angle,
+                    axis[0], axis[1], axis[2]);
     double speed = uniform(r, 5.0, 50.0), down = uniform(r, 0.0, 0.6);
     unit_vector(r, spin);
-    put(t, "vel %.17g 0 %.17g %.17g %.17g %.17g %.17g\n", speed * sqrt(1.0 - down * down), -speed * down,
-        uniform(r, 0.0, 720.0), spin[0], spin[1], spin[2]);
+    pd_text_appendf(t, "vel %.17g 0 %.17g %.17g %.17g %.17g %.17g\n", speed * sqrt(1.0 - down * down), -speed * down,
+                    uniform(r, 0.0, 720.0), spin[0], spin[1], spin[2]);
     material_lines(r, t, elastic);
   }
   return n + 2;
 }
 
-static int free_scene(gsl_rng* r, text* t, double L, bool* elastic) {
+static int free_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   int n = 2 + (int)gsl_rng_uniform_int(r, 9);
   settings_lines(r, t, 0.5);
-  put(t, "gravity 0 0 0\n");
+  pd_text_appendf(t, "gravity 0 0 0\n");
   // on a ring of radius R in the xy plane, each aimed at the middle with a little scatter
   double R = 3.0 * L * n;
   for (int i = 0; i < n; ++i) {
@@ -224,19 +203,19 @@ static int free_scene(gsl_rng* r, text* t, double L, bool* elastic) {
     shape_line(r, t, name, L * log_uniform(r, 0.5, 2.0), false);
     double a = 2.0 * PI * i / n, x = R * cos(a), y = R * sin(a), z = uniform(r, -0.3, 0.3) * L, angle, axis[3], spin[3];
     turn(r, &angle, axis);
-    put(t, "loc %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", x, y, z, angle, axis[0], axis[1], axis[2]);
+    pd_text_appendf(t, "loc %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", x, y, z, angle, axis[0], axis[1], axis[2]);
     // reaches the middle in about a quarter second, at most 50 m/s
     double speed = fmin(R / 0.25, 50.0) * uniform(r, 0.8, 1.2);
     double sx = -x / R + uniform(r, -0.1, 0.1), sy = -y / R + uniform(r, -0.1, 0.1), norm = hypot(sx, sy);
     unit_vector(r, spin);
-    put(t, "vel %.17g %.17g 0 %.17g %.17g %.17g %.17g\n", speed * sx / norm, speed * sy / norm, uniform(r, 0.0, 360.0),
-        spin[0], spin[1], spin[2]);
+    pd_text_appendf(t, "vel %.17g %.17g 0 %.17g %.17g %.17g %.17g\n", speed * sx / norm, speed * sy / norm,
+                    uniform(r, 0.0, 360.0), spin[0], spin[1], spin[2]);
     material_lines(r, t, elastic);
   }
   return n;
 }
 
-static int overlap_scene(gsl_rng* r, text* t, double L, bool* elastic) {
+static int overlap_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   settings_lines(r, t, 0.2);
   floor_lines(t, 20.0 * L);
   double a[3] = {L * log_uniform(r, 0.5, 2.0), L * log_uniform(r, 0.5, 2.0), L * log_uniform(r, 0.5, 2.0)};
@@ -244,10 +223,11 @@ static int overlap_scene(gsl_rng* r, text* t, double L, bool* elastic) {
   double height = 2.0 * fmax(fmax(a[1], a[2]), fmax(b[1], b[2]));
   // aligned along x (turned about x only, which keeps their x extents): overlapping by a fraction of the smaller
   double overlap = uniform(r, 0.05, 0.3) * fmin(a[0], b[0]);
-  put(t, "cube p grey %.17g %.17g %.17g\nloc 0 0 %.17g %.17g 1 0 0\n", a[0], a[1], a[2], height, uniform(r, 0, 90));
+  pd_text_appendf(t, "cube p grey %.17g %.17g %.17g\nloc 0 0 %.17g %.17g 1 0 0\n", a[0], a[1], a[2], height,
+                  uniform(r, 0, 90));
   material_lines(r, t, elastic);
-  put(t, "cube q grey %.17g %.17g %.17g\nloc %.17g 0 %.17g %.17g 1 0 0\n", b[0], b[1], b[2],
-      0.5 * (a[0] + b[0]) - overlap, height, uniform(r, 0, 90));
+  pd_text_appendf(t, "cube q grey %.17g %.17g %.17g\nloc %.17g 0 %.17g %.17g 1 0 0\n", b[0], b[1], b[2],
+                  0.5 * (a[0] + b[0]) - overlap, height, uniform(r, 0, 90));
   material_lines(r, t, elastic);
   return 3;
 }
@@ -259,8 +239,9 @@ pdSoakScene pd_soak_scene(unsigned long seed, long index) {
   gsl_rng_set(r, (seed * 2654435761ul + (unsigned long)index * 40503ul + 1ul) & 0xfffffffful);
   pdSoakScene s = {.kind = (pdSoakKind)gsl_rng_uniform_int(r, pd_soakKindCount)};
   double L = log_uniform(r, 0.01, 10.0);  // the scene's length scale: three orders of magnitude
-  text t = {0};
-  put(&t, "# polydyn soak: seed %lu, scene %ld (%s), length scale %.3g m\n", seed, index, pdSoakKindNames[s.kind], L);
+  pdTextBuffer t = {0};
+  pd_text_appendf(&t, "# polydyn soak: seed %lu, scene %ld (%s), length scale %.3g m\n", seed, index,
+                  pdSoakKindNames[s.kind], L);
   bool elastic = false;
   switch (s.kind) {
     case pd_soakDrop: s.objects = drop_scene(r, &t, L, &elastic); break;

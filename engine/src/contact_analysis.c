@@ -74,11 +74,17 @@ static bool inside_body(const pdPolyhedron* s, pdVec3 q, double tol) {
 // they settle (1e-7 m on a 0.1 m brick), which a roundoff-sized tolerance would not absorb.
 #define FLUSH_TOL_DEFLECTIONS 1e-3
 
-// Does body sv (at pv) cross face f's plane of body sf (at pf) by more than tol, i.e. lie partly outside it?
-static bool crosses_face_plane(const pdPolyhedron* sv, const pdPose* pv, const pdPolyhedron* sf, const pdPose* pf,
-                               int f, double tol) {
+// δ_max of a pair: the deflection times the smaller body's size, m.
+static double pair_delta_max(const pdModel* m, int i, int j) {
+  return m->settings.deflection * fmin(m->bodies[i].size, m->bodies[j].size);
+}
+
+// Does body sv, placed in sf's frame by rotation rel and offset off, cross face f's plane of sf by more
+// than tol, i.e. lie partly outside it?
+static bool crosses_face_plane(const pdPolyhedron* sv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf, int f,
+                               double tol) {
   for (int i = 0; i < sv->vertexCount; ++i)
-    if (face_depth(sf, f, to_local(pf, to_world(pv, sv->vertices[i]))) < -tol) return true;
+    if (face_depth(sf, f, pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[i]))) < -tol) return true;
   return false;
 }
 
@@ -113,7 +119,11 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
   const pdPolyhedron* sv = &m->bodies[iv].shape;
   const pdPolyhedron* sf = &m->bodies[jf].shape;
   double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
-  double flushTol = FLUSH_TOL_DEFLECTIONS * m->settings.deflection * fmin(m->bodies[iv].size, m->bodies[jf].size);
+  double flushTol = FLUSH_TOL_DEFLECTIONS * pair_delta_max(m, iv, jf);
+  // the vertex body in the face body's frame: rotation R_fᵀ R_v, offset R_fᵀ (x_v − x_f)
+  pdMat3 RfT = pd_mat3_transpose(&pf->R);
+  pdMat3 rel = pd_mat3_mul(&RfT, &pv->R);
+  pdVec3 off = pd_mat3_mulv(&RfT, pd_v3_sub(pv->x, pf->x));
   for (int i = 0; i < sv->vertexCount; ++i) {
     pdVec3 p = to_world(pv, sv->vertices[i]);
     pdVec3 q = to_local(pf, p);
@@ -127,7 +137,7 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
     for (int f = 0; f < sf->faceCount && !outside; ++f) {
       double d = face_depth(sf, f, q);
       outside = d < -tol;
-      if (d <= flushTol && !crosses_face_plane(sv, pv, sf, pf, f, flushTol)) continue;
+      if (d <= flushTol && !crosses_face_plane(sv, &rel, off, sf, f, flushTol)) continue;
       penetration = fmin(penetration, d);
     }
     if (outside || !(penetration > tol)) continue;
@@ -142,7 +152,7 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
       int any = 0;
       for (int f = 0; f < sf->faceCount; ++f) {
         double d = face_depth(sf, f, q);
-        if (!(d > tol) || (d <= flushTol && !crosses_face_plane(sv, pv, sf, pf, f, flushTol))) continue;
+        if (!(d > tol) || (d <= flushTol && !crosses_face_plane(sv, &rel, off, sf, f, flushTol))) continue;
         if (d < bestAny) bestAny = d, any = f;
         if (d < best && projects_inside(sf, f, q, tol)) best = d, face = f;
       }
@@ -268,10 +278,7 @@ static bool in_shared_plane(const pdPolyhedron* sa, const pdEdge* ea, pdVec3 b0,
   for (int k = 0; k < 2; ++k) {
     int f = ea->f[k];
     if (fabs(face_depth(sa, f, b0)) > flushTol || fabs(face_depth(sa, f, b1)) > flushTol) continue;
-    bool crosses = false;
-    for (int v = 0; v < sb->vertexCount && !crosses; ++v)
-      crosses = face_depth(sa, f, pd_v3_add(off, pd_mat3_mulv(rel, sb->vertices[v]))) < -flushTol;
-    if (!crosses) return true;
+    if (!crosses_face_plane(sb, rel, off, sa, f, flushTol)) return true;
   }
   return false;
 }
@@ -289,7 +296,7 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   pdMat3 rel = pd_mat3_mul(&RaT, &pb->R);
   pdVec3 off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
   double tolA = BOUNDARY_TOL_REL * model->bodies[ia].size, tolB = BOUNDARY_TOL_REL * model->bodies[ib].size;
-  double deltaMax = model->settings.deflection * fmin(model->bodies[ia].size, model->bodies[ib].size);
+  double deltaMax = pair_delta_max(model, ia, ib);
   double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
   faceMask maskA[PRUNE_VERTICES_MAX], maskB[PRUNE_VERTICES_MAX];  // A's vertices against B's faces, and B's against A's
   bool prune = sa->vertexCount <= PRUNE_VERTICES_MAX && sb->vertexCount <= PRUNE_VERTICES_MAX;
@@ -440,8 +447,8 @@ static bool edge_points_inside(const pdModel* model, const pdContactId* id, cons
   const pdBody* b2 = &model->bodies[id->body2];
   // as the search accepts a sharp edge's pair (find_ee): the points within the pair's depth of inside,
   // up to the deepest a new pair may be; else a pair found again every step would break at every commit
-  double deltaMax = model->settings.deflection * fmin(b1->size, b2->size);
-  double sharp = fmin(fmax(g->depth, 0.0), EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax);
+  double deepest = EE_NEW_DEPTH_MAX_DEFLECTIONS * pair_delta_max(model, id->body1, id->body2);
+  double sharp = fmin(fmax(g->depth, 0.0), deepest);
   double tol1 = fmax(TRACK_INSIDE_TOL_REL * model->settings.deflection * b1->size, sharp);
   double tol2 = fmax(TRACK_INSIDE_TOL_REL * model->settings.deflection * b2->size, sharp);
   return inside_body(&b1->shape, to_local(p1, on2), tol1) && inside_body(&b2->shape, to_local(p2, on1), tol2);
@@ -492,8 +499,7 @@ bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose*
     // over its face polygon within the flush tolerance: a corner resting on a shared side plane wanders
     // across it by roundoff and must not break and be found again on the side face
     double over = fmax(BOUNDARY_TOL_REL * model->bodies[id->body2].size,
-                       FLUSH_TOL_DEFLECTIONS * model->settings.deflection *
-                           fmin(model->bodies[id->body1].size, model->bodies[id->body2].size));
+                       FLUSH_TOL_DEFLECTIONS * pair_delta_max(model, id->body1, id->body2));
     return projects_inside(s2, id->feat2, q, over) && inside_body(s2, q, outside);
   }
   // an edge pair stays a contact while its closest points lie inside both edges and it spans a face of
