@@ -1,5 +1,6 @@
 // polydyn gedanken — helpers the experiment files share, and the closed forms used by several of them.
 #include <stdlib.h>
+#include <time.h>
 
 #include "gedanken_internal.h"
 
@@ -164,4 +165,14 @@ void gk_note(pdGkMeasured* out, const char* fmt, ...) {
 double gk_energy_gain(const pdGkRecord* rec) {
   if (rec->count < 1 || !(rec->energy[0] > 0.0)) return NAN;
   return pd_gk_largest_rise(rec->energy, rec->count, rec->energy[0]);
+}
+
+double gk_wall_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void gk_csv_number(FILE* out, double x) {
+  if (isfinite(x)) fprintf(out, "%.17g", x);
 }

@@ -79,3 +79,28 @@ double gk_kinetic_energy(const pdModel* model, int body, const pdBodyState* b);
 // Effective mass of `body` (model index) for a push along world direction n at world point p, at the
 // body's initial pose (paper eqs. (19)–(20)).
 double gk_effective_mass(const pdModel* model, int body, pdVec3 p, pdVec3 n);
+
+// Monotonic wall clock, s (for the measured wall times).
+double gk_wall_seconds(void);
+
+// A CSV number with %.17g, or nothing when it is not finite (no NaN is ever written).
+void gk_csv_number(FILE* out, double x);
+
+// ---------------------------------------------------------------------------------------------------------
+// The suite's cases, shared with the work-precision runs (precision.c)
+
+// One (experiment, input) of a suite run: its generated scene, compiled once and shared read-only by its runs.
+typedef struct gkCase {
+  const pdGkExperiment* experiment;
+  double input;
+  char label[64];         // "e=0.5" or ""
+  char* sceneText;        // the generated scene (owned)
+  pdModel* model;         // compiled from it (owned)
+  pdGkExpected expected;  // tolerance already scaled
+} gkCase;
+
+// The work-precision runs of `options->precision` (gedanken/RESULT_SCHEMAS.md, precision.csv): for each
+// selected quantitative experiment, its precision input (pd_gk_precision_input) on every selected engine over
+// its accuracy knob. Runs as a batch like the suite's runs and writes root/precision.csv. False with err when
+// the batch failed or the file could not be written (interruption: false, err names it).
+bool gk_precision_run(const pdGkOptions* options, const gkCase* cases, int caseCount, const char* root, pdError* err);

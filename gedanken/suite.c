@@ -37,12 +37,6 @@ bool pd_gk_applies(const pdGkExperiment* e, pdGkEngine engine, bool matched) {
 
 enum { SERIES_MAX_ROWS = 500 };  // per run (RESULT_SCHEMAS.md: "at most ~500 rows per run")
 
-static double wall_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 // ---------------------------------------------------------------------------------------------------------
 // files
 
@@ -79,11 +73,6 @@ static void make_parents(const char* path) {
   free(p);
 }
 
-// A number with %.17g, or nothing when it is not finite (no NaN is ever written).
-static void csv_number(FILE* out, double x) {
-  if (isfinite(x)) fprintf(out, "%.17g", x);
-}
-
 bool pd_gk_out_replaceable(const char* out, pdError* err) {
   struct stat st;
   if (stat(out, &st) != 0) return true;
@@ -96,15 +85,6 @@ bool pd_gk_out_replaceable(const char* out, pdError* err) {
 
 // ---------------------------------------------------------------------------------------------------------
 // cases and jobs
-
-typedef struct gkCase {
-  const pdGkExperiment* experiment;
-  double input;
-  char label[64];        // "e=0.5" or ""
-  char* sceneText;       // the generated scene (owned)
-  pdModel* model;        // compiled from it (owned)
-  pdGkExpected expected; // tolerance already scaled
-} gkCase;
 
 typedef struct gkJob {
   gkCase* c;
@@ -253,23 +233,23 @@ static void run_job(gkSuite* s, gkJob* job) {
   bool written = false, completed = false;
   if (job->engine == pd_gkSoft) {
     pdState* state = pd_state_create(model);
-    double energyStart = pd_state_energy(model, state), t0 = wall_now();
+    double energyStart = pd_state_energy(model, state), t0 = gk_wall_seconds();
     completed = pd_advance(model, state, model->settings.tend, observe_soft, &observer);
-    job->wallSeconds = wall_now() - t0;
+    job->wallSeconds = gk_wall_seconds() - t0;
     if (state->stopped) {
       pd_run_abort(writer);
     } else {
       pdRunInfo info = {.engine = "polydyn-soft", .energyStart = energyStart, .energyEnd = pd_state_energy(model, state),
                         .wallSeconds = job->wallSeconds, .completed = completed};
-          written = pd_run_finish(writer, model, state, &info, &err);
-          if (!completed) job_note(job, "the run stopped at t = %.6g s", state->t);
+      written = pd_run_finish(writer, model, state, &info, &err);
+      if (!completed) job_note(job, "the run stopped at t = %.6g s", state->t);
     }
     pd_state_free(state);
   } else {
     pdRefOptions options = {.variant = job->variant, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
     pdRefRunStats stats;
-      written = pd_ref_run(model, adapter, &options, writer, observe_ref, &observer, &stats, &err);
-      job->wallSeconds = stats.wallSeconds;
+    written = pd_ref_run(model, adapter, &options, writer, observe_ref, &observer, &stats, &err);
+    job->wallSeconds = stats.wallSeconds;
     completed = stats.completed;
     if (!written && stats.refused) {
       job->status = pd_gkRefused;
@@ -288,8 +268,8 @@ static void run_job(gkSuite* s, gkJob* job) {
     job->runDir[0] = '\0';
     job_note(job, "the run directory could not be written: %s", err.message[0] ? err.message : "a write failed");
   } else {
-      bool copied = write_scene_copy(dir, c->sceneText);
-      if (!completed) {
+    bool copied = write_scene_copy(dir, c->sceneText);
+    if (!completed) {
       job->status = pd_gkFail;
     } else if (!copied) {
       job->status = pd_gkError;
@@ -385,15 +365,15 @@ static bool write_results(const gkSuite* s, pdError* err) {
     fputc(',', out);
     pd_write_csv_text(out, job->c->label);
     fputc(',', out);
-    if (judged) csv_number(out, job->measured);
+    if (judged) gk_csv_number(out, job->measured);
     fputc(',', out);
-    if (quantitative) csv_number(out, job->c->expected.value);
+    if (quantitative) gk_csv_number(out, job->c->expected.value);
     fputc(',', out);
-    if (judged && quantitative) csv_number(out, job->error);
+    if (judged && quantitative) gk_csv_number(out, job->error);
     fputc(',', out);
-    if (quantitative) csv_number(out, job->c->expected.tolerance);
+    if (quantitative) gk_csv_number(out, job->c->expected.tolerance);
     fprintf(out, ",%s,", pdGkStatusNames[job->status]);
-    csv_number(out, job->wallSeconds);
+    gk_csv_number(out, job->wallSeconds);
     fputc(',', out);
     pd_write_csv_text(out, job->runDir);
     fputc(',', out);
@@ -559,8 +539,9 @@ static void free_suite(gkSuite* s) {
 
 bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* err) {
   PD_ASSERT(options && options->out && summary && options->jobs >= 1 && options->toleranceScale > 0.0);
+  PD_ASSERT(!options->precision || options->repeats >= 1);
   memset(summary, 0, sizeof *summary);
-  double wall0 = wall_now();
+  double wall0 = gk_wall_seconds();
   for (int i = 0; i < options->onlyCount; ++i)
     if (!pd_gk_find(options->only[i])) {
       pd_error_set(err, options->only[i], 0, 0, "no such experiment");
@@ -649,6 +630,10 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
       pd_error_set(err, options->out, 0, 0, "%s", why);
     }
   }
+  if (ok && options->precision) {
+    ok = gk_precision_run(options, s.cases, s.caseCount, s.root, err);
+    summary->interrupted = interrupted(&s);
+  }
   // rank 0 writes the files; every rank has every row (the same summary, the same exit status)
   if (pd_batch_is_root())
     ok = ok && write_results(&s, err) && write_experiments(&s, err) && write_series_files(&s, err) && install(&s, err);
@@ -668,7 +653,7 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
       }
     }
   }
-  summary->wallSeconds = wall_now() - wall0;
+  summary->wallSeconds = gk_wall_seconds() - wall0;
   free_suite(&s);
   return ok;
 }

@@ -12,6 +12,7 @@
 #include "polydyn/cubetoss.h"
 #include "polydyn/output.h"
 #include "polydyn/scene.h"
+#include "polydyn/stats.h"
 #include "text_buffer.h"
 
 // Default stiffness of each side, N/m: eq. (11) for the cube, m vmax²/δ_max² with δ_max = 0.01 × side
@@ -328,11 +329,6 @@ bool pd_toss_write_record(const pdToss* toss, const pdTossParams* params, const 
 
 // ---------------------------------------------------------------- statistics
 
-static int compare_doubles(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
 // Type-7 percentile of sorted x[0..n), p in [0, 1].
 static double percentile(const double* x, int n, double p) {
   double h = p * (double)(n - 1);
@@ -354,7 +350,7 @@ pdTossStats pd_toss_stats(const double* v, int count) {
     }
   pdTossStats s = {n, NAN, NAN, NAN};
   if (n > 0) {
-    qsort(x, (size_t)n, sizeof *x, compare_doubles);
+    pd_sort_doubles(x, (size_t)n);
     s.mean = sum / n;
     s.median = percentile(x, n, 0.5);
     s.p90 = percentile(x, n, 0.9);

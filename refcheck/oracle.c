@@ -19,6 +19,7 @@
 
 #include "interference.h"
 #include "polydyn/error.h"
+#include "polydyn/stats.h"
 
 const char* const pdOracleKindNames[pd_oracleKindCount] = {
     "agree_overlap", "agree_separate", "we_overlap", "we_separate", "touching", "mpr_differs", "depth", "ccd_stalled",
@@ -256,11 +257,6 @@ long pd_oracle_stats_failures(const pdOracleStats* s) {
   return s->kinds[pd_oracleWeOverlap] + s->kinds[pd_oracleWeSeparate];
 }
 
-static int compare_doubles(const void* x, const void* y) {
-  double a = *(const double*)x, b = *(const double*)y;
-  return (a > b) - (a < b);
-}
-
 // max, median and 99th percentile (nearest rank) of |v|, and the signed extremes
 static void print_errors(FILE* out, const char* label, const pdOracleSample* s) {
   if (s->count == 0) {
@@ -275,7 +271,7 @@ static void print_errors(FILE* out, const char* label, const pdOracleSample* s) 
     lo = fmin(lo, s->v[i]);
     hi = fmax(hi, s->v[i]);
   }
-  qsort(a, (size_t)s->count, sizeof *a, compare_doubles);
+  pd_sort_doubles(a, (size_t)s->count);
   long p99 = (long)ceil(0.99 * (double)s->count) - 1;
   fprintf(out, "%s: max %.3g, median %.3g, p99 %.3g (signed: %.3g to %.3g; %ld pairs)\n", label, a[s->count - 1],
           a[(s->count - 1) / 2], a[p99], lo, hi, s->count);

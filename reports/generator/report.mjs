@@ -17,7 +17,8 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { InputError, UsageError, SetupError } from './lib/errors.mjs';
-import { readResults, readExperiments, readSeries, readSweep, readMetrics, readSummary, readCubetoss } from './lib/inputs.mjs';
+import { readResults, readExperiments, readSeries, readSweep, readPrecision, readMetrics, readSummary, readCubetoss } from './lib/inputs.mjs';
+import { precision as derivePrecision } from './lib/precision.mjs';
 import { loadTypical } from './lib/cubetoss.mjs';
 import { compactTrajectory, compactContacts } from './lib/replay.mjs';
 import * as derive from './lib/derive.mjs';
@@ -41,6 +42,8 @@ plus the numbers it shows as JSON and CSV beside it. Sections appear when their 
   series/EXPERIMENT.csv           each experiment's quantity over time against the analytic line
   runs/*/*/summary.json           the parameters every engine actually used
   sweep.csv                       work-precision diagrams and the cost to reach error 1e-3
+  precision.csv                   work-precision of each experiment against its closed form, the cost to
+                                  reach its tolerance, and the summary's fronts (gedanken --precision)
   metrics.csv                     comparison metrics
   cubetoss/summary.csv            cube tosses against reality (per_toss.csv, fit.csv, replay/TOSS/ or
                                   runs/TOSS/ beside it); DIR may also be a polydyn cubetoss directory
@@ -84,11 +87,12 @@ export function loadInputs(dir) {
     experiments: readExperiments(dir),
     series: readSeries(dir),
     sweep: readSweep(dir),
+    precision: readPrecision(dir),
     metrics: readMetrics(dir),
     cubetoss: readCubetoss(dir),
   };
-  if (!inputs.results && !inputs.experiments && !inputs.series && !inputs.sweep && !inputs.metrics && !inputs.cubetoss)
-    throw new InputError(dir, 0, 'nothing to report: none of results.csv, experiments.json, series/*.csv, sweep.csv, metrics.csv, ' +
+  if (!inputs.results && !inputs.experiments && !inputs.series && !inputs.sweep && !inputs.precision && !inputs.metrics && !inputs.cubetoss)
+    throw new InputError(dir, 0, 'nothing to report: none of results.csv, experiments.json, series/*.csv, sweep.csv, precision.csv, metrics.csv, ' +
       'cubetoss/summary.csv is there');
   inputs.cubetossTypical = inputs.cubetoss ? loadTypical(dir, inputs.cubetoss) : null;
   // run directories named in results.csv, each once
@@ -145,7 +149,9 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
   const results = inputs.results;
   const matrix = lazy(() => (results && results.rows.length ? derive.matrix(results, inputs.experiments) : null));
   const wp = lazy(() => (inputs.sweep && inputs.sweep.rows.length ? derive.workPrecision(inputs.sweep) : null));
+  const prec = lazy(() => (inputs.precision && inputs.precision.rows.length ? derivePrecision(inputs.precision, inputs.experiments) : null));
   const evOrder = derive.orderEngineVariants([...(results ? results.rows : []), ...(inputs.sweep ? inputs.sweep.rows : []),
+    ...(inputs.precision ? inputs.precision.rows : []),
     ...(inputs.metrics ? inputs.metrics.rows : []), ...(inputs.cubetoss ? inputs.cubetoss.summary : [])]).map((x) => x.ev);
   const ctx = {
     dir,
@@ -167,6 +173,7 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
     get restitution() { return results ? derive.restitution(results) : null; },
     get frictionCone() { return results ? derive.frictionCone(results) : null; },
     get workPrecision() { return wp(); },
+    get precision() { return prec(); },
     get cost() { return matrix() || wp() ? derive.cost(matrix(), wp()) : null; },
     color: (ev) => colorOf(ev, evOrder),
     chart(option, { height = 320, width = null } = {}) {
@@ -258,6 +265,7 @@ function inputList(inputs) {
   if (inputs.series) list.push(...[...inputs.series.keys()].map((n) => `series/${n}.csv`));
   if (inputs.runs.some((r) => r.summary)) list.push(`${inputs.runs.filter((r) => r.summary).length} × runs/…/summary.json`);
   if (inputs.sweep) list.push('sweep.csv');
+  if (inputs.precision) list.push('precision.csv');
   if (inputs.metrics) list.push('metrics.csv');
   if (inputs.cubetoss) list.push(`${inputs.cubetoss.at === '.' ? '' : inputs.cubetoss.at + '/'}summary.csv`);
   return list;
@@ -272,6 +280,7 @@ function shortInputs(inputs) {
   const summaries = inputs.runs.filter((r) => r.summary).length;
   if (summaries) list.push(`${summaries} run summaries`);
   if (inputs.sweep) list.push(`sweep.csv (${inputs.sweep.rows.length} points)`);
+  if (inputs.precision) list.push(`precision.csv (${inputs.precision.rows.length} points)`);
   if (inputs.metrics) list.push('metrics.csv');
   if (inputs.cubetoss) list.push(`cube-toss results (${new Set(inputs.cubetoss.summary.map((r) => r.ev)).size} engines)`);
   return list.join(', ');

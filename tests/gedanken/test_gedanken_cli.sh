@@ -94,6 +94,40 @@ check "model prediction: experiments.json names the kind, the judged variants an
 check "a law: every variant judged, no reason" \
   '[ "$(python3 -c "import json; e = [x for x in json.load(open(\"$FAST/experiments.json\")) if x[\"name\"] == \"c2_momentum\"][0]; print(e[\"kind\"], len(e[\"applies_to\"]), e[\"not_applicable_reason\"])")" = "law 5 None" ]'
 
+# --- work-precision against the closed form (--precision, issue 17 item 1) ----------------------------
+PREC=$SCRATCH/precision
+PHEADER='experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,judged,status,wall_seconds,wall_per_sim_second,steps,repeats,note'
+run_pd gedanken --only a1_restitution,c3_eccentric_bar --precision --repeats 2 --out "$PREC"
+check "--precision: exit 0 and precision.csv with the fixed header" '[ $rc -eq 0 ] && [ "$(head -n 1 "$PREC/precision.csv")" = "$PHEADER" ]'
+# every knob of every engine, loosest first; an engine without an adapter is two not_built rows, never left out
+check "--precision: soft at tol 1e-2 ... 1e-10 and fixed dt 1e-3 ... 1e-5, ODE and Bullet at 5 steps per variant (or not_built)" \
+  '[ "$(csv_query "$PREC/precision.csv" "all([(r[\"variant\"], r[\"value\"]) for r in rows if r[\"experiment\"] == x and r[\"engine\"] == \"soft\"] == [(\"adaptive\", \"%g\" % 10**-k) for k in range(2, 11)] + [(\"fixed\", v) for v in (\"0.001\", \"0.0003\", \"0.0001\", \"3e-05\", \"1e-05\")] and all([(r[\"variant\"], r[\"value\"]) for r in rows if r[\"experiment\"] == x and r[\"engine\"] == e] in ([(v, s) for v in (\"native\", \"matched\") for s in (\"0.0166667\", \"0.004\", \"0.001\", \"0.00025\", \"6.25e-05\")], [(\"native\", \"\"), (\"matched\", \"\")]) for e in (\"ode\", \"bullet\")) for x in (\"a1_restitution\", \"c3_eccentric_bar\"))")" = True ]'
+check "--precision: not_built rows say which adapter is missing" \
+  '[ "$(csv_query "$PREC/precision.csv" "all(r[\"engine\"] in r[\"note\"] and r[\"setting\"] == \"\" for r in rows if r[\"status\"] == \"not_built\")")" = True ]'
+check "--precision: one input per experiment, the middle one (a1: e=0.5 of 0.1 ... 0.95)" \
+  '[ "$(csv_query "$PREC/precision.csv" "sorted({(r[\"experiment\"], r[\"input\"]) for r in rows})")" = "[('"'"'a1_restitution'"'"', '"'"'e=0.5'"'"'), ('"'"'c3_eccentric_bar'"'"', '"'"''"'"')]" ]'
+check "--precision: the expected value and tolerance are those results.csv judges by" \
+  '[ "$(python3 -c "import csv; res = {(r[\"experiment\"], r[\"input\"]): (r[\"expected\"], r[\"tolerance\"]) for r in csv.DictReader(open(\"$PREC/results.csv\"))}; print(all(res[(r[\"experiment\"], r[\"input\"])] == (r[\"expected\"], r[\"tolerance\"]) for r in csv.DictReader(open(\"$PREC/precision.csv\"))))")" = True ]'
+check "--precision: every ok point's error is |measured - expected| (relative: |measured/expected - 1|) to 1e-15" \
+  '[ "$(csv_query "$PREC/precision.csv" "all(abs(float(r[\"error\"]) - (abs(float(r[\"measured\"]) / float(r[\"expected\"]) - 1) if r[\"relative\"] == \"true\" else abs(float(r[\"measured\"]) - float(r[\"expected\"])))) <= 1e-15 * max(1.0, abs(float(r[\"expected\"]))) for r in rows if r[\"status\"] == \"ok\")")" = True ]'
+check "--precision: ok points have a positive wall time and steps; the repeats column says 2" \
+  '[ "$(csv_query "$PREC/precision.csv" "all(float(r[\"wall_seconds\"]) > 0 and int(r[\"steps\"]) > 0 for r in rows if r[\"status\"] == \"ok\") and {r[\"repeats\"] for r in rows} == {\"2\"}")" = True ]'
+check "--precision: judged follows the kind (c3, a soft-model prediction: native variants not judged; a1, a law: all judged)" \
+  '[ "$(csv_query "$PREC/precision.csv" "all((r[\"judged\"] == \"false\") == (r[\"experiment\"] == \"c3_eccentric_bar\" and r[\"variant\"] == \"native\") for r in rows)")" = True ]'
+# eq. (15) is exact for the model: its restitution converges to the requested e as the tolerance tightens
+check "--precision: soft restitution converges to e = 0.5: within the 0.005 tolerance at tol <= 1e-4, 1e-6 at tol 1e-10" \
+  '[ "$(csv_query "$PREC/precision.csv" "all(float(r[\"error\"]) <= 0.005 for r in rows if r[\"experiment\"] == \"a1_restitution\" and r[\"variant\"] == \"adaptive\" and float(r[\"value\"]) <= 1e-4) and [float(r[\"error\"]) < 1e-6 for r in rows if r[\"experiment\"] == \"a1_restitution\" and r[\"variant\"] == \"adaptive\" and r[\"value\"] == \"1e-10\"] == [True]")" = True ]'
+strip_precision_wall() { python3 -c 'import csv, sys
+for r in csv.reader(open(sys.argv[1], newline="")): print(r[:16] + r[18:])' "$1"; }
+run_pd gedanken --only c2_momentum,a1_restitution --engines soft,ode --precision --jobs 1 --out "$SCRATCH/pdet1"
+run_pd gedanken --only c2_momentum,a1_restitution --engines soft,ode --precision --jobs 2 --out "$SCRATCH/pdet2"
+check "--precision: precision.csv identical with 1 and 2 worker processes (but wall times)" \
+  '[ -s "$SCRATCH/pdet1/precision.csv" ] && [ "$(strip_precision_wall "$SCRATCH/pdet1/precision.csv")" = "$(strip_precision_wall "$SCRATCH/pdet2/precision.csv")" ]'
+check "--precision: engines not asked for have no rows" \
+  '[ "$(csv_query "$SCRATCH/pdet1/precision.csv" "sorted({r[\"engine\"] for r in rows})")" = "['"'"'ode'"'"', '"'"'soft'"'"']" ]'
+run_pd gedanken --only c2_momentum --engines soft --out "$SCRATCH/noprec"
+check "without --precision there is no precision.csv" '[ $rc -eq 0 ] && [ ! -e "$SCRATCH/noprec/precision.csv" ]'
+
 # --- a failing soft experiment exits 1, and still writes its results -----------------------------------
 FAILDIR=$SCRATCH/failing
 run_pd gedanken --only a3_sinkage --engines soft --tolerance-scale 1e-12 --out "$FAILDIR"
@@ -138,6 +172,9 @@ bad_args "--jobs not a number" --out "$BADOUT" --jobs two
 bad_args "a negative tolerance scale" --out "$BADOUT" --tolerance-scale -1
 bad_args "--out without a value" --out
 bad_args "an empty selection" --out "$BADOUT" --fast --only a4_elastic_apex
+bad_args "--repeats without --precision" --out "$BADOUT" --repeats 2
+bad_args "--repeats 0" --out "$BADOUT" --precision --repeats 0
+bad_args "--repeats 22" --out "$BADOUT" --precision --repeats 22
 mkdir -p "$SCRATCH/precious"
 touch "$SCRATCH/precious/keep"
 run_pd gedanken --only c2_momentum --engines soft --out "$SCRATCH/precious"

@@ -39,9 +39,9 @@ expect_bad() {
 # --- the fixture: every output, no temporary left, deterministic
 fresh
 if "$polydyn" report "$work/d" --no-viewer 2>"$work/err"; then ok "the fixture report is written (exit 0)"; else bad "report on the fixture failed: $(cat "$work/err")"; fi
-want="report-cost.csv report-friction-cone.csv report-matrix.csv report-parameters.csv report-restitution.csv report-verdict.csv report-work-precision.csv report.html report.json"
+want="report-cost.csv report-friction-cone.csv report-matrix.csv report-parameters.csv report-restitution.csv report-summary.csv report-verdict.csv report-work-precision.csv report.html report.json"
 got=$(cd "$work/d" && ls -d report* | tr '\n' ' ' | sed 's/ $//')
-[[ $got == "$want" ]] && ok "page, report.json and 7 CSV tables, no temporary file" || bad "outputs: '$got'"
+[[ $got == "$want" ]] && ok "page, report.json and 8 CSV tables, no temporary file" || bad "outputs: '$got'"
 cp "$work/d/report.html" "$work/first.html"
 cp "$work/d/report.json" "$work/first.json"
 "$polydyn" report "$work/d" --no-viewer 2>/dev/null
@@ -140,6 +140,25 @@ fresh; printf '{\n  "engine": "ode",\n  "engine_settings": {"step": 0.001,,}\n}\
 expect_bad "a malformed summary.json" "$work/d/runs/A3/ode-native/summary.json:3: malformed JSON"
 fresh; printf 'a,b\n' >"$work/d/metrics.csv"
 expect_bad "metrics.csv with a wrong header" "$work/d/metrics.csv:1: header must be exactly"
+# precision.csv (gedanken --precision): a header and two good rows, then one broken thing at a time
+precision_csv() {
+  {
+    echo 'experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,judged,status,wall_seconds,wall_per_sim_second,steps,repeats,note'
+    echo 'A1,law,soft,adaptive,tol,0.01,e=0.5,restitution,,0.51,0.5,0.01,false,0.005,true,ok,0.001,0.001,120,1,'
+    echo 'A1,law,ode,native,,,e=0.5,restitution,,,0.5,,false,0.005,true,not_built,,,0,1,this build of polydyn has no ode adapter'
+  } >"$work/d/precision.csv"
+}
+fresh; precision_csv
+"$polydyn" report "$work/d" --no-viewer 2>"$work/err" && grep -q '"precision"' "$work/d/report.json" &&
+  ok "a good precision.csv gives the precision section" || bad "precision.csv: $(cat "$work/err")"
+fresh; precision_csv; sed -i '2s/,ok,/,fine,/' "$work/d/precision.csv"
+expect_bad "an unknown precision status" "$work/d/precision.csv:2: status: expected one of ok, failed, no_measure, refused, not_built"
+fresh; precision_csv; sed -i '2s/,0.01,false,/,,false,/' "$work/d/precision.csv"
+expect_bad "an ok precision point without its error" "$work/d/precision.csv:2: an ok point needs its error"
+fresh; precision_csv; sed -i '2s/,true,ok,/,yes,ok,/' "$work/d/precision.csv"
+expect_bad "judged neither true nor false" "$work/d/precision.csv:2: judged: expected true or false"
+fresh; precision_csv; sed -i '2s/,tol,0.01,/,tol,0,/' "$work/d/precision.csv"
+expect_bad "a precision setting of 0" "$work/d/precision.csv:2: value: must be a finite number > 0"
 fresh; printf '\x00\x01binary' >"$work/d/sweep.csv"
 expect_bad "a binary sweep.csv" "$work/d/sweep.csv: not a text file"
 

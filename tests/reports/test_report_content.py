@@ -39,6 +39,17 @@ def same(a, b):
     return (math.isnan(a) and math.isnan(b)) or a == b
 
 
+def make_report(src, out_dir):
+    """polydyn report SRC into OUT_DIR/report.html: (the page's text, report.json)."""
+    out = os.path.join(out_dir, "report.html")
+    subprocess.run([POLYDYN, "report", src, "-o", out, "--no-viewer"], check=True, stderr=subprocess.DEVNULL,
+                   env={**os.environ, "PD_REPORT_GENERATOR": os.path.join(SOURCE, "reports", "generator", "report.mjs")})
+    with open(out, encoding="utf-8") as f:
+        page = f.read()
+    with open(os.path.join(out_dir, "report.json"), encoding="utf-8") as f:
+        return page, json.load(f)
+
+
 class Page(html.parser.HTMLParser):
     """Collects the tags, the matrix cells (with their text) and the scripts of the page."""
 
@@ -73,23 +84,8 @@ class Page(html.parser.HTMLParser):
             self.in_script["text"] += data
 
 
-class FixtureReport(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.dir = tempfile.mkdtemp()
-        cls.out = os.path.join(cls.dir, "report.html")
-        subprocess.run([POLYDYN, "report", FIXTURE, "-o", cls.out, "--no-viewer"], check=True, stderr=subprocess.DEVNULL,
-                       env={**os.environ, "PD_REPORT_GENERATOR": os.path.join(SOURCE, "reports", "generator", "report.mjs")})
-        with open(cls.out, encoding="utf-8") as f:
-            cls.html = f.read()
-        with open(os.path.join(cls.dir, "report.json"), encoding="utf-8") as f:
-            cls.json = json.load(f)
-        with open(os.path.join(FIXTURE, "results.csv"), newline="", encoding="utf-8") as f:
-            cls.results = list(csv.DictReader(f))
-        with open(os.path.join(FIXTURE, "sweep.csv"), newline="", encoding="utf-8") as f:
-            cls.sweep = [r for r in csv.DictReader(f) if r["scene"] != "scene"]  # two sweeps, header repeated
-        cls.page = Page()
-        cls.page.feed(cls.html)
+class ReportInDir(unittest.TestCase):
+    """A report written into the temporary directory cls.dir (made by the subclass's setUpClass)."""
 
     @classmethod
     def tearDownClass(cls):
@@ -98,6 +94,19 @@ class FixtureReport(unittest.TestCase):
     def table(self, name):
         with open(os.path.join(self.dir, f"report-{name}.csv"), newline="", encoding="utf-8") as f:
             return list(csv.DictReader(f))
+
+
+class FixtureReport(ReportInDir):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp()
+        cls.html, cls.json = make_report(FIXTURE, cls.dir)
+        with open(os.path.join(FIXTURE, "results.csv"), newline="", encoding="utf-8") as f:
+            cls.results = list(csv.DictReader(f))
+        with open(os.path.join(FIXTURE, "sweep.csv"), newline="", encoding="utf-8") as f:
+            cls.sweep = [r for r in csv.DictReader(f) if r["scene"] != "scene"]  # two sweeps, header repeated
+        cls.page = Page()
+        cls.page.feed(cls.html)
 
     # --- self-contained
     def test_page_loads_nothing_from_outside(self):
@@ -305,6 +314,105 @@ class CompareReport(unittest.TestCase):
                 else:
                     self.assertTrue(same(from_json(j[k]), num(v)), f"{k}: {j[k]} vs {v}")
             self.assertIn(r["restitution_impacts"], page)
+
+
+class PrecisionReport(ReportInDir):
+    """Work-precision against the closed form (precision.csv of polydyn gedanken --precision) and the summary that
+    opens the report: numbers recomputed here from the CSVs; an engine missing from the build is reported."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp()
+        cls.src = os.path.join(cls.dir, "gedanken")
+        subprocess.run([POLYDYN, "gedanken", "--only", "a1_restitution,c2_momentum,c3_eccentric_bar", "--precision",
+                        "--out", cls.src], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        # as a build without Bullet writes it: two not_built rows per experiment instead of Bullet's points
+        path = os.path.join(cls.src, "precision.csv")
+        with open(path, newline="", encoding="utf-8") as f:
+            reader = csv.DictReader(f)
+            header, rows = reader.fieldnames, list(reader)
+        kept, seen = [], set()
+        for r in rows:
+            if r["engine"] != "bullet":
+                kept.append(r)
+            elif (r["experiment"], r["variant"]) not in seen:
+                seen.add((r["experiment"], r["variant"]))
+                kept.append({**r, "setting": "", "value": "", "measured": "", "error": "", "status": "not_built", "wall_seconds": "",
+                             "wall_per_sim_second": "", "steps": "0", "note": "this build of polydyn has no bullet adapter"})
+        with open(path, "w", newline="", encoding="utf-8") as f:
+            w = csv.DictWriter(f, header, lineterminator="\n")
+            w.writeheader()
+            w.writerows(kept)
+        cls.rows = kept
+        with open(os.path.join(cls.src, "results.csv"), newline="", encoding="utf-8") as f:
+            cls.results = list(csv.DictReader(f))
+        cls.html, cls.json = make_report(cls.src, cls.dir)
+
+    def expected_cost(self, experiment, ev):
+        """(kind, cost, smallest error): the first setting, loosest first, whose error is within the tolerance,
+        the cost interpolated log-log from the setting before it."""
+        pts = [r for r in self.rows if r["experiment"] == experiment and f'{r["engine"]} {r["variant"]}' == ev]
+        if all(r["status"] == "not_built" for r in pts):
+            return "not_built", None, None
+        ok = sorted(([float(r["value"]), float(r["error"]), float(r["wall_per_sim_second"])] for r in pts if r["status"] == "ok"), reverse=True)
+        tol = float(pts[0]["tolerance"])
+        smallest = min(e for _, e, _ in ok) if ok else None
+        for k, (_, e, w) in enumerate(ok):
+            if e <= tol:
+                if k == 0 or e <= 0:
+                    return "at_most", w, smallest
+                e0, w0 = ok[k - 1][1], ok[k - 1][2]
+                s = (math.log(tol) - math.log(e0)) / (math.log(e) - math.log(e0))
+                return "interpolated", math.exp(math.log(w0) + s * (math.log(w) - math.log(w0))), smallest
+        return "never", None, smallest
+
+    def test_summary_opens_the_report_and_precision_is_a_section(self):
+        self.assertEqual(self.json["sections"][0], "summary")
+        self.assertIn("precision", self.json["sections"])
+
+    def test_one_curve_per_experiment_and_engine_variant_with_the_cost_to_its_tolerance(self):
+        got = {(r["experiment"], f'{r["engine"]} {r["variant"]}'): r for r in self.table("precision")}
+        want = {(r["experiment"], f'{r["engine"]} {r["variant"]}') for r in self.rows}
+        self.assertEqual(set(got), want)
+        for (experiment, ev), r in got.items():
+            kind, cost, smallest = self.expected_cost(experiment, ev)
+            self.assertEqual(r["to_tolerance"], kind, f"{experiment} {ev}")
+            if cost is not None:
+                self.assertAlmostEqual(float(r["wall_per_sim_second"]), cost, delta=1e-12 * cost, msg=f"{experiment} {ev}")
+            if smallest is not None:
+                self.assertEqual(float(r["smallest_error"]), smallest)
+            if kind == "never":
+                self.assertIn(r["never_reason"], ("stalls", "still_falling", "no_result", "one_point"))
+
+    def test_a_missing_engine_is_reported_not_built_not_left_out(self):
+        rows = [r for r in self.table("precision") if r["engine"] == "bullet"]
+        self.assertEqual(len(rows), 2 * 3)
+        self.assertTrue(all(r["to_tolerance"] == "not_built" for r in rows))
+        self.assertIn("not built", self.html)
+        summary = {f'{r["engine"]} {r["variant"]}': r for r in self.table("summary")}
+        self.assertIn("bullet native", summary)
+
+    def test_summary_counts_equal_the_results_and_the_precision_curves(self):
+        summary = {f'{r["engine"]} {r["variant"]}': r for r in self.table("summary")}
+        for ev in {f'{r["engine"]} {r["variant"]}' for r in self.results if r["status"] not in ("NOT_BUILT",)}:
+            cells = {}
+            for r in self.results:
+                if f'{r["engine"]} {r["variant"]}' == ev:
+                    cells.setdefault(r["experiment"], []).append(r["status"])
+            judged = [x for x, st in cells.items() if "NOT_APPLICABLE" not in st]
+            self.assertEqual(int(summary[ev]["experiments"]), len(judged), ev)
+            self.assertEqual(int(summary[ev]["pass"]), sum(all(s == "PASS" for s in cells[x]) for x in judged), ev)
+        for ev, r in summary.items():
+            if ev.startswith("bullet"):
+                continue
+            judged = {x["experiment"] for x in self.rows if f'{x["engine"]} {x["variant"]}' == ev and x["judged"] == "true"}
+            reached = [x for x in judged if self.expected_cost(x, ev)[0] in ("at_most", "interpolated")]
+            self.assertEqual((int(r["judged"]), int(r["reached"])), (len(judged), len(reached)), ev)
+            costs = sorted(self.expected_cost(x, ev)[1] for x in reached)
+            if costs:
+                m = len(costs) // 2
+                med = costs[m] if len(costs) % 2 else (costs[m - 1] + costs[m]) / 2
+                self.assertAlmostEqual(float(r["median_cost_to_tolerance"]), med, delta=1e-12 * med, msg=ev)
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@ import { parseCsv, writeCsv } from '../../reports/generator/lib/csv.mjs';
 import { parseJson, lineOf } from '../../reports/generator/lib/json.mjs';
 import { costToReach, matrix, orderEngineVariants, median, verdicts } from '../../reports/generator/lib/derive.mjs';
 import { num } from '../../reports/generator/lib/html.mjs';
+import { precision } from '../../reports/generator/lib/precision.mjs';
 import { parseArgs, outputPaths } from '../../reports/generator/report.mjs';
 import { shortDouble, shortFloat32, compactTrajectory, compactContacts } from '../../reports/generator/lib/replay.mjs';
 import { readRunFiles } from '../../viewer/src/data.js';
@@ -211,4 +212,29 @@ test('replay data: the viewer reads the shortened files of a run into the very s
   assert.equal(a.contacts, 3);
   const bytes = (v) => Buffer.from(v.buffer, v.byteOffset, v.byteLength);
   for (const k of ['t', 'pose', 'vel', 'contactStart', 'contactFloat', 'contactInt']) assert.ok(bytes(a[k]).equals(bytes(b[k])), k);
+});
+
+test('precision: the cost to the tolerance per curve; "never" stalls or still falls; not built and n/a are not counted', () => {
+  const row = (engine, variant, value, error, wall, extra = {}) => ({ experiment: 'x1', kind: 'law', engine, variant, ev: `${engine} ${variant}`,
+    setting: 'step', value, input: '', quantity: 'q', unit: '', measured: 1, expected: 1, error, relative: false, tolerance: 0.01,
+    judged: true, status: 'ok', wall_seconds: wall, wall_per_sim_second: wall, steps: 10, repeats: 1, note: '', ...extra });
+  const rows = [
+    row('soft', 'adaptive', 1e-2, 1, 1), row('soft', 'adaptive', 1e-3, 1e-4, 100),        // crosses 0.01 at 10
+    row('ode', 'native', 1e-2, 0.5, 1), row('ode', 'native', 1e-3, 0.3, 2), row('ode', 'native', 1e-4, 0.29, 4),  // stalls
+    row('ode', 'matched', 1e-2, 0.5, 1), row('ode', 'matched', 1e-3, 0.1, 2),              // still falling
+    row('bullet', 'native', null, null, null, { setting: '', status: 'not_built' }),
+    row('bullet', 'matched', 1e-2, 1e-3, 3, { judged: false }),                            // reaches it, but n/a
+  ];
+  const p = precision({ rows }, null);
+  const c = Object.fromEntries(p.experiments[0].curves.map((x) => [x.ev, x]));
+  assert.equal(c['soft adaptive'].to_tolerance.kind, 'interpolated');
+  assert.ok(Math.abs(c['soft adaptive'].to_tolerance.wall_per_sim_second - 10) < 1e-9);
+  assert.deepEqual([c['ode native'].never.why, c['ode native'].floor], ['stalls', 0.29]);
+  assert.deepEqual([c['ode matched'].never.why, c['ode matched'].floor], ['still_falling', 0.1]);
+  assert.equal(c['bullet native'].to_tolerance.kind, 'not_built');
+  const s = Object.fromEntries(p.summary.map((x) => [x.ev, x]));
+  assert.deepEqual([s['soft adaptive'].judged, s['soft adaptive'].reached], [1, 1]);
+  assert.deepEqual(s['ode native'].never, ['x1']);
+  assert.deepEqual([s['bullet native'].judged, s['bullet native'].not_built], [0, true]);
+  assert.deepEqual([s['bullet matched'].judged, s['bullet matched'].not_applicable], [0, ['x1']]);
 });

@@ -201,6 +201,13 @@ typedef struct pdGkExperiment {
   double (*series)(const pdModel* model, const pdGkRecord* rec, int k, double input, double* analytic);
 } pdGkExperiment;
 
+// Work-precision (issue 17 item 1): each quantitative experiment also runs at every setting of each engine's
+// accuracy knob, on one input (the middle one of its inputs, listed first when there are two), and its error
+// against the closed form is written with the wall time (out/precision.csv). The knobs, loosest first:
+//   soft adaptive: tol 1e-2 … 1e-10 (decades); soft fixed-step RK4: dt 1e-3, 3e-4, 1e-4, 3e-5, 1e-5 s;
+//   ODE and Bullet, native and matched: step 1/60, 1/250, 1/1000, 1/4000, 1/16000 s.
+int pd_gk_precision_input(const pdGkExperiment* e);  // index into e->inputs
+
 int pd_gk_experiment_count(void);
 const pdGkExperiment* pd_gk_experiment(int index);
 const pdGkExperiment* pd_gk_find(const char* name);  // NULL when there is none
@@ -245,6 +252,8 @@ typedef struct pdGkOptions {
   bool fast;                  // only the experiments marked fast
   int jobs;                   // >= 1: worker processes of this process (or MPI rank) for the runs
   double toleranceScale;      // > 0: every tolerance is multiplied by it (1 = the catalogue's); for tests
+  bool precision;             // also the work-precision runs: out/precision.csv (pd_gk_precision_input)
+  int repeats;                // >= 1 with precision: runs per work-precision point, the wall time is their median
   volatile sig_atomic_t* interrupt;  // nullable: non-zero stops the suite (nothing is written)
   pdGkProgressFcn* progress;  // nullable
   void* progressUser;

@@ -12,6 +12,10 @@ export const RESULTS_HEADER = ['experiment', 'group', 'title', 'engine', 'varian
 export const SERIES_HEADER = ['t', 'engine', 'variant', 'input', 'value', 'analytic'];
 export const SWEEP_HEADER = ['scene', 'engine', 'variant', 'setting', 'value', 'error', 'error_kind', 'wall_seconds',
   'wall_per_sim_second', 'steps', 'repeats', 'reference'];
+export const PRECISION_HEADER = ['experiment', 'kind', 'engine', 'variant', 'setting', 'value', 'input', 'quantity', 'unit',
+  'measured', 'expected', 'error', 'relative', 'tolerance', 'judged', 'status', 'wall_seconds', 'wall_per_sim_second', 'steps',
+  'repeats', 'note'];
+export const PRECISION_STATUSES = ['ok', 'failed', 'no_measure', 'refused', 'not_built'];
 export const METRICS_HEADER = ['scene', 'engine', 'variant', 'reference', 'pos_err_final', 'pos_err_rms',
   'rot_err_final_rad', 'rot_err_rms_rad', 'energy_drift_rel', 'momentum_drift_rel', 'max_penetration_over_size',
   'wall_per_sim_second', 'steps', 'restitution_impacts'];
@@ -221,6 +225,53 @@ export function readSweep(dir) {
       repeats: number(f.repeats, 'repeats', src.file, line, { integer: true }),
       reference: f.reference,
     };
+    row.ev = `${row.engine} ${row.variant}`;
+    rows.push(row);
+  }
+  return { file: src.file, rows };
+}
+
+function bool(value, column, file, line) {
+  if (value !== 'true' && value !== 'false') throw new InputError(file, line, `${column}: expected true or false, found '${value}'`);
+  return value === 'true';
+}
+
+// precision.csv of `polydyn gedanken --precision` (gedanken/RESULT_SCHEMAS.md): one row per work-precision point.
+export function readPrecision(dir) {
+  const src = readText(dir, 'precision.csv');
+  if (!src) return null;
+  const rows = [];
+  for (const { line, f } of table(src, PRECISION_HEADER)) {
+    if (f.experiment === '') throw new InputError(src.file, line, 'experiment: empty');
+    const status = oneOf(f.status, PRECISION_STATUSES, 'status', src.file, line);
+    if (status !== 'not_built' && f.setting !== 'tol' && f.setting !== 'step')
+      throw new InputError(src.file, line, `setting: expected tol or step, found '${f.setting}'`);
+    const row = {
+      line,
+      experiment: word(f.experiment, 'experiment', src.file, line),
+      kind: oneOf(f.kind, ['law', 'model_prediction'], 'kind', src.file, line),
+      engine: word(f.engine, 'engine', src.file, line),
+      variant: word(f.variant, 'variant', src.file, line),
+      setting: f.setting,
+      value: number(f.value, 'value', src.file, line, { required: status !== 'not_built', positive: status !== 'not_built' }),
+      input: f.input,
+      quantity: f.quantity,
+      unit: f.unit,
+      measured: number(f.measured, 'measured', src.file, line),
+      expected: number(f.expected, 'expected', src.file, line, { required: true }),
+      error: number(f.error, 'error', src.file, line),
+      relative: bool(f.relative, 'relative', src.file, line),
+      tolerance: number(f.tolerance, 'tolerance', src.file, line, { required: true, positive: true }),
+      judged: bool(f.judged, 'judged', src.file, line),
+      status,
+      wall_seconds: number(f.wall_seconds, 'wall_seconds', src.file, line),
+      wall_per_sim_second: number(f.wall_per_sim_second, 'wall_per_sim_second', src.file, line),
+      steps: number(f.steps, 'steps', src.file, line, { integer: true }),
+      repeats: number(f.repeats, 'repeats', src.file, line, { integer: true }),
+      note: f.note,
+    };
+    if (status === 'ok' && (row.error === null || row.wall_per_sim_second === null))
+      throw new InputError(src.file, line, 'an ok point needs its error and wall_per_sim_second');
     row.ev = `${row.engine} ${row.variant}`;
     rows.push(row);
   }

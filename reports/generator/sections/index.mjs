@@ -5,7 +5,9 @@
 // html goes into the page under the section's title, data into report.json under the section's id,
 // each csv into report-NAME.csv beside the page. Charts are made with ctx.chart(echartsOption).
 // To add a section, write sections/NAME.mjs and list it here.
+import summary from './summary.mjs';
 import verdict from './verdict.mjs';
+import precision from './precision.mjs';
 import matrix from './matrix.mjs';
 import restitution from './restitution.mjs';
 import frictionCone from './friction_cone.mjs';
@@ -16,4 +18,4 @@ import experiments from './experiments.mjs';
 import parameters from './parameters.mjs';
 import cubetoss from './cubetoss.mjs';
 
-export const sections = [verdict, matrix, restitution, frictionCone, workPrecision, cost, compare, cubetoss, experiments, parameters];
+export const sections = [summary, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, experiments, parameters];

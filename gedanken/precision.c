@@ -1,0 +1,356 @@
+// polydyn gedanken — work-precision against the closed form (issue 17 item 1; RESULT_SCHEMAS.md, precision.csv).
+//
+// The sweep (`polydyn sweep`) measures each engine against runs of its own; here each engine is measured against
+// what physics says: every quantitative experiment runs on its precision input at every setting of each engine's
+// accuracy knob, and the experiment's own measure gives the error against its closed form (restitution error,
+// stop-distance error, acceleration error, ...). One point = one (experiment, engine, variant, setting) run
+// `repeats` times with no output files: the error from the first run (every run is deterministic), the wall time
+// the median. The points are the tasks of a batch (refcheck/include/polydyn/batch.h), written in task order:
+// the file is the same bytes whatever the number of processes, except the wall times.
+#include <errno.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "gedanken_internal.h"
+#include "polydyn/batch.h"
+#include "polydyn/output.h"
+#include "polydyn/refcheck.h"
+#include "polydyn/scene.h"
+#include "polydyn/stats.h"
+
+// The knobs, loosest first (the header lists them; README "Work-precision per experiment").
+static const double softTolerances[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
+static const double softFixedSteps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};                              // s
+static const double referenceSteps[] = {1.0 / 60, 1.0 / 250, 1.0 / 1000, 1.0 / 4000, 1.0 / 16000};  // s
+enum {
+  SOFT_TOL_COUNT = sizeof softTolerances / sizeof softTolerances[0],
+  SOFT_FIXED_COUNT = sizeof softFixedSteps / sizeof softFixedSteps[0],
+  REFERENCE_STEP_COUNT = sizeof referenceSteps / sizeof referenceSteps[0],
+  MAX_REPEATS = 21,
+};
+
+int pd_gk_precision_input(const pdGkExperiment* e) { return (e->inputCount - 1) / 2; }
+
+typedef enum gkPointStatus {
+  gkPointOk,
+  gkPointFailed,
+  gkPointNoMeasure,
+  gkPointRefused,
+  gkPointNotBuilt
+} gkPointStatus;
+static const char* const pointStatusNames[] = {"ok", "failed", "no_measure", "refused", "not_built"};
+
+typedef struct gkPoint {
+  const gkCase* c;
+  pdGkEngine engine;
+  const char* variant;  // "adaptive", "fixed", "native", "matched"
+  const char* setting;  // "tol", "step"; "" for a not_built row
+  double value;
+  // measured (travels between processes as gkPointResult)
+  gkPointStatus status;
+  double measured, error, wall;
+  long steps;
+  char note[PD_GK_NOTE_MAX];
+} gkPoint;
+
+typedef struct gkPointResult {
+  int32_t status;
+  int32_t unused;
+  double measured, error, wall;
+  int64_t steps;
+  char note[PD_GK_NOTE_MAX];
+} gkPointResult;
+
+typedef struct gkPrecision {
+  const pdGkOptions* options;
+  gkPoint* points;
+  int count;
+} gkPrecision;
+
+static bool interrupted(const gkPrecision* p) { return p->options->interrupt && *p->options->interrupt; }
+
+static void point_note(gkPoint* p, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+static void point_note(gkPoint* p, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(p->note, sizeof p->note, fmt, ap);
+  va_end(ap);
+}
+
+typedef struct gkPointObserver {
+  pdGkRecord* rec;  // NULL after the first repeat: only the wall time is wanted then
+  const gkPrecision* precision;
+  bool soft;
+} gkPointObserver;
+
+static bool observe(const pdModel* model, const pdState* state, void* user) {
+  gkPointObserver* o = user;
+  if (o->rec) {
+    if (o->soft)
+      pd_gk_record_observe(model, state, o->rec);
+    else
+      pd_gk_record_observe_ref(model, state, o->rec);
+  }
+  return !interrupted(o->precision);
+}
+
+// The case's scene compiled with the point's setting (the scene's tol or dt replaced; nothing else changes, so
+// the contact constants and the expected value are those of the suite's run).
+static pdModel* compile_with_setting(const gkPoint* p, pdError* err) {
+  pdScene* scene = pd_scene_parse_buffer("scene.scene", p->c->sceneText, strlen(p->c->sceneText), err);
+  if (!scene) return NULL;
+  if (strcmp(p->variant, "fixed") == 0)
+    scene->settings.dt = p->value;
+  else
+    scene->settings.tol = p->value;
+  pdModel* model = pd_model_compile(scene, err);
+  pd_scene_free(scene);
+  return model;
+}
+
+// The error of a measured value against the case's closed form (relative when the experiment says so), as
+// results.csv writes it.
+static double error_of(const gkCase* c, double measured) {
+  const pdGkExperiment* e = c->experiment;
+  return e->relative ? fabs(measured / c->expected.value - 1.0) : fabs(measured - c->expected.value);
+}
+
+static void measure_point(const gkPrecision* s, gkPoint* p) {
+  p->measured = p->error = p->wall = NAN;
+  p->steps = 0;
+  p->note[0] = '\0';
+  const gkCase* c = p->c;
+  int repeats = s->options->repeats;
+  double walls[MAX_REPEATS];
+  pdGkRecord rec;
+  pd_gk_record_init(&rec, c->model->movingCount);
+  bool completed = true;
+  pdModel* model = NULL;  // soft: compiled with the setting; the reference engines run the suite's model
+  const pdRefAdapter* adapter = NULL;
+  pdError err = {0};
+  if (p->engine == pd_gkSoft) {
+    model = compile_with_setting(p, &err);
+    PD_ASSERT(model != NULL);  // the same text compiled in the suite; tol and dt are checked > 0 there
+  } else {
+    adapter = pd_ref_adapter(pdGkEngineNames[p->engine]);
+    PD_ASSERT(adapter != NULL);  // points of engines with no adapter are not_built rows, never run
+  }
+  for (int r = 0; r < repeats && completed && !interrupted(s); ++r) {
+    gkPointObserver observer = {r == 0 ? &rec : NULL, s, p->engine == pd_gkSoft};
+    if (model) {
+      pdState* state = pd_state_create(model);
+      state->stepper = strcmp(p->variant, "fixed") == 0 ? pd_stepperRK4Fixed : pd_stepperRK4Adaptive;
+      double t0 = gk_wall_seconds();
+      completed = pd_advance(model, state, model->settings.tend, observe, &observer);
+      walls[r] = gk_wall_seconds() - t0;
+      p->steps = state->count.accepted;
+      if (!completed) point_note(p, "the run stopped at t = %.6g s", state->t);
+      pd_state_free(state);
+    } else {
+      pdRefOptions options = {.variant = strcmp(p->variant, "matched") == 0 ? pd_refMatched : pd_refNative,
+                              .step = p->value,
+                              .odeFriction = pd_odeFrictionPyramid};
+      pdRefRunStats stats;
+      bool ran = pd_ref_run(c->model, adapter, &options, NULL, observe, &observer, &stats, &err);
+      walls[r] = stats.wallSeconds;
+      p->steps = stats.steps;
+      if (!ran && stats.refused) {
+        p->status = gkPointRefused;
+        point_note(p, "%s", err.message);
+        pd_gk_record_free(&rec);
+        return;
+      }
+      completed = ran && stats.completed;
+      if (!completed) point_note(p, "%s produced a non-finite state after %ld steps", adapter->name, stats.steps);
+    }
+  }
+  if (model) pd_model_free(model);
+  if (!completed || !rec.finite || rec.count < 2) {
+    p->status = gkPointFailed;
+    if (!p->note[0])
+      point_note(p, "the run produced %s", rec.count < 2 ? "fewer than 2 samples" : "a non-finite state");
+    pd_gk_record_free(&rec);
+    return;
+  }
+  pdGkMeasured m = {.value = NAN};
+  c->experiment->measure(c->model, &rec, c->input, &m);
+  pd_gk_record_free(&rec);
+  snprintf(p->note, sizeof p->note, "%s", m.note);
+  if (!isfinite(m.value)) {
+    p->status = gkPointNoMeasure;
+    return;
+  }
+  p->status = gkPointOk;
+  p->measured = m.value;
+  p->error = error_of(c, m.value);
+  p->wall = pd_median_in_place(walls, repeats);
+}
+
+static void point_task(int task, pdBatchBuffer* result, void* user) {
+  gkPrecision* s = user;
+  gkPoint* p = &s->points[task];
+  measure_point(s, p);
+  gkPointResult r;
+  memset(&r, 0, sizeof r);  // no uninitialised padding in the bytes
+  r.status = (int32_t)p->status;
+  r.measured = p->measured;
+  r.error = p->error;
+  r.wall = p->wall;
+  r.steps = p->steps;
+  memcpy(r.note, p->note, sizeof r.note);
+  pd_batch_append(result, &r, sizeof r);
+}
+
+static void take_point(gkPoint* p, const pdBatchBuffer* bytes) {
+  gkPointResult r;
+  size_t at = 0;
+  bool whole = pd_batch_read(bytes, &at, &r, sizeof r);
+  PD_ASSERT(whole);
+  p->status = (gkPointStatus)r.status;
+  p->measured = r.measured;
+  p->error = r.error;
+  p->wall = r.wall;
+  p->steps = (long)r.steps;
+  memcpy(p->note, r.note, sizeof p->note);
+}
+
+static bool point_progress(int task, int done, int total, void* user) {
+  const gkPrecision* s = user;
+  if (task >= 0 && s->options->progress) {
+    const gkPoint* p = &s->points[task];
+    char engine[64];
+    snprintf(engine, sizeof engine, "%s-%s %s=%g (work-precision)", pdGkEngineNames[p->engine], p->variant, p->setting,
+             p->value);
+    pdGkProgress progress = {done, total, p->c->experiment->name, engine, p->c->label};
+    s->options->progress(&progress, s->options->progressUser);
+  }
+  return !interrupted(s);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+
+static void add(gkPrecision* s, const gkCase* c, pdGkEngine engine, const char* variant, const char* setting,
+                double value) {
+  s->points[s->count++] = (gkPoint){.c = c, .engine = engine, .variant = variant, .setting = setting, .value = value};
+}
+
+// The points of one case, in the order precision.csv lists them.
+static void add_case_points(gkPrecision* s, const gkCase* c) {
+  const pdGkOptions* o = s->options;
+  if (o->engines[pd_gkSoft]) {
+    for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "adaptive", "tol", softTolerances[k]);
+    for (int k = 0; k < SOFT_FIXED_COUNT; ++k) add(s, c, pd_gkSoft, "fixed", "step", softFixedSteps[k]);
+  }
+  for (int engine = pd_gkOde; engine < pd_gkEngineCount; ++engine) {
+    if (!o->engines[engine]) continue;
+    bool built = pd_ref_adapter(pdGkEngineNames[engine]) != NULL;
+    for (int v = 0; v < 2; ++v) {
+      const char* variant = v ? "matched" : "native";
+      if (!built) {  // reported, not skipped: one row per variant says the engine is missing
+        add(s, c, (pdGkEngine)engine, variant, "", NAN);
+        s->points[s->count - 1].status = gkPointNotBuilt;
+        point_note(&s->points[s->count - 1], "this build of polydyn has no %s adapter", pdGkEngineNames[engine]);
+        continue;
+      }
+      for (int k = 0; k < REFERENCE_STEP_COUNT; ++k) add(s, c, (pdGkEngine)engine, variant, "step", referenceSteps[k]);
+    }
+  }
+}
+
+static bool write_precision(const gkPrecision* s, const char* root, pdError* err) {
+  size_t n = strlen(root) + 32;
+  char* path = malloc(n);
+  PD_ASSERT(path != NULL);
+  snprintf(path, n, "%s/precision.csv", root);
+  FILE* out = fopen(path, "w");
+  free(path);
+  if (!out) {
+    pd_error_set(err, s->options->out, 0, 0, "cannot write precision.csv: %s", strerror(errno));
+    return false;
+  }
+  fputs(
+      "experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,"
+      "judged,status,wall_seconds,wall_per_sim_second,steps,repeats,note\n",
+      out);
+  for (int i = 0; i < s->count; ++i) {
+    const gkPoint* p = &s->points[i];
+    const gkCase* c = p->c;
+    const pdGkExperiment* e = c->experiment;
+    pd_write_csv_text(out, e->name);
+    fprintf(out, ",%s,%s,%s,%s,", pdGkKindNames[e->kind], pdGkEngineNames[p->engine], p->variant, p->setting);
+    if (isfinite(p->value)) fprintf(out, "%.6g", p->value);  // the setting as it is named (1/60 s: 0.0166667)
+    fputc(',', out);
+    pd_write_csv_text(out, c->label);
+    fputc(',', out);
+    pd_write_csv_text(out, e->quantity);
+    fputc(',', out);
+    pd_write_csv_text(out, e->unit);
+    fputc(',', out);
+    gk_csv_number(out, p->measured);
+    fputc(',', out);
+    gk_csv_number(out, c->expected.value);
+    fputc(',', out);
+    gk_csv_number(out, p->error);
+    fprintf(out, ",%s,", e->relative ? "true" : "false");
+    gk_csv_number(out, c->expected.tolerance);
+    bool judged = pd_gk_applies(e, p->engine, strcmp(p->variant, "matched") == 0);
+    fprintf(out, ",%s,%s,", judged ? "true" : "false", pointStatusNames[p->status]);
+    gk_csv_number(out, p->wall);
+    fputc(',', out);
+    gk_csv_number(out, p->wall / c->model->settings.tend);
+    fprintf(out, ",%ld,%d,", p->steps, s->options->repeats);
+    pd_write_csv_text(out, p->note);
+    fputc('\n', out);
+  }
+  bool ok = !ferror(out);
+  ok = fclose(out) == 0 && ok;
+  if (!ok) pd_error_set(err, s->options->out, 0, 0, "cannot write precision.csv");
+  return ok;
+}
+
+bool gk_precision_run(const pdGkOptions* options, const gkCase* cases, int caseCount, const char* root, pdError* err) {
+  PD_ASSERT(options->repeats >= 1 && options->repeats <= MAX_REPEATS);
+  int perCase = SOFT_TOL_COUNT + SOFT_FIXED_COUNT + 2 * (pd_gkEngineCount - 1) * REFERENCE_STEP_COUNT;
+  gkPrecision s = {.options = options, .points = calloc((size_t)caseCount * (size_t)perCase + 1, sizeof(gkPoint))};
+  PD_ASSERT(s.points != NULL);
+  for (int i = 0; i < caseCount; ++i) {
+    const gkCase* c = &cases[i];
+    const pdGkExperiment* e = c->experiment;
+    if (e->qualitative || !isfinite(c->expected.value)) continue;  // no closed form: nothing to measure against
+    if (c->input != e->inputs[pd_gk_precision_input(e)]) continue;
+    add_case_points(&s, c);
+  }
+  // not_built rows are not tasks: a task per point that runs; the others keep their status
+  int* run = malloc(((size_t)s.count + 1) * sizeof *run);
+  PD_ASSERT(run != NULL);
+  int tasks = 0;
+  for (int i = 0; i < s.count; ++i)
+    if (s.points[i].status != gkPointNotBuilt) run[tasks++] = i;
+  gkPoint* all = s.points;
+  gkPoint* runnable = calloc((size_t)tasks + 1, sizeof *runnable);
+  PD_ASSERT(runnable != NULL);
+  for (int k = 0; k < tasks; ++k) runnable[k] = all[run[k]];
+  s.points = runnable;
+  pdBatchBuffer* results = calloc((size_t)tasks + 1, sizeof *results);
+  PD_ASSERT(results != NULL);
+  pdBatchOptions batch = {.workers = options->jobs, .everywhere = true, .progress = point_progress, .progressUser = &s};
+  char why[256] = "";
+  bool ok = pd_batch_run(tasks, point_task, &s, &batch, results, why, sizeof why);
+  for (int k = 0; k < tasks; ++k) {
+    if (ok) take_point(&all[run[k]], &results[k]);
+    pd_batch_buffer_free(&results[k]);
+  }
+  free(results);
+  free(runnable);
+  free(run);
+  s.points = all;
+  if (interrupted(&s)) {
+    pd_error_set(err, options->out, 0, 0, "interrupted; nothing written");
+    ok = false;
+  } else if (!ok) {
+    pd_error_set(err, options->out, 0, 0, "%s", why);
+  }
+  if (ok && pd_batch_is_root()) ok = write_precision(&s, root, err);
+  free(s.points);
+  return ok;
+}
