@@ -2,8 +2,13 @@
 // reports/FORMATS.md, protocol: shared reference speed-accuracy.md §4.4).
 //
 // Every point runs the same model (only tol, or the step, changes) with no output files, R times; the
-// wall time is the median, the error (deterministic) is taken from the first. The reference is the soft
-// engine at the tightest tolerance, checked against one 10× tighter; both are written.
+// wall time is the median, the errors (deterministic) are taken from the first run. Each point has two
+// errors: `error` against the soft engine at the tightest tolerance (checked against one 10× tighter; both
+// are written), and `self_error`, its self-convergence: against its own engine-variant's finest run (the
+// soft engine, adaptive or fixed-step: the same tol 1e-12 reference, a finer solution of the very
+// equations the fixed-step RK4 integrates; ODE and Bullet, native and matched: their own run at the
+// finest step swept, 1/16000 s). `horizon_seconds` is the first sample at which a point's run leaves its
+// own finest run by more than SWEEP_HORIZON_THRESHOLD: the horizon of predictability of a chaotic scene.
 #include <errno.h>
 #include <math.h>
 #include <stdint.h>
@@ -25,15 +30,28 @@
 #define SWEEP_REFERENCE_TOL 1e-12
 #define SWEEP_REFERENCE_CHECK_TOL 1e-13
 #define SWEEP_MAX_REPEATS 21
+// The horizon of predictability: the first sample time at which a run's pose error against its own finest
+// run, max over moving bodies of max(|x - x_ref| / size, rotation angle in rad), exceeds this (no unit: a
+// tenth of a body size, or 0.1 rad = 5.7°). Far above what runs that agree leave between them (a resting or
+// sliding body: 1e-3 of its size at a loose setting), far below what runs that went separate ways show (a
+// tumbling box landing on another face, a pile's box elsewhere: 0.5 and more).
+#define SWEEP_HORIZON_THRESHOLD 0.1
 
 static const char* const help =
     "usage: polydyn sweep SCENE --out DIR [--repeats R] [--engines soft,ode,bullet] [--tend T] [--jobs N]\n"
     "\n"
     "Work-precision sweep of SCENE: polydyn's adaptive RK4 at tol 1e-2 ... 1e-10 (decades) and its fixed-step\n"
-    "RK4 at dt 1e-3 ... 1e-5, ODE and Bullet (native and matched) at steps 1/60 ... 1/16000 s. The error of\n"
-    "each point is the RMS over samples and moving bodies of max(|x - x_ref| / body size, rotation angle in\n"
-    "rad) against the soft engine at tol 1e-12 (whose own error, against tol 1e-13, is reported as the\n"
-    "reference's). Wall time: median of R runs (default 3), no output files written during the runs.\n"
+    "RK4 at dt 1e-3 ... 1e-5, ODE and Bullet (native and matched) at steps 1/60 ... 1/16000 s. Errors are\n"
+    "the RMS over samples and moving bodies of max(|x - x_ref| / body size, rotation angle in rad):\n"
+    "  error        against the soft engine at tol 1e-12 (whose own error, against tol 1e-13, is reported as\n"
+    "               the reference's);\n"
+    "  self_error   self-convergence: against the engine-variant's own finest run (soft, adaptive and fixed:\n"
+    "               the same tol 1e-12 run; ODE and Bullet: their own run at 1/16000 s, whose self_error is\n"
+    "               empty, it has no finer run of its own);\n"
+    "  horizon      the horizon of predictability: the first sample time at which the run's error against\n"
+    "               its own finest run exceeds 0.1 (a tenth of a body size or 0.1 rad) for some body; empty\n"
+    "               when it never does.\n"
+    "Wall time: median of R runs (default 3), no output files written during the runs.\n"
     "Writes DIR/sweep.csv (reports/FORMATS.md) and DIR/reference.json; DIR is replaced atomically.\n"
     "\n"
     "  --jobs N   run N points at a time in worker processes (default 1); under mpirun or srun the points are\n"
@@ -53,11 +71,15 @@ static double median(double* v, int n) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// RMS over samples and bodies of max(position error / size, rotation angle) against the reference.
-static double pose_error(const pdModel* model, const pdTrajectory* run, const pdTrajectory* ref) {
+// RMS over samples and bodies of max(position error / size, rotation angle) against the reference; with
+// horizon (nullable), the first sample time at which that error exceeds SWEEP_HORIZON_THRESHOLD for some
+// body, NAN when it never does.
+static double pose_error(const pdModel* model, const pdTrajectory* run, const pdTrajectory* ref, double* horizon) {
   double sum = 0.0;
   long count = 0;
-  for (long s = 0; s < run->samples; ++s)
+  if (horizon) *horizon = NAN;
+  for (long s = 0; s < run->samples; ++s) {
+    double worst = 0.0;
     for (int k = 0; k < run->movingCount; ++k) {
       const pdBodyState* b = &run->bodies[(size_t)s * (size_t)run->movingCount + (size_t)k];
       pdBodyState r = pd_trajectory_at(ref, k, run->t[s]);
@@ -67,7 +89,10 @@ static double pose_error(const pdModel* model, const pdTrajectory* run, const pd
       double e = fmax(pos, rot);
       sum += e * e;
       ++count;
+      worst = fmax(worst, e);
     }
+    if (horizon && isnan(*horizon) && worst > SWEEP_HORIZON_THRESHOLD) *horizon = run->t[s];
+  }
   return count ? sqrt(sum / (double)count) : 0.0;
 }
 
@@ -77,9 +102,13 @@ typedef struct point {
   const char* variant;
   const char* setting;  // tol | step
   double value;
+  int self;             // index in the kept runs of its own finest run (0: the soft reference)
+  bool finest;          // it is that run (an ODE or Bullet variant's finest step): no self_error, no horizon
   // measured: travels between processes as these bytes (pointMeasure)
   bool completed;
-  double error;         // NAN when the run did not complete
+  double error;         // against the soft reference; NAN when the run did not complete
+  double selfError;     // against its own finest run; NAN when not measured (not completed, the finest itself)
+  double horizon;       // s; NAN when never (or not measured)
   double wall;          // median over repeats, s
   long steps;
 } point;
@@ -87,7 +116,7 @@ typedef struct point {
 typedef struct pointMeasure {
   int32_t completed;
   int32_t unused;
-  double error, wall;
+  double error, selfError, horizon, wall;
   int64_t steps;
 } pointMeasure;
 
@@ -103,6 +132,7 @@ static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* traj
   return ok;
 }
 
+// A soft point R times; its errors against the soft reference, which is also its own finest run.
 static void measure_soft(const char* scene, const pdCliOverrides* base, int repeats, const pdTrajectory* ref, point* p) {
   pdCliOverrides o = *base;
   bool fixed = strcmp(p->variant, "fixed") == 0;
@@ -110,7 +140,7 @@ static void measure_soft(const char* scene, const pdCliOverrides* base, int repe
   else o.tol = p->value;
   pdModel* model = pd_cli_load_model(scene, &o, NULL);
   p->completed = false;
-  p->error = p->wall = NAN;
+  p->error = p->selfError = p->horizon = p->wall = NAN;
   p->steps = 0;
   if (!model) return;
   double walls[SWEEP_MAX_REPEATS];
@@ -121,21 +151,21 @@ static void measure_soft(const char* scene, const pdCliOverrides* base, int repe
     if (!p->completed) break;
   }
   if (p->completed) {
-    p->error = pose_error(model, tr, ref);
+    p->error = p->selfError = pose_error(model, tr, ref, &p->horizon);
     p->wall = median(walls, repeats);
   }
   pd_trajectory_free(tr);
   pd_model_free(model);
 }
 
-static void measure_reference_engine(const pdModel* model, int repeats, const pdTrajectory* ref, point* p) {
+// An ODE or Bullet point R times, the first run's trajectory into tr (made empty); completed, wall, steps.
+static void run_reference_engine(const pdModel* model, int repeats, point* p, pdTrajectory* tr) {
   const pdRefAdapter* adapter = pd_ref_adapter(p->engine);
   PD_ASSERT(adapter != NULL);
   p->completed = false;
-  p->error = p->wall = NAN;
+  p->error = p->selfError = p->horizon = p->wall = NAN;
   p->steps = 0;
   double walls[SWEEP_MAX_REPEATS];
-  pdTrajectory* tr = pd_trajectory_create(model);
   pdRefOptions o = {strcmp(p->variant, "matched") == 0 ? pd_refMatched : pd_refNative, p->value, pd_odeFrictionPyramid};
   for (int r = 0; r < repeats; ++r) {
     pdRefRunStats stats;
@@ -147,58 +177,88 @@ static void measure_reference_engine(const pdModel* model, int repeats, const pd
     walls[r] = stats.wallSeconds;
     if (!p->completed) break;
   }
-  if (p->completed) {
-    p->error = pose_error(model, tr, ref);
-    p->wall = median(walls, repeats);
-  }
-  pd_trajectory_free(tr);
+  if (p->completed) p->wall = median(walls, repeats);
 }
 
 // ---------------------------------------------------------------- the runs as batch tasks
 
-// The reference or its check: a soft run at a tight tolerance whose trajectory every rank gets.
-typedef struct referenceRun {
+// A run whose trajectory every rank gets, a task of the first batch: the soft reference (kept run 0) or
+// its check (1), both with point NULL, or the finest point of an ODE or Bullet variant, measured as every
+// point (R repeats) and kept as its variant's own reference for the coarser points of the second batch.
+typedef struct keptRun {
   const pdModel* model;
+  point* point;  // NULL: a soft run at model's tolerance
   pdTrajectory* trajectory;
+  bool completed;
   double wall;
   long steps;
-} referenceRun;
+} keptRun;
 
-typedef struct referenceHeader {
+typedef struct keptRuns {
+  keptRun* runs;
+  int repeats;
+} keptRuns;
+
+typedef struct keptHeader {
   int32_t completed, movingCount;
   int64_t samples, steps;
   double wall;
-} referenceHeader;
+} keptHeader;
 
-static void reference_task(int task, pdBatchBuffer* result, void* user) {
-  const referenceRun* r = &((const referenceRun*)user)[task];
+static void kept_task(int task, pdBatchBuffer* result, void* user) {
+  const keptRuns* all = user;
+  const keptRun* r = &all->runs[task];
   pdTrajectory* tr = pd_trajectory_create(r->model);
   double wall;
   long steps;
-  bool completed = soft_run(r->model, pd_stepperRK4Adaptive, tr, &wall, &steps);
-  referenceHeader h = {completed, tr->movingCount, tr->samples, steps, wall};
+  bool completed;
+  if (r->point) {
+    point p = *r->point;
+    run_reference_engine(r->model, all->repeats, &p, tr);
+    completed = p.completed;
+    wall = p.wall;
+    steps = p.steps;
+  } else {
+    completed = soft_run(r->model, pd_stepperRK4Adaptive, tr, &wall, &steps);
+  }
+  keptHeader h = {completed, tr->movingCount, tr->samples, steps, wall};
   pd_batch_append(result, &h, sizeof h);
   pd_batch_append(result, tr->t, (size_t)tr->samples * sizeof *tr->t);
   pd_batch_append(result, tr->bodies, (size_t)tr->samples * (size_t)tr->movingCount * sizeof *tr->bodies);
   pd_trajectory_free(tr);
 }
 
-// Fills r->trajectory (made empty), wall and steps from a reference_task's bytes; false when the run failed.
-static bool take_reference(const pdBatchBuffer* bytes, referenceRun* r) {
-  referenceHeader h;
+// Fills r->trajectory (made empty), completed, wall and steps from a kept_task's bytes; false when they are
+// not whole (a run that did not complete still reads true, with r->completed false).
+static bool take_kept(const pdBatchBuffer* bytes, keptRun* r) {
+  keptHeader h;
   size_t at = 0;
-  if (!pd_batch_read(bytes, &at, &h, sizeof h) || !h.completed || h.movingCount != r->trajectory->movingCount)
-    return false;
+  if (!pd_batch_read(bytes, &at, &h, sizeof h) || h.movingCount != r->trajectory->movingCount) return false;
   pdTrajectory* tr = r->trajectory;
   size_t bodies = (size_t)h.samples * (size_t)h.movingCount;
   tr->t = malloc((size_t)h.samples * sizeof *tr->t + 1);
   tr->bodies = malloc(bodies * sizeof *tr->bodies + 1);
   if (!tr->t || !tr->bodies) abort();
   tr->samples = tr->capacity = (long)h.samples;
+  r->completed = h.completed;
   r->wall = h.wall;
   r->steps = (long)h.steps;
   return pd_batch_read(bytes, &at, tr->t, (size_t)h.samples * sizeof *tr->t) &&
          pd_batch_read(bytes, &at, tr->bodies, bodies * sizeof *tr->bodies);
+}
+
+static bool kept_progress(int task, int done, int total, void* user) {
+  const keptRuns* all = user;
+  if (task >= 0) {
+    const point* p = all->runs[task].point;
+    if (p)
+      fprintf(stderr, "\rpolydyn sweep: reference runs: %s %s %s %.3g (%d/%d)\033[K", p->engine, p->variant, p->setting,
+              p->value, done, total);
+    else
+      fprintf(stderr, "\rpolydyn sweep: reference runs: soft tol %g (%d/%d)\033[K", all->runs[task].model->settings.tol,
+              done, total);
+  }
+  return true;
 }
 
 typedef struct pointRuns {
@@ -206,17 +266,27 @@ typedef struct pointRuns {
   const pdCliOverrides* base;
   int repeats;
   const pdModel* refModel;
-  const pdTrajectory* ref;
+  const keptRun* kept;  // [0]: the soft reference
   point* points;
+  const int* todo;      // the second batch's task k is point todo[k]
   bool progress;
 } pointRuns;
 
 static void point_task(int task, pdBatchBuffer* result, void* user) {
   const pointRuns* r = user;
-  point p = r->points[task];
-  if (strcmp(p.engine, "soft") == 0) measure_soft(r->scene, r->base, r->repeats, r->ref, &p);
-  else measure_reference_engine(r->refModel, r->repeats, r->ref, &p);
-  pointMeasure m = {p.completed, 0, p.error, p.wall, p.steps};
+  point p = r->points[r->todo[task]];
+  const pdTrajectory* ref = r->kept[0].trajectory;
+  if (strcmp(p.engine, "soft") == 0) {
+    measure_soft(r->scene, r->base, r->repeats, ref, &p);
+  } else {
+    pdTrajectory* tr = pd_trajectory_create(r->refModel);
+    run_reference_engine(r->refModel, r->repeats, &p, tr);
+    const keptRun* self = &r->kept[p.self];
+    if (p.completed) p.error = pose_error(r->refModel, tr, ref, NULL);
+    if (p.completed && self->completed) p.selfError = pose_error(r->refModel, tr, self->trajectory, &p.horizon);
+    pd_trajectory_free(tr);
+  }
+  pointMeasure m = {p.completed, 0, p.error, p.selfError, p.horizon, p.wall, p.steps};
   pd_batch_append(result, &m, sizeof m);
 }
 
@@ -227,6 +297,8 @@ static void take_point(const pdBatchBuffer* bytes, point* p) {
   PD_ASSERT(whole);
   p->completed = m.completed;
   p->error = m.error;
+  p->selfError = m.selfError;
+  p->horizon = m.horizon;
   p->wall = m.wall;
   p->steps = (long)m.steps;
 }
@@ -234,11 +306,18 @@ static void take_point(const pdBatchBuffer* bytes, point* p) {
 static bool point_progress(int task, int done, int total, void* user) {
   const pointRuns* r = user;
   if (task >= 0) {
-    const point* p = &r->points[task];
+    const point* p = &r->points[r->todo[task]];
     fprintf(stderr, "\rpolydyn sweep: %s %s %s %.3g (%d/%d)\033[K", p->engine, p->variant, p->setting, p->value,
             done, total);
   }
   return true;
+}
+
+// "ENGINE VARIANT SETTING=VALUE" of the run a point's self_error is measured against.
+static void self_reference_name(const keptRun* kept, const point* p, char* name, size_t size) {
+  const point* f = kept[p->self].point;
+  if (f) snprintf(name, size, "%s %s %s=%.6g", f->engine, f->variant, f->setting, f->value);
+  else snprintf(name, size, "soft tol=%g", SWEEP_REFERENCE_TOL);
 }
 
 int pd_cmd_sweep(int argc, char** argv) {
@@ -294,7 +373,39 @@ int pd_cmd_sweep(int argc, char** argv) {
 
   jobs = pd_cli_default_jobs(jobs, 1);  // one at a time unless asked: the wall times are the measurement
 
-  // the reference and its check: two tasks, their trajectories on every rank (every point needs the reference)
+  // the points, in the order of sweep.csv
+  enum { MAX_POINTS = 64, MAX_KEPT = 2 + 4 };
+  point points[MAX_POINTS];
+  int count = 0;
+  static const double tols[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
+  static const double fixedSteps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};
+  static const double refSteps_[] = {1.0 / 60, 1.0 / 250, 1.0 / 1000, 1.0 / 4000, 1.0 / 16000};
+  enum { REF_STEPS = sizeof refSteps_ / sizeof refSteps_[0] };
+  if (pd_cli_list_has(engines, "soft")) {
+    for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i) points[count++] = (point){.engine = "soft", .variant = "adaptive", .setting = "tol", .value = tols[i]};
+    for (size_t i = 0; i < sizeof fixedSteps / sizeof fixedSteps[0]; ++i)
+      points[count++] = (point){.engine = "soft", .variant = "fixed", .setting = "step", .value = fixedSteps[i]};
+  }
+  // the kept runs: the soft reference, its check, and each ODE and Bullet variant's finest step (its own
+  // reference: the variant's coarser points are measured against it in the second batch)
+  keptRun kept[MAX_KEPT] = {{.model = NULL}};
+  int keptCount = 2;
+  static const char* const refNames[] = {"ode", "bullet"};
+  for (int e = 0; e < 2; ++e) {
+    if (!pd_cli_list_has(engines, refNames[e])) continue;
+    if (!pd_ref_adapter(refNames[e])) {
+      if (pd_batch_is_root()) fprintf(stderr, "polydyn sweep: this build has no %s adapter; skipped\n", refNames[e]);
+      continue;
+    }
+    for (int v = 0; v < 2; ++v) {
+      for (int i = 0; i < REF_STEPS; ++i)
+        points[count++] = (point){.engine = refNames[e], .variant = v ? "matched" : "native", .setting = "step",
+                                  .value = refSteps_[i], .self = keptCount, .finest = i == REF_STEPS - 1};
+      kept[keptCount++].point = &points[count - 1];
+    }
+  }
+
+  // the first batch: the kept runs, their trajectories on every rank (every point needs the reference)
   pdCliOverrides refO = base, checkO = base;
   refO.tol = SWEEP_REFERENCE_TOL;
   checkO.tol = SWEEP_REFERENCE_CHECK_TOL;
@@ -305,65 +416,56 @@ int pd_cmd_sweep(int argc, char** argv) {
     pd_model_free(refModel);
     return PD_EXIT_BAD_INPUT;
   }
-  if (progress) fprintf(stderr, "\rpolydyn sweep: reference (tol %g) and its check (tol %g)\033[K", SWEEP_REFERENCE_TOL,
-                        SWEEP_REFERENCE_CHECK_TOL);
-  referenceRun references[2] = {{.model = refModel}, {.model = checkModel}};
-  pdBatchBuffer referenceBytes[2];
+  for (int k = 0; k < keptCount; ++k) kept[k].model = k == 1 ? checkModel : refModel;
+  keptRuns keptAll = {kept, (int)repeats};
+  pdBatchBuffer keptBytes[MAX_KEPT];
   char why[256] = "";
-  pdBatchOptions batch = {.workers = jobs, .everywhere = true};
-  bool refOk = pd_batch_run(2, reference_task, references, &batch, referenceBytes, why, sizeof why);
-  for (int k = 0; k < 2; ++k) {
-    references[k].trajectory = pd_trajectory_create(references[k].model);
-    refOk = refOk && take_reference(&referenceBytes[k], &references[k]);
-    pd_batch_buffer_free(&referenceBytes[k]);
+  pdBatchOptions batch = {.workers = jobs, .everywhere = true, .progress = progress ? kept_progress : NULL,
+                          .progressUser = &keptAll};
+  bool refOk = pd_batch_run(keptCount, kept_task, &keptAll, &batch, keptBytes, why, sizeof why);
+  for (int k = 0; k < keptCount; ++k) {
+    kept[k].trajectory = pd_trajectory_create(kept[k].model);
+    refOk = refOk && take_kept(&keptBytes[k], &kept[k]);
+    pd_batch_buffer_free(&keptBytes[k]);
   }
-  pdTrajectory* ref = references[0].trajectory;
-  pdTrajectory* check = references[1].trajectory;
+  pdTrajectory* ref = kept[0].trajectory;
+  pdTrajectory* check = kept[1].trajectory;
+  refOk = refOk && kept[0].completed && kept[1].completed;
   if (!refOk) {
     if (progress) fputs("\r\033[K", stderr);
     if (why[0]) fprintf(stderr, "polydyn sweep: %s\n", why);
     fprintf(stderr, "polydyn sweep: the reference run (soft at tol %g) did not complete\n", SWEEP_REFERENCE_TOL);
-    pd_trajectory_free(ref);
-    pd_trajectory_free(check);
+    for (int k = 0; k < keptCount; ++k) pd_trajectory_free(kept[k].trajectory);
     pd_model_free(refModel);
     pd_model_free(checkModel);
     return PD_EXIT_FAILURE;
   }
-  double refError = pose_error(refModel, ref, check);
-  double refWall = references[0].wall;
-  long refSteps = references[0].steps;
+  double refHorizon;  // when the reference itself leaves its check: where no point can be judged any more
+  double refError = pose_error(refModel, ref, check, &refHorizon);
+  double refWall = kept[0].wall;
+  long refSteps = kept[0].steps;
+  // the finest points measured in the first batch: their error against the soft reference
+  for (int k = 2; k < keptCount; ++k) {
+    point* p = kept[k].point;
+    p->completed = kept[k].completed;
+    p->error = p->completed ? pose_error(refModel, kept[k].trajectory, ref, NULL) : NAN;
+    p->selfError = p->horizon = NAN;
+    p->wall = p->completed ? kept[k].wall : NAN;
+    p->steps = kept[k].steps;
+  }
 
-  // the points: one task each, in the order of sweep.csv
-  enum { MAX_POINTS = 64 };
-  point points[MAX_POINTS];
-  int count = 0;
-  static const double tols[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
-  static const double fixedSteps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};
-  static const double refSteps_[] = {1.0 / 60, 1.0 / 250, 1.0 / 1000, 1.0 / 4000, 1.0 / 16000};
-  if (pd_cli_list_has(engines, "soft")) {
-    for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i) points[count++] = (point){.engine = "soft", .variant = "adaptive", .setting = "tol", .value = tols[i]};
-    for (size_t i = 0; i < sizeof fixedSteps / sizeof fixedSteps[0]; ++i)
-      points[count++] = (point){.engine = "soft", .variant = "fixed", .setting = "step", .value = fixedSteps[i]};
-  }
-  static const char* const refNames[] = {"ode", "bullet"};
-  for (int e = 0; e < 2; ++e) {
-    if (!pd_cli_list_has(engines, refNames[e])) continue;
-    if (!pd_ref_adapter(refNames[e])) {
-      if (pd_batch_is_root()) fprintf(stderr, "polydyn sweep: this build has no %s adapter; skipped\n", refNames[e]);
-      continue;
-    }
-    for (int v = 0; v < 2; ++v)
-      for (size_t i = 0; i < sizeof refSteps_ / sizeof refSteps_[0]; ++i)
-        points[count++] = (point){.engine = refNames[e], .variant = v ? "matched" : "native", .setting = "step", .value = refSteps_[i]};
-  }
-  pointRuns runs = {scene, &base, (int)repeats, refModel, ref, points, progress};
-  pdBatchBuffer* measured = calloc((size_t)count + 1, sizeof *measured);
+  // the second batch: every other point, one task each
+  int todo[MAX_POINTS], todoCount = 0;
+  for (int i = 0; i < count; ++i)
+    if (!points[i].finest) todo[todoCount++] = i;
+  pointRuns runs = {scene, &base, (int)repeats, refModel, kept, points, todo, progress};
+  pdBatchBuffer* measured = calloc((size_t)todoCount + 1, sizeof *measured);
   if (!measured) abort();
   batch = (pdBatchOptions){.workers = jobs, .progress = progress ? point_progress : NULL, .progressUser = &runs};
-  bool pointsOk = pd_batch_run(count, point_task, &runs, &batch, measured, why, sizeof why);
-  for (int i = 0; i < count; ++i) {
-    if (pointsOk && pd_batch_is_root()) take_point(&measured[i], &points[i]);
-    pd_batch_buffer_free(&measured[i]);
+  bool pointsOk = pd_batch_run(todoCount, point_task, &runs, &batch, measured, why, sizeof why);
+  for (int k = 0; k < todoCount; ++k) {
+    if (pointsOk && pd_batch_is_root()) take_point(&measured[k], &points[todo[k]]);
+    pd_batch_buffer_free(&measured[k]);
   }
   free(measured);
   if (progress) fputs("\r\033[K", stderr);
@@ -372,8 +474,7 @@ int pd_cmd_sweep(int argc, char** argv) {
   bool opened = pointsOk && pd_cli_out_open("sweep", out, "sweep.csv", tmp, sizeof tmp);
   if (!opened || !pd_batch_is_root()) {
     if (!pointsOk) fprintf(stderr, "polydyn sweep: %s\n", why);
-    pd_trajectory_free(ref);
-    pd_trajectory_free(check);
+    for (int k = 0; k < keptCount; ++k) pd_trajectory_free(kept[k].trajectory);
     pd_model_free(refModel);
     pd_model_free(checkModel);
     return !pointsOk ? PD_EXIT_FAILURE : opened ? PD_EXIT_OK : PD_EXIT_BAD_INPUT;
@@ -390,15 +491,22 @@ int pd_cmd_sweep(int argc, char** argv) {
     FILE* f = fopen(path, "w");
     bool ok = f != NULL;
     if (f) {
-      fputs("scene,engine,variant,setting,value,error,error_kind,wall_seconds,wall_per_sim_second,steps,repeats,reference\n", f);
+      fputs("scene,engine,variant,setting,value,error,error_kind,wall_seconds,wall_per_sim_second,steps,repeats,"
+            "reference,self_error,self_reference,horizon_seconds\n", f);
       for (int i = 0; i < count; ++i) {
         const point* p = &points[i];
+        char selfName[128];
+        self_reference_name(kept, p, selfName, sizeof selfName);
         fprintf(f, "\"%s\",%s,%s,%s,%.6g,", scene, p->engine, p->variant, p->setting, p->value);
         if (p->completed) fprintf(f, "%.6g", p->error);
         fprintf(f, ",rms_pose,");
         if (p->completed) fprintf(f, "%.6g,%.6g", p->wall, p->wall / tend);
         else fputc(',', f);
-        fprintf(f, ",%ld,%ld,%s\n", p->steps, repeats, refName);
+        fprintf(f, ",%ld,%ld,%s,", p->steps, repeats, refName);
+        if (p->completed && !isnan(p->selfError)) fprintf(f, "%.6g", p->selfError);
+        fprintf(f, ",%s,", selfName);
+        if (p->completed && !isnan(p->horizon)) fprintf(f, "%.6g", p->horizon);
+        fputc('\n', f);
       }
       ok = !ferror(f);
       ok = fclose(f) == 0 && ok;
@@ -406,11 +514,15 @@ int pd_cmd_sweep(int argc, char** argv) {
     snprintf(path, sizeof path, "%s/reference.json", tmp);
     f = ok ? fopen(path, "w") : NULL;
     if (f) {
+      char horizonText[32] = "null";
+      if (!isnan(refHorizon)) snprintf(horizonText, sizeof horizonText, "%.6g", refHorizon);
       fprintf(f,
               "{\"scene\": \"%s\", \"engine\": \"soft\", \"tol\": %g, \"steps\": %ld, \"wall_seconds\": %.6g,\n"
               " \"check_tol\": %g, \"error_against_check\": %.6g,\n"
-              " \"error_kind\": \"rms over samples and moving bodies of max(|x - x_ref| / size, rotation angle rad)\"}\n",
-              scene, SWEEP_REFERENCE_TOL, refSteps, refWall, SWEEP_REFERENCE_CHECK_TOL, refError);
+              " \"error_kind\": \"rms over samples and moving bodies of max(|x - x_ref| / size, rotation angle rad)"
+              "\",\n \"horizon_threshold\": %g, \"horizon_against_check_seconds\": %s}\n",
+              scene, SWEEP_REFERENCE_TOL, refSteps, refWall, SWEEP_REFERENCE_CHECK_TOL, refError,
+              SWEEP_HORIZON_THRESHOLD, horizonText);
       ok = !ferror(f);
       ok = fclose(f) == 0 && ok;
     } else {
@@ -423,21 +535,28 @@ int pd_cmd_sweep(int argc, char** argv) {
     if (!ok || !pd_cli_out_close("sweep", tmp, out)) {
       status = PD_EXIT_FAILURE;
     } else {
-      printf("%-8s %-9s %-5s %10s %12s %12s\n", "engine", "variant", "set", "value", "error", "wall/sim s");
+      printf("%-8s %-9s %-5s %10s %12s %12s %12s %10s\n", "engine", "variant", "set", "value", "error", "self error",
+             "wall/sim s", "horizon");
       for (int i = 0; i < count; ++i) {
         const point* p = &points[i];
+        char self[32] = "-", horizon[32] = "never";
+        if (!isnan(p->selfError)) snprintf(self, sizeof self, "%.3g", p->selfError);
+        if (isnan(p->selfError)) snprintf(horizon, sizeof horizon, "-");
+        else if (!isnan(p->horizon)) snprintf(horizon, sizeof horizon, "%.3g s", p->horizon);
         if (p->completed)
-          printf("%-8s %-9s %-5s %10.3g %12.3g %12.3g\n", p->engine, p->variant, p->setting, p->value, p->error,
-                 p->wall / tend);
+          printf("%-8s %-9s %-5s %10.3g %12.3g %12s %12.3g %10s\n", p->engine, p->variant, p->setting, p->value,
+                 p->error, self, p->wall / tend, horizon);
         else
           printf("%-8s %-9s %-5s %10.3g %12s\n", p->engine, p->variant, p->setting, p->value, "failed");
       }
-      printf("reference: soft at tol %g (its error against tol %g: %.3g); %s/sweep.csv\n", SWEEP_REFERENCE_TOL,
-             SWEEP_REFERENCE_CHECK_TOL, refError, out);
+      printf("reference: soft at tol %g (its error against tol %g: %.3g", SWEEP_REFERENCE_TOL,
+             SWEEP_REFERENCE_CHECK_TOL, refError);
+      if (!isnan(refHorizon)) printf(", apart by %g from %.3g s", SWEEP_HORIZON_THRESHOLD, refHorizon);
+      printf("); self error: against the engine-variant's own finest run; horizon: the first time it is %g apart;"
+             " %s/sweep.csv\n", SWEEP_HORIZON_THRESHOLD, out);
     }
   }
-  pd_trajectory_free(ref);
-  pd_trajectory_free(check);
+  for (int k = 0; k < keptCount; ++k) pd_trajectory_free(kept[k].trajectory);
   pd_model_free(refModel);
   pd_model_free(checkModel);
   return status;

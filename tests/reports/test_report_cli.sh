@@ -94,6 +94,34 @@ sections=$(python3 -c 'import json,sys; print(",".join(json.load(open(sys.argv[1
 [[ $sections == "verdict,work-precision,cost" ]] && ok "only sweep.csv: sections verdict, work-precision, cost" || bad "sweep-only sections: $sections"
 grep -q 'PASS/FAIL matrix' "$work/s/report.html" && bad "the sweep-only page has a matrix" || ok "the sweep-only page has no matrix"
 
+# a sweep.csv written before the self-convergence columns (the first twelve only) still loads: the cost
+# is then read on the error against the reference, and the page says the columns are missing
+mkdir "$work/old"
+cut -d, -f1-12 "$fixture/sweep.csv" >"$work/old/sweep.csv"
+if "$polydyn" report "$work/old" --no-viewer 2>"$work/err" &&
+  python3 - "$work/old/report.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["sections"] == ["verdict", "work-precision", "cost"], j["sections"]
+assert not any(s["self_convergence"] for s in j["work-precision"])
+assert all(c["to_target"] == c["to_target_reference"] for s in j["work-precision"] for c in s["curves"])
+assert all(p["self_error"] is None and p["horizon_seconds"] is None for s in j["work-precision"] for c in s["curves"] for p in c["points"])
+ode = j["cost"]["rows"][[r["ev"] for r in j["cost"]["rows"]].index("ode native")]
+assert ode["to_target"]["cases/gedanken/slide.scene"]["kind"] == "never", ode
+PY
+then
+  grep -q 'no self-convergence columns' "$work/old/report.html" && ! grep -q 'class="horizon"' "$work/old/report.html" &&
+    ok "an old sweep.csv (12 columns) loads: the error against the reference, no horizon table" ||
+    bad "the old sweep.csv page does not say it has no self-convergence columns"
+else
+  bad "an old sweep.csv (12 columns) does not load: $(cat "$work/err")"
+fi
+# an old sweep concatenated after a new one: each part read with its own header
+{ cat "$fixture/sweep.csv"; cut -d, -f1-12 "$fixture/sweep.csv" | sed 's#cases/gedanken/#old/#'; } >"$work/old/sweep.csv"
+"$polydyn" report "$work/old" --no-viewer 2>"$work/err" &&
+  [[ $(python3 -c 'import json,sys; print(sum(s["self_convergence"] for s in json.load(open(sys.argv[1]))["work-precision"]))' "$work/old/report.json") == 2 ]] &&
+  ok "a new and an old sweep concatenated: each part read with its header" || bad "a mixed sweep.csv: $(cat "$work/err")"
+
 # a compare directory (metrics.csv only) gets the comparison table only
 "$polydyn" report "$src/tests/reports/fixtures/compare" -o "$work/o/cmp.html" --no-viewer 2>/dev/null
 sections=$(python3 -c 'import json,sys; print(",".join(json.load(open(sys.argv[1]))["sections"]))' "$work/o/cmp.json")
@@ -126,6 +154,12 @@ fresh; sed -i '3s/,tol,0.001,/,tol,-1,/' "$work/d/sweep.csv"
 expect_bad "a negative sweep setting" "$work/d/sweep.csv:3: value: must be a finite number > 0"
 fresh; sed -i '4s/,step,/,dt,/; 4s/,tol,/,dt,/' "$work/d/sweep.csv"
 expect_bad "an unknown sweep setting" "$work/d/sweep.csv:4: setting: expected tol or step"
+fresh; sed -i '3s/,[^,]*$/,-0.5/' "$work/d/sweep.csv"
+expect_bad "a negative horizon" "$work/d/sweep.csv:3: horizon_seconds: must be empty or a finite number ≥ 0"
+fresh; sed -i '3s/,[^,]*,[^,]*,[^,]*$/,x,soft tol=1e-12,/' "$work/d/sweep.csv"
+expect_bad "a self_error that is not a number" "$work/d/sweep.csv:3: self_error: not a number: 'x'"
+fresh; sed -i '1s/,horizon_seconds$/,horizon/' "$work/d/sweep.csv"
+expect_bad "a sweep header neither new nor old" "$work/d/sweep.csv:1: header must be exactly"
 fresh; sed -i '10s/^\([^,]*\),/\1x,/' "$work/d/series/A1.csv"
 expect_bad "a series time that is not a number" "$work/d/series/A1.csv:10: t: not a number"
 fresh; sed -i '3s/"name": "A1",/"name": "A1"/' "$work/d/experiments.json"

@@ -3,7 +3,8 @@
 json and html.parser): the page is self-contained; the PASS/FAIL matrix has one cell per
 (experiment, engine-variant) of results.csv, each showing its error; the numbers in report.json and
 report-*.csv equal those in the input CSVs and summaries; the cost to reach 1e-3 follows the
-log-log interpolation.
+log-log interpolation of the self-convergence error; the horizon of predictability table shows the
+horizons of sweep.csv.
 
 usage: test_report_content.py POLYDYN SOURCE_DIR
 """
@@ -31,6 +32,15 @@ def num(text):
 def from_json(v):
     """A number of report.json: non-finite ones are the strings nan, inf, -inf."""
     return float(v) if isinstance(v, str) else v
+
+
+def fmt(x):
+    """num() of reports/generator/lib/html.mjs for the values of the fixture: 3 significant digits."""
+    if 1e-3 <= abs(x) < 1e5:
+        t = f"{x:.3g}"
+        return t
+    m, e = f"{x:.2e}".split("e")
+    return f"{m.rstrip('0').rstrip('.')}e{int(e)}"
 
 
 def same(a, b):
@@ -133,11 +143,37 @@ class FixtureReport(ReportInDir):
         self.assertEqual(len(polar), 1)
         self.assertTrue(all(s["coordinateSystem"] == "polar" for s in polar[0]["option"]["series"]))
         loglog = [c for c in charts if c["option"].get("xAxis", {}).get("type") == "log" and c["option"]["yAxis"]["type"] == "log"]
-        self.assertEqual(len(loglog), len({r["scene"] for r in self.sweep}), "one work-precision diagram per scene")
-        # one curve per engine-variant (and setting) of each scene
-        for c, scene in zip(loglog, dict.fromkeys(r["scene"] for r in self.sweep)):
+        scenes = list(dict.fromkeys(r["scene"] for r in self.sweep))
+        self.assertEqual(len(loglog), 2 * len(scenes), "two diagrams per scene: self-convergence, against the reference")
+        # one curve per engine-variant (and setting) of each scene, the self-convergence diagram first
+        for k, scene in enumerate(scenes):
             curves = {(r["engine"], r["variant"], r["setting"]) for r in self.sweep if r["scene"] == scene}
-            self.assertEqual(len(c["option"]["series"]), len(curves))
+            for c in loglog[2 * k:2 * k + 2]:
+                self.assertEqual(len(c["option"]["series"]), len(curves))
+            self.assertIn("its own finest run", loglog[2 * k]["option"]["yAxis"]["name"])
+            self.assertIn("against", loglog[2 * k + 1]["option"]["yAxis"]["name"])
+            # the self-convergence diagram draws self_error (no point for an engine's own finest run)
+            drawn = sorted(p[1] for s in loglog[2 * k]["option"]["series"] for p in s["data"])
+            want = sorted(num(r["self_error"]) for r in self.sweep if r["scene"] == scene and r["self_error"] and num(r["self_error"]) > 0)
+            self.assertEqual(drawn, want)
+
+    # --- self-convergence: the title, the horizon of predictability
+    def test_self_convergence_title_and_horizon_table(self):
+        self.assertIn("Self-convergence (each engine against its own finest run)", self.html)
+        self.assertIn("against polydyn soft at tol 1e-12", self.html)
+        m = re.search(r'<table class="horizon">(.*?)</table>', self.html, re.S)
+        self.assertIsNotNone(m, "the horizon of predictability table")
+        rows = re.findall(r"<tr><td>(.*?)</td><td>(.*?)</td>", m.group(1))
+        parting = {r["scene"] for r in self.sweep if r["horizon_seconds"]}
+        self.assertEqual({scene for scene, _ in rows}, parting, "a row for the scenes whose runs part, only")
+        self.assertEqual(len(rows), len({(r["scene"], r["engine"], r["variant"], r["setting"]) for r in self.sweep if r["scene"] in parting}))
+        self.assertRegex(self.html, r"No run leaves its own finest run by 0\.1 in cases/gedanken/slide\.scene")
+        # every horizon of the csv is in its row's cell, the finest steps (their own reference) are not listed
+        text = m.group(1)
+        for r in self.sweep:
+            if r["horizon_seconds"]:
+                self.assertIn(f'{r["setting"]} {fmt(num(r["value"]))}: {fmt(num(r["horizon_seconds"]))} s', text)
+        self.assertNotIn("step 2.6e-4", text)
 
     # --- PASS/FAIL matrix
     def test_matrix_has_one_cell_per_experiment_and_engine_variant(self):
@@ -229,17 +265,20 @@ class FixtureReport(ReportInDir):
             self.assertTrue(same(p["error"], num(r["error"])))
             self.assertEqual(p["wall_per_sim_second"], num(r["wall_per_sim_second"]))
             self.assertEqual(p["wall_seconds"], num(r["wall_seconds"]))
+            self.assertTrue(same(p["self_error"], num(r["self_error"])))
+            self.assertEqual(p["self_reference"], r["self_reference"])
+            self.assertTrue(same(p["horizon_seconds"], num(r["horizon_seconds"])))
 
-    def test_cost_to_reach_1e_3_is_the_log_log_interpolation_on_the_curve(self):
+    def test_cost_to_reach_1e_3_is_the_log_log_interpolation_on_the_self_convergence_curve(self):
         target = 1e-3
         cost = {r["ev"]: r for r in self.json["cost"]["rows"]}
         for scene in {r["scene"] for r in self.sweep}:
             for ev in {f'{r["engine"]} {r["variant"]}' for r in self.sweep if r["scene"] == scene}:
                 best = None
                 for setting in ("tol", "step"):
-                    pts = sorted(([num(r["value"]), num(r["error"]), num(r["wall_per_sim_second"])] for r in self.sweep
+                    pts = sorted(([num(r["value"]), num(r["self_error"]), num(r["wall_per_sim_second"])] for r in self.sweep
                                   if r["scene"] == scene and f'{r["engine"]} {r["variant"]}' == ev and r["setting"] == setting
-                                  and r["error"] not in ("", "nan")), reverse=True)
+                                  and r["self_error"] not in ("", "nan")), reverse=True)
                     for k, (_, e, w) in enumerate(pts):
                         if e <= target:
                             if k == 0:
@@ -255,7 +294,12 @@ class FixtureReport(ReportInDir):
                     self.assertEqual(got["kind"], "never", f"{scene} {ev}")
                 else:
                     self.assertAlmostEqual(got["wall_per_sim_second"], best, delta=1e-12 * best, msg=f"{scene} {ev}")
-        self.assertEqual(cost["ode native"]["to_target"]["cases/gedanken/slide.scene"]["kind"], "never")
+        # ODE converges to its own answer, not to the reference's (0.004 + 2 h): cost read on self_error, not on error
+        self.assertEqual(cost["ode native"]["to_target"]["cases/gedanken/slide.scene"]["kind"], "interpolated")
+        ode = next(c for s in self.json["work-precision"] if s["scene"] == "cases/gedanken/slide.scene" for c in s["curves"] if c["ev"] == "ode native")
+        self.assertEqual(ode["to_target_reference"]["kind"], "never")
+        self.assertTrue(all(self.json["cost"]["self_convergence"].values()))
+        self.assertIn("to self-convergence error 0.001", self.html)
 
     def test_cost_table_wall_times_equal_results_csv(self):
         for r in self.json["cost"]["rows"]:

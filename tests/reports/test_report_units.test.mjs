@@ -4,11 +4,13 @@
 import test from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
+import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { parseCsv, writeCsv } from '../../reports/generator/lib/csv.mjs';
 import { parseJson, lineOf } from '../../reports/generator/lib/json.mjs';
-import { costToReach, matrix, orderEngineVariants, median, verdicts } from '../../reports/generator/lib/derive.mjs';
+import { costToReach, isOwnReference, matrix, orderEngineVariants, median, verdicts, workPrecision } from '../../reports/generator/lib/derive.mjs';
+import { readSweep } from '../../reports/generator/lib/inputs.mjs';
 import { num } from '../../reports/generator/lib/html.mjs';
 import { precision } from '../../reports/generator/lib/precision.mjs';
 import { parseArgs, outputPaths } from '../../reports/generator/report.mjs';
@@ -65,6 +67,47 @@ test('costToReach: interpolates linearly in log error and log cost between the p
   assert.equal(c.kind, 'interpolated');
   // error falls 3 decades over 2 decades of cost: 1e-3 is 2/3 of the way: cost 10^(-3 + 4/3)
   assert.ok(Math.abs(Math.log10(c.wall_per_sim_second) - (-3 + 4 / 3)) < 1e-12);
+});
+
+test('sweep.csv: the header with the self-convergence columns and the one before them both load', () => {
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'pd-units-'));
+  try {
+    const old = 'scene,engine,variant,setting,value,error,error_kind,wall_seconds,wall_per_sim_second,steps,repeats,reference';
+    const rows = (scene, own) => [
+      `${scene},ode,native,step,0.004,0.05,rms_pose,0.01,0.01,300,3,soft tol=1e-12${own ? ',0.02,ode native step=0.001,0.5' : ''}`,
+      `${scene},ode,native,step,0.001,0.05,rms_pose,0.04,0.04,1000,3,soft tol=1e-12${own ? ',,ode native step=0.001,' : ''}`];
+    fs.writeFileSync(path.join(dir, 'sweep.csv'), [old, ...rows('a', false)].join('\n') + '\n');
+    const a = readSweep(dir);
+    assert.deepEqual(a.rows.map((r) => [r.has_self, r.self_error, r.self_reference, r.horizon_seconds]), [[false, null, null, null], [false, null, null, null]]);
+    const wpOld = workPrecision(a);
+    assert.equal(wpOld[0].self_convergence, false);
+    assert.equal(wpOld[0].curves[0].to_target.kind, 'never');  // read on error: 0.05 never reaches 1e-3
+    fs.writeFileSync(path.join(dir, 'sweep.csv'), [`${old},self_error,self_reference,horizon_seconds`, ...rows('b', true), old, ...rows('a', false)].join('\n') + '\n');
+    const b = readSweep(dir);
+    assert.deepEqual(b.rows.map((r) => [r.scene, r.has_self, r.self_error, r.horizon_seconds]),
+      [['b', true, 0.02, 0.5], ['b', true, null, null], ['a', false, null, null], ['a', false, null, null]]);
+    const wp = workPrecision(b);
+    assert.equal(wp[0].self_convergence, true);
+    assert.equal(wp[0].has_horizon, true);
+    assert.equal(wp[0].curves[0].to_target.kind, 'never');  // 0.02 is the only self_error: above 1e-3
+    assert.deepEqual(wp[0].curves[0].self_references, ['ode native step=0.001']);
+    assert.equal(isOwnReference(wp[0].curves[0], wp[0].curves[0].points[1]), true);
+    assert.equal(isOwnReference(wp[0].curves[0], wp[0].curves[0].points[0]), false);
+    assert.equal(wp[1].self_convergence, false);
+  } finally {
+    fs.rmSync(dir, { recursive: true, force: true });
+  }
+});
+
+test('workPrecision: the cost is read on self_error where the sweep has it, and on error for to_target_reference', () => {
+  const row = (value, error, self, wps) => ({ scene: 's', engine: 'ode', variant: 'native', ev: 'ode native', setting: 'step', value, error,
+    self_error: self, wall_per_sim_second: wps, has_self: true, self_reference: 'ode native step=0.0001', horizon_seconds: null });
+  const wp = workPrecision({ rows: [row(0.01, 0.05, 1e-2, 1), row(0.001, 0.05, 1e-4, 10), row(0.0001, 0.05, null, 100)] });
+  const c = wp[0].curves[0];
+  assert.equal(c.to_target.kind, 'interpolated');
+  assert.ok(Math.abs(c.to_target.wall_per_sim_second - Math.sqrt(10)) < 1e-12);  // halfway in log between 1e-2 and 1e-4
+  assert.equal(c.to_target_reference.kind, 'never');
+  assert.equal(wp[0].has_horizon, false);
 });
 
 test('costToReach: "at_most" when the loosest usable point is already there, "never" when none is, failed points skipped', () => {

@@ -164,11 +164,15 @@ export function frictionCone(results) {
 
 // Work-precision curves of sweep.csv, per scene: one curve per engine-variant (split by setting when
 // an engine-variant was swept over both tol and step), points ordered from the loosest setting to
-// the tightest (value descending), each curve's cost to reach TARGET_ERROR.
+// the tightest (value descending). Each curve's cost to reach TARGET_ERROR (`to_target`, what the cost
+// table reads) is read on its self-convergence error (self_error: against the engine-variant's own finest
+// run) when every row of the scene has that column (`self_convergence`), else — a sweep.csv written before
+// it — on its error against the reference; `to_target_reference` is always read on the latter.
 export function workPrecision(sweep, target = TARGET_ERROR) {
   const scenes = [...new Set(sweep.rows.map((r) => r.scene))];
   return scenes.map((scene) => {
     const rows = sweep.rows.filter((r) => r.scene === scene);
+    const self = rows.every((r) => r.has_self);
     const curves = [];
     for (const { ev, engine, variant } of orderEngineVariants(rows)) {
       const mine = rows.filter((r) => r.ev === ev);
@@ -176,14 +180,38 @@ export function workPrecision(sweep, target = TARGET_ERROR) {
       for (const setting of settings) {
         const pts = mine.filter((r) => r.setting === setting).sort((a, b) => b.value - a.value).map((r) => ({
           value: r.value, error: r.error, wall_seconds: r.wall_seconds, wall_per_sim_second: r.wall_per_sim_second,
-          steps: r.steps, repeats: r.repeats, line: r.line }));
+          steps: r.steps, repeats: r.repeats, line: r.line, self_error: r.self_error, self_reference: r.self_reference,
+          horizon_seconds: r.horizon_seconds }));
         const label = settings.length > 1 ? `${ev} (${setting})` : ev;
-        curves.push({ label, ev, engine, variant, setting, points: pts, to_target: costToReach(pts, target) });
+        const toReference = costToReach(pts, target);
+        curves.push({ label, ev, engine, variant, setting,
+          self_references: self ? [...new Set(pts.map((p) => p.self_reference))] : [],
+          points: pts,
+          to_target: self ? costToReach(pts.map((p) => ({ ...p, error: p.self_error })), target) : toReference,
+          to_target_reference: toReference });
       }
     }
-    return { scene, error_kinds: [...new Set(rows.map((r) => r.error_kind))], references: [...new Set(rows.map((r) => r.reference))],
-      target, curves };
+    return { scene, self_convergence: self, error_kinds: [...new Set(rows.map((r) => r.error_kind))],
+      references: [...new Set(rows.map((r) => r.reference))], target,
+      has_horizon: self && rows.some((r) => r.horizon_seconds !== null), curves };
   });
+}
+
+// A point's own reference: the run its self_error is measured against is the point itself (an ODE or
+// Bullet variant's finest step: no self_error, no horizon).
+export function isOwnReference(curve, p) {
+  return p.self_reference !== null && p.self_reference === `${curve.engine} ${curve.variant} ${curve.setting}=${formatG(p.value)}`;
+}
+
+// C's %.6g for the settings swept (what polydyn sweep writes into self_reference).
+function formatG(x) {
+  const e = Math.floor(Math.log10(Math.abs(x)));
+  if (e < -4 || e >= 6) {
+    const [m, ex] = x.toExponential(5).split('e');
+    const n = Number(ex);
+    return `${m.replace(/\.?0+$/, '')}e${n < 0 ? '-' : '+'}${String(Math.abs(n)).padStart(2, '0')}`;
+  }
+  return String(Number(x.toPrecision(6)));
 }
 
 // Cost (wall seconds per simulated second) at which a curve first reaches `target`, walking from the
@@ -208,7 +236,8 @@ export function costToReach(points, target) {
 }
 
 // Cost table: per engine-variant, the wall time of the Gedanken runs (total and median per
-// experiment) and, per swept scene, the cost to reach the target error (the cheapest of its curves).
+// experiment) and, per swept scene, the cost to reach the target error (the cheapest of its curves): the
+// self-convergence error where the sweep has it (self_convergence[scene]), else the error against its reference.
 export function cost(mat, wp) {
   const evs = orderEngineVariants([
     ...(mat ? mat.cells : []).map((c) => ({ ev: c.ev, engine: c.engine, variant: c.variant })),
@@ -236,7 +265,8 @@ export function cost(mat, wp) {
       to_target,
     };
   });
-  return { scenes, target: wp && wp.length ? wp[0].target : TARGET_ERROR, rows };
+  const self_convergence = Object.fromEntries((wp || []).map((s) => [s.scene, s.self_convergence]));
+  return { scenes, self_convergence, target: wp && wp.length ? wp[0].target : TARGET_ERROR, rows };
 }
 
 // Flattens a JSON object into [key, value] pairs with dotted keys; arrays of numbers stay one value.

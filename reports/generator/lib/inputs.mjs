@@ -10,8 +10,10 @@ import { InputError } from './errors.mjs';
 export const RESULTS_HEADER = ['experiment', 'group', 'title', 'engine', 'variant', 'quantity', 'unit', 'input',
   'measured', 'expected', 'error', 'tolerance', 'status', 'wall_seconds', 'run_dir', 'note'];
 export const SERIES_HEADER = ['t', 'engine', 'variant', 'input', 'value', 'analytic'];
-export const SWEEP_HEADER = ['scene', 'engine', 'variant', 'setting', 'value', 'error', 'error_kind', 'wall_seconds',
+// sweep.csv as written since the self-convergence columns (the last three), and before them: both are read.
+export const SWEEP_HEADER_V1 = ['scene', 'engine', 'variant', 'setting', 'value', 'error', 'error_kind', 'wall_seconds',
   'wall_per_sim_second', 'steps', 'repeats', 'reference'];
+export const SWEEP_HEADER = [...SWEEP_HEADER_V1, 'self_error', 'self_reference', 'horizon_seconds'];
 export const PRECISION_HEADER = ['experiment', 'kind', 'engine', 'variant', 'setting', 'value', 'input', 'quantity', 'unit',
   'measured', 'expected', 'error', 'relative', 'tolerance', 'judged', 'status', 'wall_seconds', 'wall_per_sim_second', 'steps',
   'repeats', 'note'];
@@ -58,17 +60,25 @@ function number(value, column, file, line, { required = false, positive = false,
 }
 
 // Records of a CSV file with an exact header; blank lines and repeated header lines (several files
-// concatenated) are skipped. Returns [{line, f: {column: text}}].
-function table(src, header) {
+// concatenated) are skipped. `older`: earlier headers also accepted, each part of the file read with the
+// header above it (the columns it lacks absent from f). Returns [{line, f: {column: text}}].
+function table(src, header, older = []) {
   const records = parseCsv(src.text, src.file);
   if (records.length === 0) throw new InputError(src.file, 1, `empty file (expected the header ${header.join(',')})`);
   const first = records[0];
-  if (first.fields.join(',') !== header.join(','))
-    throw new InputError(src.file, first.line, `header must be exactly '${header.join(',')}', found '${first.fields.join(',')}'`);
+  const headers = [header, ...older];
+  const find = (fields) => headers.findIndex((h) => h.join(',') === fields.join(','));
+  if (find(first.fields) < 0)
+    throw new InputError(src.file, first.line, `header must be exactly '${header.join(',')}'` +
+      `${older.map((h) => ` or '${h.join(',')}'`).join('')}, found '${first.fields.join(',')}'`);
+  header = headers[find(first.fields)];
   const out = [];
   for (const r of records.slice(1)) {
     if (r.fields.length === 1 && r.fields[0].trim() === '') continue;
-    if (r.fields.join(',') === header.join(',')) continue;
+    if (find(r.fields) >= 0) {
+      header = headers[find(r.fields)];
+      continue;
+    }
     if (r.fields.length !== header.length)
       throw new InputError(src.file, r.line, `${header.length} fields expected, ${r.fields.length} found`);
     const f = {};
@@ -206,7 +216,7 @@ export function readSweep(dir) {
   const src = readText(dir, 'sweep.csv');
   if (!src) return null;
   const rows = [];
-  for (const { line, f } of table(src, SWEEP_HEADER)) {
+  for (const { line, f } of table(src, SWEEP_HEADER, [SWEEP_HEADER_V1])) {
     if (f.scene === '') throw new InputError(src.file, line, 'scene: empty');
     if (f.setting !== 'tol' && f.setting !== 'step')
       throw new InputError(src.file, line, `setting: expected tol or step, found '${f.setting}'`);
@@ -224,7 +234,14 @@ export function readSweep(dir) {
       steps: number(f.steps, 'steps', src.file, line, { integer: true }),
       repeats: number(f.repeats, 'repeats', src.file, line, { integer: true }),
       reference: f.reference,
+      // self-convergence (absent before those columns: has_self false, the three null)
+      has_self: 'self_reference' in f,
+      self_error: 'self_error' in f ? number(f.self_error, 'self_error', src.file, line) : null,
+      self_reference: 'self_reference' in f ? f.self_reference : null,
+      horizon_seconds: 'horizon_seconds' in f ? number(f.horizon_seconds, 'horizon_seconds', src.file, line) : null,
     };
+    if (row.horizon_seconds !== null && !(row.horizon_seconds >= 0 && Number.isFinite(row.horizon_seconds)))
+      throw new InputError(src.file, line, `horizon_seconds: must be empty or a finite number ≥ 0, not '${f.horizon_seconds}'`);
     row.ev = `${row.engine} ${row.variant}`;
     rows.push(row);
   }

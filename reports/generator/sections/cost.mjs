@@ -11,7 +11,8 @@ export default {
     const hasRuns = c.rows.some((r) => r.experiments > 0);
     const header = ['engine variant'];
     if (hasRuns) header.push('experiments run', 'wall time, total (s)', 'wall time, median per experiment (s)');
-    for (const s of c.scenes) header.push(`${esc(s)}: s per simulated s to error ${num(c.target)}`);
+    for (const s of c.scenes)
+      header.push(`${esc(s)}: s per simulated s to ${c.self_convergence[s] ? 'self-convergence error' : 'error'} ${num(c.target)}`);
     const rows = c.rows.map((r) => {
       const row = [esc(r.ev)];
       if (hasRuns) row.push({ html: String(r.experiments), cls: 'n' }, { html: num(r.total_wall_seconds), cls: 'n' },
@@ -19,15 +20,19 @@ export default {
       for (const s of c.scenes) {
         const t = r.to_target[s];
         if (!t) row.push({ html: '—', cls: 'n muted', title: 'not swept' });
-        else if (t.kind === 'never') row.push({ html: 'never', cls: 'n bad', title: 'no setting swept reaches the target error' });
+        else if (t.kind === 'never') row.push({ html: 'never', cls: 'n bad', title: 'no setting swept reaches the target error' +
+          (c.self_convergence[s] ? ' against its own finest run (a chaotic scene: see the horizon of predictability)' : '') });
         else row.push({ html: (t.kind === 'at_most' ? '≤ ' : '') + num(t.wall_per_sim_second), cls: 'n',
           title: t.kind === 'at_most' ? `already reached at the loosest setting (${t.setting_value}) of ${t.curve}` : `interpolated on ${t.curve}` });
       }
       return row;
     });
     let html = table(header, rows, 'cost');
+    const anySelf = c.scenes.some((s) => c.self_convergence[s]);
     html += `<p class="legend">Wall times are those the runs measured on the machine that ran them. The cost to reach error ${num(c.target)} is read on ` +
-      'the work-precision curve, interpolated linearly in log error–log cost between the settings on either side; "≤" when the loosest ' +
+      (anySelf ? 'the self-convergence curve (each engine against its own finest run; the error against the reference where a sweep has no ' +
+        'self-convergence column), ' : 'the work-precision curve, ') +
+      'interpolated linearly in log error–log cost between the settings on either side; "≤" when the loosest ' +
       'setting swept is already accurate enough; "never" when no setting swept gets there; the cheapest curve of an engine-variant counts.</p>';
     return {
       html,

@@ -28,7 +28,7 @@ export default {
         const reach = costs.rows.filter((r) => r.to_target[scene] && r.to_target[scene].kind !== 'never')
           .sort((a, b) => a.to_target[scene].wall_per_sim_second - b.to_target[scene].wall_per_sim_second);
         const never = costs.rows.filter((r) => r.to_target[scene] && r.to_target[scene].kind === 'never');
-        let s = `To reach an error of ${num(costs.target)} on <b>${esc(scene)}</b>, `;
+        let s = `To reach ${costs.self_convergence[scene] ? 'a self-convergence error (against its own finest run)' : 'an error'} of ${num(costs.target)} on <b>${esc(scene)}</b>, `;
         s += reach.length
           ? reach.map((r) => `${esc(r.ev)} needs ${r.to_target[scene].kind === 'at_most' ? 'at most ' : ''}${num(r.to_target[scene].wall_per_sim_second)} s per simulated second`).join(', ')
           : 'no engine gets there';
