@@ -1,6 +1,7 @@
 // polydyn CLI — shared helpers of the subcommands.
 #pragma once
 
+#include <signal.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -38,6 +39,13 @@ void pd_cli_remove_tree(const char* path);
 // directories, every rank gets tmp's name (or false), and the others' pd_cli_out_close does nothing.
 bool pd_cli_out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize);
 bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out);
+
+// Interrupts (SIGINT, SIGTERM) of the commands that catch them with pd_cli_catch_interrupts: the flag is set
+// and the command stops at its next check, removes what it had started and exits 130 ("interrupted; nothing
+// written"). pd_cli_out_close holds them back while it swaps the directories, so an interrupt never lands
+// between the two renames.
+extern volatile sig_atomic_t pd_cli_interrupted;
+void pd_cli_catch_interrupts(void);
 
 // --jobs N of the batch commands (README, Batch runs): a whole number 1..PD_CLI_MAX_JOBS; false when not.
 #define PD_CLI_MAX_JOBS 64

@@ -46,7 +46,8 @@ static const char* const help =
     "the rows of all of them, in that order. Every scene is read first: one bad scene, nothing written.\n"
     "\n"
     "An engine that is not built, or that cannot represent the scene, is reported and skipped.\n"
-    "Exit status: 0 ok, 1 the soft engine's run of a scene failed, 2 bad input.\n";
+    "Exit status: 0 ok, 1 the soft engine's run of a scene failed or DIR could not be written (then nothing is\n"
+    "kept), 2 bad input, 130 interrupted (SIGINT, SIGTERM: nothing written, an earlier DIR kept).\n";
 
 typedef struct compareRun {
   char name[32];  // ENGINE-VARIANT
@@ -59,6 +60,7 @@ typedef struct compareRun {
   double wallSeconds;
   long steps;
   pdCompareMetrics metrics;  // when status is ok
+  bool writeFailed;          // its run directory could not be written (a full disk): nothing of the scene is kept
 } compareRun;
 
 typedef struct softObserver {
@@ -68,7 +70,17 @@ typedef struct softObserver {
 
 static bool observe_soft(const pdModel* model, const pdState* state, void* user) {
   softObserver* o = user;
-  return pd_run_observe(model, state, o->writer) && pd_trajectory_observe(model, state, o->trajectory);
+  return pd_run_observe(model, state, o->writer) && pd_trajectory_observe(model, state, o->trajectory) &&
+         !pd_cli_interrupted;
+}
+
+static bool observe_reference(const pdModel* model, const pdState* state, void* user) {
+  return pd_trajectory_observe(model, state, user) && !pd_cli_interrupted;
+}
+
+static bool batch_progress(int task, int done, int total, void* user) {
+  (void)task, (void)done, (void)total, (void)user;
+  return !pd_cli_interrupted;
 }
 
 // Every word of `list` is one of `allowed` (NULL-terminated); false names the first stranger in *bad.
@@ -98,6 +110,7 @@ static void run_soft(const char* scene, const pdCliOverrides* overrides, const c
   pdRunWriter* writer = pd_run_open(dir, &err);
   if (!writer) {
     r->status = "failed";
+    r->writeFailed = true;
     snprintf(r->message, sizeof r->message, "%s", err.message);
     pd_model_free(model);
     return;
@@ -113,6 +126,7 @@ static void run_soft(const char* scene, const pdCliOverrides* overrides, const c
                     .wallSeconds = r->wallSeconds, .completed = completed};
   if (!pd_run_finish(writer, model, state, &info, &err)) {
     r->status = "failed";
+    r->writeFailed = true;
     snprintf(r->message, sizeof r->message, "%s", err.message);
   } else {
     r->status = completed ? "ok" : "failed";
@@ -128,16 +142,18 @@ static void run_reference_engine(const pdModel* model, const pdRefAdapter* adapt
   pdRunWriter* writer = pd_run_open(dir, &err);
   if (!writer) {
     r->status = "failed";
+    r->writeFailed = true;
     snprintf(r->message, sizeof r->message, "%s", err.message);
     return;
   }
   r->trajectory = pd_trajectory_create(model);
   pdRefRunStats stats;
-  bool ok = pd_ref_run(model, adapter, options, writer, pd_trajectory_observe, r->trajectory, &stats, &err);
+  bool ok = pd_ref_run(model, adapter, options, writer, observe_reference, r->trajectory, &stats, &err);
   r->wallSeconds = stats.wallSeconds;
   r->steps = stats.steps;
   if (!ok) {
     r->status = stats.refused ? "refused" : "failed";
+    r->writeFailed = !stats.refused;  // its observer never stops the run: the directory could not be written
     snprintf(r->message, sizeof r->message, "%s", err.message);
   } else if (!stats.completed) {
     r->status = "failed";
@@ -311,6 +327,7 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
       fprintf(stderr, "polydyn compare: %s: %s %s: %s\n", scene, r->name, r->status, r->message);
       if (strcmp(r->engine, "soft") == 0) h.status = PD_EXIT_FAILURE;
     }
+    if (r->writeFailed) h.written = false;
   }
   const compareRun* reference = strcmp(runs[0].status, "ok") == 0 ? &runs[0] : NULL;
   for (int i = 0; i < count; ++i)
@@ -541,6 +558,7 @@ int pd_cmd_compare(int argc, char** argv) {
       return PD_EXIT_BAD_INPUT;
     }
   char tmp[4096];
+  pd_cli_catch_interrupts();  // from here on an interrupt must remove the temporary directory
   if (!pd_cli_out_open("compare", out, "metrics.csv", tmp, sizeof tmp)) {
     free_scenes(&list);
     return PD_EXIT_BAD_INPUT;
@@ -551,10 +569,15 @@ int pd_cmd_compare(int argc, char** argv) {
 
   pdBatchBuffer* results = calloc((size_t)list.count, sizeof *results);
   if (!results) abort();
-  pdBatchOptions batch = {.workers = jobs};
+  pdBatchOptions batch = {.workers = jobs, .progress = batch_progress};
   char why[256] = "";
   int status = PD_EXIT_OK;
-  if (!pd_batch_run(list.count, scene_task, &list, &batch, results, why, sizeof why)) {
+  bool ran = pd_batch_run(list.count, scene_task, &list, &batch, results, why, sizeof why);
+  if (pd_cli_interrupted) {
+    if (pd_batch_is_root()) fprintf(stderr, "polydyn compare: interrupted; nothing written\n");
+    pd_cli_remove_tree(tmp);
+    status = 130;
+  } else if (!ran) {
     fprintf(stderr, "polydyn compare: %s\n", why);
     pd_cli_remove_tree(tmp);
     status = PD_EXIT_FAILURE;

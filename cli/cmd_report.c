@@ -63,6 +63,14 @@ static const char* generator_path(void) {
   return PD_SOURCE_DIR "/reports/generator/report.mjs";
 }
 
+// The generator's process while it runs, and the interrupt received (forwarded to it).
+static volatile pid_t child = 0;
+static volatile sig_atomic_t forwarded = 0;
+static void forward_signal(int sig) {
+  forwarded = sig;
+  if (child > 0) kill(child, sig);
+}
+
 int pd_cmd_report(int argc, char** argv) {
   const char* dir = NULL;
   const char* out = NULL;
@@ -130,18 +138,23 @@ int pd_cmd_report(int argc, char** argv) {
   }
   args[n] = NULL;
 
-  // like system(): the child gets Ctrl-C (same process group) and cleans up its temporary files;
-  // this process waits for it instead of dying first
-  struct sigaction ignore = {0}, oldInt, oldQuit;
+  // like system(), but an interrupt sent to this process alone (kill PID) reaches the child too: the child
+  // gets SIGINT/SIGTERM, cleans up its temporary files and exits 130; this process waits for it instead of
+  // dying first and leaving it writing
+  struct sigaction forward = {0}, ignore = {0}, oldInt, oldTerm, oldQuit;
+  forward.sa_handler = forward_signal;
+  sigemptyset(&forward.sa_mask);
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
-  sigaction(SIGINT, &ignore, &oldInt);
+  sigaction(SIGINT, &forward, &oldInt);
+  sigaction(SIGTERM, &forward, &oldTerm);
   sigaction(SIGQUIT, &ignore, &oldQuit);
   posix_spawnattr_t attr;
   posix_spawnattr_init(&attr);
   sigset_t defaults;
   sigemptyset(&defaults);
   sigaddset(&defaults, SIGINT);
+  sigaddset(&defaults, SIGTERM);
   sigaddset(&defaults, SIGQUIT);
   posix_spawnattr_setsigdefault(&attr, &defaults);
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
@@ -151,6 +164,8 @@ int pd_cmd_report(int argc, char** argv) {
   posix_spawnattr_destroy(&attr);
   int status = 0;
   if (rc == 0) {
+    child = pid;
+    if (forwarded) kill(pid, forwarded);  // a signal that came while spawning
     while (waitpid(pid, &status, 0) < 0) {
       if (errno != EINTR) {
         rc = errno;
@@ -158,7 +173,9 @@ int pd_cmd_report(int argc, char** argv) {
       }
     }
   }
+  child = 0;
   sigaction(SIGINT, &oldInt, NULL);
+  sigaction(SIGTERM, &oldTerm, NULL);
   sigaction(SIGQUIT, &oldQuit, NULL);
 
   if (rc != 0) {
@@ -166,7 +183,11 @@ int pd_cmd_report(int argc, char** argv) {
             node, strerror(rc));
     return PD_EXIT_FAILURE;
   }
-  if (WIFSIGNALED(status)) return WTERMSIG(status) == SIGINT ? 130 : PD_EXIT_FAILURE;
+  bool stopped = WIFSIGNALED(status) && (WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM);
+  if (stopped || (WIFEXITED(status) && WEXITSTATUS(status) == 130)) {
+    fprintf(stderr, "polydyn report: interrupted; nothing written\n");
+    return 130;
+  }
   if (!WIFEXITED(status)) return PD_EXIT_FAILURE;
   int code = WEXITSTATUS(status);
   // the generator's own statuses pass through; anything else (node itself failing) is a failure

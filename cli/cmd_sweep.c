@@ -59,7 +59,8 @@ static const char* const help =
     "             after the other, but points running side by side share the machine: the wall times then\n"
     "             measure a loaded machine. Everything but the wall times is the same bytes whatever N.\n"
     "\n"
-    "Progress goes to stderr on a terminal. Exit status: 0 ok, 1 the reference run failed, 2 bad input.\n";
+    "Progress goes to stderr on a terminal. Exit status: 0 ok, 1 the reference run failed or DIR could not be\n"
+    "written, 2 bad input, 130 interrupted (SIGINT, SIGTERM: nothing written, an earlier DIR kept).\n";
 
 static int compare_doubles(const void* a, const void* b) {
   double x = *(const double*)a, y = *(const double*)b;
@@ -120,12 +121,19 @@ typedef struct pointMeasure {
   int64_t steps;
 } pointMeasure;
 
+// Every run's observer: records the trajectory when one is given; stops the run at its next sample once the
+// sweep is interrupted (pd_cli_catch_interrupts).
+static bool observe(const pdModel* model, const pdState* state, void* trajectory) {
+  if (pd_cli_interrupted) return false;
+  return !trajectory || pd_trajectory_observe(model, state, trajectory);
+}
+
 // One soft run: trajectory (when wanted), wall time, steps, completed.
 static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* trajectory, double* wall, long* steps) {
   pdState* state = pd_state_create(model);
   state->stepper = stepper;
   double t0 = pd_cli_wall_seconds();
-  bool ok = pd_advance(model, state, model->settings.tend, trajectory ? pd_trajectory_observe : NULL, trajectory);
+  bool ok = pd_advance(model, state, model->settings.tend, observe, trajectory);
   *wall = pd_cli_wall_seconds() - t0;
   *steps = state->count.accepted;
   pd_state_free(state);
@@ -170,8 +178,7 @@ static void run_reference_engine(const pdModel* model, int repeats, point* p, pd
   for (int r = 0; r < repeats; ++r) {
     pdRefRunStats stats;
     pdError err = {0};
-    bool ok = pd_ref_run(model, adapter, &o, NULL, r == 0 ? pd_trajectory_observe : NULL, r == 0 ? tr : NULL,
-                         &stats, &err);
+    bool ok = pd_ref_run(model, adapter, &o, NULL, observe, r == 0 ? tr : NULL, &stats, &err);
     p->completed = ok && stats.completed;
     p->steps = stats.steps;
     walls[r] = stats.wallSeconds;
@@ -197,6 +204,7 @@ typedef struct keptRun {
 typedef struct keptRuns {
   keptRun* runs;
   int repeats;
+  bool progress;  // show it (stderr is a terminal)
 } keptRuns;
 
 typedef struct keptHeader {
@@ -249,7 +257,7 @@ static bool take_kept(const pdBatchBuffer* bytes, keptRun* r) {
 
 static bool kept_progress(int task, int done, int total, void* user) {
   const keptRuns* all = user;
-  if (task >= 0) {
+  if (task >= 0 && all->progress) {
     const point* p = all->runs[task].point;
     if (p)
       fprintf(stderr, "\rpolydyn sweep: reference runs: %s %s %s %.3g (%d/%d)\033[K", p->engine, p->variant, p->setting,
@@ -258,7 +266,7 @@ static bool kept_progress(int task, int done, int total, void* user) {
       fprintf(stderr, "\rpolydyn sweep: reference runs: soft tol %g (%d/%d)\033[K", all->runs[task].model->settings.tol,
               done, total);
   }
-  return true;
+  return !pd_cli_interrupted;
 }
 
 typedef struct pointRuns {
@@ -305,12 +313,12 @@ static void take_point(const pdBatchBuffer* bytes, point* p) {
 
 static bool point_progress(int task, int done, int total, void* user) {
   const pointRuns* r = user;
-  if (task >= 0) {
+  if (task >= 0 && r->progress) {
     const point* p = &r->points[r->todo[task]];
     fprintf(stderr, "\rpolydyn sweep: %s %s %s %.3g (%d/%d)\033[K", p->engine, p->variant, p->setting, p->value,
             done, total);
   }
-  return true;
+  return !pd_cli_interrupted;
 }
 
 // "ENGINE VARIANT SETTING=VALUE" of the run a point's self_error is measured against.
@@ -417,11 +425,11 @@ int pd_cmd_sweep(int argc, char** argv) {
     return PD_EXIT_BAD_INPUT;
   }
   for (int k = 0; k < keptCount; ++k) kept[k].model = k == 1 ? checkModel : refModel;
-  keptRuns keptAll = {kept, (int)repeats};
+  keptRuns keptAll = {kept, (int)repeats, progress};
+  pd_cli_catch_interrupts();
   pdBatchBuffer keptBytes[MAX_KEPT];
   char why[256] = "";
-  pdBatchOptions batch = {.workers = jobs, .everywhere = true, .progress = progress ? kept_progress : NULL,
-                          .progressUser = &keptAll};
+  pdBatchOptions batch = {.workers = jobs, .everywhere = true, .progress = kept_progress, .progressUser = &keptAll};
   bool refOk = pd_batch_run(keptCount, kept_task, &keptAll, &batch, keptBytes, why, sizeof why);
   for (int k = 0; k < keptCount; ++k) {
     kept[k].trajectory = pd_trajectory_create(kept[k].model);
@@ -431,14 +439,19 @@ int pd_cmd_sweep(int argc, char** argv) {
   pdTrajectory* ref = kept[0].trajectory;
   pdTrajectory* check = kept[1].trajectory;
   refOk = refOk && kept[0].completed && kept[1].completed;
+  if (pd_cli_interrupted) refOk = false;
   if (!refOk) {
     if (progress) fputs("\r\033[K", stderr);
-    if (why[0]) fprintf(stderr, "polydyn sweep: %s\n", why);
-    fprintf(stderr, "polydyn sweep: the reference run (soft at tol %g) did not complete\n", SWEEP_REFERENCE_TOL);
+    if (pd_cli_interrupted) {
+      if (pd_batch_is_root()) fprintf(stderr, "polydyn sweep: interrupted; nothing written\n");
+    } else {
+      if (why[0]) fprintf(stderr, "polydyn sweep: %s\n", why);
+      fprintf(stderr, "polydyn sweep: the reference run (soft at tol %g) did not complete\n", SWEEP_REFERENCE_TOL);
+    }
     for (int k = 0; k < keptCount; ++k) pd_trajectory_free(kept[k].trajectory);
     pd_model_free(refModel);
     pd_model_free(checkModel);
-    return PD_EXIT_FAILURE;
+    return pd_cli_interrupted ? 130 : PD_EXIT_FAILURE;
   }
   double refHorizon;  // when the reference itself leaves its check: where no point can be judged any more
   double refError = pose_error(refModel, ref, check, &refHorizon);
@@ -461,7 +474,7 @@ int pd_cmd_sweep(int argc, char** argv) {
   pointRuns runs = {scene, &base, (int)repeats, refModel, kept, points, todo, progress};
   pdBatchBuffer* measured = calloc((size_t)todoCount + 1, sizeof *measured);
   if (!measured) abort();
-  batch = (pdBatchOptions){.workers = jobs, .progress = progress ? point_progress : NULL, .progressUser = &runs};
+  batch = (pdBatchOptions){.workers = jobs, .progress = point_progress, .progressUser = &runs};
   bool pointsOk = pd_batch_run(todoCount, point_task, &runs, &batch, measured, why, sizeof why);
   for (int k = 0; k < todoCount; ++k) {
     if (pointsOk && pd_batch_is_root()) take_point(&measured[k], &points[todo[k]]);
@@ -471,13 +484,17 @@ int pd_cmd_sweep(int argc, char** argv) {
   if (progress) fputs("\r\033[K", stderr);
   // DIR under a temporary name, made only now (an interrupted sweep leaves nothing); MPI: rank 0 writes
   char tmp[4096];
+  if (pd_cli_interrupted) pointsOk = false;
   bool opened = pointsOk && pd_cli_out_open("sweep", out, "sweep.csv", tmp, sizeof tmp);
   if (!opened || !pd_batch_is_root()) {
-    if (!pointsOk) fprintf(stderr, "polydyn sweep: %s\n", why);
+    if (pd_cli_interrupted && pd_batch_is_root())
+      fprintf(stderr, "polydyn sweep: interrupted; nothing written\n");
+    else if (!pointsOk)
+      fprintf(stderr, "polydyn sweep: %s\n", why);
     for (int k = 0; k < keptCount; ++k) pd_trajectory_free(kept[k].trajectory);
     pd_model_free(refModel);
     pd_model_free(checkModel);
-    return !pointsOk ? PD_EXIT_FAILURE : opened ? PD_EXIT_OK : PD_EXIT_BAD_INPUT;
+    return pd_cli_interrupted ? 130 : !pointsOk ? PD_EXIT_FAILURE : opened ? PD_EXIT_OK : PD_EXIT_BAD_INPUT;
   }
 
   // write DIR's files, then rename

@@ -1,6 +1,7 @@
 // polydyn — the command line: subcommands dispatch to the engine (and later refcheck, reports).
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -127,6 +128,9 @@ int main(int argc, char** argv) {
     return PD_EXIT_BAD_INPUT;
   }
   if (!pd_batch_is_root() && !freopen("/dev/null", "w", stdout)) return PD_EXIT_FAILURE;
+  // A file-size limit (ulimit -f) must end in a failed write that the command reports and cleans up after,
+  // like a full disk, not in SIGXFSZ killing the process with a temporary directory left behind.
+  signal(SIGXFSZ, SIG_IGN);
   int status = dispatch(argc, argv);
   pd_batch_mpi_stop();
   return status;

@@ -71,8 +71,29 @@ static bool out_open(const char* cmd, const char* out, const char* marker, char*
   return true;
 }
 
+volatile sig_atomic_t pd_cli_interrupted = 0;
+static void on_interrupt(int sig) {
+  (void)sig;
+  pd_cli_interrupted = 1;
+}
+
+void pd_cli_catch_interrupts(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_interrupt;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+}
+
 bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out) {
   if (!pd_batch_is_root()) return true;
+  // no interrupt between moving the earlier result aside and the new one into place (delivered after)
+  sigset_t held, saved;
+  sigemptyset(&held);
+  sigaddset(&held, SIGINT);
+  sigaddset(&held, SIGTERM);
+  sigaddset(&held, SIGHUP);
+  sigprocmask(SIG_BLOCK, &held, &saved);
   struct stat st;
   char old[4200];
   snprintf(old, sizeof old, "%s.old-%ld", out, (long)getpid());
@@ -83,5 +104,6 @@ bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out) {
     fprintf(stderr, "polydyn %s: cannot write %s: %s\n", cmd, out, strerror(errno));
     pd_cli_remove_tree(tmp);
   }
+  sigprocmask(SIG_SETMASK, &saved, NULL);
   return ok;
 }

@@ -630,6 +630,15 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
       pd_error_set(err, options->out, 0, 0, "%s", why);
     }
   }
+  // a run directory that could not be written (a full disk, a file-size limit) fails the whole suite: its rows
+  // would replace a complete earlier result with ERROR rows that measure the disk, not the engine
+  for (int i = 0; ok && !interrupted(&s) && i < s.jobCount; ++i)
+    if (s.jobs[i].status == pd_gkError) {
+      pd_error_set(err, options->out, 0, 0, "%s %s%s%s: %s; nothing written", s.jobs[i].c->experiment->name,
+                   pdGkEngineNames[s.jobs[i].engine], s.jobs[i].c->label[0] ? " " : "", s.jobs[i].c->label,
+                   s.jobs[i].note);
+      ok = false;
+    }
   if (ok && options->precision) {
     ok = gk_precision_run(options, s.cases, s.caseCount, s.root, err);
     summary->interrupted = interrupted(&s);

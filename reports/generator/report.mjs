@@ -16,7 +16,7 @@ import crypto from 'node:crypto';
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { InputError, UsageError, SetupError } from './lib/errors.mjs';
+import { InputError, UsageError, SetupError, WriteError } from './lib/errors.mjs';
 import { readResults, readExperiments, readSeries, readSweep, readPrecision, readMetrics, readSummary, readCubetoss } from './lib/inputs.mjs';
 import { precision as derivePrecision } from './lib/precision.mjs';
 import { loadTypical } from './lib/cubetoss.mjs';
@@ -294,6 +294,7 @@ export function outputPaths(dir, out, csvNames = []) {
 }
 
 const temporaries = new Set();
+let written = false;  // every output renamed into place
 const removeTree = (p) => fs.rmSync(p, { recursive: true, force: true });
 
 // Writes every file under a temporary name, and the replay folder (replays: [name, text] pairs, or
@@ -322,6 +323,9 @@ function writeAll(files, folder, replays) {
       fs.renameSync(t, file);
       temporaries.delete(t);
     }
+  } catch (e) {
+    if (e && e.code && e.syscall) throw new WriteError(`cannot write ${e.path || path.dirname(folder)}: ${e.code} (${e.syscall})`);
+    throw e;
   } finally {
     for (const t of temporaries) removeTree(t);
     temporaries.clear();
@@ -349,6 +353,7 @@ export function main(argv) {
   const { html, json, csvs, replays } = generate(dir, inputs, { viewerSource, replayFolder: path.basename(replayFolder) });
   const out = outputPaths(dir, opts.out, csvs.map((c) => c.name));
   writeAll([[out.json, json], ...csvs.map((c) => [out.csv[c.name], c.text]), [out.page, html]], out.replays, replays.length ? replays : null);
+  written = true;
   const mb = (n) => `${(n / 1e6).toFixed(1)} MB`;
   process.stderr.write(`polydyn report: wrote ${out.page} (${mb(html.length)}), ${path.basename(out.json)}, ${csvs.length} CSV table${csvs.length === 1 ? '' : 's'}` +
     `${replays.length ? ` and ${replays.length} replays in ${path.basename(out.replays)}/ (${mb(replays.reduce((n, [, t]) => n + t.length, 0))})` : ''}\n`);
@@ -356,10 +361,12 @@ export function main(argv) {
 }
 
 if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.meta.url)) {
+  // A signal is handled between synchronous work: after writeAll it finds the report complete (exit 0), before
+  // it nothing written but temporaries, which it removes (exit 130).
   for (const sig of ['SIGINT', 'SIGTERM']) {
     process.on(sig, () => {
       for (const tmp of temporaries) removeTree(tmp);
-      process.exit(130);
+      process.exit(written ? 0 : 130);
     });
   }
   let status;
@@ -372,7 +379,7 @@ if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.me
     } else if (e instanceof UsageError) {
       process.stderr.write(`polydyn report: ${e.message} (see 'polydyn report --help')\n`);
       status = 2;
-    } else if (e instanceof SetupError) {
+    } else if (e instanceof SetupError || e instanceof WriteError) {
       process.stderr.write(`polydyn report: ${e.message}\n`);
       status = 1;
     } else {

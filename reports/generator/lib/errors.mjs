@@ -15,3 +15,7 @@ export class UsageError extends Error {}
 
 // A failure of the set-up (charting library not installed, ...): exit status 1.
 export class SetupError extends Error {}
+
+// An output that could not be written (a full disk, a file-size limit, a directory without permission): exit 1,
+// nothing of the report left behind.
+export class WriteError extends Error {}
