@@ -155,13 +155,14 @@ int pd_cmd_soak(int argc, char** argv) {
   }
   if (job.engineCount == 0) return pd_cli_usage_error("soak", "--engines needs a list like soft,ode,bullet");
 
-  char tmp[4096];
-  if (!pd_cli_out_open("soak", out, "summary.csv", tmp, sizeof tmp)) return PD_EXIT_BAD_INPUT;
+  // caught before the temporary directory is made, so that an interrupt always removes it
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = on_signal;
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
+  char tmp[4096];
+  if (!pd_cli_out_open("soak", out, "summary.csv", tmp, sizeof tmp)) return PD_EXIT_BAD_INPUT;
 
   pdBatchBuffer* results = calloc((size_t)scenes, sizeof *results);
   if (!results) abort();
