@@ -7,15 +7,16 @@
 # command completed and replaced it with a complete one), never a temporary directory left behind, and an exit
 # status that says what happened (0 done, 1 could not write, 2 bad input, 130 interrupted).
 #
-# usage: test_faults.sh POLYDYN_BINARY SOURCE_DIR [SEED]
+# usage: test_faults.sh POLYDYN_BINARY SOURCE_DIR [SEED [MOMENTS]]   (MOMENTS per signal, default 3)
 set -u
 if [ $# -lt 2 ]; then
-  echo "usage: $0 POLYDYN_BINARY SOURCE_DIR [SEED]" >&2
+  echo "usage: $0 POLYDYN_BINARY SOURCE_DIR [SEED [MOMENTS]]" >&2
   exit 2
 fi
 PD=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
 SRC=$(cd "$2" && pwd)
 SEED=${3:-1}
+MOMENTS=${4:-3}
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_faults.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
 . "$SRC/tests/lib.sh"  # check, no_partial
@@ -46,7 +47,7 @@ names() { (cd "$1" && find . -type f | sort); }
 delays() {
   python3 -c 'import random, sys
 r = random.Random(int(sys.argv[1]) * 1000 + int(sys.argv[2]))
-print(" ".join("%.3f" % (0.1 + 1.4 * r.random() ** 2) for _ in range(3)))' "$SEED" "$1"
+print(" ".join("%.3f" % (0.1 + 1.4 * r.random() ** 2) for _ in range(int(sys.argv[3]))))' "$SEED" "$1" "$MOMENTS"
 }
 
 index=0
