@@ -242,7 +242,8 @@ static int make_engines(const options* o, engineSpec* specs, char* why, size_t w
     bool soft = e == 0;
     s->variant = soft ? "adaptive" : o->variant == pd_refMatched ? "matched" : "native";
     snprintf(s->label, sizeof s->label, soft ? "%s" : "%s-%s", s->name, s->variant);
-    s->engine = (pdTossEngine){.name = s->name, .ref = {o->variant, o->step, pd_odeFrictionPyramid}};
+    s->engine = (pdTossEngine){.name = s->name,
+                               .ref = {.variant = o->variant, .step = o->step, .odeFriction = pd_odeFrictionPyramid}};
     s->built = soft || pd_ref_adapter(s->name) != NULL;
     s->params = pd_toss_default_params();
     s->params.tol = o->tol;

@@ -75,7 +75,7 @@ int pd_cmd_run(int argc, char** argv) {
   const char* engine = "soft";
   pdCliOverrides overrides = {0};
   pdStepper stepper = pd_stepperRK4Adaptive;
-  pdRefOptions ref = {pd_refNative, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid};
+  pdRefOptions ref = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
   bool refOptionGiven = false, stepperGiven = false;
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];

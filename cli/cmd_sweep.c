@@ -174,7 +174,9 @@ static void run_reference_engine(const pdModel* model, int repeats, point* p, pd
   p->error = p->selfError = p->horizon = p->wall = NAN;
   p->steps = 0;
   double walls[SWEEP_MAX_REPEATS];
-  pdRefOptions o = {strcmp(p->variant, "matched") == 0 ? pd_refMatched : pd_refNative, p->value, pd_odeFrictionPyramid};
+  pdRefOptions o = {.variant = strcmp(p->variant, "matched") == 0 ? pd_refMatched : pd_refNative,
+                    .step = p->value,
+                    .odeFriction = pd_odeFrictionPyramid};
   for (int r = 0; r < repeats; ++r) {
     pdRefRunStats stats;
     pdError err = {0};

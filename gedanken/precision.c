@@ -22,10 +22,14 @@
 static const double softTolerances[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
 static const double softFixedSteps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};                              // s
 static const double referenceSteps[] = {1.0 / 60, 1.0 / 250, 1.0 / 1000, 1.0 / 4000, 1.0 / 16000};  // s
+// Bullet's sequential-impulse solver iterations per step, at the default step (ODE's dWorldStep solves its LCP
+// exactly: it has no such knob). The adapter's default is 100.
+static const double bulletIterations[] = {5, 10, 20, 50, 100, 200};
 enum {
   SOFT_TOL_COUNT = sizeof softTolerances / sizeof softTolerances[0],
   SOFT_FIXED_COUNT = sizeof softFixedSteps / sizeof softFixedSteps[0],
   REFERENCE_STEP_COUNT = sizeof referenceSteps / sizeof referenceSteps[0],
+  BULLET_ITERATION_COUNT = sizeof bulletIterations / sizeof bulletIterations[0],
   MAX_REPEATS = 21,
 };
 
@@ -44,7 +48,7 @@ typedef struct gkPoint {
   const gkCase* c;
   pdGkEngine engine;
   const char* variant;  // "adaptive", "fixed", "native", "matched"
-  const char* setting;  // "tol", "step"; "" for a not_built row
+  const char* setting;  // "tol", "step", "iterations"; "" for a not_built row
   double value;
   // measured (travels between processes as gkPointResult)
   gkPointStatus status;
@@ -147,9 +151,11 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
       if (!completed) point_note(p, "the run stopped at t = %.6g s", state->t);
       pd_state_free(state);
     } else {
+      bool iterations = strcmp(p->setting, "iterations") == 0;
       pdRefOptions options = {.variant = strcmp(p->variant, "matched") == 0 ? pd_refMatched : pd_refNative,
-                              .step = p->value,
-                              .odeFriction = pd_odeFrictionPyramid};
+                              .step = iterations ? PD_REF_DEFAULT_STEP : p->value,
+                              .odeFriction = pd_odeFrictionPyramid,
+                              .iterations = iterations ? (int)p->value : 0};
       pdRefRunStats stats;
       bool ran = pd_ref_run(c->model, adapter, &options, NULL, observe, &observer, &stats, &err);
       walls[r] = stats.wallSeconds;
@@ -253,6 +259,9 @@ static void add_case_points(gkPrecision* s, const gkCase* c) {
         continue;
       }
       for (int k = 0; k < REFERENCE_STEP_COUNT; ++k) add(s, c, (pdGkEngine)engine, variant, "step", referenceSteps[k]);
+      if (engine == pd_gkBullet)
+        for (int k = 0; k < BULLET_ITERATION_COUNT; ++k)
+          add(s, c, (pdGkEngine)engine, variant, "iterations", bulletIterations[k]);
     }
   }
 }
@@ -310,7 +319,8 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
 
 bool gk_precision_run(const pdGkOptions* options, const gkCase* cases, int caseCount, const char* root, pdError* err) {
   PD_ASSERT(options->repeats >= 1 && options->repeats <= MAX_REPEATS);
-  int perCase = SOFT_TOL_COUNT + SOFT_FIXED_COUNT + 2 * (pd_gkEngineCount - 1) * REFERENCE_STEP_COUNT;
+  int perCase = SOFT_TOL_COUNT + SOFT_FIXED_COUNT + 2 * (pd_gkEngineCount - 1) * REFERENCE_STEP_COUNT +
+                2 * BULLET_ITERATION_COUNT;
   gkPrecision s = {.options = options, .points = calloc((size_t)caseCount * (size_t)perCase + 1, sizeof(gkPoint))};
   PD_ASSERT(s.points != NULL);
   for (int i = 0; i < caseCount; ++i) {

@@ -155,6 +155,7 @@ static pdRefWorld* bullet_create(const pdModel* model, const pdRefOptions* optio
   w->model = model;
   w->variant = options->variant;
   w->solver = options->variant == pd_refMatched ? matchedSettings : nativeSettings;
+  if (options->iterations > 0) w->solver.iterations = options->iterations;  // work-precision over the solver
   w->principal = calloc((size_t)model->movingCount + 1, sizeof *w->principal);
   w->last = calloc((size_t)model->movingCount + 1, sizeof *w->last);
   if (!w->principal || !w->last) abort();

@@ -17,7 +17,7 @@
 
 static void check_applied_force(const pdRefAdapter* adapter, pdRefVariant variant) {
   const double h = PD_REF_DEFAULT_STEP, T = 1.0;
-  pdRefOptions options = {variant, h, pd_odeFrictionPyramid};
+  pdRefOptions options = {.variant = variant, .step = h, .odeFriction = pd_odeFrictionPyramid};
   pdError err;
   memset(&err, 0, sizeof err);
 

@@ -55,7 +55,7 @@ static const pdRefAdapter* bullet(void) {
 static pdRefWorld* create(const pdModel* m, pdRefVariant variant, double step) {
   pdError err;
   memset(&err, 0, sizeof err);
-  pdRefOptions options = {variant, step, pd_odeFrictionPyramid};
+  pdRefOptions options = {.variant = variant, .step = step, .odeFriction = pd_odeFrictionPyramid};
   pdRefWorld* w = bullet()->create(m, &options, &err);
   if (!w) fail_msg("create: %d:%d: %s", err.line, err.col, err.message);
   return w;
@@ -301,7 +301,7 @@ static bool run_to(const pdModel* model, pdRefVariant variant, const char* dir, 
                    bool* finite) {
   pdRunWriter* writer = pd_run_open(dir, err);
   if (!writer) fail_msg("%s: %s", dir, err->message);
-  pdRefOptions options = {variant, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid};
+  pdRefOptions options = {.variant = variant, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
   *finite = true;
   return pd_ref_run(model, bullet(), &options, writer, all_finite, finite, stats, err);
 }
@@ -394,7 +394,7 @@ static void test_spin_too_fast_for_the_step_is_refused(void** state) {
                             "cube box red 0.1 0.1 0.1\nvel 0 0 0  50000 0 0 1\n");  // 873 rad/s > (π/4)/1 ms
   pdError err;
   memset(&err, 0, sizeof err);
-  pdRefOptions options = {pd_refNative, 1e-3, pd_odeFrictionPyramid};
+  pdRefOptions options = {.variant = pd_refNative, .step = 1e-3, .odeFriction = pd_odeFrictionPyramid};
   assert_null(bullet()->create(m, &options, &err));
   print_message("refused: %s:%d:%d: %s\n", err.file, err.line, err.col, err.message);
   assert_int_equal(err.line, 2);

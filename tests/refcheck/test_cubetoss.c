@@ -437,7 +437,9 @@ static void test_missing_adapter_is_reported_not_built(void** state) {
   pdTossParams p = pd_toss_default_params();
   const char* const names[] = {"ode", "bullet"};
   for (int i = 0; i < 2; ++i) {
-    pdTossEngine e = {.name = names[i], .ref = {pd_refNative, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid}};
+    pdTossEngine e = {
+        .name = names[i],
+        .ref = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid}};
     pdTossResult r;
     pdTrajectory* tr = pd_toss_simulate(&set->tosses[0], &p, &e, NULL, &r);
     if (pd_ref_adapter(names[i])) {

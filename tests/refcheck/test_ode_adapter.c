@@ -92,7 +92,7 @@ static const pdRefAdapter* ode(void) {
 }
 
 static pdRefWorld* create(const pdModel* m, pdRefVariant variant, pdOdeFriction friction) {
-  pdRefOptions o = {variant, PD_REF_DEFAULT_STEP, friction};
+  pdRefOptions o = {.variant = variant, .step = PD_REF_DEFAULT_STEP, .odeFriction = friction};
   pdError err;
   memset(&err, 0, sizeof err);
   pdRefWorld* w = ode()->create(m, &o, &err);
@@ -172,7 +172,7 @@ static void test_trajectory_starts_at_the_scene_pose(void** state) {
   char* tmp = temp_dir();
   char dir[512];
   snprintf(dir, sizeof dir, "%s/run", tmp);
-  pdRefOptions o = {pd_refNative, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid};
+  pdRefOptions o = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
   pdRefRunStats stats;
   pdError err;
   memset(&err, 0, sizeof err);
@@ -394,8 +394,9 @@ static char* read_all(const char* path, size_t* size) {
 static void test_two_runs_give_identical_bytes(void** state) {
   (void)state;
   pdModel* m = compile_file(PD_SOURCE_DIR "/cases/examples/demo.scene");
-  const pdRefOptions options[] = {{pd_refNative, PD_REF_DEFAULT_STEP, pd_odeFrictionAligned},
-                                  {pd_refMatched, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid}};
+  const pdRefOptions options[] = {
+      {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionAligned},
+      {.variant = pd_refMatched, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid}};
   for (int i = 0; i < 2; ++i) {
     char* tmp = temp_dir();
     char dirs[2][512];
@@ -504,7 +505,7 @@ static void run_cases_in(const char* folder) {
       char* tmp = temp_dir();
       char dir[512];
       snprintf(dir, sizeof dir, "%s/run", tmp);
-      pdRefOptions o = {variants[v], PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid};
+      pdRefOptions o = {.variant = variants[v], .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
       pdRefRunStats stats;
       pdError err;
       memset(&err, 0, sizeof err);

@@ -370,19 +370,19 @@ class PrecisionReport(ReportInDir):
         cls.src = os.path.join(cls.dir, "gedanken")
         subprocess.run([POLYDYN, "gedanken", "--only", "a1_restitution,c2_momentum,c3_eccentric_bar", "--precision",
                         "--out", cls.src], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        # as a build without Bullet writes it: two not_built rows per experiment instead of Bullet's points
+        # as a build without ODE writes it: two not_built rows per experiment instead of ODE's points
         path = os.path.join(cls.src, "precision.csv")
         with open(path, newline="", encoding="utf-8") as f:
             reader = csv.DictReader(f)
             header, rows = reader.fieldnames, list(reader)
         kept, seen = [], set()
         for r in rows:
-            if r["engine"] != "bullet":
+            if r["engine"] != "ode":
                 kept.append(r)
             elif (r["experiment"], r["variant"]) not in seen:
                 seen.add((r["experiment"], r["variant"]))
                 kept.append({**r, "setting": "", "value": "", "measured": "", "error": "", "status": "not_built", "wall_seconds": "",
-                             "wall_per_sim_second": "", "steps": "0", "note": "this build of polydyn has no bullet adapter"})
+                             "wall_per_sim_second": "", "steps": "0", "note": "this build of polydyn has no ode adapter"})
         with open(path, "w", newline="", encoding="utf-8") as f:
             w = csv.DictWriter(f, header, lineterminator="\n")
             w.writeheader()
@@ -392,13 +392,21 @@ class PrecisionReport(ReportInDir):
             cls.results = list(csv.DictReader(f))
         cls.html, cls.json = make_report(cls.src, cls.dir)
 
-    def expected_cost(self, experiment, ev):
-        """(kind, cost, smallest error): the first setting, loosest first, whose error is within the tolerance,
-        the cost interpolated log-log from the setting before it."""
-        pts = [r for r in self.rows if r["experiment"] == experiment and f'{r["engine"]} {r["variant"]}' == ev]
+    def expected_cost(self, experiment, ev, setting=None):
+        """(kind, cost, smallest error) of one curve (one knob of an engine-variant; None: the cheapest that reaches
+        the tolerance): the first setting, loosest first (largest tol or step, fewest iterations), whose error is
+        within the tolerance, the cost interpolated log-log from the setting before it."""
+        if setting is None:
+            curves = [self.expected_cost(experiment, ev, k) for k in {r["setting"] for r in self.rows
+                      if r["experiment"] == experiment and f'{r["engine"]} {r["variant"]}' == ev}]
+            reached = [c for c in curves if c[0] in ("at_most", "interpolated")]
+            return min(reached, key=lambda c: c[1]) if reached else curves[0]
+        pts = [r for r in self.rows if r["experiment"] == experiment and f'{r["engine"]} {r["variant"]}' == ev
+               and (r["setting"] == setting or r["status"] == "not_built")]
         if all(r["status"] == "not_built" for r in pts):
             return "not_built", None, None
-        ok = sorted(([float(r["value"]), float(r["error"]), float(r["wall_per_sim_second"])] for r in pts if r["status"] == "ok"), reverse=True)
+        ok = sorted(([float(r["value"]), float(r["error"]), float(r["wall_per_sim_second"])] for r in pts if r["status"] == "ok"),
+                    reverse=setting != "iterations")
         tol = float(pts[0]["tolerance"])
         smallest = min(e for _, e, _ in ok) if ok else None
         for k, (_, e, w) in enumerate(ok):
@@ -415,11 +423,13 @@ class PrecisionReport(ReportInDir):
         self.assertIn("precision", self.json["sections"])
 
     def test_one_curve_per_experiment_and_engine_variant_with_the_cost_to_its_tolerance(self):
-        got = {(r["experiment"], f'{r["engine"]} {r["variant"]}'): r for r in self.table("precision")}
-        want = {(r["experiment"], f'{r["engine"]} {r["variant"]}') for r in self.rows}
+        got = {(r["experiment"], f'{r["engine"]} {r["variant"]}', r["setting"]): r for r in self.table("precision")}
+        want = {(r["experiment"], f'{r["engine"]} {r["variant"]}', r["setting"]) for r in self.rows}
         self.assertEqual(set(got), want)
-        for (experiment, ev), r in got.items():
-            kind, cost, smallest = self.expected_cost(experiment, ev)
+        if any(r["engine"] == "bullet" for r in self.rows if r["status"] != "not_built"):  # a build with Bullet
+            self.assertIn(("a1_restitution", "bullet native", "iterations"), want)
+        for (experiment, ev, setting), r in got.items():
+            kind, cost, smallest = self.expected_cost(experiment, ev, setting)
             self.assertEqual(r["to_tolerance"], kind, f"{experiment} {ev}")
             if cost is not None:
                 self.assertAlmostEqual(float(r["wall_per_sim_second"]), cost, delta=1e-12 * cost, msg=f"{experiment} {ev}")
@@ -429,12 +439,12 @@ class PrecisionReport(ReportInDir):
                 self.assertIn(r["never_reason"], ("stalls", "still_falling", "no_result", "one_point"))
 
     def test_a_missing_engine_is_reported_not_built_not_left_out(self):
-        rows = [r for r in self.table("precision") if r["engine"] == "bullet"]
+        rows = [r for r in self.table("precision") if r["engine"] == "ode"]
         self.assertEqual(len(rows), 2 * 3)
         self.assertTrue(all(r["to_tolerance"] == "not_built" for r in rows))
         self.assertIn("not built", self.html)
         summary = {f'{r["engine"]} {r["variant"]}': r for r in self.table("summary")}
-        self.assertIn("bullet native", summary)
+        self.assertIn("ode native", summary)
 
     def test_summary_counts_equal_the_results_and_the_precision_curves(self):
         summary = {f'{r["engine"]} {r["variant"]}': r for r in self.table("summary")}
@@ -447,7 +457,7 @@ class PrecisionReport(ReportInDir):
             self.assertEqual(int(summary[ev]["experiments"]), len(judged), ev)
             self.assertEqual(int(summary[ev]["pass"]), sum(all(s == "PASS" for s in cells[x]) for x in judged), ev)
         for ev, r in summary.items():
-            if ev.startswith("bullet"):
+            if ev.startswith("ode"):
                 continue
             judged = {x["experiment"] for x in self.rows if f'{x["engine"]} {x["variant"]}' == ev and x["judged"] == "true"}
             reached = [x for x in judged if self.expected_cost(x, ev)[0] in ("at_most", "interpolated")]

@@ -46,6 +46,8 @@ typedef struct pdRefOptions {
   pdRefVariant variant;
   double step;                // s, > 0
   pdOdeFriction odeFriction;  // ODE only
+  int iterations;             // Bullet: sequential-impulse iterations per step, 0 for the adapter's (100); ODE's
+                              // dWorldStep solves its LCP exactly and has none
 } pdRefOptions;
 
 typedef struct pdRefWorld pdRefWorld;

@@ -261,8 +261,8 @@ export function readPrecision(dir) {
   for (const { line, f } of table(src, PRECISION_HEADER)) {
     if (f.experiment === '') throw new InputError(src.file, line, 'experiment: empty');
     const status = oneOf(f.status, PRECISION_STATUSES, 'status', src.file, line);
-    if (status !== 'not_built' && f.setting !== 'tol' && f.setting !== 'step')
-      throw new InputError(src.file, line, `setting: expected tol or step, found '${f.setting}'`);
+    if (status !== 'not_built' && !['tol', 'step', 'iterations'].includes(f.setting))
+      throw new InputError(src.file, line, `setting: expected tol, step or iterations, found '${f.setting}'`);
     const row = {
       line,
       experiment: word(f.experiment, 'experiment', src.file, line),

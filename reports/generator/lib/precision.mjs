@@ -37,20 +37,30 @@ export function precision(prec, experiments) {
   const order = experiments ? experiments.list.map((e) => e.name) : [];
   names.sort((a, b) => ((order.indexOf(a) + 1) || Infinity) - ((order.indexOf(b) + 1) || Infinity));
   const evs = orderEngineVariants(rows).map((x) => x.ev);
+  // one curve per engine-variant and knob (Bullet has two: its step and its solver's iterations), labelled
+  // "ENGINE VARIANT (KNOB)" when its engine-variant has more than one
+  const knobsOf = (ev) => [...new Set(rows.filter((r) => r.ev === ev && r.setting).map((r) => r.setting))]
+    .sort((a, b) => KNOB_ORDER.indexOf(a) - KNOB_ORDER.indexOf(b));
+  const curveKeys = evs.flatMap((ev) => {
+    const knobs = knobsOf(ev);
+    if (!knobs.length) return [{ ev, setting: '', label: ev }];
+    return knobs.map((setting) => ({ ev, setting, label: knobs.length > 1 ? `${ev} (${setting})` : ev }));
+  });
   const out = names.map((name) => {
     const mine = rows.filter((r) => r.experiment === name);
     const first = mine[0];
     const curves = [];
-    for (const ev of evs) {
-      const pts = mine.filter((r) => r.ev === ev);
+    for (const { ev, setting, label } of curveKeys) {
+      const pts = mine.filter((r) => r.ev === ev && (r.setting === setting || r.status === 'not_built'));
       if (!pts.length) continue;
-      const ordered = [...pts].sort((a, b) => (b.value ?? 0) - (a.value ?? 0));  // loosest first
+      // loosest first: the largest tolerance or step, the fewest iterations
+      const ordered = [...pts].sort((a, b) => (setting === 'iterations' ? 1 : -1) * ((a.value ?? 0) - (b.value ?? 0)));
       const judged = pts[0].judged;
       const notBuilt = pts.every((p) => p.status === 'not_built');
       const to = notBuilt ? { kind: 'not_built', wall_per_sim_second: null, setting_value: null }
         : costToReach(ordered.filter(usable), first.tolerance);
       const curve = {
-        ev, engine: pts[0].engine, variant: pts[0].variant, setting: pts[0].setting, judged,
+        label, ev, engine: pts[0].engine, variant: pts[0].variant, setting: pts[0].setting, judged,
         points: ordered.map((p) => ({ value: p.value, measured: p.measured, error: p.error, wall_seconds: p.wall_seconds,
           wall_per_sim_second: p.wall_per_sim_second, steps: p.steps, status: p.status, note: p.note })),
         to_tolerance: to,
@@ -69,7 +79,20 @@ export function precision(prec, experiments) {
       not_applicable_reason: m && typeof m.not_applicable_reason === 'string' ? m.not_applicable_reason : null, curves,
     };
   });
-  return { experiments: out, engine_variants: evs, summary: summarize(out, evs) };
+  return { experiments: out, engine_variants: evs, curves: curveKeys.map((k) => k.label), summary: summarize(out, evs) };
+}
+
+const KNOB_ORDER = ['tol', 'step', 'iterations'];
+
+// The cheapest of an engine-variant's curves that reaches the tolerance, else its first curve (its main knob).
+export function bestCurve(curves) {
+  let best = null;
+  for (const c of curves) {
+    const t = c.to_tolerance;
+    if (t.kind !== 'interpolated' && t.kind !== 'at_most') continue;
+    if (!best || t.wall_per_sim_second < best.to_tolerance.wall_per_sim_second) best = c;
+  }
+  return best || curves[0] || null;
 }
 
 // Per engine-variant: how many judged experiments it reaches the tolerance of at some setting, the median cost
@@ -77,19 +100,22 @@ export function precision(prec, experiments) {
 // setting the median (over the judged experiments) of error/tolerance and of the wall time per simulated second.
 function summarize(exps, evs) {
   return evs.map((ev) => {
-    const cells = exps.map((e) => ({ e, c: e.curves.find((c) => c.ev === ev) })).filter((x) => x.c);
+    const cells = exps.map((e) => ({ e, c: bestCurve(e.curves.filter((c) => c.ev === ev)) })).filter((x) => x.c);
+    // the front follows the main knob (the first: tol or step), at whose settings the experiments line up
+    const main = exps.map((e) => ({ e, c: e.curves.find((c) => c.ev === ev) })).filter((x) => x.c && x.c.judged &&
+      x.c.to_tolerance.kind !== 'not_built');
     const judged = cells.filter((x) => x.c.judged && x.c.to_tolerance.kind !== 'not_built');
     const reached = judged.filter((x) => x.c.to_tolerance.kind === 'interpolated' || x.c.to_tolerance.kind === 'at_most');
     const never = judged.filter((x) => x.c.to_tolerance.kind === 'never');
-    const settings = [...new Set(judged.flatMap((x) => x.c.points.map((p) => p.value)))].filter((v) => v !== null).sort((a, b) => b - a);
+    const settings = [...new Set(main.flatMap((x) => x.c.points.map((p) => p.value)))].filter((v) => v !== null).sort((a, b) => b - a);
     const front = settings.map((value) => {
-      const pts = judged.map((x) => ({ p: x.c.points.find((p) => p.value === value), tol: x.e.tolerance })).filter((y) => y.p && usable(y.p));
+      const pts = main.map((x) => ({ p: x.c.points.find((p) => p.value === value), tol: x.e.tolerance })).filter((y) => y.p && usable(y.p));
       return { value, experiments: pts.length, median_error_over_tolerance: median(pts.map((y) => y.p.error / y.tol)),
         median_wall_per_sim_second: median(pts.map((y) => y.p.wall_per_sim_second)) };
     }).filter((f) => f.experiments > 0);
     return {
       ev,
-      setting: cells.length ? cells[0].c.setting : '',
+      setting: main.length ? main[0].c.setting : '',
       judged: judged.length,
       reached: reached.length,
       never: never.map((x) => x.e.experiment),

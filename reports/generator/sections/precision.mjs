@@ -36,7 +36,7 @@ export function costCell(e, c) {
 function knobText(c) {
   if (!c.setting) return '—';
   const a = num(c.points[0].value), b = num(c.points[c.points.length - 1].value);
-  return `${c.setting} ${a} … ${b}${c.setting === 'step' ? ' s' : ''}`;
+  return `${c.setting} ${a} … ${b}${c.setting === 'step' ? ' s' : c.setting === 'iterations' ? ' (step 1 ms)' : ''}`;
 }
 
 // The points of a curve that the diagram cannot show, in one phrase: "error 0 at every setting", or each one.
@@ -44,8 +44,8 @@ function undrawnText(c) {
   const missing = c.points.filter((p) => !drawable(p));
   if (!missing.length) return '';
   const zero = missing.filter((p) => p.status === 'ok');
-  if (zero.length === c.points.length) return `${c.ev}: error 0 at every setting`;
-  return `${c.ev} ` + missing.map((p) => `${c.setting}=${num(p.value)}: ${p.status === 'ok' ? `error ${num(p.error)}` :
+  if (zero.length === c.points.length) return `${c.label}: error 0 at every setting`;
+  return `${c.label} ` + missing.map((p) => `${c.setting}=${num(p.value)}: ${p.status === 'ok' ? `error ${num(p.error)}` :
     `${p.status.replace('_', ' ')}${p.note ? ` (${p.note})` : ''}`}`).join(', ');
 }
 
@@ -60,7 +60,7 @@ export default {
   build(ctx) {
     const pr = ctx.precision;
     if (!pr) return null;
-    const evs = pr.engine_variants;
+    const labels = pr.curves;
     let html = '<p>Each Gedanken experiment with a closed form, run at every setting of each engine’s accuracy knob (soft: ' +
       'tolerance of the adaptive RK4 and the step of fixed-step RK4; ODE and Bullet: the time step, native and matched). The error is the ' +
       'experiment’s own measure against its closed form — the same number the PASS/FAIL matrix judges — and the cost the wall time per ' +
@@ -72,21 +72,22 @@ export default {
       `<a href="#precision-${esc(ctx.slug(e.experiment))}">${esc(e.experiment)}</a>${e.input ? ` <span class="muted">${esc(e.input)}</span>` : ''}`,
       { html: e.kind === 'law' ? 'law' : 'model', cls: 'muted', title: KIND_TEXT[e.kind] },
       { html: errText(e.tolerance, e.relative), cls: 'n' },
-      ...evs.map((ev) => {
-        const c = costCell(e, e.curves.find((x) => x.ev === ev));
+      ...labels.map((label) => {
+        const c = costCell(e, e.curves.find((x) => x.label === label));
         return { html: c.html, cls: c.cls, title: c.title };
       }),
     ]);
-    html += table(['experiment', 'kind', 'tolerance', ...evs.map(esc)], rows, 'precision-cost');
-    html += '<p class="legend">“≤”: the loosest setting already reaches the tolerance; otherwise the cost is interpolated log–log between the ' +
+    html += table(['experiment', 'kind', 'tolerance', ...labels.map(esc)], rows, 'precision-cost');
+    html += '<p class="legend">Bullet has two knobs: its step, and its solver’s iterations at the default 1 ms step (ODE’s ' +
+      'dWorldStep solves its LCP exactly: no iterations). “≤”: the loosest setting already reaches the tolerance; otherwise the cost is interpolated log–log between the ' +
       'settings on either side of it. “never”: no setting reaches it; the floor is the smallest error any setting gave, “stalls” when the two ' +
       'finest settings differ by less than 30 % (refining does not help), “still falling” when they do not. “n/a”: a prediction of the soft model ' +
       'that this variant does not have (measured anyway: hover).</p>';
     html += '<div class="charts multi wide">';
     for (const e of pr.experiments) {
-      const series = e.curves.filter((c) => c.to_tolerance.kind !== 'not_built').map((c) => logLogLine(`${c.ev}${c.judged ? '' : ' (n/a)'}`,
+      const series = e.curves.filter((c) => c.to_tolerance.kind !== 'not_built').map((c) => logLogLine(`${c.label}${c.judged ? '' : ' (n/a)'}`,
         ctx.color(c.ev), c.points.filter(drawable).map((p) => [p.wall_per_sim_second, p.error, `${c.setting}=${p.value}`]),
-        c.judged ? 'solid' : 'dotted'));
+        !c.judged ? 'dotted' : c.setting === 'iterations' ? 'dashed' : 'solid'));
       html += `<div class="chartbox" id="precision-${esc(ctx.slug(e.experiment))}"><h3>${esc(e.experiment)}${e.input ? ` <span class="muted">${esc(e.input)}</span>` : ''}</h3>`;
       html += `<p class="muted">${esc(e.title)} — ${esc(e.quantity)}${e.unit ? ` (${esc(e.unit)})` : ''}, expected ${num(e.expected, 6)}, ` +
         `${e.relative ? 'relative ' : ''}error against it; ${esc(KIND_TEXT[e.kind])}</p>`;
@@ -97,7 +98,7 @@ export default {
         e.curves.map((c) => {
           const ok = c.points.filter((p) => p.status === 'ok');
           const cell = costCell(e, c);
-          return [esc(c.ev), { html: esc(knobText(c)), cls: 'nowrap' },
+          return [esc(c.label), { html: esc(knobText(c)), cls: 'nowrap' },
             { html: cell.html, cls: cell.cls, title: cell.title },
             { html: ok.length ? errText(ok[0].error, e.relative) : '—', cls: 'n' },
             { html: ok.length ? errText(ok[ok.length - 1].error, e.relative) : '—', cls: 'n' },
