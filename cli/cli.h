@@ -22,6 +22,14 @@ int pd_cmd_gedanken(int argc, char** argv);
 int pd_cmd_oracle(int argc, char** argv);
 int pd_cmd_soak(int argc, char** argv);
 
+// `polydyn ARGS...`: argv[1] names the subcommand (cli/dispatch.c; main() calls it). Returns the exit status.
+int pd_cli_dispatch(int argc, char** argv);
+
+// Set only by the command-line fuzzer (tests/fuzz/fuzz_cli.c): each subcommand returns PD_EXIT_OK as soon as
+// its arguments are accepted, before it opens, reads or writes any file or starts any work. Help and usage
+// errors are printed as usual. Never set in the polydyn command.
+extern bool pd_cli_parse_only;
+
 // Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr (on MPI rank 0 only:
 // every rank sees the same arguments); returns 2.
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) __attribute__((format(printf, 2, 3)));

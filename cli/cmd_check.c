@@ -174,6 +174,7 @@ int pd_cmd_check(int argc, char** argv) {
     }
   }
   if (!scene) return pd_cli_usage_error("check", "no scene given");
+  if (pd_cli_parse_only) return PD_EXIT_OK;
   pdSceneSettings settings;
   pdModel* m = pd_cli_load_model(scene, NULL, &settings);
   if (!m) return PD_EXIT_BAD_INPUT;

@@ -542,6 +542,7 @@ int pd_cmd_compare(int argc, char** argv) {
   if (!scene) return pd_cli_usage_error("compare", "no scene given");
   if (!out) return pd_cli_usage_error("compare", "--out DIR is required");
   if (strlen(out) > COMPARE_PATH_MAX) return pd_cli_usage_error("compare", "--out: path longer than %d bytes", COMPARE_PATH_MAX);
+  if (pd_cli_parse_only) return PD_EXIT_OK;
   jobs = pd_cli_default_jobs(jobs, 1);  // one at a time unless asked: wall_per_sim_second is a measurement
 
   // every scene read first: a bad one is refused before anything is written

@@ -825,6 +825,7 @@ int pd_cmd_cubetoss(int argc, char** argv) {
   if (parsed >= 0) return parsed;
   o.jobs = pd_cli_default_jobs(o.jobs, DEFAULT_JOBS);
   if (!o.label && !o.fit) o.label = o.paramCount > 0 ? "params" : "default";
+  if (pd_cli_parse_only) return PD_EXIT_OK;
 
   pdError err = {0};
   pdTossSet* set = pd_toss_read(o.data, &err);

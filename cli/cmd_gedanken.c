@@ -162,6 +162,7 @@ int pd_cmd_gedanken(int argc, char** argv) {
     return pd_cli_usage_error("gedanken", "no experiment selected (--only names none of the --fast subset)");
   if (!enginesGiven)
     for (int e = 0; e < pd_gkEngineCount; ++e) options.engines[e] = true;
+  if (pd_cli_parse_only) return PD_EXIT_OK;
   pdError err = {0};
   if (!pd_gk_out_replaceable(options.out, &err)) {
     fprintf(stderr, "polydyn gedanken: ");

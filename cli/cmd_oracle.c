@@ -284,140 +284,80 @@ done:
 
 // ---------------------------------------------------------------- --replay
 
-typedef struct lines {
-  char** line;
-  long count, capacity;
-} lines;
-
-static void lines_free(lines* l) {
-  for (long i = 0; i < l->count; ++i) free(l->line[i]);
-  free(l->line);
-}
-
 // Reads the whole file (so that a bad row is refused before anything is checked or written).
-static bool read_lines(const char* path, lines* out) {
-  memset(out, 0, sizeof *out);
-  FILE* f = fopen(path, "r");
+static char* read_file(const char* path, size_t* size) {
+  FILE* f = fopen(path, "rb");
   if (!f) {
     fprintf(stderr, "%s: cannot open: %s\n", path, strerror(errno));
-    return false;
+    return NULL;
   }
-  char* buf = NULL;
-  size_t cap = 0;
-  ssize_t n;
-  while ((n = getline(&buf, &cap, f)) >= 0) {
-    if (n > 0 && buf[n - 1] == '\n') buf[--n] = '\0';
-    if (n > 0 && buf[n - 1] == '\r') buf[--n] = '\0';
-    if (strlen(buf) != (size_t)n) {
-      fprintf(stderr, "%s:%ld:1: not a text line (NUL byte)\n", path, out->count + 1);
-      free(buf);
-      fclose(f);
-      lines_free(out);
-      return false;
+  char* data = NULL;
+  size_t n = 0, capacity = 0;
+  for (;;) {
+    if (n == capacity) {
+      capacity = capacity ? 2 * capacity : 64 * 1024;
+      if (!(data = realloc(data, capacity))) abort();
     }
-    if (out->count == out->capacity) {
-      out->capacity = out->capacity ? 2 * out->capacity : 64;
-      out->line = realloc(out->line, (size_t)out->capacity * sizeof *out->line);
-      if (!out->line) abort();
-    }
-    if (!(out->line[out->count++] = strdup(buf))) abort();
+    size_t got = fread(data + n, 1, capacity - n, f);
+    n += got;
+    if (got == 0) break;
   }
   bool ok = !ferror(f);
   if (!ok) fprintf(stderr, "%s: cannot read: %s\n", path, strerror(errno));
-  free(buf);
   fclose(f);
-  if (!ok) lines_free(out);
-  return ok;
-}
-
-// A shape kept across rows: consecutive rows usually list the same bodies.
-typedef struct cachedShape {
-  pdOracleShape s;
-  bool valid;
-} cachedShape;
-
-static bool cached_shape(cachedShape* c, const char* spec, char* why, int whySize) {
-  if (c->valid && strcmp(c->s.spec, spec) == 0) return true;
-  if (c->valid) pd_oracle_shape_free(&c->s);
-  c->valid = pd_oracle_shape_parse(spec, &c->s, why, whySize);
-  return c->valid;
-}
-
-// Pass 1 (check = false): every row and shape is valid; pass 2: check each pair again.
-static bool replay_rows(const char* path, const lines* l, char* rowBuf, bool check, pdOracleStats* stats, csvOut* csv) {
-  cachedShape shapes[2];
-  memset(shapes, 0, sizeof shapes);
-  bool ok = true;
-  for (long i = 1; i < l->count && ok && !interrupted; ++i) {
-    if (l->line[i][0] == '\0') continue;
-    strcpy(rowBuf, l->line[i]);
-    pdOracleRow row;
-    int col = 1;
-    char why[PD_ERROR_MESSAGE_MAX];
-    if (!pd_oracle_csv_read(rowBuf, &row, &col, why, sizeof why)) {
-      fprintf(stderr, "%s:%ld:%d: %s\n", path, i + 1, col, why);
-      ok = false;
-      break;
-    }
-    const char* specs[2] = {row.specA, row.specB};
-    for (int k = 0; k < 2 && ok; ++k) {
-      if (!cached_shape(&shapes[k], specs[k], why, sizeof why)) {
-        // the field starts where its (unquoted) text starts in the split copy
-        fprintf(stderr, "%s:%ld:%d: shape_%c: %s\n", path, i + 1, (int)(specs[k] - rowBuf) + 1, 'a' + k, why);
-        ok = false;
-      }
-    }
-    if (!ok || !check) continue;
-    pdOracleResult was = row.r;
-    pdOracleBody a = {&shapes[0].s.poly, row.xa, row.qa}, b = {&shapes[1].s.poly, row.xb, row.qb};
-    pd_oracle_check(&a, &b, &row.r);
-    pd_oracle_stats_add(stats, &row.r);
-    if (csv->f) {
-      pd_oracle_csv_write(csv->f, &row);
-      ++csv->rows;
-    }
-    printf("line %ld: %s #%ld t=%.6g %s/%s: was %s, now %s (ours %s %.3g m, GJK %s, MPR %s", i + 1, row.source,
-           row.index, row.t, row.nameA, row.nameB, pdOracleKindNames[was.kind], pdOracleKindNames[row.r.kind],
-           row.r.ours ? "overlap" : "separate", row.r.ourDepth, row.r.gjk ? "overlap" : "separate",
-           row.r.mpr ? "overlap" : "separate");
-    if (row.r.hasEpa) printf(", EPA %.3g m", row.r.epaDepth);
-    if (row.r.hasMprDepth) printf(", MPR depth %.3g m", row.r.mprDepth);
-    printf(")\n");
+  if (!ok) {
+    free(data);
+    return NULL;
   }
-  for (int k = 0; k < 2; ++k)
-    if (shapes[k].valid) pd_oracle_shape_free(&shapes[k].s);
-  return ok;
+  *size = n;
+  return data;
+}
+
+typedef struct replayRun {
+  pdOracleStats* stats;
+  csvOut* csv;
+} replayRun;
+
+// Checks one listed pair again (pdOracleReplayFcn).
+static bool replay_row(const pdOracleRow* listed, const pdOracleShape* sa, const pdOracleShape* sb, long line,
+                       void* user) {
+  replayRun* run = user;
+  pdOracleRow row = *listed;
+  pdOracleResult was = row.r;
+  pdOracleBody a = {&sa->poly, row.xa, row.qa}, b = {&sb->poly, row.xb, row.qb};
+  pd_oracle_check(&a, &b, &row.r);
+  pd_oracle_stats_add(run->stats, &row.r);
+  if (run->csv->f) {
+    pd_oracle_csv_write(run->csv->f, &row);
+    ++run->csv->rows;
+  }
+  printf("line %ld: %s #%ld t=%.6g %s/%s: was %s, now %s (ours %s %.3g m, GJK %s, MPR %s", line, row.source,
+         row.index, row.t, row.nameA, row.nameB, pdOracleKindNames[was.kind], pdOracleKindNames[row.r.kind],
+         row.r.ours ? "overlap" : "separate", row.r.ourDepth, row.r.gjk ? "overlap" : "separate",
+         row.r.mpr ? "overlap" : "separate");
+  if (row.r.hasEpa) printf(", EPA %.3g m", row.r.epaDepth);
+  if (row.r.hasMprDepth) printf(", MPR depth %.3g m", row.r.mprDepth);
+  printf(")\n");
+  return !interrupted;
 }
 
 static int run_replay(const char* path, const char* out) {
-  lines l;
-  if (!read_lines(path, &l)) return PD_EXIT_BAD_INPUT;
-  // the header this command writes
-  char* header = NULL;
-  size_t headerSize = 0;
-  FILE* h = open_memstream(&header, &headerSize);
-  if (!h) abort();
-  pd_oracle_csv_header(h);
-  fclose(h);
-  header[strcspn(header, "\n")] = '\0';
-  bool ok = l.count > 0 && strcmp(l.line[0], header) == 0;
-  free(header);
-  if (!ok) {
-    fprintf(stderr, "%s:1:1: not an oracle CSV (the header differs from the one 'polydyn oracle' writes)\n", path);
-    lines_free(&l);
-    return PD_EXIT_BAD_INPUT;
-  }
-  size_t longest = 0;
-  for (long i = 0; i < l.count; ++i) longest = strlen(l.line[i]) > longest ? strlen(l.line[i]) : longest;
-  char* rowBuf = malloc(longest + 1);
-  if (!rowBuf) abort();
+  size_t size = 0;
+  char* data = read_file(path, &size);
+  if (!data) return PD_EXIT_BAD_INPUT;
   pdOracleStats stats;
   pd_oracle_stats_init(&stats);
   csvOut csv = {0};
+  pdError err = {0};
   int status = PD_EXIT_BAD_INPUT;
-  if (!replay_rows(path, &l, rowBuf, false, &stats, &csv)) goto done;
+  // every row and shape valid before anything is checked or written
+  if (!pd_oracle_replay_buffer(path, data, size, NULL, NULL, &err)) {
+    pd_error_print(&err, stderr);
+    goto done;
+  }
   if (out && !csv_open(&csv, out)) goto done;
-  replay_rows(path, &l, rowBuf, true, &stats, &csv);
+  replayRun run = {&stats, &csv};
+  pd_oracle_replay_buffer(path, data, size, replay_row, &run, &err);
   if (interrupted) {
     csv_abort(&csv);
     fprintf(stderr, "polydyn oracle: interrupted; nothing written\n");
@@ -430,9 +370,8 @@ static int run_replay(const char* path, const char* out) {
   if (out && written) printf("listed: %ld pairs in %s\n", stats.pairs, out);
   status = !written || pd_oracle_stats_failures(&stats) ? PD_EXIT_FAILURE : PD_EXIT_OK;
 done:
-  free(rowBuf);
+  free(data);
   pd_oracle_stats_free(&stats);
-  lines_free(&l);
   return status;
 }
 
@@ -494,6 +433,7 @@ int pd_cmd_oracle(int argc, char** argv) {
   if (random != seedGiven) return pd_cli_usage_error("oracle", "--random and --seed go together");
   if (!scene && (overrides.tend > 0.0 || overrides.sample > 0.0))
     return pd_cli_usage_error("oracle", "--tend and --sample are for a SCENE");
+  if (pd_cli_parse_only) return PD_EXIT_OK;
 
   // an interrupt removes the partial CSV
   struct sigaction sa;

@@ -97,6 +97,7 @@ int pd_cmd_report(int argc, char** argv) {
   }
   if (!dir) return pd_cli_usage_error("report", "DIR is missing");
   if (viewer && noViewer) return pd_cli_usage_error("report", "--viewer and --no-viewer exclude each other");
+  if (pd_cli_parse_only) return PD_EXIT_OK;
 
   // the directory: checked here too, so that a typo does not wait for node to start
   struct stat st;

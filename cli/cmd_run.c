@@ -138,6 +138,7 @@ int pd_cmd_run(int argc, char** argv) {
   if (!soft && stepperGiven) return pd_cli_usage_error("run", "--stepper is for the soft engine");
   if (strcmp(engine, "bullet") == 0 && ref.odeFriction != pd_odeFrictionPyramid)
     return pd_cli_usage_error("run", "--ode-friction is for --engine ode");
+  if (pd_cli_parse_only) return PD_EXIT_OK;
 
   pdModel* model = pd_cli_load_model(scene, &overrides, NULL);
   if (!model) return PD_EXIT_BAD_INPUT;

@@ -154,6 +154,7 @@ int pd_cmd_soak(int argc, char** argv) {
     if (!*p) return pd_cli_usage_error("soak", "--engines: an empty name");
   }
   if (job.engineCount == 0) return pd_cli_usage_error("soak", "--engines needs a list like soft,ode,bullet");
+  if (pd_cli_parse_only) return PD_EXIT_OK;
 
   // caught before the temporary directory is made, so that an interrupt always removes it
   struct sigaction sa;

@@ -379,6 +379,7 @@ int pd_cmd_sweep(int argc, char** argv) {
   }
   if (!scene) return pd_cli_usage_error("sweep", "no scene given");
   if (!out) return pd_cli_usage_error("sweep", "--out DIR is required");
+  if (pd_cli_parse_only) return PD_EXIT_OK;
   bool progress = isatty(STDERR_FILENO) == 1;
 
   jobs = pd_cli_default_jobs(jobs, 1);  // one at a time unless asked: the wall times are the measurement

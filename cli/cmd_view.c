@@ -185,6 +185,7 @@ int pd_cmd_view(int argc, char** argv) {
   if (dirCount == 0) return pd_cli_usage_error("view", "no run directory given");
   if ((strcmp(fps, "60") != 0 || strcmp(speed, "1") != 0) && !movie)
     return pd_cli_usage_error("view", "--fps and --speed are for --movie");
+  if (pd_cli_parse_only) return PD_EXIT_OK;
 
   pdViewRun* runs[MAX_RUNS];
   int loaded = 0, status = PD_EXIT_OK;

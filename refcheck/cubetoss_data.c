@@ -57,23 +57,44 @@ static bool parse_id(const char* text, long* v) {
   return end != text && *end == '\0' && errno != ERANGE;
 }
 
-pdTossSet* pd_toss_read(const char* path, pdError* err) {
-  FILE* in = fopen(path, "r");
-  if (!in) {
-    pd_error_set(err, path, 0, 0, "cannot read: %s", strerror(errno));
-    return NULL;
+// The lines of a file (getline) or of a caller's buffer (each copied out in turn), so that pd_toss_read and
+// pd_toss_parse_buffer run the same code on the same bytes. A line keeps its '\n' and any NUL bytes.
+typedef struct lineSource {
+  FILE* file;        // NULL: the buffer
+  const char* data;
+  size_t size, at;
+  char* line;        // the current line (owned, NUL-terminated)
+  size_t capacity;
+} lineSource;
+
+// The next line's length in bytes (as getline), or -1 at the end (or on a read error of the file).
+static ssize_t next_line(lineSource* s) {
+  if (s->file) return getline(&s->line, &s->capacity, s->file);
+  if (s->at >= s->size) return -1;
+  const char* start = s->data + s->at;
+  const char* newline = memchr(start, '\n', s->size - s->at);
+  size_t len = newline ? (size_t)(newline - start) + 1 : s->size - s->at;
+  if (len + 1 > s->capacity) {
+    s->capacity = len + 1;
+    s->line = grow(s->line, s->capacity, 1);
   }
+  memcpy(s->line, start, len);
+  s->line[len] = '\0';
+  s->at += len;
+  return (ssize_t)len;
+}
+
+static pdTossSet* parse(const char* path, lineSource* src, pdError* err) {
   pdTossSet* set = calloc(1, sizeof *set);
   if (!set) abort();
   set->path = strdup(path);
   if (!set->path) abort();
   int capacity = 0, sampleCapacity = 0;
-  char* line = NULL;
-  size_t lineSize = 0;
   long lineNo = 0;
   bool ok = true;
   pdToss* cur = NULL;
-  for (ssize_t len; ok && (len = getline(&line, &lineSize, in)) >= 0;) {
+  for (ssize_t len; ok && (len = next_line(src)) >= 0;) {
+    char* line = src->line;
     ++lineNo;
     while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) line[--len] = '\0';
     if ((size_t)len != strlen(line)) {
@@ -157,7 +178,7 @@ pdTossSet* pd_toss_read(const char* path, pdError* err) {
                                     .w = {v[11], v[12], v[13]}};
     ++cur->sampleCount;
   }
-  if (ok && ferror(in)) {
+  if (ok && src->file && ferror(src->file)) {
     pd_error_set(err, path, 0, 0, "read error");
     ok = false;
   }
@@ -173,12 +194,31 @@ pdTossSet* pd_toss_read(const char* path, pdError* err) {
     pd_error_set(err, path, (int)cur->line, 1, "toss %ld has one row: a toss needs at least 2", cur->id);
     ok = false;
   }
-  free(line);
-  fclose(in);
   if (!ok) {
     pd_toss_set_free(set);
     return NULL;
   }
+  return set;
+}
+
+pdTossSet* pd_toss_read(const char* path, pdError* err) {
+  FILE* in = fopen(path, "r");
+  if (!in) {
+    pd_error_set(err, path, 0, 0, "cannot read: %s", strerror(errno));
+    return NULL;
+  }
+  lineSource src = {.file = in};
+  pdTossSet* set = parse(path, &src, err);
+  free(src.line);
+  fclose(in);
+  return set;
+}
+
+pdTossSet* pd_toss_parse_buffer(const char* name, const char* data, size_t size, pdError* err) {
+  PD_ASSERT(data != NULL || size == 0);
+  lineSource src = {.data = data, .size = size};
+  pdTossSet* set = parse(name ? name : "<buffer>", &src, err);
+  free(src.line);
   return set;
 }
 

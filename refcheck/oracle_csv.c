@@ -185,3 +185,75 @@ bool pd_oracle_csv_read(char* buf, pdOracleRow* row, int* col, char* why, int wh
     return fail(col, at[30], why, whySize, "not a finite number, or given without epa_depth", f[30]);
   return true;
 }
+
+// ---------------------------------------------------------------- replaying a whole file
+
+// A shape kept across rows: consecutive rows usually list the same bodies.
+typedef struct cachedShape {
+  pdOracleShape s;
+  bool valid;
+} cachedShape;
+
+static bool cached_shape(cachedShape* c, const char* spec, char* why, int whySize) {
+  if (c->valid && strcmp(c->s.spec, spec) == 0) return true;
+  if (c->valid) pd_oracle_shape_free(&c->s);
+  c->valid = pd_oracle_shape_parse(spec, &c->s, why, whySize);
+  return c->valid;
+}
+
+bool pd_oracle_replay_buffer(const char* name, const char* data, size_t size, pdOracleReplayFcn* visit, void* user,
+                             pdError* err) {
+  PD_ASSERT(data != NULL || size == 0);
+  if (!name) name = "<buffer>";
+  cachedShape shapes[2];
+  memset(shapes, 0, sizeof shapes);
+  char* line = NULL;  // the current line, split in place by pd_oracle_csv_read
+  size_t capacity = 0;
+  bool ok = true, going = true;
+  long lineNo = 0;
+  for (size_t at = 0; ok && going && (at < size || lineNo == 0);) {
+    ++lineNo;
+    const char* start = data ? data + at : "";
+    const char* newline = size > at ? memchr(start, '\n', size - at) : NULL;
+    size_t len = newline ? (size_t)(newline - start) : size - at;
+    at += newline ? len + 1 : len;
+    if (len > 0 && start[len - 1] == '\r') --len;
+    if (len + 1 > capacity) {
+      capacity = len + 1;
+      if (!(line = realloc(line, capacity))) abort();
+    }
+    memcpy(line, start, len);
+    line[len] = '\0';
+    if (strlen(line) != len) {
+      pd_error_set(err, name, (int)lineNo, (int)strlen(line) + 1, "not a text line (NUL byte)");
+      ok = false;
+    } else if (lineNo == 1) {
+      if (strlen(header) - 1 != len || strncmp(line, header, len) != 0) {
+        pd_error_set(err, name, 1, 1, "not an oracle CSV (the header differs from the one 'polydyn oracle' writes)");
+        ok = false;
+      }
+    } else if (len > 0) {
+      pdOracleRow row;
+      int col = 1;
+      char why[PD_ERROR_MESSAGE_MAX];
+      if (!pd_oracle_csv_read(line, &row, &col, why, sizeof why)) {
+        pd_error_set(err, name, (int)lineNo, col, "%s", why);
+        ok = false;
+        break;
+      }
+      const char* specs[2] = {row.specA, row.specB};
+      for (int k = 0; k < 2 && ok; ++k) {
+        if (!cached_shape(&shapes[k], specs[k], why, sizeof why)) {
+          // the field starts where its (unquoted) text starts in the split line
+          pd_error_set(err, name, (int)lineNo, (int)(specs[k] - line) + 1, "shape_%c: %s", 'a' + k, why);
+          ok = false;
+        }
+      }
+      if (ok && visit) going = visit(&row, &shapes[0].s, &shapes[1].s, lineNo, user);
+    }
+  }
+  for (int k = 0; k < 2; ++k)
+    if (shapes[k].valid) pd_oracle_shape_free(&shapes[k].s);
+  free(line);
+  return ok;
+}

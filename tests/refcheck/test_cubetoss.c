@@ -259,6 +259,13 @@ static void expect_refused(const char* name, const char* text, int line, int col
   if (set) fail_msg("%s: accepted", name);
   if (err.line != line || err.col != col || !strstr(err.message, needle))
     fail_msg("%s: got %d:%d: %s; expected %d:%d: ...%s...", name, err.line, err.col, err.message, line, col, needle);
+  // the same bytes from memory: the same answer
+  pdError fromBuffer = {0};
+  assert_null(pd_toss_parse_buffer(path, text, strlen(text), &fromBuffer));
+  assert_string_equal(fromBuffer.file, err.file);
+  assert_int_equal(fromBuffer.line, err.line);
+  assert_int_equal(fromBuffer.col, err.col);
+  assert_string_equal(fromBuffer.message, err.message);
 }
 
 #define HEADER "toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n"
@@ -290,6 +297,18 @@ static void test_bad_csv_is_refused_at_its_line_and_column(void** state) {
   assert_int_equal(set->count, 1);
   assert_int_equal(set->tosses[0].sampleCount, 2);
   pd_toss_set_free(set);
+  // from memory, without a final newline and not NUL-terminated: the same set
+  const char text[] = HEADER ROW0 "1,0.006757,0,0,0.3,1,0,0,0,0,0,0,0,0,0";
+  set = pd_toss_parse_buffer(NULL, text, sizeof text - 1, &err);
+  assert_non_null(set);
+  assert_string_equal(set->path, "<buffer>");
+  assert_int_equal(set->count, 1);
+  assert_int_equal(set->tosses[0].sampleCount, 2);
+  assert_int_equal(set->tosses[0].line, 2);
+  pd_toss_set_free(set);
+  const char cut[] = HEADER ROW0 ROW1;  // a buffer ending inside the header is refused by the header
+  assert_null(pd_toss_parse_buffer("cut.csv", cut, 20, &err));
+  assert_true(err.line == 1 && err.col == 1);
 }
 
 // ---------------------------------------------------------------- statistics, lists, fragments

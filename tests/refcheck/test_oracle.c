@@ -334,6 +334,59 @@ static void test_csv_rows_read_back_exactly_with_quoted_names(void** state) {
   assert_int_equal(col, xCol);
 }
 
+// pdOracleReplayFcn: counts the rows and keeps the last line
+static bool count_row(const pdOracleRow* row, const pdOracleShape* a, const pdOracleShape* b, long line, void* user) {
+  long* seen = user;
+  assert_non_null(row->source);
+  assert_true(a->poly.vertexCount >= 4 && b->poly.vertexCount >= 4);
+  seen[0] += 1;
+  seen[1] = line;
+  return true;
+}
+
+static void test_a_replay_file_is_read_whole_and_refused_at_its_first_bad_line(void** state) {
+  (void)state;
+  char* text = NULL;
+  size_t size = 0;
+  FILE* f = open_memstream(&text, &size);
+  assert_non_null(f);
+  pd_oracle_csv_header(f);
+  pdOracleRow row = {.source = "random", .nameA = "A", .nameB = "B", .specA = "cube 1 1 1", .specB = "prism 5 1 1 1",
+                     .xb = {0.9, 0, 0}, .qa = pd_quat_identity(), .qb = pd_quat_identity()};
+  pd_oracle_csv_write(f, &row);
+  fputs("\r\n", f);  // a blank line (CRLF) is skipped
+  pd_oracle_csv_write(f, &row);
+  fclose(f);
+  pdError err = {0};
+  long seen[2] = {0, 0};
+  if (!pd_oracle_replay_buffer("r.csv", text, size, count_row, seen, &err)) fail_msg("%s", err.message);
+  assert_int_equal(seen[0], 2);
+  assert_int_equal(seen[1], 4);
+  assert_true(pd_oracle_replay_buffer(NULL, text, size, NULL, NULL, &err));  // checking only
+  // a NUL byte: at its line and column; a bad shape: at its field; another header, or none: at 1:1
+  size_t second = size - 1;  // where the last row starts
+  while (second > 0 && text[second - 1] != '\n') --second;
+  text[second + 3] = '\0';
+  assert_false(pd_oracle_replay_buffer("r.csv", text, size, NULL, NULL, &err));
+  assert_string_equal(err.file, "r.csv");
+  assert_int_equal(err.line, 4);
+  assert_int_equal(err.col, 4);
+  text[second + 3] = 'd';
+  char* shape = strstr(text + second, "prism 5");
+  shape[6] = '2';  // a prism of 2 sides
+  assert_false(pd_oracle_replay_buffer("r.csv", text, size, NULL, NULL, &err));
+  print_message("%s:%d:%d: %s\n", err.file, err.line, err.col, err.message);
+  assert_int_equal(err.line, 4);
+  assert_int_equal(err.col, (int)(shape - (text + second)) + 1);
+  assert_non_null(strstr(err.message, "shape_b"));
+  text[0] = 'S';
+  assert_false(pd_oracle_replay_buffer("r.csv", text, size, NULL, NULL, &err));
+  assert_true(err.line == 1 && err.col == 1);
+  assert_false(pd_oracle_replay_buffer("r.csv", "", 0, NULL, NULL, &err));
+  assert_true(err.line == 1 && err.col == 1);
+  free(text);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_unit_cubes_apart_and_overlapping_give_the_closed_form_depth),
@@ -346,6 +399,7 @@ int main(void) {
       cmocka_unit_test(test_specs_rebuild_the_models_polyhedra_bit_for_bit),
       cmocka_unit_test(test_bad_specs_are_refused_with_a_reason),
       cmocka_unit_test(test_csv_rows_read_back_exactly_with_quoted_names),
+      cmocka_unit_test(test_a_replay_file_is_read_whole_and_refused_at_its_first_bad_line),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

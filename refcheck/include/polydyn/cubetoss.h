@@ -83,6 +83,9 @@ typedef struct pdTossSet {
 // file that cannot be read, a wrong header, a field that is not a finite number, a toss whose rows are
 // not consecutive, a t that is not k/148, a quaternion that is not unit, or a toss of fewer than 2 rows.
 pdTossSet* pd_toss_read(const char* path, pdError* err);
+// The same from `size` bytes in memory (need not be NUL-terminated); `name` (nullable: "<buffer>") stands for
+// the file in messages and in the set's path. pd_toss_read runs this code on the file's lines.
+pdTossSet* pd_toss_parse_buffer(const char* name, const char* data, size_t size, pdError* err);
 void pd_toss_set_free(pdTossSet* set);
 
 typedef enum pdTossSplit { pd_tossTrain, pd_tossTest } pdTossSplit;

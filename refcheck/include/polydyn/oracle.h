@@ -227,3 +227,19 @@ void pd_oracle_csv_write(FILE* out, const pdOracleRow* row);
 // of the bad field in *col.
 enum { PD_ORACLE_CSV_FIELDS = 31 };
 bool pd_oracle_csv_read(char* buf, pdOracleRow* row, int* col, char* why, int whySize);
+
+// Called for each row of a replay in file order: the row (its text fields point into a copy of the line,
+// valid during the call), both shapes built from its specs, and its 1-based line. Returns false to stop
+// (an interrupt).
+typedef bool pdOracleReplayFcn(const pdOracleRow* row, const pdOracleShape* a, const pdOracleShape* b, long line,
+                               void* user);
+
+// Goes through the text of such a CSV (`size` bytes, need not be NUL-terminated; `name`, nullable, stands for
+// the file in messages): the header exactly as pd_oracle_csv_header writes it, then one row per line (blank
+// lines skipped, CRLF accepted). Reads each row, builds both of its shapes and, when `visit` is not NULL,
+// calls it. Returns false with `NAME:LINE:COL: message` in err at the first line that is not text (a NUL
+// byte), another header, a malformed row or a shape that cannot be built; true at the end or when visit
+// stopped. `polydyn oracle --replay` calls it once with visit NULL, so that a bad file is refused before
+// anything is checked or written, then again to replay.
+bool pd_oracle_replay_buffer(const char* name, const char* data, size_t size, pdOracleReplayFcn* visit, void* user,
+                             pdError* err);
