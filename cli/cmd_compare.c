@@ -495,9 +495,10 @@ int pd_cmd_compare(int argc, char** argv) {
   const char* scene = NULL;
   const char* out = NULL;
   int jobs = 0;
-  compareSettings c = {.engines = "soft,ode,bullet",
-                       .variants = "native,matched",
-                       .refOptions = {pd_refNative, PD_REF_DEFAULT_STEP, pd_odeFrictionPyramid}};
+  compareSettings c = {
+      .engines = "soft,ode,bullet",
+      .variants = "native,matched",
+      .refOptions = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid}};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     if (pd_cli_is_help(a)) {
