@@ -147,7 +147,9 @@ typedef bool pdObserverFcn(const pdModel* model, const pdState* state, void* use
 // Advances the state to tEnd, s (tEnd >= state->t, asserted; clamping to settings.tend is the caller's
 // choice), calling `observer` (nullable) with `user` at every output sample t = k / sampleRate <= tEnd,
 // including t = 0 when the state is there. Call it again with a later tEnd to go on: the samples continue
-// where they stopped. Returns true when state->t == tEnd; false if the run had to stop (state->failed,
+// where they stopped, and a run stopped on a sample time (tEnd = k / sampleRate, that very division) and
+// resumed computes the same numbers as one call (tests/engine/test_determinism.c); any other tEnd cuts a
+// step there. Returns true when state->t == tEnd; false if the run had to stop (state->failed,
 // with the reason counted in state->warnings; the state stays finite and later calls return false at once)
 // or the observer asked to stop (state->stopped; state->t is then that sample's time).
 PD_API bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
