@@ -24,6 +24,7 @@
 #include "polydyn/compare.h"
 #include "polydyn/refcheck.h"
 #include "polydyn/state.h"
+#include "polydyn/stats.h"
 
 // The reference tolerance and its check: the sweep's tightest point is 1e-10, the reference two decades
 // below it, and its own error is estimated against one a decade tighter still.
@@ -61,16 +62,6 @@ static const char* const help =
     "\n"
     "Progress goes to stderr on a terminal. Exit status: 0 ok, 1 the reference run failed or DIR could not be\n"
     "written, 2 bad input, 130 interrupted (SIGINT, SIGTERM: nothing written, an earlier DIR kept).\n";
-
-static int compare_doubles(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double* v, int n) {
-  qsort(v, (size_t)n, sizeof *v, compare_doubles);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // RMS over samples and bodies of max(position error / size, rotation angle) against the reference; with
 // horizon (nullable), the first sample time at which that error exceeds SWEEP_HORIZON_THRESHOLD for some
@@ -160,7 +151,7 @@ static void measure_soft(const char* scene, const pdCliOverrides* base, int repe
   }
   if (p->completed) {
     p->error = p->selfError = pose_error(model, tr, ref, &p->horizon);
-    p->wall = median(walls, repeats);
+    p->wall = pd_median_in_place(walls, repeats);
   }
   pd_trajectory_free(tr);
   pd_model_free(model);
@@ -186,7 +177,7 @@ static void run_reference_engine(const pdModel* model, int repeats, point* p, pd
     walls[r] = stats.wallSeconds;
     if (!p->completed) break;
   }
-  if (p->completed) p->wall = median(walls, repeats);
+  if (p->completed) p->wall = pd_median_in_place(walls, repeats);
 }
 
 // ---------------------------------------------------------------- the runs as batch tasks

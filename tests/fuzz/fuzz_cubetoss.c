@@ -9,18 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fuzz_checks.h"
 #include "polydyn/cubetoss.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
-
-static void check_error(const pdError* err) {
-  size_t n = strnlen(err->message, sizeof err->message);
-  if (n == 0 || n == sizeof err->message || err->line < 0 || err->col < 0) __builtin_trap();
-  for (size_t i = 0; i < n; ++i) {
-    unsigned char c = (unsigned char)err->message[i];
-    if (c < 0x20 || c == 0x7f) __builtin_trap();  // one printable line
-  }
-}
 
 static bool finite3(pdVec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
@@ -60,7 +52,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   pdError err;
   pdTossSet* set = pd_toss_parse_buffer("fuzz.csv", (const char*)data, csvSize, &err);
   if (!set) {
-    check_error(&err);
+    fuzz_check_error(&err, 0);
     return 0;
   }
   check_set(set);
@@ -80,7 +72,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (model)
     pd_model_free(model);
   else
-    check_error(&err);
+    fuzz_check_error(&err, 0);
   pd_toss_set_free(set);
   return 0;
 }

@@ -9,18 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fuzz_checks.h"
 #include "polydyn/oracle.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
-
-static void check_error(const pdError* err) {
-  size_t n = strnlen(err->message, sizeof err->message);
-  if (n == 0 || n == sizeof err->message || err->line < 1 || err->col < 1) __builtin_trap();
-  for (size_t i = 0; i < n; ++i) {
-    unsigned char c = (unsigned char)err->message[i];
-    if (c < 0x20 || c == 0x7f) __builtin_trap();  // one printable line
-  }
-}
 
 static bool unit(pdQuat q) { return fabs(sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) - 1.0) <= 1e-9; }
 
@@ -61,6 +53,6 @@ static bool visit(const pdOracleRow* listed, const pdOracleShape* sa, const pdOr
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   pdError err;
   long rows = 0;
-  if (!pd_oracle_replay_buffer("fuzz.csv", (const char*)data, size, visit, &rows, &err)) check_error(&err);
+  if (!pd_oracle_replay_buffer("fuzz.csv", (const char*)data, size, visit, &rows, &err)) fuzz_check_error(&err, 1);
   return 0;
 }

@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "fuzz_checks.h"
 #include "polydyn/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
@@ -35,22 +36,13 @@ static void check_scene(const pdScene* sc) {
   }
 }
 
-static void check_error(const pdError* err) {
-  size_t n = strnlen(err->message, sizeof err->message);
-  if (n == 0 || n == sizeof err->message || err->line < 0 || err->col < 0) __builtin_trap();
-  for (size_t i = 0; i < n; ++i) {
-    unsigned char c = (unsigned char)err->message[i];
-    if (c < 0x20 || c == 0x7f) __builtin_trap();  // one printable line
-  }
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   pdError err;
   pdScene* sc = pd_scene_parse_buffer("fuzz.scene", (const char*)data, size, &err);
   if (sc) {
     check_scene(sc);
   } else {
-    check_error(&err);
+    fuzz_check_error(&err, 0);
   }
   pd_scene_free(sc);
   return 0;
