@@ -781,7 +781,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   }
   s->stageSeconds[pd_stageContactAnalysis] += pd_clock_seconds() - t0c;
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
-  if (refineStep > 0.0 && s->stepper == pd_stepperRK4Adaptive && 0.5 * h >= refineStep) {
+  if (refineStep > 0.0 && s->stepper != pd_stepperRK4Fixed && 0.5 * h >= refineStep) {
     ++s->count.refinements;
     *hRetry = 0.5 * h;
     return pd_eventRetry;
