@@ -49,12 +49,15 @@
 // the period (the stability bound), and every halving throws away a whole trial step.
 #define PD_REFINE_PERIOD_FRACTION 0.05
 // Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can
-// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (stable_step). Classic
+// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (stable_step_exact). Classic
 // RK4 is stable to |hλ| ≈ 2.8 along both the negative real and the imaginary axis; 2.5 leaves a margin
 // for what the bound does not see (contacts coupled through a fixed body's neighbours count none). Without
 // the bound the error control walks the step up to the stability edge, where round-off grows until a
 // step is rejected: a block at rest then jitters at the tolerance (µm/s) instead of round-off.
 #define PD_STABLE_STEP_OMEGA 2.5
+// Relative margin on the cheap stability bound (stability_prepare) against the rounding of the sums it
+// bounds, which are exact to ~1e-15: the cheap step must never exceed the exact one as computed.
+#define PD_STABLE_CHEAP_MARGIN 1e-9
 // Tunnelling guard: over one step, two bodies whose swept boxes overlap may move relative to each other by
 // at most this fraction of the thinner one's width. A quarter keeps a vertex that crossed a face within
 // the first half of the body, so the face it crossed is still the nearest one and the contact is found
@@ -135,11 +138,15 @@ struct pdContactSet {
   double* width;           // (bodyCount) smallest width of each body across its face planes, m
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
   int onsetRetries;        // onset retries of the step under way
-  // stability bound (stable_step), sized with the list
+  // stability bound (stability_prepare, stable_step_exact), sized with the list
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])
   int* bodyList;           // (2 capacity)
-  double stableStep;       // s: the largest stable step for the current list (INFINITY: no contacts)
+  double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
+  double stableCheap;      // s: a step never above stableStep, from the cheap bound (stable_step_cheap)
+  bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
+  double* bodyNormK;       // (bodyCount) Σ ‖K_j^½‖∞ over the contacts j of each body
+  double* bodyNormRight;   // (bodyCount) Σ ‖W [r_j]ₓ K_j^½‖∞ over the contacts j of each body
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
 };
 
@@ -174,7 +181,10 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   set->bodyFirst = grow(NULL, n + 1, sizeof *set->bodyFirst);
   set->invInertiaWorld = grow(NULL, n, sizeof *set->invInertiaWorld);
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
-  set->stableStep = INFINITY;
+  set->stableStep = set->stableCheap = INFINITY;
+  set->stableKnown = true;
+  set->bodyNormK = grow(NULL, n, sizeof *set->bodyNormK);
+  set->bodyNormRight = grow(NULL, n, sizeof *set->bodyNormRight);
   set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
   PD_ASSERT(set->travel != NULL);
   for (int i = 0; i < n; ++i) {
@@ -232,6 +242,8 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->stability);
   free(set->bodyFirst);
   free(set->bodyList);
+  free(set->bodyNormK);
+  free(set->bodyNormRight);
   free(set->invInertiaWorld);
   free(set->travel);
   free(set->torque);
@@ -248,7 +260,8 @@ void pd_contact_set_free(pdContactSet* set) {
 
 void pd_contact_set_clear(pdContactSet* set) {
   set->count = 0;
-  set->stableStep = INFINITY;
+  set->stableStep = set->stableCheap = INFINITY;
+  set->stableKnown = true;
   set->candidateCount = 0;
   set->cacheCount = 0;
   set->onsetRetries = 0;
@@ -483,14 +496,35 @@ static double row_abs_sum(const pdMat3* m, int row) {
 
 static double overdamp_factor(double zeta) { return zeta > 1.0 ? zeta + sqrt(zeta * zeta - 1.0) : 1.0; }
 
-// The largest step h with h ω_max ≤ PD_STABLE_STEP_OMEGA, ω_max bounded by the Gershgorin row sums of M
-// (above) over every contact sharing a moving body, times the over-damping factor of damped modes whose
-// fast root exceeds ω. A Gershgorin sum is never below the true eigenvalue, and for a cube resting on a
-// face it is within 15 % of it (8 k/m against the rocking mode's 6 k/m).
-static double stable_step(const pdModel* model, pdContactSet* set, const pdPose* poses) {
-  if (set->count == 0) return INFINITY;
+// ‖m‖∞, the largest absolute row sum.
+static double norm_inf(const pdMat3* m) { return fmax(row_abs_sum(m, 0), fmax(row_abs_sum(m, 1), row_abs_sum(m, 2))); }
+
+static double step_of(double omega2, double overdamp) {
+  double omega = sqrt(omega2) * overdamp;
+  // the stepper keeps the result of two half steps (integrator.c): they are the ones that must be stable
+  return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
+}
+
+// The stability bound in two parts. stability_prepare (after every new list, O(contacts)) forms each
+// contact's terms, the per-body contact lists, and a cheap bound: by ‖AB‖∞ ≤ ‖A‖∞‖B‖∞, each Gershgorin
+// row sum of stable_step_exact is at most Σ over the contact's moving ends B of
+// ‖K_i^½‖∞ Σ_j ‖K_j^½‖∞ / m_B + ‖K_i^½ [r_i]ₓᵀ‖∞ Σ_j ‖W_B [r_j]ₓ K_j^½‖∞ (j over B's contacts), so its step
+// (stableCheap) never exceeds the exact one. The exact bound, O(contacts × contacts per body), is computed
+// only when the step the stepper wants exceeds the cheap one (pd_contact_set_limit_step): a resting stack
+// whose error control keeps the step below the bound then never pays for it, and the step taken is the
+// same bit for bit as with the exact bound computed every time.
+static double stable_step_exact(const pdModel* model, pdContactSet* set);
+
+static void stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+  set->stableKnown = false;
+  if (set->count == 0) {
+    set->stableStep = set->stableCheap = INFINITY;
+    set->stableKnown = true;
+    return;
+  }
   int bodies = model->bodyCount;
   for (int k = 0; k <= bodies; ++k) set->bodyFirst[k] = 0;
+  for (int k = 0; k < bodies; ++k) set->bodyNormK[k] = set->bodyNormRight[k] = 0.0;
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     const pdContactParams* p = &c->params;
@@ -514,6 +548,8 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
       t->left[e] = pd_mat3_mul(&t->k, &rxT);
       pdMat3 wrx = pd_mat3_mul(&set->invInertiaWorld[ends[e]], &rx);
       t->right[e] = pd_mat3_mul(&wrx, &t->k);
+      set->bodyNormK[ends[e]] += norm_inf(&t->k);
+      set->bodyNormRight[ends[e]] += norm_inf(&t->right[e]);
     }
   }
   for (int k = 0; k < bodies; ++k) set->bodyFirst[k + 1] += set->bodyFirst[k];
@@ -525,7 +561,37 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
   }
   for (int k = bodies; k > 0; --k) set->bodyFirst[k] = set->bodyFirst[k - 1];
   set->bodyFirst[0] = 0;
+  // the cheap bound; its margin covers the rounding of both sums (~1e-15 relative), so that it stays above
+  // the exact one as computed
+  double cheap2 = 0.0, overdamp = 1.0;
+  for (int i = 0; i < set->count; ++i) {
+    const contactSlot* c = &set->items[i];
+    const stabilityTerms* ti = &set->stability[i];
+    overdamp = fmax(overdamp, ti->overdamp);
+    double normK = norm_inf(&ti->k), sum = 0.0;
+    int ends[2] = {c->id.body1, c->id.body2};
+    for (int e = 0; e < 2; ++e) {
+      const pdBody* b = &model->bodies[ends[e]];
+      if (b->fixed) continue;
+      sum += normK * set->bodyNormK[ends[e]] * b->invMass + norm_inf(&ti->left[e]) * set->bodyNormRight[ends[e]];
+    }
+    cheap2 = fmax(cheap2, sum);
+  }
+  set->stableCheap = step_of(cheap2 * (1.0 + PD_STABLE_CHEAP_MARGIN), overdamp);
+#ifndef NDEBUG
+  // Debug builds (the sanitizer run of every test) check the inequality the laziness rests on, every list
+  set->stableStep = stable_step_exact(model, set);
+  set->stableKnown = true;
+  PD_ASSERT(set->stableCheap <= set->stableStep);
+#endif
+}
 
+// The exact Gershgorin bound: the largest step h with h ω_max ≤ PD_STABLE_STEP_OMEGA, ω_max bounded by the
+// Gershgorin row sums of M (above) over every contact sharing a moving body, times the over-damping factor
+// of damped modes whose fast root exceeds ω. A Gershgorin sum is never below the true eigenvalue, and for a
+// cube resting on a face it is within 15 % of it (8 k/m against the rocking mode's 6 k/m). Needs the terms
+// of stability_prepare for the current list.
+static double stable_step_exact(const pdModel* model, pdContactSet* set) {
   double omega2 = 0.0, overdamp = 1.0;
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
@@ -562,12 +628,17 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
     }
     omega2 = fmax(omega2, fmax(rows[0], fmax(rows[1], rows[2])));
   }
-  double omega = sqrt(omega2) * overdamp;
-  // the stepper keeps the result of two half steps (integrator.c): they are the ones that must be stable
-  return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
+  return step_of(omega2, overdamp);
 }
 
-double pd_contact_set_stable_step(const pdContactSet* set) { return set->stableStep; }
+double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction) {
+  if (fraction * set->stableCheap >= h) return h;  // the exact bound, never below the cheap one, cannot bind
+  if (!set->stableKnown) {
+    set->stableStep = stable_step_exact(model, set);
+    set->stableKnown = true;
+  }
+  return fmin(h, fraction * set->stableStep);
+}
 
 // Records geometry and force of every listed contact at state y for output, realignment and refinement.
 // poses must be those of y.
@@ -597,7 +668,7 @@ static void prepare_list(const pdModel* model, pdContactSet* set, const double* 
   }
   set_modal_dampers(model, set, poses);
   record(model, set, y, poses);
-  set->stableStep = stable_step(model, set, poses);
+  stability_prepare(model, set, poses);
 }
 
 // ---------------------------------------------------------------- the contact search at y1

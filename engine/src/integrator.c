@@ -10,7 +10,7 @@
 // (state.c: body size for positions, vmax for velocities, vmax/size for angular velocities, 1 for
 // quaternion components). A step is accepted when norm <= tol, or when h is already at dtmin (then
 // a warning is counted). The next step is h · clamp(0.9 (tol/norm)^(1/5), 0.2, 5), within
-// [dtmin, dtmax], and at most the contacts' stability bound (contact_set.h, pd_contact_set_stable_step).
+// [dtmin, dtmax], and at most the contacts' stability bound (contact_set.h, pd_contact_set_limit_step).
 //
 // Output samples fall exactly on t = k / sampleRate: a step that would pass the next sample is cut
 // to end on it (the time is then set to the sample time itself, so stamps never drift), and the
@@ -186,7 +186,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       s->h = fmin(set->dtmax, fmax(set->dtmin, grow * h));
     }
     // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge
-    s->h = fmax(set->dtmin, fmin(s->h, stableFraction * pd_contact_set_stable_step(s->contacts)));
+    s->h = fmax(set->dtmin, pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction));
     return h;
   }
 }
