@@ -145,8 +145,8 @@ struct pdContactSet {
   double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
   double stableCheap;      // s: a step never above stableStep, from the cheap bound (stable_step_cheap)
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
-  double* bodyNormK;       // (bodyCount) Σ ‖K_j^½‖∞ over the contacts j of each body
-  double* bodyNormRight;   // (bodyCount) Σ ‖W [r_j]ₓ K_j^½‖∞ over the contacts j of each body
+  pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
+  pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
 };
 
@@ -183,8 +183,8 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
   set->stableStep = set->stableCheap = INFINITY;
   set->stableKnown = true;
-  set->bodyNormK = grow(NULL, n, sizeof *set->bodyNormK);
-  set->bodyNormRight = grow(NULL, n, sizeof *set->bodyNormRight);
+  set->bodyRowsK = grow(NULL, n, sizeof *set->bodyRowsK);
+  set->bodyRowsRight = grow(NULL, n, sizeof *set->bodyRowsRight);
   set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
   PD_ASSERT(set->travel != NULL);
   for (int i = 0; i < n; ++i) {
@@ -242,8 +242,8 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->stability);
   free(set->bodyFirst);
   free(set->bodyList);
-  free(set->bodyNormK);
-  free(set->bodyNormRight);
+  free(set->bodyRowsK);
+  free(set->bodyRowsRight);
   free(set->invInertiaWorld);
   free(set->travel);
   free(set->torque);
@@ -496,8 +496,16 @@ static double row_abs_sum(const pdMat3* m, int row) {
 
 static double overdamp_factor(double zeta) { return zeta > 1.0 ? zeta + sqrt(zeta * zeta - 1.0) : 1.0; }
 
-// ‖m‖∞, the largest absolute row sum.
-static double norm_inf(const pdMat3* m) { return fmax(row_abs_sum(m, 0), fmax(row_abs_sum(m, 1), row_abs_sum(m, 2))); }
+// The absolute row sums of m.
+static pdVec3 row_abs_sums(const pdMat3* m) {
+  return (pdVec3){row_abs_sum(m, 0), row_abs_sum(m, 1), row_abs_sum(m, 2)};
+}
+
+// rows[r] += scale Σ_p |a_rp| w_p: bounds row r's absolute sum of a·b summed over all b whose rows sum to w.
+static void add_weighted_rows(const pdMat3* a, pdVec3 w, double scale, double rows[3]) {
+  for (int r = 0; r < 3; ++r)
+    rows[r] += scale * (fabs(a->m[r][0]) * w.x + fabs(a->m[r][1]) * w.y + fabs(a->m[r][2]) * w.z);
+}
 
 static double step_of(double omega2, double overdamp) {
   double omega = sqrt(omega2) * overdamp;
@@ -506,10 +514,11 @@ static double step_of(double omega2, double overdamp) {
 }
 
 // The stability bound in two parts. stability_prepare (after every new list, O(contacts)) forms each
-// contact's terms, the per-body contact lists, and a cheap bound: by ‖AB‖∞ ≤ ‖A‖∞‖B‖∞, each Gershgorin
-// row sum of stable_step_exact is at most Σ over the contact's moving ends B of
-// ‖K_i^½‖∞ Σ_j ‖K_j^½‖∞ / m_B + ‖K_i^½ [r_i]ₓᵀ‖∞ Σ_j ‖W_B [r_j]ₓ K_j^½‖∞ (j over B's contacts), so its step
-// (stableCheap) never exceeds the exact one. The exact bound, O(contacts × contacts per body), is computed
+// contact's terms, the per-body contact lists, and a cheap bound: by |Σ_j (A B_j)_rq| ≤ Σ_p |A_rp| |(B_j)_pq|,
+// row r of contact i's Gershgorin sum in stable_step_exact is at most Σ over its moving ends B of
+// Σ_p |(K_i^½)_rp| w_p / m_B + Σ_p |(K_i^½ [r_i]ₓᵀ)_rp| u_p, where w_p and u_p are the row-p absolute sums of
+// K_j^½ and of W_B [r_j]ₓ K_j^½ summed over B's contacts j; so its step (stableCheap) never exceeds the
+// exact one. The exact bound, O(contacts × contacts per body), is computed
 // only when the step the stepper wants exceeds the cheap one (pd_contact_set_limit_step): a resting stack
 // whose error control keeps the step below the bound then never pays for it, and the step taken is the
 // same bit for bit as with the exact bound computed every time.
@@ -524,7 +533,7 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
   }
   int bodies = model->bodyCount;
   for (int k = 0; k <= bodies; ++k) set->bodyFirst[k] = 0;
-  for (int k = 0; k < bodies; ++k) set->bodyNormK[k] = set->bodyNormRight[k] = 0.0;
+  for (int k = 0; k < bodies; ++k) set->bodyRowsK[k] = set->bodyRowsRight[k] = (pdVec3){0, 0, 0};
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     const pdContactParams* p = &c->params;
@@ -548,8 +557,8 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
       t->left[e] = pd_mat3_mul(&t->k, &rxT);
       pdMat3 wrx = pd_mat3_mul(&set->invInertiaWorld[ends[e]], &rx);
       t->right[e] = pd_mat3_mul(&wrx, &t->k);
-      set->bodyNormK[ends[e]] += norm_inf(&t->k);
-      set->bodyNormRight[ends[e]] += norm_inf(&t->right[e]);
+      set->bodyRowsK[ends[e]] = pd_v3_add(set->bodyRowsK[ends[e]], row_abs_sums(&t->k));
+      set->bodyRowsRight[ends[e]] = pd_v3_add(set->bodyRowsRight[ends[e]], row_abs_sums(&t->right[e]));
     }
   }
   for (int k = 0; k < bodies; ++k) set->bodyFirst[k + 1] += set->bodyFirst[k];
@@ -568,14 +577,15 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
     const contactSlot* c = &set->items[i];
     const stabilityTerms* ti = &set->stability[i];
     overdamp = fmax(overdamp, ti->overdamp);
-    double normK = norm_inf(&ti->k), sum = 0.0;
+    double rows[3] = {0, 0, 0};
     int ends[2] = {c->id.body1, c->id.body2};
     for (int e = 0; e < 2; ++e) {
       const pdBody* b = &model->bodies[ends[e]];
       if (b->fixed) continue;
-      sum += normK * set->bodyNormK[ends[e]] * b->invMass + norm_inf(&ti->left[e]) * set->bodyNormRight[ends[e]];
+      add_weighted_rows(&ti->k, set->bodyRowsK[ends[e]], b->invMass, rows);
+      add_weighted_rows(&ti->left[e], set->bodyRowsRight[ends[e]], 1.0, rows);
     }
-    cheap2 = fmax(cheap2, sum);
+    cheap2 = fmax(cheap2, fmax(rows[0], fmax(rows[1], rows[2])));
   }
   set->stableCheap = step_of(cheap2 * (1.0 + PD_STABLE_CHEAP_MARGIN), overdamp);
 #ifndef NDEBUG
