@@ -145,6 +145,7 @@ struct pdContactSet {
   double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
   double stableCheap;      // s: a step never above stableStep, from the cheap bound (stable_step_cheap)
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
+  double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
@@ -572,13 +573,13 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
   set->bodyFirst[0] = 0;
   // the cheap bound; its margin covers the rounding of both sums (~1e-15 relative), so that it stays above
   // the exact one as computed
-  double cheap2 = 0.0, overdamp = 1.0;
+  double cheap2 = 0.0;
+  set->overdamp = 1.0;
   for (int i = 0; i < set->count; ++i) {
-    const contactSlot* c = &set->items[i];
     const stabilityTerms* ti = &set->stability[i];
-    overdamp = fmax(overdamp, ti->overdamp);
+    set->overdamp = fmax(set->overdamp, ti->overdamp);
     double rows[3] = {0, 0, 0};
-    int ends[2] = {c->id.body1, c->id.body2};
+    int ends[2] = {set->items[i].id.body1, set->items[i].id.body2};
     for (int e = 0; e < 2; ++e) {
       const pdBody* b = &model->bodies[ends[e]];
       if (b->fixed) continue;
@@ -587,7 +588,7 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
     }
     cheap2 = fmax(cheap2, fmax(rows[0], fmax(rows[1], rows[2])));
   }
-  set->stableCheap = step_of(cheap2 * (1.0 + PD_STABLE_CHEAP_MARGIN), overdamp);
+  set->stableCheap = step_of(cheap2 * (1.0 + PD_STABLE_CHEAP_MARGIN), set->overdamp);
 #ifndef NDEBUG
   // Debug builds (the sanitizer run of every test) check the inequality the laziness rests on, every list
   set->stableStep = stable_step_exact(model, set);
@@ -602,11 +603,10 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
 // cube resting on a face it is within 15 % of it (8 k/m against the rocking mode's 6 k/m). Needs the terms
 // of stability_prepare for the current list.
 static double stable_step_exact(const pdModel* model, pdContactSet* set) {
-  double omega2 = 0.0, overdamp = 1.0;
+  double omega2 = 0.0;
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     const stabilityTerms* ti = &set->stability[i];
-    overdamp = fmax(overdamp, ti->overdamp);
     double rows[3] = {0, 0, 0};
     int ends[2] = {c->id.body1, c->id.body2};
     int lo = ends[0] < ends[1] ? ends[0] : ends[1], hi = ends[0] < ends[1] ? ends[1] : ends[0];
@@ -638,7 +638,7 @@ static double stable_step_exact(const pdModel* model, pdContactSet* set) {
     }
     omega2 = fmax(omega2, fmax(rows[0], fmax(rows[1], rows[2])));
   }
-  return step_of(omega2, overdamp);
+  return step_of(omega2, set->overdamp);
 }
 
 double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction) {
