@@ -11,6 +11,12 @@
 // quaternion components). A step is accepted when norm <= tol, or when h is already at dtmin (then
 // a warning is counted). The next step is h · clamp(0.9 (tol/norm)^(1/5), 0.2, 5), within
 // [dtmin, dtmax], and at most the contacts' stability bound (contact_set.h, pd_contact_set_limit_step).
+// The embedded stepper (pd_stepperRK43Embedded) keeps one RK4 step and estimates its error with RK4's
+// third-order partner, h (k4 − f(t + h, y1))/6: 5 evaluations per step instead of 11, but twice the
+// steps for the same stability bound (a single RK4 step must now be stable), and the contact events are
+// analysed once per accepted step — so it wins on impacts and free flight and loses on resting and sliding
+// contacts (README, "Integration"); step doubling stays the default. Both run through adaptive_step,
+// which takes the trial, the order of its estimate (the controller's exponents) and the bound's share.
 //
 // Output samples fall exactly on t = k / sampleRate: a step that would pass the next sample is cut
 // to end on it (the time is then set to the sample time itself, so stamps never drift), and the
