@@ -14,8 +14,8 @@
 
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
-    "                         [--stepper adaptive|fixed] [--variant native|matched] [--step H]\n"
-    "                         [--ode-friction pyramid|aligned]\n"
+    "                         [--stepper adaptive|fixed|embedded] [--variant native|matched]\n"
+    "                         [--step H] [--ode-friction pyramid|aligned]\n"
     "\n"
     "Simulates SCENE and writes DIR/trajectory.csv and DIR/summary.json. DIR is written under a\n"
     "temporary name and renamed when complete; an existing run directory DIR is replaced.\n"
@@ -26,7 +26,8 @@ static const char* const help =
     "  --tend T         simulated seconds, overrides the scene's tend\n"
     "  --sample HZ      output samples per second, overrides the scene's sample\n"
     "  --stepper NAME   adaptive: RK4 with step-doubling error control (default);\n"
-    "                   fixed: RK4 with the scene's dt, no error control (soft engine)\n"
+    "                   fixed: RK4 with the scene's dt, no error control;\n"
+    "                   embedded: RK4 with its embedded third-order error estimate (soft engine)\n"
     "  --variant NAME   ode, bullet: native (the engine's own hard contact, default) or matched (its\n"
     "                   soft contact set to polydyn's k and c)\n"
     "  --step H         ode, bullet: the fixed step, s (default 1e-3)\n"
@@ -120,8 +121,11 @@ int pd_cmd_run(int argc, char** argv) {
       } else if (strcmp(v, "fixed") == 0) {
         stepperGiven = true;
         stepper = pd_stepperRK4Fixed;
+      } else if (strcmp(v, "embedded") == 0) {
+        stepperGiven = true;
+        stepper = pd_stepperRK43Embedded;
       } else {
-        return pd_cli_usage_error("run", "--stepper must be adaptive or fixed");
+        return pd_cli_usage_error("run", "--stepper must be adaptive, fixed or embedded");
       }
     } else if (a[0] == '-' && a[1] != '\0') {
       return pd_cli_usage_error("run", "unknown option '%s'", a);

@@ -41,18 +41,20 @@
 static const char* const help =
     "usage: polydyn sweep SCENE --out DIR [--repeats R] [--engines soft,ode,bullet] [--tend T] [--jobs N]\n"
     "\n"
-    "Work-precision sweep of SCENE: polydyn's adaptive RK4 at tol 1e-2 ... 1e-10 (decades) and its fixed-step\n"
-    "RK4 at dt 1e-3 ... 1e-5, ODE and Bullet (native and matched) at steps 1/60 ... 1/16000 s. Errors are\n"
-    "the RMS over samples and moving bodies of max(|x - x_ref| / body size, rotation angle in rad):\n"
+    "Work-precision sweep of SCENE: polydyn's adaptive RK4 (step doubling) and its embedded RK4(3) pair at\n"
+    "tol 1e-2 ... 1e-10 (decades), its fixed-step RK4 at dt 1e-3 ... 1e-5, ODE and Bullet (native and matched)\n"
+    "at steps 1/60 ... 1/16000 s. Errors are the RMS over samples and moving bodies of\n"
+    "max(|x - x_ref| / body size, rotation angle in rad):\n"
     "  error        against the soft engine at tol 1e-12 (whose own error, against tol 1e-13, is reported as\n"
     "               the reference's);\n"
-    "  self_error   self-convergence: against the engine-variant's own finest run (soft, adaptive and fixed:\n"
-    "               the same tol 1e-12 run; ODE and Bullet: their own run at 1/16000 s, whose self_error is\n"
+    "  self_error   self-convergence: against the engine-variant's own finest run (soft, every stepper: the\n"
+    "               same adaptive tol 1e-12 run; ODE and Bullet: their own run at 1/16000 s, whose self_error is\n"
     "               empty, it has no finer run of its own);\n"
     "  horizon      the horizon of predictability: the first sample time at which the run's error against\n"
     "               its own finest run exceeds 0.1 (a tenth of a body size or 0.1 rad) for some body; empty\n"
     "               when it never does.\n"
-    "Wall time: median of R runs (default 3), no output files written during the runs.\n"
+    "Wall time: median of R runs (default 3), no output files written during the runs; derivatives: the soft\n"
+    "engine's derivative evaluations (the cost that does not depend on the machine).\n"
     "Writes DIR/sweep.csv (reports/FORMATS.md) and DIR/reference.json; DIR is replaced atomically.\n"
     "\n"
     "  --jobs N   run N points at a time in worker processes (default 1); under mpirun or srun the points are\n"
@@ -103,13 +105,14 @@ typedef struct point {
   double horizon;       // s; NAN when never (or not measured)
   double wall;          // median over repeats, s
   long steps;
+  long derivatives;  // derivative evaluations of the soft engine's last run; -1 for ODE and Bullet
 } point;
 
 typedef struct pointMeasure {
   int32_t completed;
   int32_t unused;
   double error, selfError, horizon, wall;
-  int64_t steps;
+  int64_t steps, derivatives;
 } pointMeasure;
 
 // Every run's observer: records the trajectory when one is given; stops the run at its next sample once the
@@ -119,14 +122,16 @@ static bool observe(const pdModel* model, const pdState* state, void* trajectory
   return !trajectory || pd_trajectory_observe(model, state, trajectory);
 }
 
-// One soft run: trajectory (when wanted), wall time, steps, completed.
-static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* trajectory, double* wall, long* steps) {
+// One soft run: trajectory (when wanted), wall time, steps, derivative evaluations (when wanted), completed.
+static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* trajectory, double* wall, long* steps,
+                     long* derivatives) {
   pdState* state = pd_state_create(model);
   state->stepper = stepper;
   double t0 = pd_cli_wall_seconds();
   bool ok = pd_advance(model, state, model->settings.tend, observe, trajectory);
   *wall = pd_cli_wall_seconds() - t0;
   *steps = state->count.accepted;
+  if (derivatives) *derivatives = state->count.derivatives;
   pd_state_free(state);
   return ok;
 }
@@ -140,13 +145,15 @@ static void measure_soft(const char* scene, const pdCliOverrides* base, int repe
   pdModel* model = pd_cli_load_model(scene, &o, NULL);
   p->completed = false;
   p->error = p->selfError = p->horizon = p->wall = NAN;
-  p->steps = 0;
+  p->steps = p->derivatives = 0;
   if (!model) return;
   double walls[SWEEP_MAX_REPEATS];
   pdTrajectory* tr = pd_trajectory_create(model);
+  pdStepper stepper = fixed                                 ? pd_stepperRK4Fixed
+                      : strcmp(p->variant, "embedded") == 0 ? pd_stepperRK43Embedded
+                                                            : pd_stepperRK4Adaptive;
   for (int r = 0; r < repeats; ++r) {
-    p->completed = soft_run(model, fixed ? pd_stepperRK4Fixed : pd_stepperRK4Adaptive, r == 0 ? tr : NULL,
-                            &walls[r], &p->steps);
+    p->completed = soft_run(model, stepper, r == 0 ? tr : NULL, &walls[r], &p->steps, &p->derivatives);
     if (!p->completed) break;
   }
   if (p->completed) {
@@ -164,6 +171,7 @@ static void run_reference_engine(const pdModel* model, int repeats, point* p, pd
   p->completed = false;
   p->error = p->selfError = p->horizon = p->wall = NAN;
   p->steps = 0;
+  p->derivatives = -1;
   double walls[SWEEP_MAX_REPEATS];
   pdRefOptions o = {.variant = strcmp(p->variant, "matched") == 0 ? pd_refMatched : pd_refNative,
                     .step = p->value,
@@ -220,7 +228,7 @@ static void kept_task(int task, pdBatchBuffer* result, void* user) {
     wall = p.wall;
     steps = p.steps;
   } else {
-    completed = soft_run(r->model, pd_stepperRK4Adaptive, tr, &wall, &steps);
+    completed = soft_run(r->model, pd_stepperRK4Adaptive, tr, &wall, &steps, NULL);
   }
   keptHeader h = {completed, tr->movingCount, tr->samples, steps, wall};
   pd_batch_append(result, &h, sizeof h);
@@ -287,7 +295,7 @@ static void point_task(int task, pdBatchBuffer* result, void* user) {
     if (p.completed && self->completed) p.selfError = pose_error(r->refModel, tr, self->trajectory, &p.horizon);
     pd_trajectory_free(tr);
   }
-  pointMeasure m = {p.completed, 0, p.error, p.selfError, p.horizon, p.wall, p.steps};
+  pointMeasure m = {p.completed, 0, p.error, p.selfError, p.horizon, p.wall, p.steps, p.derivatives};
   pd_batch_append(result, &m, sizeof m);
 }
 
@@ -302,6 +310,7 @@ static void take_point(const pdBatchBuffer* bytes, point* p) {
   p->horizon = m.horizon;
   p->wall = m.wall;
   p->steps = (long)m.steps;
+  p->derivatives = (long)m.derivatives;
 }
 
 static bool point_progress(int task, int done, int total, void* user) {
@@ -387,6 +396,8 @@ int pd_cmd_sweep(int argc, char** argv) {
     for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i) points[count++] = (point){.engine = "soft", .variant = "adaptive", .setting = "tol", .value = tols[i]};
     for (size_t i = 0; i < sizeof fixedSteps / sizeof fixedSteps[0]; ++i)
       points[count++] = (point){.engine = "soft", .variant = "fixed", .setting = "step", .value = fixedSteps[i]};
+    for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i)
+      points[count++] = (point){.engine = "soft", .variant = "embedded", .setting = "tol", .value = tols[i]};
   }
   // the kept runs: the soft reference, its check, and each ODE and Bullet variant's finest step (its own
   // reference: the variant's coarser points are measured against it in the second batch)
@@ -459,6 +470,7 @@ int pd_cmd_sweep(int argc, char** argv) {
     p->selfError = p->horizon = NAN;
     p->wall = p->completed ? kept[k].wall : NAN;
     p->steps = kept[k].steps;
+    p->derivatives = -1;
   }
 
   // the second batch: every other point, one task each
@@ -502,8 +514,10 @@ int pd_cmd_sweep(int argc, char** argv) {
     FILE* f = fopen(path, "w");
     bool ok = f != NULL;
     if (f) {
-      fputs("scene,engine,variant,setting,value,error,error_kind,wall_seconds,wall_per_sim_second,steps,repeats,"
-            "reference,self_error,self_reference,horizon_seconds\n", f);
+      fputs(
+          "scene,engine,variant,setting,value,error,error_kind,wall_seconds,wall_per_sim_second,steps,repeats,"
+          "reference,self_error,self_reference,horizon_seconds,derivatives\n",
+          f);
       for (int i = 0; i < count; ++i) {
         const point* p = &points[i];
         char selfName[128];
@@ -517,6 +531,8 @@ int pd_cmd_sweep(int argc, char** argv) {
         if (p->completed && !isnan(p->selfError)) fprintf(f, "%.6g", p->selfError);
         fprintf(f, ",%s,", selfName);
         if (p->completed && !isnan(p->horizon)) fprintf(f, "%.6g", p->horizon);
+        fputc(',', f);
+        if (p->completed && p->derivatives >= 0) fprintf(f, "%ld", p->derivatives);
         fputc('\n', f);
       }
       ok = !ferror(f);

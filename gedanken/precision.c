@@ -47,7 +47,7 @@ static const char* const pointStatusNames[] = {"ok", "failed", "no_measure", "re
 typedef struct gkPoint {
   const gkCase* c;
   pdGkEngine engine;
-  const char* variant;  // "adaptive", "fixed", "native", "matched"
+  const char* variant;  // "adaptive", "fixed", "embedded", "native", "matched"
   const char* setting;  // "tol", "step", "iterations"; "" for a not_built row
   double value;
   // measured (travels between processes as gkPointResult)
@@ -143,7 +143,9 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
     gkPointObserver observer = {r == 0 ? &rec : NULL, s, p->engine == pd_gkSoft};
     if (model) {
       pdState* state = pd_state_create(model);
-      state->stepper = strcmp(p->variant, "fixed") == 0 ? pd_stepperRK4Fixed : pd_stepperRK4Adaptive;
+      state->stepper = strcmp(p->variant, "fixed") == 0      ? pd_stepperRK4Fixed
+                       : strcmp(p->variant, "embedded") == 0 ? pd_stepperRK43Embedded
+                                                             : pd_stepperRK4Adaptive;
       double t0 = gk_wall_seconds();
       completed = pd_advance(model, state, model->settings.tend, observe, &observer);
       walls[r] = gk_wall_seconds() - t0;
@@ -246,6 +248,7 @@ static void add_case_points(gkPrecision* s, const gkCase* c) {
   if (o->engines[pd_gkSoft]) {
     for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "adaptive", "tol", softTolerances[k]);
     for (int k = 0; k < SOFT_FIXED_COUNT; ++k) add(s, c, pd_gkSoft, "fixed", "step", softFixedSteps[k]);
+    for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "embedded", "tol", softTolerances[k]);
   }
   for (int engine = pd_gkOde; engine < pd_gkEngineCount; ++engine) {
     if (!o->engines[engine]) continue;
@@ -319,7 +322,7 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
 
 bool gk_precision_run(const pdGkOptions* options, const gkCase* cases, int caseCount, const char* root, pdError* err) {
   PD_ASSERT(options->repeats >= 1 && options->repeats <= MAX_REPEATS);
-  int perCase = SOFT_TOL_COUNT + SOFT_FIXED_COUNT + 2 * (pd_gkEngineCount - 1) * REFERENCE_STEP_COUNT +
+  int perCase = 2 * SOFT_TOL_COUNT + SOFT_FIXED_COUNT + 2 * (pd_gkEngineCount - 1) * REFERENCE_STEP_COUNT +
                 2 * BULLET_ITERATION_COUNT;
   gkPrecision s = {.options = options, .points = calloc((size_t)caseCount * (size_t)perCase + 1, sizeof(gkPoint))};
   PD_ASSERT(s.points != NULL);

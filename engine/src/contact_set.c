@@ -49,12 +49,15 @@
 // the period (the stability bound), and every halving throws away a whole trial step.
 #define PD_REFINE_PERIOD_FRACTION 0.05
 // Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can
-// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (stable_step). Classic
+// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (stable_step_exact). Classic
 // RK4 is stable to |hλ| ≈ 2.8 along both the negative real and the imaginary axis; 2.5 leaves a margin
 // for what the bound does not see (contacts coupled through a fixed body's neighbours count none). Without
 // the bound the error control walks the step up to the stability edge, where round-off grows until a
 // step is rejected: a block at rest then jitters at the tolerance (µm/s) instead of round-off.
 #define PD_STABLE_STEP_OMEGA 2.5
+// Relative margin on the cheap stability bound (stability_prepare) against the rounding of the sums it
+// bounds, which are exact to ~1e-15: the cheap step must never exceed the exact one as computed.
+#define PD_STABLE_CHEAP_MARGIN 1e-9
 // Tunnelling guard: over one step, two bodies whose swept boxes overlap may move relative to each other by
 // at most this fraction of the thinner one's width. A quarter keeps a vertex that crossed a face within
 // the first half of the body, so the face it crossed is still the nearest one and the contact is found
@@ -135,11 +138,16 @@ struct pdContactSet {
   double* width;           // (bodyCount) smallest width of each body across its face planes, m
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
   int onsetRetries;        // onset retries of the step under way
-  // stability bound (stable_step), sized with the list
+  // stability bound (stability_prepare, stable_step_exact), sized with the list
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])
   int* bodyList;           // (2 capacity)
-  double stableStep;       // s: the largest stable step for the current list (INFINITY: no contacts)
+  double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
+  double stableCheap;      // s: a step never above stableStep, from the cheap bound (stable_step_cheap)
+  bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
+  double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
+  pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
+  pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
 };
 
@@ -174,7 +182,10 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   set->bodyFirst = grow(NULL, n + 1, sizeof *set->bodyFirst);
   set->invInertiaWorld = grow(NULL, n, sizeof *set->invInertiaWorld);
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
-  set->stableStep = INFINITY;
+  set->stableStep = set->stableCheap = INFINITY;
+  set->stableKnown = true;
+  set->bodyRowsK = grow(NULL, n, sizeof *set->bodyRowsK);
+  set->bodyRowsRight = grow(NULL, n, sizeof *set->bodyRowsRight);
   set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
   PD_ASSERT(set->travel != NULL);
   for (int i = 0; i < n; ++i) {
@@ -232,6 +243,8 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->stability);
   free(set->bodyFirst);
   free(set->bodyList);
+  free(set->bodyRowsK);
+  free(set->bodyRowsRight);
   free(set->invInertiaWorld);
   free(set->travel);
   free(set->torque);
@@ -248,7 +261,8 @@ void pd_contact_set_free(pdContactSet* set) {
 
 void pd_contact_set_clear(pdContactSet* set) {
   set->count = 0;
-  set->stableStep = INFINITY;
+  set->stableStep = set->stableCheap = INFINITY;
+  set->stableKnown = true;
   set->candidateCount = 0;
   set->cacheCount = 0;
   set->onsetRetries = 0;
@@ -483,14 +497,44 @@ static double row_abs_sum(const pdMat3* m, int row) {
 
 static double overdamp_factor(double zeta) { return zeta > 1.0 ? zeta + sqrt(zeta * zeta - 1.0) : 1.0; }
 
-// The largest step h with h ω_max ≤ PD_STABLE_STEP_OMEGA, ω_max bounded by the Gershgorin row sums of M
-// (above) over every contact sharing a moving body, times the over-damping factor of damped modes whose
-// fast root exceeds ω. A Gershgorin sum is never below the true eigenvalue, and for a cube resting on a
-// face it is within 15 % of it (8 k/m against the rocking mode's 6 k/m).
-static double stable_step(const pdModel* model, pdContactSet* set, const pdPose* poses) {
-  if (set->count == 0) return INFINITY;
+// The absolute row sums of m.
+static pdVec3 row_abs_sums(const pdMat3* m) {
+  return (pdVec3){row_abs_sum(m, 0), row_abs_sum(m, 1), row_abs_sum(m, 2)};
+}
+
+// rows[r] += scale Σ_p |a_rp| w_p: bounds row r's absolute sum of a·b summed over all b whose rows sum to w.
+static void add_weighted_rows(const pdMat3* a, pdVec3 w, double scale, double rows[3]) {
+  for (int r = 0; r < 3; ++r)
+    rows[r] += scale * (fabs(a->m[r][0]) * w.x + fabs(a->m[r][1]) * w.y + fabs(a->m[r][2]) * w.z);
+}
+
+static double step_of(double omega2, double overdamp) {
+  double omega = sqrt(omega2) * overdamp;
+  // the stepper keeps the result of two half steps (integrator.c): they are the ones that must be stable
+  return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
+}
+
+// The stability bound in two parts. stability_prepare (after every new list, O(contacts)) forms each
+// contact's terms, the per-body contact lists, and a cheap bound: by |Σ_j (A B_j)_rq| ≤ Σ_p |A_rp| |(B_j)_pq|,
+// row r of contact i's Gershgorin sum in stable_step_exact is at most Σ over its moving ends B of
+// Σ_p |(K_i^½)_rp| w_p / m_B + Σ_p |(K_i^½ [r_i]ₓᵀ)_rp| u_p, where w_p and u_p are the row-p absolute sums of
+// K_j^½ and of W_B [r_j]ₓ K_j^½ summed over B's contacts j; so its step (stableCheap) never exceeds the
+// exact one. The exact bound, O(contacts × contacts per body), is computed
+// only when the step the stepper wants exceeds the cheap one (pd_contact_set_limit_step): a resting stack
+// whose error control keeps the step below the bound then never pays for it, and the step taken is the
+// same bit for bit as with the exact bound computed every time.
+static double stable_step_exact(const pdModel* model, pdContactSet* set);
+
+static void stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+  set->stableKnown = false;
+  if (set->count == 0) {
+    set->stableStep = set->stableCheap = INFINITY;
+    set->stableKnown = true;
+    return;
+  }
   int bodies = model->bodyCount;
   for (int k = 0; k <= bodies; ++k) set->bodyFirst[k] = 0;
+  for (int k = 0; k < bodies; ++k) set->bodyRowsK[k] = set->bodyRowsRight[k] = (pdVec3){0, 0, 0};
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     const pdContactParams* p = &c->params;
@@ -514,6 +558,8 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
       t->left[e] = pd_mat3_mul(&t->k, &rxT);
       pdMat3 wrx = pd_mat3_mul(&set->invInertiaWorld[ends[e]], &rx);
       t->right[e] = pd_mat3_mul(&wrx, &t->k);
+      set->bodyRowsK[ends[e]] = pd_v3_add(set->bodyRowsK[ends[e]], row_abs_sums(&t->k));
+      set->bodyRowsRight[ends[e]] = pd_v3_add(set->bodyRowsRight[ends[e]], row_abs_sums(&t->right[e]));
     }
   }
   for (int k = 0; k < bodies; ++k) set->bodyFirst[k + 1] += set->bodyFirst[k];
@@ -525,12 +571,42 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
   }
   for (int k = bodies; k > 0; --k) set->bodyFirst[k] = set->bodyFirst[k - 1];
   set->bodyFirst[0] = 0;
+  // the cheap bound; its margin covers the rounding of both sums (~1e-15 relative), so that it stays above
+  // the exact one as computed
+  double cheap2 = 0.0;
+  set->overdamp = 1.0;
+  for (int i = 0; i < set->count; ++i) {
+    const stabilityTerms* ti = &set->stability[i];
+    set->overdamp = fmax(set->overdamp, ti->overdamp);
+    double rows[3] = {0, 0, 0};
+    int ends[2] = {set->items[i].id.body1, set->items[i].id.body2};
+    for (int e = 0; e < 2; ++e) {
+      const pdBody* b = &model->bodies[ends[e]];
+      if (b->fixed) continue;
+      add_weighted_rows(&ti->k, set->bodyRowsK[ends[e]], b->invMass, rows);
+      add_weighted_rows(&ti->left[e], set->bodyRowsRight[ends[e]], 1.0, rows);
+    }
+    cheap2 = fmax(cheap2, fmax(rows[0], fmax(rows[1], rows[2])));
+  }
+  set->stableCheap = step_of(cheap2 * (1.0 + PD_STABLE_CHEAP_MARGIN), set->overdamp);
+#ifndef NDEBUG
+  // Debug builds (the sanitizer run of every test) check the inequality the laziness rests on, every list
+  set->stableStep = stable_step_exact(model, set);
+  set->stableKnown = true;
+  PD_ASSERT(set->stableCheap <= set->stableStep);
+#endif
+}
 
-  double omega2 = 0.0, overdamp = 1.0;
+// The exact Gershgorin bound: the largest step h with h ω_max ≤ PD_STABLE_STEP_OMEGA, ω_max bounded by the
+// Gershgorin row sums of M (above) over every contact sharing a moving body, times the over-damping factor
+// of damped modes whose fast root exceeds ω. A Gershgorin sum is never below the true eigenvalue, and for a
+// cube resting on a face it is within 15 % of it (8 k/m against the rocking mode's 6 k/m). Needs the terms
+// of stability_prepare for the current list.
+static double stable_step_exact(const pdModel* model, pdContactSet* set) {
+  double omega2 = 0.0;
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     const stabilityTerms* ti = &set->stability[i];
-    overdamp = fmax(overdamp, ti->overdamp);
     double rows[3] = {0, 0, 0};
     int ends[2] = {c->id.body1, c->id.body2};
     int lo = ends[0] < ends[1] ? ends[0] : ends[1], hi = ends[0] < ends[1] ? ends[1] : ends[0];
@@ -562,12 +638,17 @@ static double stable_step(const pdModel* model, pdContactSet* set, const pdPose*
     }
     omega2 = fmax(omega2, fmax(rows[0], fmax(rows[1], rows[2])));
   }
-  double omega = sqrt(omega2) * overdamp;
-  // the stepper keeps the result of two half steps (integrator.c): they are the ones that must be stable
-  return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
+  return step_of(omega2, set->overdamp);
 }
 
-double pd_contact_set_stable_step(const pdContactSet* set) { return set->stableStep; }
+double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction) {
+  if (fraction * set->stableCheap >= h) return h;  // the exact bound, never below the cheap one, cannot bind
+  if (!set->stableKnown) {
+    set->stableStep = stable_step_exact(model, set);
+    set->stableKnown = true;
+  }
+  return fmin(h, fraction * set->stableStep);
+}
 
 // Records geometry and force of every listed contact at state y for output, realignment and refinement.
 // poses must be those of y.
@@ -597,7 +678,7 @@ static void prepare_list(const pdModel* model, pdContactSet* set, const double* 
   }
   set_modal_dampers(model, set, poses);
   record(model, set, y, poses);
-  set->stableStep = stable_step(model, set, poses);
+  stability_prepare(model, set, poses);
 }
 
 // ---------------------------------------------------------------- the contact search at y1
@@ -781,7 +862,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   }
   s->stageSeconds[pd_stageContactAnalysis] += pd_clock_seconds() - t0c;
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
-  if (refineStep > 0.0 && s->stepper == pd_stepperRK4Adaptive && 0.5 * h >= refineStep) {
+  if (refineStep > 0.0 && s->stepper != pd_stepperRK4Fixed && 0.5 * h >= refineStep) {
     ++s->count.refinements;
     *hRetry = 0.5 * h;
     return pd_eventRetry;

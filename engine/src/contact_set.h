@@ -52,9 +52,11 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* state, double h,
 // (§3.4) and records each contact's force for output. Grows the state's vectors if needed.
 void pd_contact_events_commit(const pdModel* model, pdState* state, const double* y1);
 
-// The largest step the adaptive stepper may take with the committed contact list: h ω_max ≤ 2.5 for the
-// fastest contact mode (contact_set.c, stable_step); INFINITY without contacts.
-double pd_contact_set_stable_step(const pdContactSet* set);
+// min(h, fraction × the largest step the adaptive stepper may take with the committed contact list), that
+// step satisfying (step/2) ω_max ≤ 2.5 for the fastest contact mode (contact_set.c, stable_step_exact;
+// INFINITY without contacts): fraction 1 for step doubling (its half steps are the ones kept), ½ for a
+// single RK4 step. The exact bound is computed only when a cheaper upper bound of ω_max lets h through.
+double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction);
 
 // Grows the state's y, weight and work to hold `contacts` contacts (between steps only).
 void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contacts);

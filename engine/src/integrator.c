@@ -10,7 +10,13 @@
 // (state.c: body size for positions, vmax for velocities, vmax/size for angular velocities, 1 for
 // quaternion components). A step is accepted when norm <= tol, or when h is already at dtmin (then
 // a warning is counted). The next step is h · clamp(0.9 (tol/norm)^(1/5), 0.2, 5), within
-// [dtmin, dtmax], and at most the contacts' stability bound (contact_set.h, pd_contact_set_stable_step).
+// [dtmin, dtmax], and at most the contacts' stability bound (contact_set.h, pd_contact_set_limit_step).
+// The embedded stepper (pd_stepperRK43Embedded) keeps one RK4 step and estimates its error with RK4's
+// third-order partner, h (k4 − f(t + h, y1))/6: 5 evaluations per step instead of 11, but twice the
+// steps for the same stability bound (a single RK4 step must now be stable), and the contact events are
+// analysed once per accepted step — so it wins on impacts and free flight and loses on resting and sliding
+// contacts (README, "Integration"); step doubling stays the default. Both run through adaptive_step,
+// which takes the trial, the order of its estimate (the controller's exponents) and the bound's share.
 //
 // Output samples fall exactly on t = k / sampleRate: a step that would pass the next sample is cut
 // to end on it (the time is then set to the sample time itself, so stamps never drift), and the
@@ -97,11 +103,43 @@ static void renormalise_quaternions(const pdModel* model, double* y) {
 // A step ending this many units of rounding short of a sample time is taken as landing on it.
 #define TIME_SNAP_ULPS 16.0
 
-// Takes one accepted step of at most `hMax` from state->t. Returns the step taken (0 on failure).
-static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
+// One trial step of h from (s->t, s->y) whose derivative k1 is in w->k1: the result goes to w->trial and the
+// function returns the error norm (max over components of |error estimate| / weight).
+typedef double trialFcn(const pdModel* model, pdState* s, stepperWork* w, double h);
+
+// Step doubling: one step of h and two of h/2; err = (y_half − y_full)/15 estimates the error of the two
+// half steps, which are kept. 11 derivative evaluations.
+static double trial_doubling(const pdModel* model, pdState* s, stepperWork* w, double h) {
+  rk4(model, s, w, s->t, s->y, w->k1, h, w->full);
+  rk4(model, s, w, s->t, s->y, w->k1, 0.5 * h, w->half);
+  derivative(model, s, s->t + 0.5 * h, w->half, w->k1half);
+  rk4(model, s, w, s->t + 0.5 * h, w->half, w->k1half, 0.5 * h, w->trial);
+  double norm = 0.0;
+  for (int i = 0; i < s->n; ++i) norm = fmax(norm, fabs(w->trial[i] - w->full[i]) / (15.0 * s->weight[i]));
+  return norm;
+}
+
+// Classic RK4 with its embedded third-order partner: with k5 = f(t + h, y1), the weights
+// (1/6, 1/3, 1/3, 0, 1/6) over (k1, k2, k3, k4, k5) satisfy the four third-order conditions, so
+// y1 − ŷ1 = h (k4 − k5)/6 estimates the third-order solution's error, an upper bound of the kept
+// fourth-order one's (local extrapolation). 5 derivative evaluations; k5 cannot be reused as the next
+// step's k1 because committing the step realigns springs and may change the contact list.
+static double trial_embedded(const pdModel* model, pdState* s, stepperWork* w, double h) {
+  rk4(model, s, w, s->t, s->y, w->k1, h, w->trial);  // leaves k4 in w->ktmp
+  derivative(model, s, s->t + h, w->trial, w->k1half);
+  double norm = 0.0;
+  for (int i = 0; i < s->n; ++i) norm = fmax(norm, fabs(h * (w->ktmp[i] - w->k1half[i])) / (6.0 * s->weight[i]));
+  return norm;
+}
+
+// Takes one accepted step of at most `hMax` from state->t with error control. Returns the step taken (0 on
+// failure). `order` is the order of the error estimate's leading term in h (5 for step doubling, 4 for the
+// embedded pair); `stableFraction` the part of the contacts' stability bound (a bound for half steps) the
+// whole trial step may use.
+static double adaptive_step(const pdModel* model, pdState* s, double hMax, trialFcn* trial, double order,
+                            double stableFraction) {
   const pdSettings* set = &model->settings;
   stepperWork w = work_of(s);
-  int n = s->n;
   derivative(model, s, s->t, s->y, w.k1);
   for (;;) {
     // a step cut short to meet a sample says nothing about a longer one: s->h keeps the wanted size
@@ -111,14 +149,8 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
     double t0 = pd_clock_seconds();
     double tDerivative = derivative_seconds(s);
 
-    rk4(model, s, &w, s->t, s->y, w.k1, h, w.full);
-    rk4(model, s, &w, s->t, s->y, w.k1, 0.5 * h, w.half);
-    derivative(model, s, s->t + 0.5 * h, w.half, w.k1half);
-    rk4(model, s, &w, s->t + 0.5 * h, w.half, w.k1half, 0.5 * h, w.trial);
-
-    double norm = 0.0;
-    for (int i = 0; i < n; ++i) norm = fmax(norm, fabs(w.trial[i] - w.full[i]) / (15.0 * s->weight[i]));
-    bool finite = isfinite(norm) && all_finite(w.trial, n);
+    double norm = trial(model, s, &w, h);
+    bool finite = isfinite(norm) && all_finite(w.trial, s->n);
     s->stageSeconds[pd_stageIntegrate] += (pd_clock_seconds() - t0) - (derivative_seconds(s) - tDerivative);
 
     if (!finite) {
@@ -133,7 +165,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
     }
     if (norm > set->tol && !atMinimum) {
       ++s->count.rejected;
-      double shrink = fmax(STEP_REJECT_SHRINK_MIN, STEP_SAFETY * pow(set->tol / norm, 0.25));
+      double shrink = fmax(STEP_REJECT_SHRINK_MIN, STEP_SAFETY * pow(set->tol / norm, 1.0 / (order - 1.0)));
       s->h = fmax(set->dtmin, shrink * h);
       continue;
     }
@@ -147,7 +179,6 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
     }
     if (verdict == pd_eventRestart) {
       w = work_of(s);
-      n = s->n;
       derivative(model, s, s->t, s->y, w.k1);
       continue;
     }
@@ -156,12 +187,12 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax) {
     renormalise_quaternions(model, s->y);
     ++s->count.accepted;
     if (!cut) {
-      double grow = norm > 0.0 ? STEP_SAFETY * pow(set->tol / norm, 0.2) : STEP_GROW_MAX;
+      double grow = norm > 0.0 ? STEP_SAFETY * pow(set->tol / norm, 1.0 / order) : STEP_GROW_MAX;
       grow = fmin(STEP_GROW_MAX, fmax(STEP_SHRINK_MIN, grow));
       s->h = fmin(set->dtmax, fmax(set->dtmin, grow * h));
     }
     // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge
-    s->h = fmax(set->dtmin, fmin(s->h, pd_contact_set_stable_step(s->contacts)));
+    s->h = fmax(set->dtmin, pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction));
     return h;
   }
 }
@@ -220,8 +251,19 @@ bool pd_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* ob
     if (s->n == 0) {
       taken = target - s->t;  // nothing moves: jump to the next sample
     } else {
-      taken = s->stepper == pd_stepperRK4Fixed ? fixed_step(model, s, target - s->t)
-                                                : adaptive_step(model, s, target - s->t);
+      double hMax = target - s->t;
+      switch (s->stepper) {
+        case pd_stepperRK4Fixed:
+          taken = fixed_step(model, s, hMax);
+          break;
+        case pd_stepperRK43Embedded:
+          taken = adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5);
+          break;
+        case pd_stepperRK4Adaptive:
+        default:
+          taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0);
+          break;
+      }
     }
     if (s->failed) return false;
     // a step cut to the target lands exactly on it, so sample stamps never drift; so does a step that

@@ -369,8 +369,7 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   fputs(",\n  \"version\": \"" PD_VERSION "\",\n  \"scene\": ", out);
   write_json_string(out, model->scenePath);
   fputs(",\n  \"stepper\": ", out);
-  write_json_string(out, info->stepper ? info->stepper
-                                       : state->stepper == pd_stepperRK4Fixed ? "rk4-fixed" : "rk4-adaptive");
+  write_json_string(out, info->stepper ? info->stepper : pd_stepper_name(state->stepper));
   fputs(",\n", out);
   if (info->engineSettingsJson) fprintf(out, "  \"engine_settings\": %s,\n", info->engineSettingsJson);
   fputs("  \"settings\": {\"gravity\": ", out);

@@ -77,3 +77,15 @@ double pd_state_energy(const pdModel* model, const pdState* s) {
   }
   return e + pd_contact_spring_energy(s->contacts, s->y, PD_BODY_STATE_SIZE * model->movingCount);
 }
+
+const char* pd_stepper_name(pdStepper stepper) {
+  switch (stepper) {
+    case pd_stepperRK4Fixed:
+      return "rk4-fixed";
+    case pd_stepperRK43Embedded:
+      return "rk43-embedded";
+    case pd_stepperRK4Adaptive:
+      break;
+  }
+  return "rk4-adaptive";
+}

@@ -23,6 +23,8 @@ pdModel* compile_text(const char* text);
 // Runs the model to its tend; asserts that it got there with finite numbers only. The record is the
 // caller's (free); the final state too when stateOut is not NULL (pd_state_free).
 record* run(const pdModel* model, pdState** stateOut);
+// The same with the given stepper (run: the default, adaptive RK4 with step doubling).
+record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut);
 // The largest rise of the energy between any earlier and any later sample, relative to |E(0)|.
 double energy_gain(const record* r);
 // Index of the body called `name`; fails the test when there is none.

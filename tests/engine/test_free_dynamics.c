@@ -452,9 +452,10 @@ static void test_samples_fall_exactly_on_k_over_rate(void** state) {
 // ---------------------------------------------------------------------------------------------
 // step limits and counts
 
-static pdCounters run_counts(const char* text) {
+static pdCounters run_counts_with(const char* text, pdStepper stepper) {
   pdModel* model = compile_text(text);
   pdState* s = pd_state_create(model);
+  s->stepper = stepper;
   assert_true(pd_advance(model, s, model->settings.tend, NULL, NULL));
   assert_true(s->t == model->settings.tend);
   pdCounters c = s->count;
@@ -462,6 +463,8 @@ static pdCounters run_counts(const char* text) {
   pd_model_free(model);
   return c;
 }
+
+static pdCounters run_counts(const char* text) { return run_counts_with(text, pd_stepperRK4Adaptive); }
 
 static void test_dtmax_bounds_the_step(void** state) {
   (void)state;
@@ -503,6 +506,44 @@ static void test_adaptive_step_costs_11_evaluations_and_a_rejection_10(void** st
   assert_int_equal(c.derivatives, 11 * c.accepted + 10 * c.rejected);
 }
 
+static void test_embedded_step_costs_5_evaluations_and_a_rejection_4(void** state) {
+  (void)state;
+  // integrator.c: k1 once per accepted step; a trial is the RK4 step (3 more) and f(t + h, y1) for the
+  // error estimate: 4 evaluations
+  pdCounters c = run_counts_with(
+      "gravity 0 0 -9.81\ntend 1\ntol 1e-10\ndt 0.01\nsample 100\n"
+      "cube box red 0.1 0.2 0.3\nvel 1 0 2  720 1 3 0.2\n",
+      pd_stepperRK43Embedded);
+  printf("  counts: %ld accepted, %ld rejected, %ld derivatives\n", c.accepted, c.rejected, c.derivatives);
+  assert_true(c.rejected > 0);
+  assert_int_equal(c.derivatives, 5 * c.accepted + 4 * c.rejected);
+}
+
+static void test_embedded_pair_keeps_the_parabola_and_steps_as_tol_to_the_quarter(void** state) {
+  (void)state;
+  pdCounters count;
+  parabolaCheck c = run_parabola(thrownBox, pd_stepperRK43Embedded, &count);
+  printf("  thrown box, embedded RK4(3): %d samples, %ld steps, max |x - x(t)| = %.3g m, max |v - v(t)| = %.3g m/s\n",
+         c.samples, count.accepted, c.maxPositionError, c.maxVelocityError);
+  assert_int_equal(c.samples, 201);
+  assert_true(c.maxPositionError <= PARABOLA_POSITION_TOL);
+  assert_true(c.maxVelocityError <= PARABOLA_VELOCITY_TOL);
+  // the error estimate is the third-order partner's, O(h⁴): ten times tighter a tolerance takes 10^(1/4) ≈ 1.78×
+  // the steps (step doubling's O(h⁵) estimate: 10^(1/5) ≈ 1.58×; a second-order estimate: 10^(1/3) ≈ 2.15×)
+  static const char* const spin =
+      "gravity 0 0 0\ntend 1\nsample 10\ncube box red 0.1 0.2 0.3\nvel 0 0 0  720 1 3 0.2\n";
+  char text[256];
+  long steps[2];
+  for (int i = 0; i < 2; ++i) {
+    snprintf(text, sizeof text, "tol %g\n%s", i == 0 ? 1e-7 : 1e-8, spin);
+    steps[i] = run_counts_with(text, pd_stepperRK43Embedded).accepted;
+  }
+  double ratio = (double)steps[1] / (double)steps[0];
+  printf("  spinning box: %ld steps at tol 1e-7, %ld at 1e-8 (ratio %.2f, 10^(1/4) = 1.78)\n", steps[0], steps[1],
+         ratio);
+  assert_true(ratio > 1.68 && ratio < 1.9);
+}
+
 // ---------------------------------------------------------------------------------------------
 // quaternions, determinism, several states
 
@@ -512,15 +553,16 @@ static void test_quaternion_stays_unit_at_every_sample(void** state) {
       "gravity 0 0 -9.81\ntend 5\ntol 1e-4\nsample 1000\n"
       "cube box red 0.1 0.2 0.3\nloc 0 0 0  70 1 1 1\nvel 0 0 0  1500 0.1 1 0.3\n"
       "sphere ball green 1 0.2 0.2 0.2\nloc 1 0 0\nvel 0 0 0  -900 1 0 0\n");
-  for (int stepper = 0; stepper < 2; ++stepper) {
-    recording r = run_recorded(model, stepper ? pd_stepperRK4Fixed : pd_stepperRK4Adaptive, NULL);
+  static const pdStepper steppers[] = {pd_stepperRK4Adaptive, pd_stepperRK4Fixed, pd_stepperRK43Embedded};
+  for (int stepper = 0; stepper < 3; ++stepper) {
+    recording r = run_recorded(model, steppers[stepper], NULL);
     double worst = 0.0;
     for (int k = 0; k < r.count; ++k)
       for (int b = 0; b < model->bodyCount; ++b) {
         pdBodyState bs = recorded_body(model, &r, k, b);
         worst = fmax(worst, fabs(quat_norm(bs.q) - 1.0));
       }
-    printf("  %s: max ||q| - 1| = %.3g over %d samples\n", stepper ? "fixed" : "adaptive", worst, r.count);
+    printf("  %s: max ||q| - 1| = %.3g over %d samples\n", pd_stepper_name(steppers[stepper]), worst, r.count);
     assert_true(worst <= UNIT_QUATERNION_TOL);
     recording_free(&r);
   }
@@ -671,6 +713,8 @@ int main(void) {
       cmocka_unit_test(test_dtmax_bounds_the_step),
       cmocka_unit_test(test_dt_equal_to_dtmin_and_dtmax_takes_exactly_1000_steps),
       cmocka_unit_test(test_adaptive_step_costs_11_evaluations_and_a_rejection_10),
+      cmocka_unit_test(test_embedded_step_costs_5_evaluations_and_a_rejection_4),
+      cmocka_unit_test(test_embedded_pair_keeps_the_parabola_and_steps_as_tol_to_the_quarter),
       cmocka_unit_test(test_quaternion_stays_unit_at_every_sample),
       cmocka_unit_test(test_constant_force_at_centre_of_mass_gives_x_equal_f_t2_over_2m),
       cmocka_unit_test(test_ramp_force_gives_x_equal_rate_t3_over_6m),

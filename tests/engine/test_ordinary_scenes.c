@@ -37,6 +37,10 @@
 #define RAMP_ACCEL_REL_TOL 0.01
 #define LATERAL_DRIFT 1e-6             // m
 
+// Every test runs twice: with the default stepper (step-doubled RK4) and with the embedded RK4(3) pair
+// (group setups below), which must reach the same closed forms at the same default tolerance.
+static pdStepper stepper = pd_stepperRK4Adaptive;
+
 // ---------------------------------------------------------------------------------------------
 // restitution
 
@@ -73,7 +77,7 @@ static double cube_on_floor_restitution(landing how, double scale, double e, dou
            "cube block red 0.1 0.1 0.1\nloc 0 0 %.17g%s\nvel 0 0 -1\nmu %g\nrestitution %g\n",
            side, side, side, -0.5 * side, mu, e, height + gap, rotation, mu, e);
   pdModel* m = compile_text(text);
-  record* r = run(m, NULL);
+  record* r = run_with(m, stepper, NULL);
   const pdBodyState* end = &r->body[0][r->count - 1];
   double measured = end->v.z;  // of the 1 m/s approach
   assert_int_equal(r->contacts[r->count - 1], 0);
@@ -116,7 +120,7 @@ static void test_two_free_cubes_collide_with_the_pairs_e(void** state) {
              "cube b blue 0.15 0.15 0.15\nspgrav 2.7\nloc 0 0 0  30 1 0 0\nmu %g\nrestitution 0.8\n",
              mus[f], mus[f]);
     pdModel* m = compile_text(text);
-    record* r = run(m, NULL);
+    record* r = run_with(m, stepper, NULL);
     int k = r->count - 1;
     double e = r->body[1][k].v.x - r->body[0][k].v.x;  // separation speed over the 1 m/s approach
     double ma = m->bodies[body_index(m, "a")].mass, mb = m->bodies[body_index(m, "b")].mass;
@@ -143,7 +147,7 @@ static void test_overdamped_restitution_and_the_smallest_e(void** state) {
            "cube a red 0.1 0.1 0.1\nloc -0.2 0 0\nvel 1 0 0\nrestitution 0.1\n"
            "cube b blue 0.2 0.2 0.2\nspgrav 0.5\nloc 0 0 0  30 1 0 0\nrestitution 0.1\n");
   pdModel* m = compile_text(text);
-  record* r = run(m, NULL);
+  record* r = run_with(m, stepper, NULL);
   int k = r->count - 1;
   double e = r->body[1][k].v.x - r->body[0][k].v.x;
   print_message("cubes 0.1 m (1 kg) and 0.2 m (4 kg), e 0.1 on both: e = %.5f\n", e);
@@ -186,7 +190,7 @@ static void test_block_below_its_friction_angle_sticks(void** state) {
   const char* extras[] = {"", "restitution 0.3", "restitution 0.9"};
   for (int i = 0; i < 3; ++i) {
     pdModel* m = cube_on_ramp(10.0, 0.3, extras[i], 2.0);
-    record* r = run(m, NULL);
+    record* r = run_with(m, stepper, NULL);
     double worst = 0.0;
     for (int k = 0; k < r->count; ++k)
       if (r->t[k] >= STICK_SETTLE) worst = fmax(worst, speed(&r->body[0][k]));
@@ -212,7 +216,7 @@ static void test_block_on_a_floor_slides_to_rest_where_coulomb_says(void** state
              "cube block red 0.1 0.1 0.1\nloc 0 0 0.05\nvel %g 0 0\nmu %g\n%s\n",
              mu, extras[i], v0, mu, extras[i]);
     pdModel* m = compile_text(text);
-    record* r = run(m, NULL);
+    record* r = run_with(m, stepper, NULL);
     int last = r->count - 1;
     double slid = r->body[0][last].x.x - r->body[0][0].x.x;
     int k = last;  // the first sample from which the block stays below REST_SPEED
@@ -233,7 +237,7 @@ static void test_block_slides_down_a_ramp_at_the_coulomb_rate_on_its_line(void**
   const double theta = 30.0, mu = 0.3, th = theta * PI / 180.0;
   const double a = G * (sin(th) - mu * cos(th));
   pdModel* m = cube_on_ramp(theta, mu, "", 1.0);
-  record* r = run(m, NULL);
+  record* r = run_with(m, stepper, NULL);
   int k0 = -1, k1 = -1;
   double drift = 0.0;
   for (int k = 0; k < r->count; ++k) {
@@ -264,5 +268,8 @@ int main(void) {
       cmocka_unit_test(test_block_on_a_floor_slides_to_rest_where_coulomb_says),
       cmocka_unit_test(test_block_slides_down_a_ramp_at_the_coulomb_rate_on_its_line),
   };
-  return cmocka_run_group_tests(tests, NULL, NULL);
+  int failed = cmocka_run_group_tests_name("default stepper (rk4-adaptive)", tests, NULL, NULL);
+  stepper = pd_stepperRK43Embedded;
+  failed += cmocka_run_group_tests_name("embedded stepper (rk43-embedded)", tests, NULL, NULL);
+  return failed;
 }

@@ -100,8 +100,8 @@ PHEADER='experiment,kind,engine,variant,setting,value,input,quantity,unit,measur
 run_pd gedanken --only a1_restitution,c3_eccentric_bar --precision --repeats 2 --out "$PREC"
 check "--precision: exit 0 and precision.csv with the fixed header" '[ $rc -eq 0 ] && [ "$(head -n 1 "$PREC/precision.csv")" = "$PHEADER" ]'
 # every knob of every engine, loosest first; an engine without an adapter is two not_built rows, never left out
-check "--precision: soft at tol 1e-2 ... 1e-10 and fixed dt 1e-3 ... 1e-5, ODE and Bullet at 5 steps per variant, Bullet also at 5 ... 200 iterations (or not_built)" \
-  '[ "$(csv_query "$PREC/precision.csv" "all([(r[\"variant\"], r[\"value\"]) for r in rows if r[\"experiment\"] == x and r[\"engine\"] == \"soft\"] == [(\"adaptive\", \"%g\" % 10**-k) for k in range(2, 11)] + [(\"fixed\", v) for v in (\"0.001\", \"0.0003\", \"0.0001\", \"3e-05\", \"1e-05\")] and all([(r[\"variant\"], r[\"setting\"], r[\"value\"]) for r in rows if r[\"experiment\"] == x and r[\"engine\"] == e] in (sum(([(v, \"step\", s) for s in (\"0.0166667\", \"0.004\", \"0.001\", \"0.00025\", \"6.25e-05\")] + [(v, \"iterations\", n) for n in ((\"5\", \"10\", \"20\", \"50\", \"100\", \"200\") if e == \"bullet\" else ())] for v in (\"native\", \"matched\")), []), [(\"native\", \"\", \"\"), (\"matched\", \"\", \"\")]) for e in (\"ode\", \"bullet\")) for x in (\"a1_restitution\", \"c3_eccentric_bar\"))")" = True ]'
+check "--precision: soft at tol 1e-2 ... 1e-10, fixed dt 1e-3 ... 1e-5 and embedded tol 1e-2 ... 1e-10, ODE and Bullet at 5 steps per variant, Bullet also at 5 ... 200 iterations (or not_built)" \
+  '[ "$(csv_query "$PREC/precision.csv" "all([(r[\"variant\"], r[\"value\"]) for r in rows if r[\"experiment\"] == x and r[\"engine\"] == \"soft\"] == [(\"adaptive\", \"%g\" % 10**-k) for k in range(2, 11)] + [(\"fixed\", v) for v in (\"0.001\", \"0.0003\", \"0.0001\", \"3e-05\", \"1e-05\")] + [(\"embedded\", \"%g\" % 10**-k) for k in range(2, 11)] and all([(r[\"variant\"], r[\"setting\"], r[\"value\"]) for r in rows if r[\"experiment\"] == x and r[\"engine\"] == e] in (sum(([(v, \"step\", s) for s in (\"0.0166667\", \"0.004\", \"0.001\", \"0.00025\", \"6.25e-05\")] + [(v, \"iterations\", n) for n in ((\"5\", \"10\", \"20\", \"50\", \"100\", \"200\") if e == \"bullet\" else ())] for v in (\"native\", \"matched\")), []), [(\"native\", \"\", \"\"), (\"matched\", \"\", \"\")]) for e in (\"ode\", \"bullet\")) for x in (\"a1_restitution\", \"c3_eccentric_bar\"))")" = True ]'
 check "--precision: not_built rows say which adapter is missing" \
   '[ "$(csv_query "$PREC/precision.csv" "all(r[\"engine\"] in r[\"note\"] and r[\"setting\"] == \"\" for r in rows if r[\"status\"] == \"not_built\")")" = True ]'
 check "--precision: one input per experiment, the middle one (a1: e=0.5 of 0.1 ... 0.95)" \
@@ -114,9 +114,12 @@ check "--precision: ok points have a positive wall time and steps; the repeats c
   '[ "$(csv_query "$PREC/precision.csv" "all(float(r[\"wall_seconds\"]) > 0 and int(r[\"steps\"]) > 0 for r in rows if r[\"status\"] == \"ok\") and {r[\"repeats\"] for r in rows} == {\"2\"}")" = True ]'
 check "--precision: judged follows the kind (c3, a soft-model prediction: native variants not judged; a1, a law: all judged)" \
   '[ "$(csv_query "$PREC/precision.csv" "all((r[\"judged\"] == \"false\") == (r[\"experiment\"] == \"c3_eccentric_bar\" and r[\"variant\"] == \"native\") for r in rows)")" = True ]'
-# eq. (15) is exact for the model: its restitution converges to the requested e as the tolerance tightens
-check "--precision: soft restitution converges to e = 0.5: within the 0.005 tolerance at tol <= 1e-4, 1e-6 at tol 1e-10" \
-  '[ "$(csv_query "$PREC/precision.csv" "all(float(r[\"error\"]) <= 0.005 for r in rows if r[\"experiment\"] == \"a1_restitution\" and r[\"variant\"] == \"adaptive\" and float(r[\"value\"]) <= 1e-4) and [float(r[\"error\"]) < 1e-6 for r in rows if r[\"experiment\"] == \"a1_restitution\" and r[\"variant\"] == \"adaptive\" and r[\"value\"] == \"1e-10\"] == [True]")" = True ]'
+# eq. (15) is exact for the model: its restitution converges to the requested e as the tolerance tightens, with
+# either error-controlled stepper
+for V in adaptive embedded; do
+  check "--precision: soft $V restitution converges to e = 0.5: within the 0.005 tolerance at tol <= 1e-4, 1e-6 at tol 1e-10" \
+    '[ "$(csv_query "$PREC/precision.csv" "all(float(r[\"error\"]) <= 0.005 for r in rows if r[\"experiment\"] == \"a1_restitution\" and r[\"variant\"] == \"$V\" and float(r[\"value\"]) <= 1e-4) and [float(r[\"error\"]) < 1e-6 for r in rows if r[\"experiment\"] == \"a1_restitution\" and r[\"variant\"] == \"$V\" and r[\"value\"] == \"1e-10\"] == [True]")" = True ]'
+done
 strip_precision_wall() { python3 -c 'import csv, sys
 for r in csv.reader(open(sys.argv[1], newline="")): print(r[:16] + r[18:])' "$1"; }
 run_pd gedanken --only c2_momentum,a1_restitution --engines soft,ode --precision --jobs 1 --out "$SCRATCH/pdet1"

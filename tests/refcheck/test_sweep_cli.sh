@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End-to-end tests of `polydyn sweep`: usage errors, sweep.csv in its documented schema (reports/FORMATS.md),
 # and the work-precision fact the sweep exists to show: the soft engine's error falls as its tolerance
-# tightens (tol 1e-5 against 1e-9 on a sliding block: at least 100× smaller). Looser tolerances do not
+# tightens (tol 1e-5 against 1e-9 on a sliding block: at least 100× smaller), for the default stepper and
+# the embedded pair alike, each soft row with its derivative evaluations (ODE's empty). Looser tolerances do not
 # count: there the step is held by the contacts' stability bound (engine/src/contact_set.c), not by the
 # error control, and the error stays at its 1e-5 level. Self-convergence (the last three columns): on a
 # tumbling cube (chaotic) with ODE, the self_reference of each row, the finest ODE step's empty self_error
@@ -25,11 +26,16 @@ OUT=$SCRATCH/sw
 "$PD" sweep "$SCENE" --out "$OUT" --engines soft --repeats 1 --tend 0.3 >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "sweep: exit 0" '[ $rc -eq 0 ]'
 check "sweep.csv header is the documented schema (the self-convergence columns last)" \
-  '[ "$(head -n 1 "$OUT/sweep.csv")" = "scene,engine,variant,setting,value,error,error_kind,wall_seconds,wall_per_sim_second,steps,repeats,reference,self_error,self_reference,horizon_seconds" ]'
-check "9 tolerances and 5 fixed steps" '[ "$(grep -c ",soft,adaptive,tol," "$OUT/sweep.csv")" -eq 9 ] && [ "$(grep -c ",soft,fixed,step," "$OUT/sweep.csv")" -eq 5 ]'
+  '[ "$(head -n 1 "$OUT/sweep.csv")" = "scene,engine,variant,setting,value,error,error_kind,wall_seconds,wall_per_sim_second,steps,repeats,reference,self_error,self_reference,horizon_seconds,derivatives" ]'
+check "9 tolerances, 5 fixed steps, 9 tolerances of the embedded pair" \
+  '[ "$(grep -c ",soft,adaptive,tol," "$OUT/sweep.csv")" -eq 9 ] && [ "$(grep -c ",soft,fixed,step," "$OUT/sweep.csv")" -eq 5 ] && [ "$(grep -c ",soft,embedded,tol," "$OUT/sweep.csv")" -eq 9 ]'
+awk -F, 'NR > 1 && $2 == "soft" && $16 !~ /^[1-9][0-9]*$/ { bad = 1 } END { exit bad }' "$OUT/sweep.csv"; rc=$?
+check "every soft row counts its derivative evaluations" '[ $rc -eq 0 ]'
 check "reference.json states the reference's own error" 'grep -q "error_against_check" "$OUT/reference.json"'
-awk -F, '$4 == "tol" && $5 == "1e-05" { a = $6 } $4 == "tol" && $5 == "1e-09" { b = $6 } END { exit !(a > 0 && b >= 0 && b * 100 < a) }' "$OUT/sweep.csv"; rc=$?
-check "error at tol 1e-9 is at least 100x below that at tol 1e-5" '[ $rc -eq 0 ]'
+for v in adaptive embedded; do
+  awk -F, -v v=$v '$3 == v && $5 == "1e-05" { a = $6 } $3 == v && $5 == "1e-09" { b = $6 } END { exit !(a > 0 && b >= 0 && b * 100 < a) }' "$OUT/sweep.csv"; rc=$?
+  check "$v: error at tol 1e-9 is at least 100x below that at tol 1e-5" '[ $rc -eq 0 ]'
+done
 
 # self-convergence and the horizon of predictability on a chaotic scene, serially and with --jobs 2
 CUBE=$SRC/cases/sweep/tumbling_cube.scene
@@ -58,7 +64,9 @@ for r in rows:
         if not (math.isfinite(e) and e >= 0): bad.append(f"{name}: self_error {r['self_error']!r} is not a finite number")
         if r["engine"] == "soft" and r["self_error"] != r["error"]: bad.append(f"{name}: soft self_error differs from error")
     if r["horizon_seconds"] and not 0 <= float(r["horizon_seconds"]) <= tend: bad.append(f"{name}: horizon {r['horizon_seconds']} outside [0, tend]")
-if len(rows) != 24: bad.append(f"{len(rows)} rows, expected 24 (14 soft, 10 ode)")
+if len(rows) != 33: bad.append(f"{len(rows)} rows, expected 33 (23 soft, 10 ode)")
+bad += [f"{r['engine']} {r['variant']} {r['value']}: derivatives {r['derivatives']!r}" for r in rows
+        if r["error"] and (r["derivatives"] == "") != (r["engine"] != "soft")]
 if not any(r["horizon_seconds"] for r in rows): bad.append("no point has a horizon on the tumbling cube")
 if not any(r["engine"] == "ode" and r["horizon_seconds"] for r in rows): bad.append("no ode point has a horizon on the tumbling cube")
 print("\n".join(bad))

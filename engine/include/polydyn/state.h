@@ -55,9 +55,13 @@ PD_API extern const char* const pdWarningNames[pd_warnCount];
 
 // Which stepper advances the state. Adaptive RK4 is the paper's; the fixed one is for sweeps.
 typedef enum pdStepper {
-  pd_stepperRK4Adaptive,  // classic RK4 with step doubling: error = |two half steps − one full step|/15
-  pd_stepperRK4Fixed,     // classic RK4 with the step fixed at settings.dt (no error control)
+  pd_stepperRK4Adaptive,   // classic RK4 with step doubling: error = |two half steps − one full step|/15
+  pd_stepperRK4Fixed,      // classic RK4 with the step fixed at settings.dt (no error control)
+  pd_stepperRK43Embedded,  // classic RK4 with its embedded third-order partner: error = h |k4 − f(t+h, y1)|/6
 } pdStepper;
+
+// The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed" or "rk43-embedded".
+PD_API const char* pd_stepper_name(pdStepper stepper);
 
 typedef struct pdCounters {
   long accepted;     // accepted steps
