@@ -248,11 +248,13 @@ static bool edge_pair_geometry(const pdPolyhedron* sa, int ea, pdVec3 b0, pdVec3
 }
 
 // Edge pruning before the Gauss-map test: an edge whose two ends lie outside one face plane of the other
-// body, by more than PRUNE_OUTSIDE_TOLS boundary tolerances, lies wholly outside that body, so its closest
-// point can never pass find_ee's inside test (which allows one tolerance): its pairs are skipped unseen.
-// The margin of one more tolerance (1e-12 × size) covers the rounding of the closest points (~1e-16 × size),
-// so pruning never changes a result. Masks hold the first 64 faces (a bit per face); vertices beyond
-// PRUNE_VERTICES_MAX are not pruned (correct, only slower).
+// body, by more than the pair's δ_max plus PRUNE_OUTSIDE_TOLS boundary tolerances, lies wholly outside that
+// body by more than find_ee's inside test allows (one tolerance, or for a sharp edge's pair up to the depth,
+// at most δ_max): its pairs are skipped unseen. The margin of one more tolerance (1e-12 × size) covers the
+// rounding of the closest points (~1e-16 × size), so pruning never changes a result. (A margin of tolerances
+// alone, from before the sharp-edge rule, pruned such pairs: seed 3, scene 1779 of the soak, two compact
+// bodies met edge on edge 0.05 of an edge from a corner and sank 15 δ_max with no contact.) Masks hold the
+// first 64 faces (a bit per face); vertices beyond PRUNE_VERTICES_MAX are not pruned (correct, only slower).
 #define PRUNE_OUTSIDE_TOLS 2.0
 #define PRUNE_VERTICES_MAX 512
 typedef unsigned long long faceMask;
@@ -303,8 +305,9 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   if (prune) {
     // A in B's frame: rotation relᵀ, translation −relᵀ off
     pdMat3 relT = pd_mat3_transpose(&rel);
-    outside_masks(sa, &relT, pd_v3_scale(pd_mat3_mulv(&relT, off), -1.0), sb, PRUNE_OUTSIDE_TOLS * tolB, maskA);
-    outside_masks(sb, &rel, off, sa, PRUNE_OUTSIDE_TOLS * tolA, maskB);
+    outside_masks(sa, &relT, pd_v3_scale(pd_mat3_mulv(&relT, off), -1.0), sb, deltaMax + PRUNE_OUTSIDE_TOLS * tolB,
+                  maskA);
+    outside_masks(sb, &rel, off, sa, deltaMax + PRUNE_OUTSIDE_TOLS * tolA, maskB);
   }
   for (int j = 0; j < sb->edgeCount; ++j) {
     const pdEdge* eb = &sb->edges[j];
