@@ -66,7 +66,7 @@ static bool inside_body(const pdPolyhedron* s, pdVec3 q, double tol) {
   return true;
 }
 
-// Tolerance of "flush", as a fraction of the pair's δ_max (deflection × the smaller size): a face plane
+// Tolerance of "flush", as a fraction of the pair's δ_max (pd_model_pair_delta_max): a face plane
 // of one body that the other body does not cross by more than this is a plane both bodies share (bricks
 // side by side, a box on a box of the same width): a vertex lying on it has crossed another face, not
 // that one, and edges crossing inside it have no depth. A contact on such a plane would carry at most
@@ -74,10 +74,8 @@ static bool inside_body(const pdPolyhedron* s, pdVec3 q, double tol) {
 // they settle (1e-7 m on a 0.1 m brick), which a roundoff-sized tolerance would not absorb.
 #define FLUSH_TOL_DEFLECTIONS 1e-3
 
-// δ_max of a pair: the deflection times the smaller body's size, m.
-static double pair_delta_max(const pdModel* m, int i, int j) {
-  return m->settings.deflection * fmin(m->bodies[i].size, m->bodies[j].size);
-}
+// δ_max of a pair, m (pd_model_pair_delta_max).
+static double pair_delta_max(const pdModel* m, int i, int j) { return pd_model_pair_delta_max(m, i, j); }
 
 // Does body sv, placed in sf's frame by rotation rel and offset off, cross face f's plane of sf by more
 // than tol, i.e. lie partly outside it?
