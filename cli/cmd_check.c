@@ -104,9 +104,11 @@ static void print_contact_pairs(const pdModel* m) {
     pdPairContact p = pd_model_pair_contact(m, a[i], b[i]);
     printf("  %s / %s: mu %.6g, restitution %.6g (%s)\n", m->bodies[a[i]].name, m->bodies[b[i]].name, p.mu,
            p.restitution, p.restitutionSource);
-    printf("    springs       kn %.6g N/m, kt %.6g N/m per contact (series of both sides; delta_max %.4g m of the "
-           "smaller body, m_pair %.6g kg)\n",
-           p.kn, p.kt, p.deltaMax, p.massPair);
+    bool thin = p.deltaMax < m->settings.deflection * fmin(m->bodies[a[i]].size, m->bodies[b[i]].size);
+    printf(
+        "    springs       kn %.6g N/m, kt %.6g N/m per contact (series of both sides; delta_max %.4g m %s, "
+        "m_pair %.6g kg)\n",
+        p.kn, p.kt, p.deltaMax, thin ? "= a quarter of the thinner body's width" : "of the smaller body", p.massPair);
     if (p.modalN)
       printf("    normal damper modal: damping ratio %.4f for the mass each contact carries (cn %.6g N s/m for one "
              "contact at m_pair)\n",

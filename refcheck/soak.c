@@ -305,7 +305,7 @@ static double deepest_overlap(const pdModel* m, const pdState* s, int* pi, int* 
       pdMat3 ra = pd_quat_to_mat3(sa.q), rb = pd_quat_to_mat3(sb.q);
       pdSatResult sat;
       if (!pd_interference(&a->shape, sa.x, &ra, &b->shape, sb.x, &rb, PD_SAT_MIN_DEPTH, NULL, &sat)) continue;
-      double ratio = sat.depth / (m->settings.deflection * fmin(a->size, b->size));
+      double ratio = sat.depth / pd_model_pair_delta_max(m, i, j);
       if (ratio > deepest) deepest = ratio, *pi = i, *pj = j;
     }
   return deepest;

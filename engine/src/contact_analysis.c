@@ -66,7 +66,7 @@ static bool inside_body(const pdPolyhedron* s, pdVec3 q, double tol) {
   return true;
 }
 
-// Tolerance of "flush", as a fraction of the pair's δ_max (deflection × the smaller size): a face plane
+// Tolerance of "flush", as a fraction of the pair's δ_max (pd_model_pair_delta_max): a face plane
 // of one body that the other body does not cross by more than this is a plane both bodies share (bricks
 // side by side, a box on a box of the same width): a vertex lying on it has crossed another face, not
 // that one, and edges crossing inside it have no depth. A contact on such a plane would carry at most
@@ -74,10 +74,8 @@ static bool inside_body(const pdPolyhedron* s, pdVec3 q, double tol) {
 // they settle (1e-7 m on a 0.1 m brick), which a roundoff-sized tolerance would not absorb.
 #define FLUSH_TOL_DEFLECTIONS 1e-3
 
-// δ_max of a pair: the deflection times the smaller body's size, m.
-static double pair_delta_max(const pdModel* m, int i, int j) {
-  return m->settings.deflection * fmin(m->bodies[i].size, m->bodies[j].size);
-}
+// δ_max of a pair, m (pd_model_pair_delta_max).
+static double pair_delta_max(const pdModel* m, int i, int j) { return pd_model_pair_delta_max(m, i, j); }
 
 // Does body sv, placed in sf's frame by rotation rel and offset off, cross face f's plane of sf by more
 // than tol, i.e. lie partly outside it?
@@ -248,11 +246,13 @@ static bool edge_pair_geometry(const pdPolyhedron* sa, int ea, pdVec3 b0, pdVec3
 }
 
 // Edge pruning before the Gauss-map test: an edge whose two ends lie outside one face plane of the other
-// body, by more than PRUNE_OUTSIDE_TOLS boundary tolerances, lies wholly outside that body, so its closest
-// point can never pass find_ee's inside test (which allows one tolerance): its pairs are skipped unseen.
-// The margin of one more tolerance (1e-12 × size) covers the rounding of the closest points (~1e-16 × size),
-// so pruning never changes a result. Masks hold the first 64 faces (a bit per face); vertices beyond
-// PRUNE_VERTICES_MAX are not pruned (correct, only slower).
+// body, by more than the pair's δ_max plus PRUNE_OUTSIDE_TOLS boundary tolerances, lies wholly outside that
+// body by more than find_ee's inside test allows (one tolerance, or for a sharp edge's pair up to the depth,
+// at most δ_max): its pairs are skipped unseen. The margin of one more tolerance (1e-12 × size) covers the
+// rounding of the closest points (~1e-16 × size), so pruning never changes a result. (A margin of tolerances
+// alone, from before the sharp-edge rule, pruned such pairs: seed 3, scene 1779 of the soak, two compact
+// bodies met edge on edge 0.05 of an edge from a corner and sank 15 δ_max with no contact.) Masks hold the
+// first 64 faces (a bit per face); vertices beyond PRUNE_VERTICES_MAX are not pruned (correct, only slower).
 #define PRUNE_OUTSIDE_TOLS 2.0
 #define PRUNE_VERTICES_MAX 512
 typedef unsigned long long faceMask;
@@ -303,8 +303,9 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   if (prune) {
     // A in B's frame: rotation relᵀ, translation −relᵀ off
     pdMat3 relT = pd_mat3_transpose(&rel);
-    outside_masks(sa, &relT, pd_v3_scale(pd_mat3_mulv(&relT, off), -1.0), sb, PRUNE_OUTSIDE_TOLS * tolB, maskA);
-    outside_masks(sb, &rel, off, sa, PRUNE_OUTSIDE_TOLS * tolA, maskB);
+    outside_masks(sa, &relT, pd_v3_scale(pd_mat3_mulv(&relT, off), -1.0), sb, deltaMax + PRUNE_OUTSIDE_TOLS * tolB,
+                  maskA);
+    outside_masks(sb, &rel, off, sa, deltaMax + PRUNE_OUTSIDE_TOLS * tolA, maskB);
   }
   for (int j = 0; j < sb->edgeCount; ++j) {
     const pdEdge* eb = &sb->edges[j];

@@ -188,20 +188,7 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   set->bodyRowsRight = grow(NULL, n, sizeof *set->bodyRowsRight);
   set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
   PD_ASSERT(set->travel != NULL);
-  for (int i = 0; i < n; ++i) {
-    // width across each face plane: the face's offset minus the lowest vertex along its normal
-    const pdPolyhedron* p = &model->bodies[i].shape;
-    double w = INFINITY;
-    for (int f = 0; f < p->faceCount; ++f) {
-      double lo = INFINITY, hi = -INFINITY;
-      for (int v = 0; v < p->vertexCount; ++v) {
-        double d = pd_v3_dot(p->faces[f].normal, p->vertices[v]);
-        lo = fmin(lo, d), hi = fmax(hi, d);
-      }
-      w = fmin(w, hi - lo);
-    }
-    set->width[i] = w;
-  }
+  for (int i = 0; i < n; ++i) set->width[i] = model->bodies[i].width;
   set->torque = grow(NULL, model->movingCount, sizeof *set->torque);
   set->poses = grow(NULL, n, sizeof *set->poses);
   set->poses0 = grow(NULL, n, sizeof *set->poses0);
@@ -400,9 +387,9 @@ static void install(const pdModel* model, pdState* s, int count) {
   s->n = base + PD_CONTACT_STATE_SIZE * count;
 }
 
-// δ_max of a contact: the smaller design deflection of its two bodies (deflection × size), m.
+// δ_max of a contact: its pair's design deflection (pd_model_pair_delta_max), m.
 static double pair_delta_max(const pdModel* model, int body1, int body2) {
-  return model->settings.deflection * fmin(model->bodies[body1].size, model->bodies[body2].size);
+  return pd_model_pair_delta_max(model, body1, body2);
 }
 
 // The shortest period of a contact, 2π√(m_min/k_s) over n and P_t (m_min: the pair's minimum effective

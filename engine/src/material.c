@@ -245,7 +245,7 @@ int pd_adjustment_describe(const pdAdjustment* a, const char* bodyName, const ch
 bool pd_material_side(const pdMaterialBody* body, const pdMaterialRequest* req, pdMaterialSide* out, char* why,
                       int whySize) {
   const unsigned set = req->setMask;
-  if (!(body->size > 0.0 && isfinite(body->size)) ||
+  if (!(body->size > 0.0 && isfinite(body->size)) || !(body->width >= 0.0 && isfinite(body->width)) ||
       (!body->fixed && !(body->mass > 0.0 && isfinite(body->mass) && body->mMin > 0.0 && isfinite(body->mMin)))) {
     pd_why(why, whySize, "invalid body (mass %g kg, minimum effective mass %g kg, size %g m)", body->mass,
            body->mMin, body->size);
@@ -272,8 +272,16 @@ bool pd_material_side(const pdMaterialBody* body, const pdMaterialRequest* req, 
       .mass = body->fixed ? 0.0 : body->mass,
       .mMin = body->fixed ? 0.0 : body->mMin,
       .size = body->size,
+      .width = body->width,
   };
   return true;
+}
+
+double pd_delta_max(double deflection, double size1, double width1, double size2, double width2) {
+  double delta = deflection * fmin(size1, size2);
+  if (width1 > 0.0) delta = fmin(delta, PD_DELTA_MAX_WIDTH_FRACTION * width1);
+  if (width2 > 0.0) delta = fmin(delta, PD_DELTA_MAX_WIDTH_FRACTION * width2);
+  return delta;
 }
 
 // Two masses in series (the pair's relative motion); 0 stands for an infinite (fixed) mass.
@@ -382,8 +390,9 @@ void pd_contact_params_pair(const pdMaterialSide* s1, const pdMaterialSide* s2, 
                             pdAdjustmentList* adj) {
   PD_ASSERT(s1->mass > 0.0 || s2->mass > 0.0);
   const double massPair = reduced_mass(s1->mass, s2->mass), massMin = reduced_mass(s1->mMin, s2->mMin);
-  // eq. (11) for the pair: ½ m_pair v_max² = ½ k_s δ_max², δ_max of the smaller body; each side 2 k_s
-  const double delta = set->deflection * fmin(s1->size, s2->size);
+  // eq. (11) for the pair: ½ m_pair v_max² = ½ k_s δ_max², δ_max of the smaller body (bounded by the thinner
+  // one's width); each side 2 k_s
+  const double delta = pd_delta_max(set->deflection, s1->size, s1->width, s2->size, s2->width);
   const double kSide = 2.0 * massPair * set->vmax * set->vmax / (delta * delta);
   *out = (pdContactParams){.mu = sqrt(s1->mu * s2->mu), .zetaN = zetaN, .zetaT = PD_TANGENTIAL_DAMPING_RATIO,
                            .massPair = massPair, .massMin = massMin};

@@ -76,6 +76,17 @@ static void measure_extents(pdBody* b) {
   b->size = ((hi.x - lo.x) + (hi.y - lo.y) + (hi.z - lo.z)) / 3.0;
   b->halfExtents = (pdVec3){fmax(-lo.x, hi.x), fmax(-lo.y, hi.y), fmax(-lo.z, hi.z)};
   b->radius = radius;
+  // thinnest width: the smallest extent of the vertices along a face normal
+  double width = INFINITY;
+  for (int f = 0; f < b->shape.faceCount; ++f) {
+    double lowest = INFINITY, highest = -INFINITY;
+    for (int v = 0; v < b->shape.vertexCount; ++v) {
+      double d = pd_v3_dot(b->shape.faces[f].normal, b->shape.vertices[v]);
+      lowest = fmin(lowest, d), highest = fmax(highest, d);
+    }
+    width = fmin(width, highest - lowest);
+  }
+  b->width = width;
 }
 
 // What the file said; -1 for a constant it did not set (cn 0 is a request: no normal damper).

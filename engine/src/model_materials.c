@@ -30,7 +30,7 @@
 #define PD_MODEL_ADJUSTMENTS_MAX 1000
 
 // memcmp on pdMaterialSide is only a bit comparison if the struct has no padding.
-_Static_assert(sizeof(pdMaterialSide) == 9 * sizeof(double), "pdMaterialSide must be 9 doubles, no padding");
+_Static_assert(sizeof(pdMaterialSide) == 10 * sizeof(double), "pdMaterialSide must be 10 doubles, no padding");
 
 struct pdMaterialTable {
   int bodyCount;
@@ -207,6 +207,7 @@ bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
         .mass = b->mass,
         .mMin = b->fixed ? 0.0 : pd_min_effective_mass(b->mass, &b->inertia, b->shape.vertices, b->shape.vertexCount),
         .size = b->size,
+        .width = b->width,
     };
     pdMaterialRequest req = {.mu = o->mu, .kn = o->kn, .kt = o->kt, .cn = o->cn, .ct = o->ct,
                              .restitution = o->restitution, .setMask = o->setMask & requestBits};
@@ -339,6 +340,11 @@ int pd_model_adjustment_describe(const pdModel* model, int i, char* buf, int siz
   return len + extra;
 }
 
+double pd_model_pair_delta_max(const pdModel* model, int a, int b) {
+  const pdBody *A = &model->bodies[a], *B = &model->bodies[b];
+  return pd_delta_max(model->settings.deflection, A->size, A->width, B->size, B->width);
+}
+
 pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b) {
   pdContactParams p = pd_model_contact_params(model, a, b);
   double kn = pd_series(p.k1n, p.k2n), kt = pd_series(p.k1t, p.k2t);
@@ -355,7 +361,7 @@ pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b) {
                         .massPair = p.massPair,
                         .massMin = p.massMin,
                         .period = kn > 0.0 ? 2.0 * PI * sqrt(p.massPair / kn) : INFINITY,
-                        .deltaMax = model->settings.deflection * fmin(model->bodies[a].size, model->bodies[b].size)};
+                        .deltaMax = pd_model_pair_delta_max(model, a, b)};
   bool ra = model->bodies[a].requested.restitution >= 0.0, rb = model->bodies[b].requested.restitution >= 0.0;
   pair.restitutionSource = ra && rb ? "requested" : (ra || rb ? "one side requested, one default" : "default");
   if (!p.modalN) {

@@ -8,7 +8,9 @@
 #   function of S and i alone, and the runs are deterministic);
 # - regressions the soak found and that are fixed (README, Reliability): seed 2 scene 2945 (a stack of eight
 #   flush boxes sank 29 delta_max), seed 1 scenes 4, 7, 19 (inside the campaign: a sliver's sharp rim pressed
-#   into a box found no edge-edge contact);
+#   into a box found no edge-edge contact), seed 3 scene 1779 (such a sharp edge's pair was pruned before the
+#   contact search looked at it: two bodies sank 15 delta_max with no contact), seed 3 scenes 1931, 2429, 2707,
+#   8264 and seed 4 scene 325 (plates 0.4-0.9 delta_max thick, whose springs let vertices through them);
 # - a run stopped at its budget writes its scene under over-budget/, and that file replays with polydyn run;
 # - bad arguments: exit 2 with a message, nothing written.
 #
@@ -39,6 +41,17 @@ check "the same rows but the measured times" \
 
 run_pd "$SCRATCH/stack.out" "$SCRATCH/stack.err" soak --seed 2 --first 2945 --scenes 1 --budget "$BUDGET" --out "$SCRATCH/stack"
 check "regression: seed 2 scene 2945 (flush stack) passes" '[ $rc -eq 0 ] && grep -q "^2,2945,stack,.*,soft,ok," "$SCRATCH/stack/summary.csv"'
+
+run_pd "$SCRATCH/edge.out" "$SCRATCH/edge.err" soak --seed 3 --first 1779 --scenes 1 --budget "$BUDGET" --out "$SCRATCH/edge"
+check "regression: seed 3 scene 1779 (a sharp edge's pair pruned unseen) passes" '[ $rc -eq 0 ] && grep -q "^3,1779,free,.*,soft,ok," "$SCRATCH/edge/summary.csv"'
+
+# plates thinner than the deflection their springs were sized for, crossed by 5.8-18 delta_max (campaigns 3, 4)
+for sc in 3:1931:free 3:2429:free 3:2707:free 3:8264:free 4:325:free; do
+  IFS=: read -r seed scene kind <<<"$sc"
+  run_pd "$SCRATCH/thin.out" "$SCRATCH/thin.err" soak --seed "$seed" --first "$scene" --scenes 1 --budget "$BUDGET" --out "$SCRATCH/thin-$seed-$scene"
+  check "regression: seed $seed scene $scene (a plate thinner than delta_max) passes" \
+    '[ $rc -eq 0 ] && grep -q "^$seed,$scene,$kind,.*,soft,ok," "$SCRATCH/thin-$seed-$scene/summary.csv"'
+done
 
 run_pd "$SCRATCH/budget.out" "$SCRATCH/budget.err" soak --seed 1 --first 13 --scenes 1 --budget 0.001 --out "$SCRATCH/budget"
 check "over budget: exit 0 (a cost finding, not a failure)" '[ $rc -eq 0 ]'

@@ -389,6 +389,41 @@ static void test_contact_geometry_is_the_tracked_geometry(void** state) {
   pd_model_free(m);
 }
 
+// Seed 3, scene 1779 of the soak: a 5-sided prism and a 13-point hull meet edge on edge, 0.05 of an edge from
+// the prism's corner. The hull's edge is a sharp one (its closest point lies outside the prism by less than
+// the depth), which find_ee keeps; the edge pruning before it, with a margin of roundoff-sized tolerances,
+// dropped the pair unseen, and the bodies sank 15 delta_max with no contact. Poses from that run, at the end of
+// the step in which the pair first overlapped (by 0.38 delta_max): the contact is found there now.
+static const char* const soakScene1779 =
+    "prism f0 orange 5 0.044861204207343651 0.042085458341677158 0.034877202772256838\n"
+    "hull f9 brown 0.0035315897908884692 0.003900355971729076 -0.012146444327136172 0.0045025524853000284 "
+    "-0.0059587271347789506 -0.0099278649313011384 0.0026602131914562387 0.013963857343787913 "
+    "-0.00055704713208306938 -0.0042723156915600051 -0.0090207269219572967 -0.0038722543599061178 "
+    "-0.0034013480180039792 -0.012493656179138038 -0.0037244663081974342 -0.00069722867723591301 "
+    "-0.00020104663901917696 0.0067250998185252554 -0.0018990989852971968 0.0056605704782138047 "
+    "0.012678157528397255 -0.00072908942206353845 -0.013775335316915441 0.00072877605499535093 "
+    "0.0036116673168147956 0.0020965762755627165 -0.011066682304245117 0.0054435418640811518 "
+    "-0.017900165005297942 0.0063788193417485956 -0.0044223025123209855 -0.01359417183030138 "
+    "-0.001993431301546114 0.0040872157465124126 -0.00124021632164168 -0.01527599188566796\n";
+
+static void test_sharp_edge_pair_is_not_pruned_before_the_inside_test(void** state) {
+  (void)state;
+  pdModel* m = compile(soakScene1779);
+  pdQuat qa = {-0.34333787861646697, 0.0011060038539183554, -0.71494811668866109, 0.60907065953463579};
+  pdQuat qb = {0.66047191899169799, -0.47869626849181929, 0.57739884225903659, -0.035175328191166526};
+  pdPose a = {{-0.033340391203570317, 0.054717232503713319, 0.0017847409073762496}, pd_quat_to_mat3(qa)};
+  pdPose b = {{-0.033952564060515389, 0.021591205878948878, 0.003015928848528832}, pd_quat_to_mat3(qb)};
+  double deltaMax = m->settings.deflection * fmin(m->bodies[0].size, m->bodies[1].size);
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &a, 1, &b, NULL, NULL, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 1);
+  assert_int_equal(c[0].id.kind, pd_contactEE);
+  assert_int_equal(c[0].id.feat1, 10);
+  assert_int_equal(c[0].id.feat2, 8);
+  assert_true(c[0].depth > 0.3 * deltaMax && c[0].depth < 0.45 * deltaMax);
+  pd_model_free(m);
+}
+
 static void test_small_capacity_reports_the_needed_count(void** state) {
   (void)state;
   pdModel* m = compile(cubeOnFloor);
@@ -414,6 +449,7 @@ int main(void) {
       cmocka_unit_test(test_vertex_on_vertex_and_parallel_edges_give_finite_contacts),
       cmocka_unit_test(test_cube_turned_45_degrees_on_a_cube_gives_eight_edge_crossings),
       cmocka_unit_test(test_contact_geometry_is_the_tracked_geometry),
+      cmocka_unit_test(test_sharp_edge_pair_is_not_pruned_before_the_inside_test),
       cmocka_unit_test(test_small_capacity_reports_the_needed_count),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,11 +1,12 @@
 // The hard cases (cases/hard/*.scene, issue item 8): thin plate, mass ratio 10⁴, a fast cube onto a thin
 // slab, crossed bars edge on edge, vertex on vertex, equal cubes face on face, a 10-box stack, a grazing
-// impact, a running-bond brick wall (flush side faces). Each scene runs through pd_advance to its tend; at every output sample the observer checks:
+// impact, a running-bond brick wall (flush side faces). Each scene runs through pd_advance to its tend; at every output
+// sample the observer checks:
 // - every number is finite (body states, energy, every contact report);
 // - the deepest penetration of any two bodies (every pair whose bounding spheres meet, whether the engine
 //   found contacts between them or not: a pair it missed falls through) stays below PENETRATION_LIMIT ×
-//   δ_max of the pair (δ_max of a body = settings.deflection × body.size; a pair's = the smaller of its
-//   two). Penetration is
+//   δ_max of the pair (pd_model_pair_delta_max: settings.deflection × the smaller body's size, at most a
+//   quarter of the thinner body's width). Penetration is
 //   the bodies' overlap: the shortest translation that separates them (the separating-axis minimum depth,
 //   interference.h), not a contact's own depth, which is measured along that contact's normal and for an
 //   edge pair nearly parallel can span a long, thin overlap;
@@ -94,9 +95,7 @@ static bool body_finite(pdBodyState b) {
          isfinite(b.q.y) && isfinite(b.q.z);
 }
 
-static double contact_delta_max(const pdModel* m, int a, int b) {
-  return m->settings.deflection * fmin(m->bodies[a].size, m->bodies[b].size);
-}
+static double contact_delta_max(const pdModel* m, int a, int b) { return pd_model_pair_delta_max(m, a, b); }
 
 static bool watch_sample(const pdModel* model, const pdState* state, void* user) {
   watch* w = user;

@@ -1,9 +1,9 @@
 // Material parameters in a compiled model (paper §3.2, §3.3; DESIGN §3.4, §4.1): the pair's k_n from
 // eq. (11) with the scene's vmax and deflection at the pair's reduced mass and the smaller body's size (a
-// floor's size does not matter), the default restitution and modal dampers, explicit constants winning,
-// pair constants (symmetry, μ = √(μ₁μ₂), e = √(e₁e₂), tabulated or computed on the fly), the §3.3.1 and
-// §3.3.2 adjustments as listed data, material classes, the shortest contact period, and the refusals of
-// compile: an unreachable restitution and bodies interpenetrating at t = 0.
+// floor's size does not matter; δ_max at most a quarter of the thinner body's width), the default restitution
+// and modal dampers, explicit constants winning, pair constants (symmetry, μ = √(μ₁μ₂), e = √(e₁e₂), tabulated
+// or computed on the fly), the §3.3.1 and §3.3.2 adjustments as listed data, material classes, the shortest
+// contact period, and the refusals of compile: an unreachable restitution and bodies interpenetrating at t = 0.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -124,6 +124,27 @@ static void test_stiffness_of_a_cube_on_a_floor_follows_eq_11_for_the_pair(void*
     assert_int_equal(pd_model_adjustment_count(m), 0);
     pd_model_free(m);
   }
+}
+
+static void test_delta_max_is_at_most_a_quarter_of_the_thinner_width(void** state) {
+  (void)state;
+  // a 100:1 plate and a cube of its size: δ_max = 0.01 × 0.67 m (the plate's average dimension) would
+  // exceed the plate's 1 cm thickness within 1.5 deflections (soak, seed 3: vertices came out on the far
+  // side); it is a quarter of the thickness, and the springs are sized for it
+  pdModel* m = compile("vmax 2\ncube plate grey 1 1 0.01\ncube box red 1 1 1\nloc 0 0 1\n");
+  const pdBody *plate = &m->bodies[0], *box = &m->bodies[1];
+  expect_rel(plate->width, 0.01, FORMULA_TOL_REL, "the plate's thinnest width");
+  expect_rel(box->width, 1.0, FORMULA_TOL_REL, "the cube's width");
+  pdPairContact p = pd_model_pair_contact(m, 0, 1);
+  expect_rel(p.deltaMax, 0.25 * 0.01, FORMULA_TOL_REL, "δ_max: a quarter of the plate's thickness");
+  expect_rel(pd_model_pair_delta_max(m, 1, 0), p.deltaMax, FORMULA_TOL_REL, "the same either way round");
+  expect_rel(p.kn, p.massPair * 4.0 / (p.deltaMax * p.deltaMax), FORMULA_TOL_REL, "k_s = m_pair vmax²/δ_max²");
+  pd_model_free(m);
+  // a 20:1 sliver at the default deflection: its 5 cm are more than 4 δ_max, δ_max stays 0.01 × its size
+  m = compile("vmax 2\ncube sliver grey 1 1 0.05\ncube box red 1 1 1\nloc 0 0 1\n");
+  expect_rel(pd_model_pair_contact(m, 0, 1).deltaMax, 0.01 * m->bodies[0].size, FORMULA_TOL_REL,
+             "δ_max of the smaller body");
+  pd_model_free(m);
 }
 
 static void test_two_moving_bodies_use_the_reduced_mass(void** state) {
@@ -433,6 +454,7 @@ static void test_touching_bodies_are_accepted(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_stiffness_of_a_cube_on_a_floor_follows_eq_11_for_the_pair),
+      cmocka_unit_test(test_delta_max_is_at_most_a_quarter_of_the_thinner_width),
       cmocka_unit_test(test_two_moving_bodies_use_the_reduced_mass),
       cmocka_unit_test(test_explicit_constants_win),
       cmocka_unit_test(test_pair_constants_are_symmetric_with_mu_the_geometric_mean),

@@ -50,6 +50,7 @@ typedef struct pdBody {
   double principal[3];    // principal moments, ascending, kg·m²
   pdMat3 principalAxes;   // columns: principal axes in body axes
   double size;            // average dimension: mean of the body-frame bounding-box extents, m
+  double width;           // thinnest width: the smallest extent across one of its face planes, m
   pdVec3 halfExtents;     // body-frame bounding-box half extents about the centre of mass, m (max |coord|)
   double radius;          // largest vertex distance from the centre of mass, m
   pdVec3 x0;              // initial centre of mass, world, m
@@ -164,8 +165,14 @@ typedef struct pdPairContact {
   double massPair;      // kg: reduced mass m₁m₂/(m₁+m₂) (a fixed body: the other's mass)
   double massMin;       // kg: the pair's minimum effective mass (App. B, both bodies in series)
   double period;        // s: 2π√(m_pair/k_n), one contact at the reduced mass
-  double deltaMax;      // m: δ_max = deflection × the smaller body's size
+  double deltaMax;      // m: δ_max = deflection × the smaller body's size, at most ¼ of the thinner body's width
+                        // (pd_model_pair_delta_max)
 } pdPairContact;
+
+// δ_max of bodies a and b, m: deflection × the smaller body's size, at most a quarter of the thinner body's
+// width (README "Contact material parameters": a deeper deflection passes through a thin plate). The deflection
+// the pair's springs are sized for, and the scale of the contact search's tolerances.
+PD_API double pd_model_pair_delta_max(const pdModel* model, int a, int b);
 
 // The pair constants of bodies a and b (model body indices, a != b, not both fixed), as used.
 PD_API pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b);

@@ -41,7 +41,7 @@ pdSoakScene pd_soak_scene(unsigned long seed, long index);
 void pd_soak_scene_free(pdSoakScene* scene);
 
 // Invariant limits (README, Reliability, says why each is what it is).
-// Deepest overlap of any two bodies over the pair's δ_max (deflection × the smaller size), soft engine.
+// Deepest overlap of any two bodies over the pair's δ_max (pd_model_pair_delta_max), soft engine.
 #define PD_SOAK_PENETRATION_LIMIT 3.0
 // Largest rise of the energy above its start in a dissipative scene, relative to the start (potential
 // energy counted from the floor's top at z = 0, so E(0) > 0 is what the scene can release): the adaptive
