@@ -18,9 +18,10 @@
 //   and then dot products with B's body-frame vertices; an edge of B is transformed once and then
 //   paired with every edge of A (outer loop over B's edges). No scratch memory but bit sets on the stack.
 // - Every polyhedron built by the constructors carries a pdSatIndex (built with it, and again by
-//   pd_polyhedron_translate): each edge as one record (its vector, face normals, length and first vertex,
-//   computed exactly as the loop would from the polyhedron, so the same bits), and what the culling bounds
-//   need, the vertex average with the inradius and circumradius about it. The culling bounds (cull_bounds)
+//   pd_polyhedron_translate) with what the culling bounds need: the vertex average with the inradius and
+//   circumradius about it; and, with many edges, each edge as one record (its vector, face normals, length
+//   and first vertex, computed exactly as the loop would from the polyhedron, so the same bits; a small
+//   polyhedron's arrays are read directly: fewer cache lines). The culling bounds (cull_bounds)
 //   are lower bounds of the overlap along whole families of axes — a face's, an edge's arc's — from the
 //   ball of the inradius inside each body: an axis whose bound exceeds the best depth so far (by a margin
 //   above rounding) cannot be the result, nor tie with it, so it is skipped, and only the axes the result
@@ -94,11 +95,11 @@ static inline satEdge edge_record(const pdPolyhedron* P, int i) {
 
 struct pdSatIndex {
   // Every polyhedron (positions: pd_polyhedron_translate builds the index again):
-  satEdge* edge;        // (E)
   pdVec3 centre;        // the vertex average (strictly inside), m
   double inradius;      // distance from it to the nearest face plane, m
   double circumradius;  // to the farthest vertex, m
-  // Polyhedra with PD_SAT_INDEX_MIN_EDGES edges or more, else NULL:
+  // Polyhedra with PD_SAT_INDEX_MIN_EDGES edges or more, else NULL (small ones: edge_record on the fly):
+  satEdge* edge;        // (E)
   int* neighbourFirst;  // (V + 1) vertex v's neighbours are neighbours[neighbourFirst[v] .. neighbourFirst[v+1])
   int* neighbours;      // (2E)
   int* byZ;             // (E) edge indices sorted by the low end of their arc's z band (arc_band, body frame)
@@ -151,9 +152,9 @@ void pd_sat_index_build(pdPolyhedron* p) {
   for (int f = 0; f < F; ++f) x->inradius = fmin(x->inradius, p->faces[f].offset - pd_v3_dot(p->faces[f].normal, c));
   x->inradius = fmax(0.0, x->inradius);
   for (int v = 0; v < V; ++v) x->circumradius = fmax(x->circumradius, pd_v3_norm(pd_v3_sub(p->vertices[v], c)));
+  if (E < PD_SAT_INDEX_MIN_EDGES) return;
   x->edge = index_alloc((size_t)E, sizeof *x->edge);
   for (int e = 0; e < E; ++e) x->edge[e] = edge_record(p, e);
-  if (E < PD_SAT_INDEX_MIN_EDGES) return;
   x->neighbourFirst = index_alloc((size_t)V + 1, sizeof *x->neighbourFirst);
   x->neighbours = index_alloc(2 * (size_t)E, sizeof *x->neighbours);
   for (int e = 0; e < E; ++e) ++x->neighbourFirst[p->edges[e].v[0] + 1], ++x->neighbourFirst[p->edges[e].v[1] + 1];
@@ -213,7 +214,7 @@ typedef struct edgeData {
 
 // Edge i of B, in A's frame (from B's record when it has one).
 static edgeData edge_of_B(const pdPolyhedron* B, int i, const relPose* f) {
-  satEdge r = B->satIndex ? B->satIndex->edge[i] : edge_record(B, i);
+  satEdge r = B->satIndex && B->satIndex->edge ? B->satIndex->edge[i] : edge_record(B, i);
   edgeData d;
   d.n0 = pd_mat3_mulv(&f->R, r.n0);
   d.n1 = pd_mat3_mulv(&f->R, r.n1);
@@ -285,7 +286,7 @@ static inline bool edge_pair_overlap(const pdPolyhedron* A, int i, const edgeDat
   //   a·(d×c) and b·(d×c) of opposite signs (A's arc crosses B's great circle),
   //   c·(b×a) and b·(d×c) of the same sign (the crossings are the same point, not antipodes).
   satEdge record;
-  const satEdge* ea = A->satIndex ? &A->satIndex->edge[i] : (record = edge_record(A, i), &record);
+  const satEdge* ea = A->satIndex && A->satIndex->edge ? &A->satIndex->edge[i] : (record = edge_record(A, i), &record);
   pdVec3 eA = ea->e;
   double cba = pd_v3_dot(b->n0, eA);  // (−n0_B)·(−e_A)
   double dba = pd_v3_dot(b->n1, eA);  // (−n1_B)·(−e_A)
@@ -403,7 +404,8 @@ static void alive_edges(const pdPolyhedron* P, const edgeCull* c, double depth, 
   for (int w = 0; w < (P->edgeCount + 63) / 64; ++w) bits[w] = 0;
   double limit = depth - c->lift;  // alive when the minimum over the arc is at most this
   for (int e = 0; e < P->edgeCount; ++e) {
-    const satEdge* r = &edge[e];
+    satEdge record;
+    const satEdge* r = edge ? &edge[e] : (record = edge_record(P, e), &record);
     pdVec3 w = pd_v3_sub(r->p, c->other);
     // an end of the arc low enough settles it; else the inside of the arc, when it holds the minimum
     bool alive = pd_v3_dot(r->n0, w) <= limit || pd_v3_dot(r->n1, w) <= limit;
