@@ -17,6 +17,7 @@ static const char* const help =
     "usage: polydyn oracle --random N --seed S [--out FILE.csv]\n"
     "       polydyn oracle SCENE [--out FILE.csv] [--tend T] [--sample HZ]\n"
     "       polydyn oracle --replay FILE.csv [--out FILE.csv]\n"
+    "       polydyn oracle --random N --seed S --timing [--repeats R] [--out FILE.csv]\n"
     "\n"
     "Checks polydyn's interference test (separating axes, minimum depth) against libccd's GJK, MPR and\n"
     "EPA on the same posed polyhedra, and prints the counts of agreement and disagreement by kind and\n"
@@ -31,12 +32,19 @@ static const char* const help =
     "  --replay FILE  checks again every pair listed in a CSV written by this command\n"
     "  --out FILE     the CSV of every pair that is not a plain agreement, with both shapes and poses\n"
     "                 (default for --random: out/random-seed-S-N.oracle.csv; for SCENE:\n"
-    "                 out/NAME.oracle.csv); with --replay, every replayed pair, only when asked\n"
+    "                 out/NAME.oracle.csv); with --replay, every replayed pair, only when asked;\n"
+    "                 with --timing, the timing table, only when asked\n"
+    "  --timing       with --random: no check; times, on the same pairs, our test as the engine calls it\n"
+    "                 (first separating axis, without and with a warm cache), ours with every axis, and\n"
+    "                 libccd's GJK, GJK + EPA and MPR (its default tolerances), each over whole batches;\n"
+    "                 prints the median us per pair by group of shapes and the ratios to GJK\n"
+    "  --repeats R    --timing: timed repeats, 1 to 101 (default 5)\n"
     "\n"
     "libccd's verdict is GJK's (MPR is reported beside it). A verdict mismatch where either depth is\n"
     "within 1e-7 x (r_A + r_B) of touching is counted as touching, not as a failure. Exit status: 0 no\n"
     "disagreement with GJK outside that band, 1 a disagreement outside it (or the soft run failed),\n"
-    "2 bad input, 130 interrupted (no CSV written).\n";
+    "2 bad input, 130 interrupted (no CSV written). With --timing: 1 when our modes disagree with each\n"
+    "other.\n";
 
 static volatile sig_atomic_t interrupted = 0;
 static void on_signal(int sig) {
@@ -182,6 +190,33 @@ static int run_random(long n, unsigned long long seed, const char* out) {
   long failures = pd_oracle_stats_failures(&stats);
   pd_oracle_stats_free(&stats);
   return !written || failures ? PD_EXIT_FAILURE : PD_EXIT_OK;
+}
+
+// ---------------------------------------------------------------- --random --timing
+
+static int run_timing(long n, unsigned long long seed, int repeats, const char* out) {
+  pdOracleTiming t;
+  double c0 = cpu_now();
+  bool agree = pd_oracle_timing(n, seed, repeats, &t);
+  printf("polydyn oracle: timing, %ld random pairs, seed %llu\n", n, seed);
+  pd_oracle_timing_print(&t, stdout);
+  printf("time: CPU %.2f s (shapes, placement, an untimed pass and the timed repeats)\n", cpu_now() - c0);
+  if (out) {
+    pd_cli_make_parents(out);
+    FILE* f = fopen(out, "w");
+    if (!f) {
+      fprintf(stderr, "polydyn oracle: %s: cannot write: %s\n", out, strerror(errno));
+      return PD_EXIT_FAILURE;
+    }
+    pd_oracle_timing_csv(&t, f);
+    if (fclose(f) != 0) {
+      fprintf(stderr, "polydyn oracle: %s: cannot write: %s\n", out, strerror(errno));
+      return PD_EXIT_FAILURE;
+    }
+    printf("listed: the timing table in %s\n", out);
+  }
+  if (!agree) fprintf(stderr, "polydyn oracle: our SAT modes disagree with each other\n");
+  return agree ? PD_EXIT_OK : PD_EXIT_FAILURE;
 }
 
 // ---------------------------------------------------------------- SCENE
@@ -390,16 +425,19 @@ static bool parse_count(const char* text, unsigned long long hi, unsigned long l
 
 int pd_cmd_oracle(int argc, char** argv) {
   const char *scene = NULL, *out = NULL, *replay = NULL;
-  unsigned long long count = 0, seed = 0;
-  bool random = false, seedGiven = false;
+  unsigned long long count = 0, seed = 0, repeats = 5;
+  bool random = false, seedGiven = false, timing = false, repeatsGiven = false;
   pdCliOverrides overrides = {0};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     if (pd_cli_is_help(a)) {
       fputs(help, stdout);
       return PD_EXIT_OK;
+    } else if (strcmp(a, "--timing") == 0) {
+      timing = true;
     } else if (strcmp(a, "--random") == 0 || strcmp(a, "--seed") == 0 || strcmp(a, "--out") == 0 ||
-               strcmp(a, "--tend") == 0 || strcmp(a, "--sample") == 0 || strcmp(a, "--replay") == 0) {
+               strcmp(a, "--tend") == 0 || strcmp(a, "--sample") == 0 || strcmp(a, "--replay") == 0 ||
+               strcmp(a, "--repeats") == 0) {
       if (i + 1 >= argc) return pd_cli_usage_error("oracle", "%s needs a value", a);
       const char* v = argv[++i];
       if (strcmp(a, "--random") == 0) {
@@ -412,6 +450,10 @@ int pd_cmd_oracle(int argc, char** argv) {
       } else if (strcmp(a, "--out") == 0) {
         if (v[0] == '\0') return pd_cli_usage_error("oracle", "--out needs a file name");
         out = v;
+      } else if (strcmp(a, "--repeats") == 0) {
+        repeatsGiven = true;
+        if (!parse_count(v, 101, &repeats) || repeats == 0)
+          return pd_cli_usage_error("oracle", "--repeats needs a whole number, 1 to 101");
       } else if (strcmp(a, "--tend") == 0) {
         if (!pd_cli_positive(v, &overrides.tend)) return pd_cli_usage_error("oracle", "--tend needs a number > 0");
       } else if (strcmp(a, "--sample") == 0) {
@@ -433,6 +475,8 @@ int pd_cmd_oracle(int argc, char** argv) {
   if (random != seedGiven) return pd_cli_usage_error("oracle", "--random and --seed go together");
   if (!scene && (overrides.tend > 0.0 || overrides.sample > 0.0))
     return pd_cli_usage_error("oracle", "--tend and --sample are for a SCENE");
+  if (timing && !random) return pd_cli_usage_error("oracle", "--timing goes with --random N --seed S");
+  if (repeatsGiven && !timing) return pd_cli_usage_error("oracle", "--repeats is for --timing");
   if (pd_cli_parse_only) return PD_EXIT_OK;
 
   // an interrupt removes the partial CSV
@@ -441,6 +485,7 @@ int pd_cmd_oracle(int argc, char** argv) {
   sa.sa_handler = on_signal;
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
+  if (timing) return run_timing((long)count, seed, (int)repeats, out);
   if (random) return run_random((long)count, seed, out);
   if (replay) return run_replay(replay, out);
   return run_scene(scene, &overrides, out);

@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "interference.h"
+#include "oracle_ccd.h"
 #include "polydyn/error.h"
 #include "polydyn/stats.h"
 
@@ -32,16 +33,7 @@ static double cpu_seconds(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-// A body as libccd sees it: scaled world coordinates (see the design note).
-typedef struct ccdBody {
-  const pdPolyhedron* shape;
-  pdMat3 Rs;      // R / scale: body frame → scaled world, without the translation
-  pdVec3 origin;  // the body origin, scaled world
-  pdVec3 centre;  // the vertex average, scaled world (strictly inside: MPR's centre)
-  long* calls;    // support calls of the current query (shared by the two bodies)
-} ccdBody;
-
-static void ccd_support(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out) {
+void pd_oracle_ccd_support(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out) {
   const ccdBody* b = obj;
   pdVec3 p = b->centre;
   // past the budget answer the centre: every libccd loop then finds no progress and stops
@@ -65,20 +57,14 @@ static void ccd_support(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out)
   out->v[2] = p.z;
 }
 
-static void ccd_centre(const void* obj, ccd_vec3_t* out) {
+void pd_oracle_ccd_centre(const void* obj, ccd_vec3_t* out) {
   const ccdBody* b = obj;
   out->v[0] = b->centre.x;
   out->v[1] = b->centre.y;
   out->v[2] = b->centre.z;
 }
 
-typedef struct shapeMeasures {
-  pdVec3 average;  // vertex average, body frame
-  double radius;   // largest vertex distance from it, m
-  double size;     // mean of the bounding-box extents, m (as pdBody.size)
-} shapeMeasures;
-
-static shapeMeasures measure(const pdPolyhedron* p) {
+shapeMeasures pd_oracle_measure(const pdPolyhedron* p) {
   shapeMeasures m = {{0, 0, 0}, 0.0, 0.0};
   pdVec3 lo = p->vertices[0], hi = p->vertices[0];
   for (int i = 0; i < p->vertexCount; ++i) {
@@ -103,6 +89,25 @@ static ccdBody ccd_body(const pdOracleBody* b, const pdMat3* R, const shapeMeasu
   c.centre = pd_v3_add(c.origin, pd_mat3_mulv(&c.Rs, m->average));
   c.calls = calls;
   return c;
+}
+
+double pd_oracle_ccd_pair(const pdOracleBody* a, const pdOracleBody* b, const pdMat3* RA, const pdMat3* RB,
+                          const shapeMeasures* ma, const shapeMeasures* mb, long* calls, ccdBody* A, ccdBody* B) {
+  double scale = ma->radius + mb->radius;
+  pdVec3 ca = pd_v3_add(a->x, pd_mat3_mulv(RA, ma->average)), cb = pd_v3_add(b->x, pd_mat3_mulv(RB, mb->average));
+  pdVec3 origin = pd_v3_scale(pd_v3_add(ca, cb), 0.5);
+  *A = ccd_body(a, RA, ma, origin, scale, calls);
+  *B = ccd_body(b, RB, mb, origin, scale, calls);
+  return scale;
+}
+
+void pd_oracle_ccd_init(ccd_t* ccd) {
+  CCD_INIT(ccd);
+  ccd->support1 = pd_oracle_ccd_support;
+  ccd->support2 = pd_oracle_ccd_support;
+  ccd->center1 = pd_oracle_ccd_centre;
+  ccd->center2 = pd_oracle_ccd_centre;
+  ccd->max_iterations = PD_ORACLE_GJK_ITERATIONS;
 }
 
 typedef int penetrationFcn(const void* o1, const void* o2, const ccd_t* ccd, ccd_real_t* depth, ccd_vec3_t* dir,
@@ -160,7 +165,7 @@ void pd_oracle_check(const pdOracleBody* a, const pdOracleBody* b, pdOracleResul
   PD_ASSERT(a->shape->vertexCount > 0 && b->shape->vertexCount > 0);
   memset(out, 0, sizeof *out);
   pdMat3 RA = pd_quat_to_mat3(a->q), RB = pd_quat_to_mat3(b->q);
-  shapeMeasures ma = measure(a->shape), mb = measure(b->shape);
+  shapeMeasures ma = pd_oracle_measure(a->shape), mb = pd_oracle_measure(b->shape);
   out->scale = ma.radius + mb.radius;
   out->size = fmin(ma.size, mb.size);
 
@@ -172,18 +177,11 @@ void pd_oracle_check(const pdOracleBody* a, const pdOracleBody* b, pdOracleResul
   double t1 = cpu_seconds();
 
   // libccd, in coordinates about the midpoint of the centres, divided by the scale
-  pdVec3 ca = pd_v3_add(a->x, pd_mat3_mulv(&RA, ma.average)), cb = pd_v3_add(b->x, pd_mat3_mulv(&RB, mb.average));
-  pdVec3 origin = pd_v3_scale(pd_v3_add(ca, cb), 0.5);
   long calls = 0;
-  ccdBody A = ccd_body(a, &RA, &ma, origin, out->scale, &calls);
-  ccdBody B = ccd_body(b, &RB, &mb, origin, out->scale, &calls);
+  ccdBody A, B;
+  pd_oracle_ccd_pair(a, b, &RA, &RB, &ma, &mb, &calls, &A, &B);
   ccd_t ccd;
-  CCD_INIT(&ccd);
-  ccd.support1 = ccd_support;
-  ccd.support2 = ccd_support;
-  ccd.center1 = ccd_centre;
-  ccd.center2 = ccd_centre;
-  ccd.max_iterations = PD_ORACLE_GJK_ITERATIONS;
+  pd_oracle_ccd_init(&ccd);
   ccd.mpr_tolerance = PD_ORACLE_MPR_TOL;
 
   // each query with a fresh support budget

@@ -16,10 +16,26 @@
 // - Everything is computed in A's frame: B's pose relative to A (R = R_Aᵀ R_B, t = R_Aᵀ (x_B − x_A))
 //   is formed once per call, and B's geometry is transformed on the fly: a face of A needs Rᵀ n once
 //   and then dot products with B's body-frame vertices; an edge of B is transformed once and then
-//   paired with every edge of A (outer loop over B's edges). No scratch memory at all.
+//   paired with every edge of A (outer loop over B's edges). No scratch memory but bit sets on the stack.
+// - Every polyhedron built by the constructors carries a pdSatIndex (built with it, and again by
+//   pd_polyhedron_translate) with what the culling bounds need: the vertex average with the inradius and
+//   circumradius about it; and, with many edges, each edge as one record (its vector, face normals, length
+//   and first vertex, computed exactly as the loop would from the polyhedron, so the same bits; a small
+//   polyhedron's arrays are read directly: fewer cache lines). The culling bounds (cull_bounds)
+//   are lower bounds of the overlap along whole families of axes — a face's, an edge's arc's — from the
+//   ball of the inradius inside each body: an axis whose bound exceeds the best depth so far (by a margin
+//   above rounding) cannot be the result, nor tie with it, so it is skipped, and only the axes the result
+//   could come from are evaluated. Since the best depth only decreases, the skipped axes stay beaten, and
+//   the first separating axis in PD_SAT_FIRST_SEPARATING mode is the same one. Faces are culled only
+//   against a body searched by linear scan (a downhill walk starts where the previous face's ended, so
+//   skipping a face could change where a walk stops among supports that tie to rounding); edges are
+//   culled on both bodies, once per call, into bit sets that the edge-pair loops go through in index
+//   order. So verdicts, depths, axes and features are unchanged to the bit; only the work counter
+//   minkowskiEdgePairs counts fewer pairs. Polyhedra filled in by hand (no pdSatIndex) are searched
+//   without culling.
 // - For a Minkowski-face edge pair the two edges are the supporting features along the axis, so the
 //   overlap is u·(p_A − p_B) with one vertex of each edge: O(1), no support search.
-// - Polyhedra with many features carry search structures (pdSatIndex, built with the polyhedron): the
+// - Polyhedra with many features carry search structures too (in their pdSatIndex): the
 //   support along a face axis is found by walking downhill over the vertex graph from the previous face's
 //   support (a local minimum of a linear function on a convex polyhedron is the minimum), and the edge
 //   pairs are narrowed to those whose Gauss-map arcs can cross: each arc lies in a spherical cap, A's
@@ -51,10 +67,39 @@
 // great circle by more than this times |e_A| (no unit: normals are unit): the full test computes the same
 // signs in A's frame, where rounding may differ by ~1e-16 |e_A|, so no pair it would accept is dropped.
 #define PD_SAT_STRADDLE_MARGIN 1e-12
+// The culling bounds' margin and knife edges: see cull_bounds.
+#define PD_SAT_CULL_MARGIN 1e-5
+#define PD_SAT_CULL_KNIFE 1e-3
 // Edges of A a bit set covers (64 per word, on the stack); past it the exhaustive loop runs.
 #define PD_SAT_BITSET_WORDS 1024
 
+// An edge as the edge-pair test reads it, in one record (one cache line and a half instead of four
+// scattered loads); the same operations as from the polyhedron, so the same bits.
+typedef struct satEdge {
+  pdVec3 e;       // v[1] − v[0]
+  pdVec3 n0, n1;  // normals of faces f[0] and f[1]
+  double len;     // |e|
+  pdVec3 p;       // v[0]
+} satEdge;
+
+static inline satEdge edge_record(const pdPolyhedron* P, int i) {
+  const pdEdge* edge = &P->edges[i];
+  satEdge r;
+  r.e = pd_v3_sub(P->vertices[edge->v[1]], P->vertices[edge->v[0]]);
+  r.n0 = P->faces[edge->f[0]].normal;
+  r.n1 = P->faces[edge->f[1]].normal;
+  r.len = pd_v3_norm(r.e);
+  r.p = P->vertices[edge->v[0]];
+  return r;
+}
+
 struct pdSatIndex {
+  // Every polyhedron (positions: pd_polyhedron_translate builds the index again):
+  pdVec3 centre;        // the vertex average (strictly inside), m
+  double inradius;      // distance from it to the nearest face plane, m
+  double circumradius;  // to the farthest vertex, m
+  // Polyhedra with PD_SAT_INDEX_MIN_EDGES edges or more, else NULL (small ones: edge_record on the fly):
+  satEdge* edge;        // (E)
   int* neighbourFirst;  // (V + 1) vertex v's neighbours are neighbours[neighbourFirst[v] .. neighbourFirst[v+1])
   int* neighbours;      // (2E)
   int* byZ;             // (E) edge indices sorted by the low end of their arc's z band (arc_band, body frame)
@@ -96,10 +141,20 @@ static int compare_z(const void* a, const void* b) {
 }
 
 void pd_sat_index_build(pdPolyhedron* p) {
-  p->satIndex = NULL;
-  if (p->edgeCount < PD_SAT_INDEX_MIN_EDGES) return;
   struct pdSatIndex* x = index_alloc(1, sizeof *x);
-  int V = p->vertexCount, E = p->edgeCount;
+  p->satIndex = x;
+  int V = p->vertexCount, E = p->edgeCount, F = p->faceCount;
+  pdVec3 c = {0, 0, 0};
+  for (int v = 0; v < V; ++v) c = pd_v3_add(c, p->vertices[v]);
+  c = pd_v3_scale(c, 1.0 / V);
+  x->centre = c;
+  x->inradius = INFINITY;
+  for (int f = 0; f < F; ++f) x->inradius = fmin(x->inradius, p->faces[f].offset - pd_v3_dot(p->faces[f].normal, c));
+  x->inradius = fmax(0.0, x->inradius);
+  for (int v = 0; v < V; ++v) x->circumradius = fmax(x->circumradius, pd_v3_norm(pd_v3_sub(p->vertices[v], c)));
+  if (E < PD_SAT_INDEX_MIN_EDGES) return;
+  x->edge = index_alloc((size_t)E, sizeof *x->edge);
+  for (int e = 0; e < E; ++e) x->edge[e] = edge_record(p, e);
   x->neighbourFirst = index_alloc((size_t)V + 1, sizeof *x->neighbourFirst);
   x->neighbours = index_alloc(2 * (size_t)E, sizeof *x->neighbours);
   for (int e = 0; e < E; ++e) ++x->neighbourFirst[p->edges[e].v[0] + 1], ++x->neighbourFirst[p->edges[e].v[1] + 1];
@@ -130,16 +185,17 @@ void pd_sat_index_build(pdPolyhedron* p) {
   }
   free(lo);
   free(hi);
-  p->satIndex = x;
 }
 
 void pd_sat_index_free(struct pdSatIndex* x) {
   if (!x) return;
+  free(x->edge);
   free(x->neighbourFirst);
   free(x->neighbours);
   free(x->byZ);
   free(x->zLo);
   free(x->zHi);
+
   free(x);
 }
 
@@ -156,16 +212,15 @@ typedef struct edgeData {
   double len;     // |e|
 } edgeData;
 
-// Edge i of B, in A's frame.
+// Edge i of B, in A's frame (from B's record when it has one).
 static edgeData edge_of_B(const pdPolyhedron* B, int i, const relPose* f) {
-  const pdEdge* edge = &B->edges[i];
-  pdVec3 p = B->vertices[edge->v[0]], e = pd_v3_sub(B->vertices[edge->v[1]], p);
+  satEdge r = B->satIndex && B->satIndex->edge ? B->satIndex->edge[i] : edge_record(B, i);
   edgeData d;
-  d.n0 = pd_mat3_mulv(&f->R, B->faces[edge->f[0]].normal);
-  d.n1 = pd_mat3_mulv(&f->R, B->faces[edge->f[1]].normal);
-  d.p = pd_v3_add(f->t, pd_mat3_mulv(&f->R, p));
-  d.e = pd_mat3_mulv(&f->R, e);
-  d.len = pd_v3_norm(e);
+  d.n0 = pd_mat3_mulv(&f->R, r.n0);
+  d.n1 = pd_mat3_mulv(&f->R, r.n1);
+  d.p = pd_v3_add(f->t, pd_mat3_mulv(&f->R, B->vertices[B->edges[i].v[0]]));
+  d.e = pd_mat3_mulv(&f->R, r.e);
+  d.len = r.len;
   return d;
 }
 
@@ -174,7 +229,7 @@ static edgeData edge_of_B(const pdPolyhedron* B, int i, const relPose* f) {
 // support, usually a few edges away), which ends at the minimum; *start receives the support.
 static double min_projection(const pdPolyhedron* P, pdVec3 u, int* start) {
   const struct pdSatIndex* x = P->satIndex;
-  if (x) {
+  if (x && x->neighbourFirst) {
     int v = *start;
     double lo = pd_v3_dot(u, P->vertices[v]);
     for (;;) {
@@ -230,23 +285,24 @@ static inline bool edge_pair_overlap(const pdPolyhedron* A, int i, const edgeDat
   //   c·(b×a) and d·(b×a) of opposite signs (B's arc crosses A's great circle),
   //   a·(d×c) and b·(d×c) of opposite signs (A's arc crosses B's great circle),
   //   c·(b×a) and b·(d×c) of the same sign (the crossings are the same point, not antipodes).
-  const pdEdge* edge = &A->edges[i];
-  pdVec3 pA = A->vertices[edge->v[0]], eA = pd_v3_sub(A->vertices[edge->v[1]], pA);
+  satEdge record;
+  const satEdge* ea = A->satIndex && A->satIndex->edge ? &A->satIndex->edge[i] : (record = edge_record(A, i), &record);
+  pdVec3 eA = ea->e;
   double cba = pd_v3_dot(b->n0, eA);  // (−n0_B)·(−e_A)
   double dba = pd_v3_dot(b->n1, eA);  // (−n1_B)·(−e_A)
   if (!opposite_signs(cba, dba)) return false;
-  pdVec3 n0 = A->faces[edge->f[0]].normal, n1 = A->faces[edge->f[1]].normal;
+  pdVec3 n0 = ea->n0, n1 = ea->n1;
   double adc = -pd_v3_dot(n0, b->e);  // n0_A·(−e_B)
   double bdc = -pd_v3_dot(n1, b->e);  // n1_A·(−e_B)
   if (!opposite_signs(adc, bdc) || !same_signs(cba, bdc)) return false;
   pdVec3 u = pd_v3_cross(eA, b->e);
   double len = pd_v3_norm(u);
-  if (!(len >= PD_SAT_PARALLEL_TOL * pd_v3_norm(eA) * b->len)) return false;
+  if (!(len >= PD_SAT_PARALLEL_TOL * ea->len * b->len)) return false;
   // The arcs cross at ±u: on A's arc u·(n0_A + n1_A) > 0, on B's negated arc u·(n0_B + n1_B) < 0.
   pdVec3 s = pd_v3_sub(pd_v3_add(n0, n1), pd_v3_add(b->n0, b->n1));
   u = pd_v3_scale(u, (pd_v3_dot(u, s) < 0.0 ? -1.0 : 1.0) / len);
   *axis = u;
-  *overlap = pd_v3_dot(u, pd_v3_sub(pA, b->p));  // both edges support their body along ±u
+  *overlap = pd_v3_dot(u, pd_v3_sub(ea->p, b->p));  // both edges support their body along ±u
   return true;
 }
 
@@ -292,6 +348,78 @@ static void band_candidates(const struct pdSatIndex* x, int edges, double lo, do
   for (int w = 0; w < (edges + 63) / 64; ++w) bits[w] = 0;
   for (int k = first; k < last; ++k)
     if (x->zHi[k] >= lo) bits[x->byZ[k] >> 6] |= (uint64_t)1 << (x->byZ[k] & 63);
+}
+
+// The culling bounds (design note). For a unit axis u the overlap is h_A(u) + h_B(−u) (h the support
+// function), and a body holds the ball of its inradius r about its vertex average c, so h_A(u) >= u·c_A + r_A
+// and likewise for B. A face axis has one of the two terms exactly (its plane). An edge-pair axis lies on
+// both edges' arcs, where each edge supports its body, so h_A(u) = u·p_i for a vertex p_i of A's edge i and
+// h_B(−u) = −u·p_j for B's edge j, and u lies on A's arc and −u on B's. Hence
+//   face i of A:  overlap >= offset_i − n_i·c_B + r_B
+//   face j of B:  overlap >= offset_j − n_j·c_A + r_A                  (in B's frame)
+//   edge i of A:  overlap >= min over v on i's arc of v·(p_i − c_B) + r_B
+//   edge j of B:  overlap >= min over v on j's arc of v·(p_j − c_A) + r_A   (in B's frame; v = −u)
+// The minimum of v·w over an arc (less than a half circle, from n0 to n1 about +e) is at an end, or, when
+// the arc holds the direction of −w's component across e, minus that component's length.
+// An axis whose bound exceeds the best depth so far by the margin cannot be taken (it would need
+// overlap < best, or a tie), so it is skipped; the margin covers the rounding of the overlap as computed,
+// whose worst case is the edge-pair axis of nearly parallel edges, off by ~1e-16 / PD_SAT_PARALLEL_TOL
+// ≈ 1e-8 of a radian, i.e. 1e-8 of the pair's size: PD_SAT_CULL_MARGIN times a bound on every coordinate
+// involved leaves a factor 1000. A knife edge (normals nearly opposite, |n_f0 + n_f1| below
+// PD_SAT_CULL_KNIFE) is never culled: its axis's sign rests on a small dot product.
+
+typedef struct edgeCull {
+  pdVec3 other;  // the other body's vertex average, in this body's frame
+  double lift;   // the other body's inradius − the margin
+} edgeCull;
+
+typedef struct cullBounds {
+  bool on;        // both polyhedra carry a pdSatIndex
+  pdVec3 cB;      // B's vertex average, A's frame
+  pdVec3 cAinB;   // A's vertex average, B's frame
+  double rA, rB;  // inradii
+  double margin;  // m
+  edgeCull edgesA, edgesB;
+} cullBounds;
+
+static void cull_bounds(const pdPolyhedron* A, const pdPolyhedron* B, const relPose* f, cullBounds* c) {
+  const struct pdSatIndex *ia = A->satIndex, *ib = B->satIndex;
+  c->on = ia && ib;
+  if (!c->on) return;
+  pdVec3 cA = ia->centre, cBlocal = ib->centre;
+  c->cB = pd_v3_add(f->t, pd_mat3_mulv(&f->R, cBlocal));
+  c->cAinB = pd_mat3_tmulv(&f->R, pd_v3_sub(cA, f->t));
+  c->rA = ia->inradius;
+  c->rB = ib->inradius;
+  // every coordinate the overlaps are computed from is at most this large
+  double size = pd_v3_norm(cA) + ia->circumradius + pd_v3_norm(cBlocal) + ib->circumradius + pd_v3_norm(f->t);
+  c->margin = PD_SAT_CULL_MARGIN * size;
+  c->edgesA = (edgeCull){c->cB, ib->inradius - c->margin};
+  c->edgesB = (edgeCull){c->cAinB, ia->inradius - c->margin};
+}
+
+// The bit set of P's edges whose bound (less the margin) does not exceed `depth`.
+static void alive_edges(const pdPolyhedron* P, const edgeCull* c, double depth, uint64_t* bits) {
+  const satEdge* edge = P->satIndex->edge;
+  for (int w = 0; w < (P->edgeCount + 63) / 64; ++w) bits[w] = 0;
+  double limit = depth - c->lift;  // alive when the minimum over the arc is at most this
+  for (int e = 0; e < P->edgeCount; ++e) {
+    satEdge record;
+    const satEdge* r = edge ? &edge[e] : (record = edge_record(P, e), &record);
+    pdVec3 w = pd_v3_sub(r->p, c->other);
+    // an end of the arc low enough settles it; else the inside of the arc, when it holds the minimum
+    bool alive = pd_v3_dot(r->n0, w) <= limit || pd_v3_dot(r->n1, w) <= limit;
+    if (!alive) {
+      pdVec3 sum = pd_v3_add(r->n0, r->n1);
+      if (pd_v3_dot(sum, sum) < PD_SAT_CULL_KNIFE * PD_SAT_CULL_KNIFE) {
+        alive = true;
+      } else if (pd_v3_dot(w, pd_v3_cross(r->e, r->n0)) <= 0.0 && pd_v3_dot(w, pd_v3_cross(r->n1, r->e)) <= 0.0) {
+        double along = pd_v3_dot(w, r->e) / r->len;
+        alive = -sqrt(fmax(0.0, pd_v3_dot(w, w) - along * along)) <= limit;
+      }
+    }
+    if (alive) bits[e >> 6] |= (uint64_t)1 << (e & 63);
+  }
 }
 
 // The cached feature's overlap, when it is still a candidate axis.
@@ -340,8 +468,14 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   if (early && cache && cached_overlap(A, B, &f, cache, &b) && b.depth < 0.0) goto done;
   b = (best){INFINITY, {0, 0, 0}, PD_SAT_NONE, -1, -1};
 
+  cullBounds cull;
+  cull_bounds(A, B, &f, &cull);
+  // a polyhedron searched by a downhill walk keeps every face axis (the walk starts where the last ended)
+  bool cullFacesA = cull.on && !B->satIndex->neighbourFirst, cullFacesB = cull.on && !A->satIndex->neighbourFirst;
   int supportB = 0, supportA = 0;
   for (int i = 0; i < A->faceCount; ++i) {
+    if (cullFacesA && A->faces[i].offset - pd_v3_dot(A->faces[i].normal, cull.cB) + cull.rB - cull.margin > b.depth)
+      continue;
     double d = face_A_overlap(A, i, B, &f, &supportB);
     if (d < b.depth) {
       b = (best){d, A->faces[i].normal, PD_SAT_FACE_A, i, -1};
@@ -349,6 +483,8 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
     }
   }
   for (int i = 0; i < B->faceCount; ++i) {
+    if (cullFacesB && B->faces[i].offset - pd_v3_dot(B->faces[i].normal, cull.cAinB) + cull.rA - cull.margin > b.depth)
+      continue;
     pdVec3 axis;
     double d = face_B_overlap(A, B, i, &f, &axis, &supportA);
     if (d < b.depth) {
@@ -360,27 +496,35 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   // bands (A's frame) meet its own negated arc's, in index order. With B's only: A's (few) edges outer,
   // each meeting the edges of B whose bands (along B's z) meet its own negated arc's and whose normals
   // straddle its great circle, tested in B's own frame (no transform) before the full test. Else every
-  // pair, B's edges outer.
-  const struct pdSatIndex* ia = A->satIndex;
-  if (ia && A->edgeCount <= 64 * PD_SAT_BITSET_WORDS) {
+  // pair, B's edges outer. In every case only the edges whose bound (cull_bounds) may beat the best depth
+  // so far: since the best only decreases, an edge culled at its value now could never improve it later.
+  const struct pdSatIndex *ia = A->satIndex, *ib = B->satIndex;
+  uint64_t aliveA[PD_SAT_BITSET_WORDS], aliveB[PD_SAT_BITSET_WORDS];
+  bool masks = cull.on && A->edgeCount <= 64 * PD_SAT_BITSET_WORDS && B->edgeCount <= 64 * PD_SAT_BITSET_WORDS;
+  if (masks) {
+    alive_edges(A, &cull.edgesA, b.depth, aliveA);
+    alive_edges(B, &cull.edgesB, b.depth, aliveB);
+  }
+  if (ia && ia->byZ && A->edgeCount <= 64 * PD_SAT_BITSET_WORDS) {
     uint64_t candidates[PD_SAT_BITSET_WORDS];
     int words = (A->edgeCount + 63) / 64;
     for (int j = 0; j < B->edgeCount; ++j) {
+      if (masks && !(aliveB[j >> 6] >> (j & 63) & 1)) continue;
       edgeData eb = edge_of_B(B, j, &f);
       double lo, hi;
       arc_band(pd_v3_scale(eb.n0, -1.0), pd_v3_scale(eb.n1, -1.0), (pdVec3){0, 0, 1}, &lo, &hi);
       band_candidates(ia, A->edgeCount, lo, hi, candidates);
       for (int w = 0; w < words; ++w)
-        for (uint64_t bits = candidates[w]; bits; bits &= bits - 1)
+        for (uint64_t bits = candidates[w] & (masks ? aliveA[w] : ~(uint64_t)0); bits; bits &= bits - 1)
           if (visit_edge_pair(A, 64 * w + __builtin_ctzll(bits), &eb, j, &b, &minkowski) && early && b.depth < 0.0)
             goto done;
     }
-  } else if (B->satIndex && B->edgeCount <= 64 * PD_SAT_BITSET_WORDS) {
-    const struct pdSatIndex* ib = B->satIndex;
+  } else if (ib && ib->byZ && B->edgeCount <= 64 * PD_SAT_BITSET_WORDS) {
     uint64_t candidates[PD_SAT_BITSET_WORDS];
     int words = (B->edgeCount + 63) / 64;
     pdVec3 zB = {f.R.m[0][2], f.R.m[1][2], f.R.m[2][2]};  // B's z axis in A's frame
     for (int i = 0; i < A->edgeCount; ++i) {
+      if (masks && !(aliveA[i >> 6] >> (i & 63) & 1)) continue;
       const pdEdge* edge = &A->edges[i];
       // A's arc against B's negated arcs = A's negated arc against B's arcs, whose bands B's index holds
       double lo, hi;
@@ -391,7 +535,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
       pdVec3 eAinB = pd_mat3_tmulv(&f.R, eA);
       double margin = PD_SAT_STRADDLE_MARGIN * pd_v3_norm(eA);
       for (int w = 0; w < words; ++w)
-        for (uint64_t bits = candidates[w]; bits; bits &= bits - 1) {
+        for (uint64_t bits = candidates[w] & (masks ? aliveB[w] : ~(uint64_t)0); bits; bits &= bits - 1) {
           int j = 64 * w + __builtin_ctzll(bits);
           const pdEdge* e = &B->edges[j];
           double s0 = pd_v3_dot(B->faces[e->f[0]].normal, eAinB), s1 = pd_v3_dot(B->faces[e->f[1]].normal, eAinB);
@@ -399,6 +543,16 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
           edgeData eb = edge_of_B(B, j, &f);
           if (visit_edge_pair(A, i, &eb, j, &b, &minkowski) && early && b.depth < 0.0) goto done;
         }
+    }
+  } else if (masks) {
+    int words = (A->edgeCount + 63) / 64;
+    for (int j = 0; j < B->edgeCount; ++j) {
+      if (!(aliveB[j >> 6] >> (j & 63) & 1)) continue;
+      edgeData eb = edge_of_B(B, j, &f);
+      for (int w = 0; w < words; ++w)
+        for (uint64_t bits = aliveA[w]; bits; bits &= bits - 1)
+          if (visit_edge_pair(A, 64 * w + __builtin_ctzll(bits), &eb, j, &b, &minkowski) && early && b.depth < 0.0)
+            goto done;
     }
   } else {
     for (int j = 0; j < B->edgeCount; ++j) {

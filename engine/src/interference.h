@@ -62,16 +62,20 @@ typedef struct pdSatResult {
   pdVec3 axis;             // world, unit, from A to B: the axis achieving `depth`
   pdSatFeature kind;       // the feature defining `axis`
   int a, b;                // its indices (as in pdSatCache)
-  int minkowskiEdgePairs;  // edge pairs that passed the Gauss-map test and were evaluated (work counter)
+  int minkowskiEdgePairs;  // edge pairs that passed the Gauss-map test and were evaluated (work counter; pairs
+                           // the culling bounds skip are not counted)
 } pdSatResult;
 
-// Search structures for polyhedra with many features, built once with the polyhedron (polyhedron.c) so
-// that the test allocates nothing: vertex adjacency, so that each face axis finds the other body's
+// The test's structures, built once with the polyhedron (polyhedron.c, and again when it is translated) so
+// that the test allocates nothing. For every polyhedron: its edges as records and the ball inside it, for
+// the culling bounds (interference.c), which change no result. For polyhedra with many features, search
+// structures too: vertex adjacency, so that each face axis finds the other body's
 // support by walking downhill from the previous one, and every edge's Gauss-map arc enclosed in a
 // spherical cap, the arcs sorted along the body's z axis, so that an edge of B meets only the edges of A
 // whose caps share its z band. Neither changes a result: a downhill walk on a convex polyhedron ends at
 // the minimum, and arcs whose caps' z bands are apart (by PD_SAT_CAP_MARGIN) cannot cross. Polyhedra
-// with fewer than PD_SAT_INDEX_MIN_EDGES edges get none (a cube is searched faster exhaustively).
+// with fewer than PD_SAT_INDEX_MIN_EDGES edges get no search structures (a cube is searched faster
+// exhaustively).
 #define PD_SAT_INDEX_MIN_EDGES 48
 void pd_sat_index_build(pdPolyhedron* p);
 void pd_sat_index_free(struct pdSatIndex* index);

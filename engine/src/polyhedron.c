@@ -528,6 +528,11 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
 void pd_polyhedron_translate(pdPolyhedron* p, pdVec3 shift) {
   for (int v = 0; v < p->vertexCount; ++v) p->vertices[v] = pd_v3_add(p->vertices[v], shift);
   for (int f = 0; f < p->faceCount; ++f) p->faces[f].offset += pd_v3_dot(p->faces[f].normal, shift);
+  // the interference test's structures hold positions (and edge vectors, rounded from these vertices)
+  if (p->satIndex) {
+    pd_sat_index_free(p->satIndex);
+    pd_sat_index_build(p);
+  }
 }
 
 void pd_polyhedron_free(pdPolyhedron* p) {

@@ -129,5 +129,23 @@ check "bad shape message names shape_a" 'grep -q "^$BAD/shape.csv:2:[0-9]*: shap
 run_pd "$OUT" "$ERR" oracle --replay "$BAD/missing.csv"
 check "replay of a missing file exits 2" '[ $rc -eq 2 ]'
 
+# --- --timing: usage errors, the table, the CSV, exit 0 when our modes agree -------------------------
+usage_error "--timing without --random" --timing
+usage_error "--timing with --replay" --replay "$R1" --timing
+usage_error "--repeats without --timing" --random 10 --seed 1 --repeats 3
+usage_error "--repeats 0" --random 10 --seed 1 --timing --repeats 0
+usage_error "--repeats too many" --random 10 --seed 1 --timing --repeats 102
+run_pd "$OUT" "$ERR" oracle --random 200 --seed 3 --timing --repeats 1 --out "$SCRATCH/timing/t.csv"
+check "--timing exits 0" '[ $rc -eq 0 ]'
+check "--timing: our modes agree" 'grep -q "^our modes agree .*: yes; result hash [0-9a-f]\{16\}$" "$OUT"'
+check "--timing prints the all row" 'grep -q "^all  *200 " "$OUT"'
+check "--timing CSV header" '[ "$(head -n 1 "$SCRATCH/timing/t.csv")" = "group,mode,pairs,repeats,us_per_pair_median,us_per_pair_min,us_per_pair_max,ratio_to_gjk" ]'
+check "--timing CSV: 8 modes for all pairs" '[ "$(grep -c "^all," "$SCRATCH/timing/t.csv")" -eq 8 ]'
+check "--timing CSV: GJK's ratio is 1" 'grep -q "^all,ccd_gjk,200,1,.*,1.0000$" "$SCRATCH/timing/t.csv"'
+run_pd "$OUT" "$ERR" oracle --random 200 --seed 3 --timing --repeats 1
+H1=$(sed -n "s/.*result hash //p" "$OUT")
+run_pd "$OUT" "$ERR" oracle --random 200 --seed 3 --timing --repeats 2
+check "--timing: the result hash depends on the pairs only" '[ -n "$H1" ] && [ "$(sed -n "s/.*result hash //p" "$OUT")" = "$H1" ]'
+
 echo "test_oracle_cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -591,7 +591,8 @@ static void test_stale_or_foreign_cache_entries_are_harmless(void** state) {
   free_pool(pool);
 }
 
-// The search structures (pdSatIndex: downhill supports, Gauss-map arcs banded along z) change no result:
+// The search structures (pdSatIndex: downhill supports, Gauss-map arcs banded along z, edge records and the
+// culling bounds, which every polyhedron built by a constructor carries) change no result:
 // the same pairs with the structures detached (the exhaustive search) give the same depth to the bit, the
 // same feature and axis in PD_SAT_MIN_DEPTH mode and the same verdict in PD_SAT_FIRST_SEPARATING mode.
 // Shapes with many features (spheres of levels 1 and 2, 16- to 64-gon prisms, hulls of 60 points) against

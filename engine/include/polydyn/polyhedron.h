@@ -38,9 +38,10 @@ typedef struct pdPolyhedron {
   pdEdge* edges;      // (edgeCount)
   pdFace* faces;      // (faceCount)
   int* faceVertices;  // (sum of face counts) vertex indices, CCW seen from outside
-  // Derived by the constructors below for polyhedra with many features (vertex adjacency, the edges'
-  // Gauss-map arcs sorted for the interference test); NULL otherwise and on a polyhedron filled in by
-  // hand, which the test then searches exhaustively. Owned: pd_polyhedron_free releases it.
+  // Derived by the constructors below for the interference test (edge records and the ball inside for its
+  // culling bounds; for polyhedra with many features, vertex adjacency and the edges' Gauss-map arcs sorted
+  // too), and again by pd_polyhedron_translate; NULL on a polyhedron filled in by hand, which the test then
+  // searches exhaustively. Owned: pd_polyhedron_free releases it.
   struct pdSatIndex* satIndex;
 } pdPolyhedron;
 

@@ -152,6 +152,58 @@ long pd_oracle_stats_failures(const pdOracleStats* s);
 // |error|/size, and the signed extremes), time. Deterministic except the line starting with "time".
 void pd_oracle_stats_print(const pdOracleStats* s, FILE* out);
 
+// ---------------------------------------------------------------- timing (polydyn oracle --timing)
+// Our SAT against libccd's queries on the same random pairs (refcheck/oracle_timing.c), each mode timed over
+// whole batches of pairs, R times, medians quoted. libccd's tolerances are its defaults here (1e-4 in its
+// scaled coordinates, as an engine calling it would use), not the oracle's tight ones above.
+typedef enum pdOracleTimingMode {
+  pd_oracleTimingFirst,          // ours as the engine calls it: PD_SAT_FIRST_SEPARATING, no cache
+  pd_oracleTimingCached,         // the same with the cache of a previous call at the same pose (best case)
+  pd_oracleTimingMinDepth,       // PD_SAT_MIN_DEPTH (every axis; the oracle's check)
+  pd_oracleTimingGjk,            // ccdGJKIntersect
+  pd_oracleTimingGjkEpa,         // ccdGJKPenetration: GJK, then EPA when overlapping
+  pd_oracleTimingMpr,            // ccdMPRIntersect
+  pd_oracleTimingFirstOverlap,   // ours, first-separating, over the pairs GJK calls overlapping only
+  pd_oracleTimingGjkEpaOverlap,  // ccdGJKPenetration over those pairs only
+  pd_oracleTimingModeCount
+} pdOracleTimingMode;
+extern const char* const pdOracleTimingModeNames[pd_oracleTimingModeCount];  // "ours_first", ...
+
+// Groups by the larger body's vertex count (the costs differ by orders of magnitude).
+typedef enum pdOracleTimingGroupKind {
+  pd_oracleTimingCubeCube,  // both cubes
+  pd_oracleTimingSmall,     // any other pair, V <= 32 (prisms, tapered prisms, hulls, icosahedra)
+  pd_oracleTimingMedium,    // V <= 162 (geodesic spheres of levels 1 and 2)
+  pd_oracleTimingLarge,     // V > 162 (geodesic spheres of level 3, 642 vertices)
+  pd_oracleTimingAll,       // every pair (a batch's time: the sum over the groups)
+  pd_oracleTimingGroupCount
+} pdOracleTimingGroupKind;
+extern const char* const pdOracleTimingGroupNames[pd_oracleTimingGroupCount];  // "cube-cube", ...
+
+typedef struct pdOracleTimingGroup {
+  long pairs, overlapping;                     // overlapping: GJK's verdict (the _overlap modes' batch)
+  double meanVertices, meanEdges;              // per body
+  double usPerPair[pd_oracleTimingModeCount];  // median over the repeats, µs
+  double usMin[pd_oracleTimingModeCount], usMax[pd_oracleTimingModeCount];
+} pdOracleTimingGroup;
+
+typedef struct pdOracleTiming {
+  long pairCount;
+  int repeats;
+  long oursOverlap, gjkOverlap, ccdStalled;
+  bool oursAgree;       // our three modes give the same verdicts (and depths where overlapping)
+  uint64_t resultHash;  // FNV-1a over every field of our three modes' results but the work counter
+  double checksum;      // a sum of all timed answers (keeps them from being optimised away)
+  pdOracleTimingGroup groups[pd_oracleTimingGroupCount];
+} pdOracleTiming;
+
+// Draws n pairs from `seed` (as --random) and times every mode over them, `repeats` times. Returns
+// out->oursAgree.
+bool pd_oracle_timing(long n, uint64_t seed, int repeats, pdOracleTiming* out);
+// The summary table (µs per pair by group and mode, ratios to GJK), and the CSV (one row per group and mode).
+void pd_oracle_timing_print(const pdOracleTiming* t, FILE* out);
+void pd_oracle_timing_csv(const pdOracleTiming* t, FILE* out);
+
 // ---------------------------------------------------------------- shapes written as text (replayable)
 
 // A shape spec is a scene object command without NAME and COLOR (README "Scene language"):
