@@ -10,7 +10,7 @@ import { fileURLToPath } from 'node:url';
 import { parseCsv, writeCsv } from '../../reports/generator/lib/csv.mjs';
 import { parseJson, lineOf } from '../../reports/generator/lib/json.mjs';
 import { costToReach, isOwnReference, matrix, orderEngineVariants, median, verdicts, workPrecision } from '../../reports/generator/lib/derive.mjs';
-import { readSweep } from '../../reports/generator/lib/inputs.mjs';
+import { readCubetoss, readPrecision, readResults, readSweep } from '../../reports/generator/lib/inputs.mjs';
 import { num } from '../../reports/generator/lib/html.mjs';
 import { precision } from '../../reports/generator/lib/precision.mjs';
 import { parseArgs, outputPaths } from '../../reports/generator/report.mjs';
@@ -69,7 +69,7 @@ test('costToReach: interpolates linearly in log error and log cost between the p
   assert.ok(Math.abs(Math.log10(c.wall_per_sim_second) - (-3 + 4 / 3)) < 1e-12);
 });
 
-test('sweep.csv: the header with the self-convergence columns and the one before them both load', () => {
+test('sweep.csv: the header with the derivative counts, the one before (self-convergence last) and the first all load', () => {
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'pd-units-'));
   try {
     const old = 'scene,engine,variant,setting,value,error,error_kind,wall_seconds,wall_per_sim_second,steps,repeats,reference';
@@ -86,7 +86,13 @@ test('sweep.csv: the header with the self-convergence columns and the one before
     const b = readSweep(dir);
     assert.deepEqual(b.rows.map((r) => [r.scene, r.has_self, r.self_error, r.horizon_seconds]),
       [['b', true, 0.02, 0.5], ['b', true, null, null], ['a', false, null, null], ['a', false, null, null]]);
-    const wp = workPrecision(b);
+    fs.writeFileSync(path.join(dir, 'sweep.csv'), [`${old},self_error,self_reference,horizon_seconds,derivatives`,
+      'c,soft,embedded,tol,1e-06,0.001,rms_pose,0.01,0.01,300,3,soft tol=1e-12,0.001,soft tol=1e-12,,1500',
+      'c,ode,native,step,0.001,0.05,rms_pose,0.04,0.04,1000,3,soft tol=1e-12,,ode native step=0.001,,'].join('\n') + '\n');
+    assert.deepEqual(readSweep(dir).rows.map((r) => [r.scene, r.variant, r.derivatives, r.has_self]),
+      [['c', 'embedded', 1500, true], ['c', 'native', null, true]]);
+    fs.writeFileSync(path.join(dir, 'sweep.csv'), [`${old},self_error,self_reference,horizon_seconds`, ...rows('b', true), old, ...rows('a', false)].join('\n') + '\n');
+    const wp = workPrecision(readSweep(dir));
     assert.equal(wp[0].self_convergence, true);
     assert.equal(wp[0].has_horizon, true);
     assert.equal(wp[0].curves[0].to_target.kind, 'never');  // 0.02 is the only self_error: above 1e-3
@@ -280,4 +286,14 @@ test('precision: the cost to the tolerance per curve; "never" stalls or still fa
   assert.deepEqual(s['ode native'].never, ['x1']);
   assert.deepEqual([s['bullet native'].judged, s['bullet native'].not_built], [0, true]);
   assert.deepEqual([s['bullet matched'].judged, s['bullet matched'].not_applicable], [0, ['x1']]);
+});
+
+// The main job (scripts/gedanken-report) reads the committed results beside its own run: a schema change in a
+// writer must reach the readers before the regenerated results are committed.
+test('the committed reports load: reports/sweep, reports/gedanken, reports/cubetoss', () => {
+  const root = path.join(HERE, '..', '..', 'reports');
+  assert.ok(readSweep(path.join(root, 'sweep')).rows.length > 0);
+  assert.ok(readResults(path.join(root, 'gedanken')).rows.length > 0);
+  assert.ok(readPrecision(path.join(root, 'gedanken')).rows.length > 0);
+  assert.ok(readCubetoss(path.join(root, 'cubetoss')) !== null);
 });

@@ -10,10 +10,12 @@ import { InputError } from './errors.mjs';
 export const RESULTS_HEADER = ['experiment', 'group', 'title', 'engine', 'variant', 'quantity', 'unit', 'input',
   'measured', 'expected', 'error', 'tolerance', 'status', 'wall_seconds', 'run_dir', 'note'];
 export const SERIES_HEADER = ['t', 'engine', 'variant', 'input', 'value', 'analytic'];
-// sweep.csv as written since the self-convergence columns (the last three), and before them: both are read.
+// sweep.csv as written since the derivative counts (the last column), before them (the self-convergence
+// columns last), and before those: all three are read.
 export const SWEEP_HEADER_V1 = ['scene', 'engine', 'variant', 'setting', 'value', 'error', 'error_kind', 'wall_seconds',
   'wall_per_sim_second', 'steps', 'repeats', 'reference'];
-export const SWEEP_HEADER = [...SWEEP_HEADER_V1, 'self_error', 'self_reference', 'horizon_seconds'];
+export const SWEEP_HEADER_V2 = [...SWEEP_HEADER_V1, 'self_error', 'self_reference', 'horizon_seconds'];
+export const SWEEP_HEADER = [...SWEEP_HEADER_V2, 'derivatives'];
 export const PRECISION_HEADER = ['experiment', 'kind', 'engine', 'variant', 'setting', 'value', 'input', 'quantity', 'unit',
   'measured', 'expected', 'error', 'relative', 'tolerance', 'judged', 'status', 'wall_seconds', 'wall_per_sim_second', 'steps',
   'repeats', 'note'];
@@ -216,7 +218,7 @@ export function readSweep(dir) {
   const src = readText(dir, 'sweep.csv');
   if (!src) return null;
   const rows = [];
-  for (const { line, f } of table(src, SWEEP_HEADER, [SWEEP_HEADER_V1])) {
+  for (const { line, f } of table(src, SWEEP_HEADER, [SWEEP_HEADER_V2, SWEEP_HEADER_V1])) {
     if (f.scene === '') throw new InputError(src.file, line, 'scene: empty');
     if (f.setting !== 'tol' && f.setting !== 'step')
       throw new InputError(src.file, line, `setting: expected tol or step, found '${f.setting}'`);
@@ -239,6 +241,8 @@ export function readSweep(dir) {
       self_error: 'self_error' in f ? number(f.self_error, 'self_error', src.file, line) : null,
       self_reference: 'self_reference' in f ? f.self_reference : null,
       horizon_seconds: 'horizon_seconds' in f ? number(f.horizon_seconds, 'horizon_seconds', src.file, line) : null,
+      // the soft engine's derivative evaluations (empty for ODE and Bullet; null before that column)
+      derivatives: 'derivatives' in f ? number(f.derivatives, 'derivatives', src.file, line, { integer: true }) : null,
     };
     if (row.horizon_seconds !== null && !(row.horizon_seconds >= 0 && Number.isFinite(row.horizon_seconds)))
       throw new InputError(src.file, line, `horizon_seconds: must be empty or a finite number ≥ 0, not '${f.horizon_seconds}'`);
