@@ -74,9 +74,6 @@ static bool inside_body(const pdPolyhedron* s, pdVec3 q, double tol) {
 // they settle (1e-7 m on a 0.1 m brick), which a roundoff-sized tolerance would not absorb.
 #define FLUSH_TOL_DEFLECTIONS 1e-3
 
-// δ_max of a pair, m (pd_model_pair_delta_max).
-static double pair_delta_max(const pdModel* m, int i, int j) { return pd_model_pair_delta_max(m, i, j); }
-
 // Does body sv, placed in sf's frame by rotation rel and offset off, cross face f's plane of sf by more
 // than tol, i.e. lie partly outside it?
 static bool crosses_face_plane(const pdPolyhedron* sv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf, int f,
@@ -117,7 +114,7 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
   const pdPolyhedron* sv = &m->bodies[iv].shape;
   const pdPolyhedron* sf = &m->bodies[jf].shape;
   double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
-  double flushTol = FLUSH_TOL_DEFLECTIONS * pair_delta_max(m, iv, jf);
+  double flushTol = FLUSH_TOL_DEFLECTIONS * pd_model_pair_delta_max(m, iv, jf);
   // the vertex body in the face body's frame: rotation R_fᵀ R_v, offset R_fᵀ (x_v − x_f)
   pdMat3 RfT = pd_mat3_transpose(&pf->R);
   pdMat3 rel = pd_mat3_mul(&RfT, &pv->R);
@@ -296,7 +293,7 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   pdMat3 rel = pd_mat3_mul(&RaT, &pb->R);
   pdVec3 off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
   double tolA = BOUNDARY_TOL_REL * model->bodies[ia].size, tolB = BOUNDARY_TOL_REL * model->bodies[ib].size;
-  double deltaMax = pair_delta_max(model, ia, ib);
+  double deltaMax = pd_model_pair_delta_max(model, ia, ib);
   double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
   faceMask maskA[PRUNE_VERTICES_MAX], maskB[PRUNE_VERTICES_MAX];  // A's vertices against B's faces, and B's against A's
   bool prune = sa->vertexCount <= PRUNE_VERTICES_MAX && sb->vertexCount <= PRUNE_VERTICES_MAX;
@@ -448,7 +445,7 @@ static bool edge_points_inside(const pdModel* model, const pdContactId* id, cons
   const pdBody* b2 = &model->bodies[id->body2];
   // as the search accepts a sharp edge's pair (find_ee): the points within the pair's depth of inside,
   // up to the deepest a new pair may be; else a pair found again every step would break at every commit
-  double deepest = EE_NEW_DEPTH_MAX_DEFLECTIONS * pair_delta_max(model, id->body1, id->body2);
+  double deepest = EE_NEW_DEPTH_MAX_DEFLECTIONS * pd_model_pair_delta_max(model, id->body1, id->body2);
   double sharp = fmin(fmax(g->depth, 0.0), deepest);
   double tol1 = fmax(TRACK_INSIDE_TOL_REL * model->settings.deflection * b1->size, sharp);
   double tol2 = fmax(TRACK_INSIDE_TOL_REL * model->settings.deflection * b2->size, sharp);
@@ -500,7 +497,7 @@ bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose*
     // over its face polygon within the flush tolerance: a corner resting on a shared side plane wanders
     // across it by roundoff and must not break and be found again on the side face
     double over = fmax(BOUNDARY_TOL_REL * model->bodies[id->body2].size,
-                       FLUSH_TOL_DEFLECTIONS * pair_delta_max(model, id->body1, id->body2));
+                       FLUSH_TOL_DEFLECTIONS * pd_model_pair_delta_max(model, id->body1, id->body2));
     return projects_inside(s2, id->feat2, q, over) && inside_body(s2, q, outside);
   }
   // an edge pair stays a contact while its closest points lie inside both edges and it spans a face of

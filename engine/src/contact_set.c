@@ -135,7 +135,6 @@ struct pdContactSet {
   pairCache *cache, *cacheNext;
   int cacheCount, cacheCapacity;
   pdVec3 *force, *torque;  // (movingCount) contact force and moment on each moving body, world
-  double* width;           // (bodyCount) smallest width of each body across its face planes, m
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
   int onsetRetries;        // onset retries of the step under way
   // stability bound (stability_prepare, stable_step_exact), sized with the list
@@ -143,7 +142,7 @@ struct pdContactSet {
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])
   int* bodyList;           // (2 capacity)
   double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
-  double stableCheap;      // s: a step never above stableStep, from the cheap bound (stable_step_cheap)
+  double stableCheap;      // s: a step never above stableStep, from the cheap bound (stability_prepare)
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
@@ -178,7 +177,6 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   int n = model->bodyCount;
   set->bodyCount = n;
   set->force = grow(NULL, model->movingCount, sizeof *set->force);
-  set->width = grow(NULL, n, sizeof *set->width);
   set->bodyFirst = grow(NULL, n + 1, sizeof *set->bodyFirst);
   set->invInertiaWorld = grow(NULL, n, sizeof *set->invInertiaWorld);
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
@@ -188,7 +186,6 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   set->bodyRowsRight = grow(NULL, n, sizeof *set->bodyRowsRight);
   set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
   PD_ASSERT(set->travel != NULL);
-  for (int i = 0; i < n; ++i) set->width[i] = model->bodies[i].width;
   set->torque = grow(NULL, model->movingCount, sizeof *set->torque);
   set->poses = grow(NULL, n, sizeof *set->poses);
   set->poses0 = grow(NULL, n, sizeof *set->poses0);
@@ -226,7 +223,6 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->previous);
   free(set->found);
   free(set->force);
-  free(set->width);
   free(set->stability);
   free(set->bodyFirst);
   free(set->bodyList);
@@ -387,11 +383,6 @@ static void install(const pdModel* model, pdState* s, int count) {
   s->n = base + PD_CONTACT_STATE_SIZE * count;
 }
 
-// δ_max of a contact: its pair's design deflection (pd_model_pair_delta_max), m.
-static double pair_delta_max(const pdModel* model, int body1, int body2) {
-  return pd_model_pair_delta_max(model, body1, body2);
-}
-
 // The shortest period of a contact, 2π√(m_min/k_s) over n and P_t (m_min: the pair's minimum effective
 // mass), times PD_REFINE_PERIOD_FRACTION: how finely a reversal in this contact is located.
 static double refine_step(const pdModel* model, const pdContactParams* p) {
@@ -406,7 +397,7 @@ static contactSlot new_slot(const pdModel* model, const pdContactGeom* g) {
   memset(&c, 0, sizeof c);
   c.id = g->id;
   c.params = pd_model_contact_params(model, g->id.body1, g->id.body2);
-  c.deltaMax = pair_delta_max(model, g->id.body1, g->id.body2);
+  c.deltaMax = pd_model_pair_delta_max(model, g->id.body1, g->id.body2);
   c.normal = g->normal;
   c.point = g->point;
   c.depth = g->depth;
@@ -728,8 +719,8 @@ static double travel_limit(const pdModel* model, pdContactSet* set, int pairCoun
   for (int p = 0; p < pairCount; ++p) {
     int a = set->pairs[p].a, b = set->pairs[p].b;
     double moved = set->travel[a] + set->travel[b];
-    double allowed = fmin(PD_TRAVEL_WIDTH_FRACTION * fmin(set->width[a], set->width[b]),
-                          PD_TRAVEL_DEFLECTIONS * pair_delta_max(model, a, b));
+    double allowed = fmin(PD_TRAVEL_WIDTH_FRACTION * fmin(model->bodies[a].width, model->bodies[b].width),
+                          PD_TRAVEL_DEFLECTIONS * pd_model_pair_delta_max(model, a, b));
     if (moved > allowed) limit = fmin(limit, allowed / moved);
   }
   return limit;
@@ -864,7 +855,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   for (int k = 0; k < set->candidateCount; ++k) {
     const candidate* c = &set->candidates[k];
     if (!c->approaching || c->inherit >= 0) continue;
-    double tol = PD_ONSET_DEPTH_TOL_REL * pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
+    double tol = PD_ONSET_DEPTH_TOL_REL * pd_model_pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
     if (c->geom.depth > tol) earliest = fmin(earliest, c->onset);
   }
   pdEventVerdict verdict = pd_eventAccept;

@@ -93,6 +93,9 @@ static inline satEdge edge_record(const pdPolyhedron* P, int i) {
   return r;
 }
 
+// Bit i of a bit set.
+static inline bool bit_is_set(const uint64_t* bits, int i) { return bits[i >> 6] >> (i & 63) & 1; }
+
 struct pdSatIndex {
   // Every polyhedron (positions: pd_polyhedron_translate builds the index again):
   pdVec3 centre;        // the vertex average (strictly inside), m
@@ -107,6 +110,13 @@ struct pdSatIndex {
   double* zHi;          // (E) in byZ order
   double zSpanMax;      // the widest band
 };
+
+// Edge i of P as a record: the stored one when P keeps records, else formed in *scratch.
+static inline const satEdge* edge_at(const pdPolyhedron* P, int i, satEdge* scratch) {
+  if (P->satIndex && P->satIndex->edge) return &P->satIndex->edge[i];
+  *scratch = edge_record(P, i);
+  return scratch;
+}
 
 static void* index_alloc(size_t n, size_t size) {
   void* p = calloc(n ? n : 1, size);
@@ -195,7 +205,6 @@ void pd_sat_index_free(struct pdSatIndex* x) {
   free(x->byZ);
   free(x->zLo);
   free(x->zHi);
-
   free(x);
 }
 
@@ -214,13 +223,14 @@ typedef struct edgeData {
 
 // Edge i of B, in A's frame (from B's record when it has one).
 static edgeData edge_of_B(const pdPolyhedron* B, int i, const relPose* f) {
-  satEdge r = B->satIndex && B->satIndex->edge ? B->satIndex->edge[i] : edge_record(B, i);
+  satEdge scratch;
+  const satEdge* r = edge_at(B, i, &scratch);
   edgeData d;
-  d.n0 = pd_mat3_mulv(&f->R, r.n0);
-  d.n1 = pd_mat3_mulv(&f->R, r.n1);
-  d.p = pd_v3_add(f->t, pd_mat3_mulv(&f->R, B->vertices[B->edges[i].v[0]]));
-  d.e = pd_mat3_mulv(&f->R, r.e);
-  d.len = r.len;
+  d.n0 = pd_mat3_mulv(&f->R, r->n0);
+  d.n1 = pd_mat3_mulv(&f->R, r->n1);
+  d.p = pd_v3_add(f->t, pd_mat3_mulv(&f->R, r->p));
+  d.e = pd_mat3_mulv(&f->R, r->e);
+  d.len = r->len;
   return d;
 }
 
@@ -285,8 +295,8 @@ static inline bool edge_pair_overlap(const pdPolyhedron* A, int i, const edgeDat
   //   c·(b×a) and d·(b×a) of opposite signs (B's arc crosses A's great circle),
   //   a·(d×c) and b·(d×c) of opposite signs (A's arc crosses B's great circle),
   //   c·(b×a) and b·(d×c) of the same sign (the crossings are the same point, not antipodes).
-  satEdge record;
-  const satEdge* ea = A->satIndex && A->satIndex->edge ? &A->satIndex->edge[i] : (record = edge_record(A, i), &record);
+  satEdge scratch;
+  const satEdge* ea = edge_at(A, i, &scratch);
   pdVec3 eA = ea->e;
   double cba = pd_v3_dot(b->n0, eA);  // (−n0_B)·(−e_A)
   double dba = pd_v3_dot(b->n1, eA);  // (−n1_B)·(−e_A)
@@ -400,12 +410,11 @@ static void cull_bounds(const pdPolyhedron* A, const pdPolyhedron* B, const relP
 
 // The bit set of P's edges whose bound (less the margin) does not exceed `depth`.
 static void alive_edges(const pdPolyhedron* P, const edgeCull* c, double depth, uint64_t* bits) {
-  const satEdge* edge = P->satIndex->edge;
   for (int w = 0; w < (P->edgeCount + 63) / 64; ++w) bits[w] = 0;
   double limit = depth - c->lift;  // alive when the minimum over the arc is at most this
   for (int e = 0; e < P->edgeCount; ++e) {
-    satEdge record;
-    const satEdge* r = edge ? &edge[e] : (record = edge_record(P, e), &record);
+    satEdge scratch;
+    const satEdge* r = edge_at(P, e, &scratch);
     pdVec3 w = pd_v3_sub(r->p, c->other);
     // an end of the arc low enough settles it; else the inside of the arc, when it holds the minimum
     bool alive = pd_v3_dot(r->n0, w) <= limit || pd_v3_dot(r->n1, w) <= limit;
@@ -509,7 +518,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
     uint64_t candidates[PD_SAT_BITSET_WORDS];
     int words = (A->edgeCount + 63) / 64;
     for (int j = 0; j < B->edgeCount; ++j) {
-      if (masks && !(aliveB[j >> 6] >> (j & 63) & 1)) continue;
+      if (masks && !bit_is_set(aliveB, j)) continue;
       edgeData eb = edge_of_B(B, j, &f);
       double lo, hi;
       arc_band(pd_v3_scale(eb.n0, -1.0), pd_v3_scale(eb.n1, -1.0), (pdVec3){0, 0, 1}, &lo, &hi);
@@ -524,7 +533,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
     int words = (B->edgeCount + 63) / 64;
     pdVec3 zB = {f.R.m[0][2], f.R.m[1][2], f.R.m[2][2]};  // B's z axis in A's frame
     for (int i = 0; i < A->edgeCount; ++i) {
-      if (masks && !(aliveA[i >> 6] >> (i & 63) & 1)) continue;
+      if (masks && !bit_is_set(aliveA, i)) continue;
       const pdEdge* edge = &A->edges[i];
       // A's arc against B's negated arcs = A's negated arc against B's arcs, whose bands B's index holds
       double lo, hi;
@@ -547,7 +556,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   } else if (masks) {
     int words = (A->edgeCount + 63) / 64;
     for (int j = 0; j < B->edgeCount; ++j) {
-      if (!(aliveB[j >> 6] >> (j & 63) & 1)) continue;
+      if (!bit_is_set(aliveB, j)) continue;
       edgeData eb = edge_of_B(B, j, &f);
       for (int w = 0; w < words; ++w)
         for (uint64_t bits = aliveA[w]; bits; bits &= bits - 1)
