@@ -26,8 +26,7 @@ const char* const pdOracleKindNames[pd_oracleKindCount] = {
     "agree_overlap", "agree_separate", "we_overlap", "we_separate", "touching", "mpr_differs", "depth", "ccd_stalled",
 };
 
-// CPU time of this process, s: the machine may be shared, and wall time would count the others.
-static double cpu_seconds(void) {
+double pd_oracle_cpu_seconds(void) {
   struct timespec ts;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
@@ -170,11 +169,11 @@ void pd_oracle_check(const pdOracleBody* a, const pdOracleBody* b, pdOracleResul
   out->size = fmin(ma.size, mb.size);
 
   // ours: every candidate axis, so the depth is the minimum whether separated or not
-  double t0 = cpu_seconds();
+  double t0 = pd_oracle_cpu_seconds();
   pdSatResult sat;
   out->ours = pd_interference(a->shape, a->x, &RA, b->shape, b->x, &RB, PD_SAT_MIN_DEPTH, NULL, &sat);
   out->ourDepth = sat.depth;
-  double t1 = cpu_seconds();
+  double t1 = pd_oracle_cpu_seconds();
 
   // libccd, in coordinates about the midpoint of the centres, divided by the scale
   long calls = 0;
@@ -198,7 +197,7 @@ void pd_oracle_check(const pdOracleBody* a, const pdOracleBody* b, pdOracleResul
     out->hasMprDepth = ccd_depth(ccdMPRPenetration, &A, &B, &ccd, out->scale, &mprStalled, &out->mprDepth);
   }
   out->stalled = out->stalled || stalled;
-  double t2 = cpu_seconds();
+  double t2 = pd_oracle_cpu_seconds();
 
   double band = PD_ORACLE_TOUCH_REL * out->scale;
   out->touching = fabs(out->ourDepth) < band || (out->hasEpa && out->epaDepth < band);

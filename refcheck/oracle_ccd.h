@@ -30,6 +30,9 @@ void pd_oracle_ccd_centre(const void* obj, ccd_vec3_t* out);
 // of their vertex averages divided by the pair's scale r_A + r_B, which it returns.
 double pd_oracle_ccd_pair(const pdOracleBody* a, const pdOracleBody* b, const pdMat3* RA, const pdMat3* RB,
                           const shapeMeasures* ma, const shapeMeasures* mb, long* calls, ccdBody* A, ccdBody* B);
+// CPU time of this process, s: what the check and the timing measure (the machine may be shared, and wall
+// time would count the others).
+double pd_oracle_cpu_seconds(void);
 // CCD_INIT with our support and centre functions and GJK's iteration bound (PD_ORACLE_GJK_ITERATIONS); the
 // tolerances stay libccd's defaults.
 void pd_oracle_ccd_init(ccd_t* ccd);

@@ -18,12 +18,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "interference.h"
 #include "oracle_ccd.h"
 #include "polydyn/error.h"
 #include "polydyn/oracle.h"
+#include "polydyn/stats.h"
 
 const char* const pdOracleTimingModeNames[pd_oracleTimingModeCount] = {
     "ours_first",  "ours_cached", "ours_min_depth",     "ccd_gjk",
@@ -48,12 +48,6 @@ typedef struct timedPair {
   bool gjk;          // GJK's verdict (the untimed pass)
   int group;
 } timedPair;
-
-static double cpu_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static int group_of(const pdOraclePair* p) {
   if (strncmp(p->a.spec, "cube ", 5) == 0 && strncmp(p->b.spec, "cube ", 5) == 0) return pd_oracleTimingCubeCube;
@@ -121,22 +115,6 @@ static double run_batch(timedPair* pairs, const int* idx, int n, int mode, const
 
 static bool overlap_mode(int mode) {
   return mode == pd_oracleTimingFirstOverlap || mode == pd_oracleTimingGjkEpaOverlap;
-}
-
-static int compare_double(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static void order_stats(const double* v, int n, double* median, double* lo, double* hi) {
-  double* s = malloc((size_t)n * sizeof *s);
-  PD_ASSERT(s != NULL);
-  memcpy(s, v, (size_t)n * sizeof *s);
-  qsort(s, (size_t)n, sizeof *s, compare_double);
-  *median = n % 2 ? s[n / 2] : 0.5 * (s[n / 2 - 1] + s[n / 2]);
-  *lo = s[0];
-  *hi = s[n - 1];
-  free(s);
 }
 
 bool pd_oracle_timing(long n, uint64_t seed, int repeats, pdOracleTiming* out) {
@@ -208,9 +186,9 @@ bool pd_oracle_timing(long n, uint64_t seed, int repeats, pdOracleTiming* out) {
     for (int m = 0; m < pd_oracleTimingModeCount; ++m)
       for (int k = 0; k < pd_oracleTimingAll; ++k) {
         int s = overlap_mode(m);
-        double t0 = cpu_seconds();
+        double t0 = pd_oracle_cpu_seconds();
         checksum += run_batch(pairs, idx[s][k], count[s][k], m, &ccd);
-        double dt = cpu_seconds() - t0;
+        double dt = pd_oracle_cpu_seconds() - t0;
         seconds[((size_t)r * pd_oracleTimingModeCount + m) * pd_oracleTimingGroupCount + k] = dt;
         seconds[((size_t)r * pd_oracleTimingModeCount + m) * pd_oracleTimingGroupCount + pd_oracleTimingAll] += dt;
       }
@@ -232,7 +210,9 @@ bool pd_oracle_timing(long n, uint64_t seed, int repeats, pdOracleTiming* out) {
       if (pairsInBatch == 0) continue;
       for (int r = 0; r < repeats; ++r)
         v[r] = 1e6 * seconds[((size_t)r * pd_oracleTimingModeCount + m) * pd_oracleTimingGroupCount + k] / pairsInBatch;
-      order_stats(v, repeats, &grp->usPerPair[m], &grp->usMin[m], &grp->usMax[m]);
+      grp->usPerPair[m] = pd_median_in_place(v, repeats);  // sorts v: its ends are the extremes
+      grp->usMin[m] = v[0];
+      grp->usMax[m] = v[repeats - 1];
     }
   }
   // the means over all pairs
