@@ -15,7 +15,7 @@
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
     "                         [--stepper adaptive|fixed|embedded] [--variant native|matched]\n"
-    "                         [--step H] [--ode-friction pyramid|aligned]\n"
+    "                         [--onsets pair|exact] [--step H] [--ode-friction pyramid|aligned]\n"
     "\n"
     "Simulates SCENE and writes DIR/trajectory.csv and DIR/summary.json. DIR is written under a\n"
     "temporary name and renamed when complete; an existing run directory DIR is replaced.\n"
@@ -28,6 +28,9 @@ static const char* const help =
     "  --stepper NAME   adaptive: RK4 with step-doubling error control (default);\n"
     "                   fixed: RK4 with the scene's dt, no error control;\n"
     "                   embedded: RK4 with its embedded third-order error estimate (soft engine)\n"
+    "  --onsets MODE    soft engine, a contact that began inside a step: exact (default) cuts the whole\n"
+    "                   step back to its onset; pair joins it at the step's end, run for that pair alone\n"
+    "                   since its onset, when it began within 1/omega and is shallow (README \"Contact onsets\")\n"
     "  --variant NAME   ode, bullet: native (the engine's own hard contact, default) or matched (its\n"
     "                   soft contact set to polydyn's k and c)\n"
     "  --step H         ode, bullet: the fixed step, s (default 1e-3)\n"
@@ -77,7 +80,8 @@ int pd_cmd_run(int argc, char** argv) {
   pdCliOverrides overrides = {0};
   pdStepper stepper = pd_stepperRK4Adaptive;
   pdRefOptions ref = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
-  bool refOptionGiven = false, stepperGiven = false;
+  pdOnsets onsets = pd_onsetsExact;
+  bool refOptionGiven = false, softOptionGiven = false;
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     bool hasValue = i + 1 < argc;
@@ -86,7 +90,7 @@ int pd_cmd_run(int argc, char** argv) {
       return PD_EXIT_OK;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--engine") == 0 || strcmp(a, "--tend") == 0 ||
                strcmp(a, "--sample") == 0 || strcmp(a, "--stepper") == 0 || strcmp(a, "--variant") == 0 ||
-               strcmp(a, "--step") == 0 || strcmp(a, "--ode-friction") == 0) {
+               strcmp(a, "--step") == 0 || strcmp(a, "--ode-friction") == 0 || strcmp(a, "--onsets") == 0) {
       if (!hasValue) return pd_cli_usage_error("run", "%s needs a value", a);
       const char* v = argv[++i];
       if (strcmp(a, "--out") == 0) {
@@ -102,6 +106,14 @@ int pd_cmd_run(int argc, char** argv) {
         if (!pd_cli_positive(v, &overrides.tend)) return pd_cli_usage_error("run", "--tend needs a number > 0");
       } else if (strcmp(a, "--sample") == 0) {
         if (!pd_cli_positive(v, &overrides.sample)) return pd_cli_usage_error("run", "--sample needs a number > 0");
+      } else if (strcmp(a, "--onsets") == 0) {
+        softOptionGiven = true;
+        if (strcmp(v, "pair") == 0)
+          onsets = pd_onsetsPair;
+        else if (strcmp(v, "exact") == 0)
+          onsets = pd_onsetsExact;
+        else
+          return pd_cli_usage_error("run", "--onsets must be pair or exact");
       } else if (strcmp(a, "--variant") == 0) {
         refOptionGiven = true;
         if (strcmp(v, "native") == 0) ref.variant = pd_refNative;
@@ -116,13 +128,13 @@ int pd_cmd_run(int argc, char** argv) {
         else if (strcmp(v, "aligned") == 0) ref.odeFriction = pd_odeFrictionAligned;
         else return pd_cli_usage_error("run", "--ode-friction must be pyramid or aligned");
       } else if (strcmp(v, "adaptive") == 0) {
-        stepperGiven = true;
+        softOptionGiven = true;
         stepper = pd_stepperRK4Adaptive;
       } else if (strcmp(v, "fixed") == 0) {
-        stepperGiven = true;
+        softOptionGiven = true;
         stepper = pd_stepperRK4Fixed;
       } else if (strcmp(v, "embedded") == 0) {
-        stepperGiven = true;
+        softOptionGiven = true;
         stepper = pd_stepperRK43Embedded;
       } else {
         return pd_cli_usage_error("run", "--stepper must be adaptive, fixed or embedded");
@@ -139,7 +151,7 @@ int pd_cmd_run(int argc, char** argv) {
   bool soft = strcmp(engine, "soft") == 0;
   if (soft && refOptionGiven)
     return pd_cli_usage_error("run", "--variant, --step and --ode-friction are for --engine ode or bullet");
-  if (!soft && stepperGiven) return pd_cli_usage_error("run", "--stepper is for the soft engine");
+  if (!soft && softOptionGiven) return pd_cli_usage_error("run", "--stepper and --onsets are for the soft engine");
   if (strcmp(engine, "bullet") == 0 && ref.odeFriction != pd_odeFrictionPyramid)
     return pd_cli_usage_error("run", "--ode-friction is for --engine ode");
   if (pd_cli_parse_only) return PD_EXIT_OK;
@@ -193,6 +205,7 @@ int pd_cmd_run(int argc, char** argv) {
 
   pdState* state = pd_state_create(model);
   state->stepper = stepper;
+  state->onsets = onsets;
   runObserver observer = {writer, isatty(STDERR_FILENO) == 1, pd_cli_wall_seconds()};
   double energyStart = pd_state_energy(model, state);
   double t0 = pd_cli_wall_seconds();

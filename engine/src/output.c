@@ -370,6 +370,10 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   write_json_string(out, model->scenePath);
   fputs(",\n  \"stepper\": ", out);
   write_json_string(out, info->stepper ? info->stepper : pd_stepper_name(state->stepper));
+  if (!info->stepper) {  // the soft engine's own state: how contacts that begin inside a step join
+    fputs(",\n  \"onsets\": ", out);
+    write_json_string(out, pd_onsets_name(state->onsets));
+  }
   fputs(",\n", out);
   if (info->engineSettingsJson) fprintf(out, "  \"engine_settings\": %s,\n", info->engineSettingsJson);
   fputs("  \"settings\": {\"gravity\": ", out);
@@ -406,13 +410,15 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
           pd_model_adjustments_dropped(model));
   fprintf(out,
           "  \"counts\": {\"accepted_steps\": %ld, \"rejected_steps\": %ld, \"derivative_evaluations\": %ld, "
-          "\"samples\": %ld, \"travel_retries\": %ld, \"onset_retries\": %ld, \"refinements\": %ld, \"contacts_made\": %ld, "
+          "\"samples\": %ld, \"travel_retries\": %ld, \"onset_retries\": %ld, \"onsets_interpolated\": %ld, "
+          "\"refinements\": %ld, \"contacts_made\": %ld, "
           "\"contacts_virtual\": %ld, \"contacts_transferred\": %ld, \"breaks_force\": %ld, "
           "\"breaks_geometry\": %ld, \"contacts_at_end\": %d},\n",
           state->count.accepted, state->count.rejected, state->count.derivatives, state->count.samples,
-          state->count.travelRetries, state->count.eventRetries, state->count.refinements, state->count.contactsMade,
-          state->count.contactsVirtual, state->count.contactsTransferred, state->count.breaksForce,
-          state->count.breaksGeometry, pd_state_contact_count(state));
+          state->count.travelRetries, state->count.eventRetries, state->count.onsetsInterpolated,
+          state->count.refinements, state->count.contactsMade, state->count.contactsVirtual,
+          state->count.contactsTransferred, state->count.breaksForce, state->count.breaksGeometry,
+          pd_state_contact_count(state));
   fputs("  \"warnings\": {", out);
   for (int w = 0; w < pd_warnCount; ++w) fprintf(out, "%s\"%s\": %ld", w ? ", " : "", pdWarningNames[w], state->warnings[w]);
   fputs("},\n  \"t_reached\": ", out);

@@ -27,6 +27,7 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   s->n = PD_BODY_STATE_SIZE * model->movingCount;
   pd_contact_set_clear(s->contacts);
   s->stepper = pd_stepperRK4Adaptive;
+  s->onsets = pd_onsetsExact;
   s->nextSample = 0;
   s->failed = false;
   s->stopped = false;
@@ -89,3 +90,5 @@ const char* pd_stepper_name(pdStepper stepper) {
   }
   return "rk4-adaptive";
 }
+
+const char* pd_onsets_name(pdOnsets onsets) { return onsets == pd_onsetsExact ? "exact" : "pair"; }

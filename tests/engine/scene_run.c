@@ -44,11 +44,16 @@ static bool record_sample(const pdModel* model, const pdState* state, void* user
 record* run(const pdModel* model, pdState** stateOut) { return run_with(model, pd_stepperRK4Adaptive, stateOut); }
 
 record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut) {
+  return run_onsets(model, stepper, pd_onsetsExact, stateOut);
+}
+
+record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdState** stateOut) {
   record* r = calloc(1, sizeof *r);
   assert_non_null(r);
   r->finite = true;
   pdState* s = pd_state_create(model);
   s->stepper = stepper;
+  s->onsets = onsets;
   assert_true(pd_advance(model, s, model->settings.tend, record_sample, r));
   assert_true(r->finite);
   assert_int_equal(s->warnings[pd_warnNonFinite], 0);

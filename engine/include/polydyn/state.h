@@ -13,8 +13,8 @@
 //
 // Reading a state: t, count, warnings, failed and stopped directly; poses with pd_state_body, contacts with
 // pd_state_contact_count and pd_state_contact (not from y, whose layout is internal to the stepper). The
-// fields are written by pd_advance and pd_state_reset; a caller writes only `stepper` (and `h`, the first
-// step to try), between pd_state_create or pd_state_reset and the first pd_advance.
+// fields are written by pd_advance and pd_state_reset; a caller writes only `stepper`, `onsets` (and `h`, the
+// first step to try), between pd_state_create or pd_state_reset and the first pd_advance.
 //
 // Memory: pd_state_create allocates everything a step needs. A step never allocates; between two steps,
 // pd_advance grows the state's vectors (doubling) only when the contact list outgrows them.
@@ -63,12 +63,25 @@ typedef enum pdStepper {
 // The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed" or "rk43-embedded".
 PD_API const char* pd_stepper_name(pdStepper stepper);
 
+// How a contact that began inside a step joins the list (paper App. C; README, "Contact onsets").
+typedef enum pdOnsets {
+  pd_onsetsExact,  // default: every onset found deeper than 1e-3 δ_max cuts the whole step back to it
+  pd_onsetsPair,   // a contact that began less than 1/ω before the step's end (ω of its pair) and is at most
+                   // ¼ δ_max deep joins there as if its pair had run alone since the onset (springs at that
+                   // deflection, the pair's impulse given to its two bodies); the step stands, so an onset in
+                   // one corner of a pile does not send every body back. Others as pd_onsetsExact.
+} pdOnsets;
+
+// The onset mode's name in summary.json: "pair" or "exact".
+PD_API const char* pd_onsets_name(pdOnsets onsets);
+
 typedef struct pdCounters {
   long accepted;     // accepted steps
   long rejected;     // rejected trial steps
   long derivatives;  // evaluations of the state derivative
   long samples;      // output samples delivered to the observer
   long eventRetries;      // trial steps cut short to land on a contact onset (App. C)
+  long onsetsInterpolated;  // contacts that joined at a step's end from an onset inside it (pd_onsetsPair)
   long travelRetries;     // trial steps cut short because two bodies that may meet moved too far (tunnelling)
   long refinements;       // trial steps halved around a reversal or a stick/slip change (§3.4)
   long contactsMade;      // contacts added at the end of a step (found, approaching)
@@ -82,6 +95,7 @@ typedef struct pdState {
   double t;          // s
   double h;          // next step to try, s
   pdStepper stepper;
+  pdOnsets onsets;   // how contacts that began inside a step join (pd_onsetsExact unless the caller sets it)
   int n;             // length of y: 13 per moving body + 8 per active contact
   int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)
   double* y;         // (n) the state vector
@@ -109,7 +123,7 @@ typedef struct pdBodyState {
 // and be the model passed with it to every other call.
 PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to the adaptive one (set state->stepper after this call for the fixed one).
+// to the adaptive one and onsets to pd_onsetsExact (set state->stepper, state->onsets after this call).
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.
 PD_API void pd_state_free(pdState* state);
