@@ -24,11 +24,10 @@
 //     re-sorted by id and the springs re-laid in the state vector.
 // Contacts start at zero spring deflection where they are added, so a late start shifts a contact's rest
 // point by the depth it was found at but injects no energy; the onset tolerance bounds that shift. A pair
-// onset instead starts the normal springs at the depth d reached in the τ since the onset (no shift) and
-// takes from the two bodies the impulse (k τ/2 + c) d the contact would have given meanwhile, which removes
-// the ½ k d² the springs now hold from the kinetic energy (and the damper's c v d): position, momentum and
-// energy right to first order in ω τ; what is left out is the slowing inside τ (relative O((ωτ)²)) and the
-// friction over τ (tangential springs start at 0).
+// onset instead starts where its pair alone would be after the τ since the onset (start_late_contacts):
+// springs at that deflection x and the two bodies given the impulse of those τ seconds (normal, and the
+// friction cone's when they slide), so its energy and phase are its own and its rest point sits d − x ≈
+// d (ωτ)²/6 deeper (d the depth reached without it).
 #include "contact_set.h"
 
 #include <math.h>
@@ -690,6 +689,19 @@ static void onset_motion(double omega2, double damping, double v0, double tau, d
   *uOut = u;
 }
 
+// The effective mass of contact c's two bodies along its normal at its point, kg (INFINITY if neither moves).
+static double point_mass(const pdModel* model, const pdContactSet* set, const pdPose* poses, const contactSlot* c) {
+  double invMass = 0.0;
+  for (int side = 0; side < 2; ++side) {
+    int b = side == 0 ? c->id.body1 : c->id.body2;
+    const pdBody* body = &model->bodies[b];
+    if (body->fixed) continue;
+    pdVec3 rn = pd_v3_cross(pd_v3_sub(c->point, poses[b].x), c->normal);
+    invMass += body->invMass + pd_v3_dot(rn, pd_mat3_mulv(&set->invInertiaWorld[b], rn));
+  }
+  return invMass > 0.0 ? 1.0 / invMass : INFINITY;
+}
+
 // Pair onsets of a list just installed at state y (poses those of y; world inverse inertias and modal dampers
 // set): each contact with an onset age τ > 0 is put where it would be after τ on its own (onset_motion, m the
 // modal mass per contact or the point's effective mass, from its approach speed now): its normal springs at
@@ -705,31 +717,22 @@ static int start_late_contacts(const pdModel* model, pdContactSet* set, double* 
     if (c->onsetAge <= 0.0) continue;
     const pdContactParams* p = &c->params;
     double k = pd_series(p->k1n, p->k2n), damper = pd_series(p->c1n, p->c2n);
-    // the approach speed and the inverse effective mass along n at the contact point
-    int b1 = c->id.body1, b2 = c->id.body2;
+    // the approach speed and the slip at the contact point
     pdVec3 n = c->normal;
-    pdVec3 du = pd_v3_sub(point_velocity(model, y, poses, b1, c->point), point_velocity(model, y, poses, b2, c->point));
+    pdVec3 du = pd_v3_sub(point_velocity(model, y, poses, c->id.body1, c->point),
+                          point_velocity(model, y, poses, c->id.body2, c->point));
     double approach = -pd_v3_dot(du, n);
     pdVec3 slip = pd_v3_sub(du, pd_v3_scale(n, -approach));  // tangential relative velocity
     double slipSpeed = pd_v3_norm(slip);
-    double invMass = 0.0;
-    for (int side = 0; side < 2; ++side) {
-      int b = side == 0 ? b1 : b2;
-      const pdBody* body = &model->bodies[b];
-      if (body->fixed) continue;
-      pdVec3 rn = pd_v3_cross(pd_v3_sub(c->point, poses[b].x), n);
-      invMass += body->invMass + pd_v3_dot(rn, pd_mat3_mulv(&set->invInertiaWorld[b], rn));
-    }
     c->onsetImpulse = (pdVec3){0, 0, 0};
-    if (invMass > 0.0 && approach > 0.0 && k > 0.0) {
-      double mass = c->modalMass > 0.0 && isfinite(c->modalMass) ? c->modalMass : 1.0 / invMass;
+    double mass = c->modalMass > 0.0 && isfinite(c->modalMass) ? c->modalMass : point_mass(model, set, poses, c);
+    if (isfinite(mass) && approach > 0.0 && k > 0.0) {
       double x, u;
       onset_motion(k / mass, damper / mass, approach, c->onsetAge, &x, &u);
       x = fmin(fmax(x, 0.0), fmax(c->depth, 0.0));
       pdSprings sp = springs_load(y + base + PD_CONTACT_STATE_SIZE * i);
       sp.s1n = -k * x / p->k1n;
       sp.s2n = k * x / p->k2n;
-      springs_store(y + base + PD_CONTACT_STATE_SIZE * i, &sp);
       double normalImpulse = mass * fmax(0.0, approach - fmax(u, 0.0));  // the pair's contacts together slow it so
       c->onsetImpulse = pd_v3_scale(n, normalImpulse);
       // friction over τ: sliding, the cone's impulse μ J against the slip (at most what stops it), and the
@@ -742,8 +745,8 @@ static int start_late_contacts(const pdModel* model, pdContactSet* set, double* 
         double ft = fmin(p->mu * k * x, kt * slipSpeed * c->onsetAge);  // |F_t| on body 1, against the slip
         sp.s1t = pd_v3_scale(along, ft / p->k1t);                       // F_t = −k1t s1t = k2t s2t = −ft · along
         sp.s2t = pd_v3_scale(along, -ft / p->k2t);
-        springs_store(y + base + PD_CONTACT_STATE_SIZE * i, &sp);
       }
+      springs_store(y + base + PD_CONTACT_STATE_SIZE * i, &sp);
     }
     ++started;
   }
@@ -939,7 +942,7 @@ static bool changes_mode(const contactSlot* c, const pdContactForce* f) { return
 // Can a new contact that began `age` seconds before the step's end join there (pd_onsetsPair)?
 static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double age) {
   int a = g->id.body1, b = g->id.body2;
-  if (g->depth > PD_ONSET_PAIR_DEPTH_REL * pd_model_pair_delta_max(model, a, b)) return false;
+  if (!(g->depth > 0.0) || g->depth > PD_ONSET_PAIR_DEPTH_REL * pd_model_pair_delta_max(model, a, b)) return false;
   pdContactParams p = pd_model_contact_params(model, a, b);
   double k = pd_series(p.k1n, p.k2n);
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
@@ -991,7 +994,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     candidate* c = &set->candidates[k];
     if (!c->approaching || c->inherit >= 0) continue;
     double age = (1.0 - c->onset) * h;
-    if (s->onsets == pd_onsetsPair && c->geom.depth > 0.0 && joins_as_pair(model, &c->geom, age)) {
+    if (s->onsets == pd_onsetsPair && joins_as_pair(model, &c->geom, age)) {
       c->onsetAge = age;
       continue;
     }
