@@ -1,0 +1,547 @@
+// polydyn — islands (issue 16 item 2; pd_islandsOn; README, "Islands").
+//
+// Design note. With islands off, one state vector carries every moving body and contact: one step size,
+// one error norm (a max over all of y), and every contact onset anywhere cuts every body's step. With
+// islands on, pd_advance goes from output sample to output sample (the sync interval [T, T'], T' the next
+// sample or tEnd); over each interval the moving bodies are partitioned into islands and each island
+// advances alone from T to T', in a pdState of its own over a model of its own, with its own step size,
+// error norm, contact events, onset retries and stability bound: the unchanged stepper of integrator.c.
+//
+// - An island's model holds its moving bodies and every fixed body, in scene order (bodies copied, their
+//   polyhedra and names shared, the material table a view with the classes remapped:
+//   pd_material_table_view). Fixed bodies carry no state, so every island may touch them without joining
+//   islands together. The order is scene order, so a contact's id sorts the same in the island and in
+//   the scene, and an island of the same bodies in another scene (same fixed bodies first) computes the
+//   same numbers bit for bit.
+// - Partition at T (union-find over the moving bodies; each island named by its lowest body): two bodies
+//   join when they share an active contact, or when their boxes at T, each grown by a bound of how far its
+//   points can move before T' (travel_bound: |v|Δ + ½|g + F/m|Δ² + |ω| r Δ + slack), overlap. Islands are
+//   listed by their lowest body, so nothing depends on the order in which they are processed: each island
+//   reads only the scene's state at T and its own state, and writes only its own bodies' entries.
+// - Persistence: an island whose bodies are the same as the last interval's keeps its state (its contact
+//   list, caches, step size) and simply goes on; a new island is set up from the scene's state at T (its
+//   bodies' numbers and contacts copied, the contacts' springs, forces and modal dampers as they were:
+//   pd_contact_set_scatter) with the smallest step its bodies' islands last wanted.
+// - Safety: after every step an island takes, each of its bodies' travel since T (centre displacement +
+//   radius × rotation angle, the tunnelling guard's measure) is compared with its bound. A body that went
+//   farther could have met a body of another island unseen. After all islands reached T', the bound of
+//   every such body becomes twice its travel, the partition is formed again, and every island whose bodies
+//   changed is set up again from the state at T (still intact: the scene's state is written only at T')
+//   and redone (counted: islandRedos); islands whose bodies did not change keep their result (their bodies
+//   stayed in their boxes). This repeats until no body left its box, so at the end no two islands' boxes
+//   overlap while every body stayed in its box: no contact between islands can have been missed.
+//   (Between two step ends a body's path may leave the box by its curvature, |a| h²/8 at most: 1 µm for
+//   g and a 1 ms step, inside the slack.)
+// - At T' the islands' bodies and contacts are gathered into the scene's state (pd_contact_set_gather:
+//   sorted by id), the counters summed in island order, and the observer sees the whole scene.
+// One island of every body computes the same numbers as islands off: the same model, state and steps.
+//
+// Memory: islands are set up, grown and freed only at sync times; a step allocates nothing.
+#include "islands.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "broad_phase.h"
+#include "clock.h"
+#include "contact_set.h"
+#include "model_contact.h"
+#include "state_layout.h"
+
+// Slack of the travel bound, in the body's design deflections δ_max (deflection × size): a body resting in
+// contact moves by its springs' deflection as loads shift, which its speed at T does not show; two δ_max
+// is also the most the tunnelling guard lets a pair sink within one step.
+#define PD_ISLAND_SLACK_DEFLECTIONS 2.0
+// ... plus this fraction of the body's size: what a push from a neighbour inside its island may add over
+// one interval. A tighter bound splits more islands but makes more of them redo their interval.
+#define PD_ISLAND_SLACK_SIZE 0.01
+// A body that moved farther than its bound gets this many times the distance it moved as its new bound.
+#define PD_ISLAND_REDO_GROWTH 2.0
+
+typedef struct island {
+  int bodyCount;   // moving bodies
+  int* bodies;     // (bodyCount) their moving-body indices k (scene body model->movingBodies[k]), ascending
+  pdModel model;   // its moving bodies and every fixed body, scene order
+  int* toScene;    // (model.bodyCount) scene body index of each of its bodies
+  pdState* state;  // at T, or at T' once advanced
+  bool advanced;   // advanced over the interval under way
+} island;
+
+struct pdIslandSet {
+  int movingCount, bodyCount, fixedCount;
+  int* fixedBodies;  // (fixedCount) scene indices of the fixed bodies, ascending
+  int* root;         // (movingCount) union-find over moving-body indices; a root is its set's lowest index
+  int* islandOf;     // (movingCount) island of each moving body in the partition under way
+  int* islandOld;    // (movingCount) index in `islands` of the island holding the body (-1: none)
+  int* members;      // (movingCount) moving bodies grouped by island, ascending within each
+  int* first;        // (movingCount + 1) island j's members: members[first[j] .. first[j + 1])
+  int partCount;     // islands in the partition under way
+  double* bound;     // (movingCount) m: how far the body's points may move over the interval
+  double* travel;    // (movingCount) m: how far they moved at most, measured at the island's step ends
+  double* h;         // (movingCount) s: the next step its island wanted at the last sync
+  pdVec3* x0;        // (movingCount) centre of mass at T, m
+  pdQuat* q0;        // (movingCount) orientation at T
+  pdAabb* boxes;     // (bodyCount) grown boxes (fixed bodies: their own)
+  pdBroadPhase* broad;
+  pdPair* pairs;
+  int pairCapacity;
+  int* toSub;        // (bodyCount) scratch: scene body → island body (-1 elsewhere)
+  int* contactOf;    // (contactCapacity) island of each of the scene's contacts at T
+  int* contactList;  // (contactCapacity) scratch: one island's contacts
+  int contactCapacity;
+  island** islands;  // (islandCapacity) the live islands, listed by their lowest body
+  island** next;     // (islandCapacity) scratch: the list being formed
+  int islandCount, islandCapacity;
+  const pdModel** subModels;  // (islandCapacity) scratch for the gather
+  const pdState** subStates;
+  const int** subMaps;
+  // work of islands freed so far (summed in with the live ones' at every sync)
+  pdCounters retired;
+  long retiredWarnings[pd_warnCount];
+  double retiredStages[pd_stageCount];
+  double observeSeconds;  // the scene's observer calls
+  long formed, largest, intervals, redos;
+};
+
+static void* grow(void* p, size_t count, size_t size) {
+  void* q = realloc(p, (count > 0 ? count : 1) * size);
+  PD_ASSERT(q != NULL);
+  return q;
+}
+
+// ---------------------------------------------------------------- one island
+
+static void island_free(island* is) {
+  if (!is) return;
+  pd_state_free(is->state);
+  pd_material_table_free(is->model.materials);
+  free(is->model.bodies);
+  free(is->model.movingBodies);
+  free(is->toScene);
+  free(is->bodies);
+  free(is);
+}
+
+// The model of members[0 .. count) (moving-body indices, ascending) and every fixed body, scene order.
+static island* island_create(const pdModel* model, const struct pdIslandSet* set, const int* members, int count) {
+  island* is = calloc(1, sizeof *is);
+  PD_ASSERT(is != NULL);
+  is->bodyCount = count;
+  is->bodies = grow(NULL, (size_t)count, sizeof *is->bodies);
+  memcpy(is->bodies, members, (size_t)count * sizeof *members);
+  int n = count + set->fixedCount;
+  is->toScene = grow(NULL, (size_t)n, sizeof *is->toScene);
+  // merge the two ascending lists of scene indices
+  for (int m = 0, f = 0, l = 0; l < n; ++l) {
+    int moving = m < count ? model->movingBodies[members[m]] : model->bodyCount;
+    int fixed = f < set->fixedCount ? set->fixedBodies[f] : model->bodyCount;
+    if (moving < fixed) {
+      is->toScene[l] = moving;
+      ++m;
+    } else {
+      is->toScene[l] = fixed;
+      ++f;
+    }
+  }
+  pdModel* sub = &is->model;
+  *sub = *model;  // settings, scene path, length scale
+  sub->bodyCount = n;
+  sub->movingCount = count;
+  sub->bodies = grow(NULL, (size_t)n, sizeof *sub->bodies);
+  sub->movingBodies = grow(NULL, (size_t)count, sizeof *sub->movingBodies);
+  for (int l = 0, k = 0; l < n; ++l) {
+    sub->bodies[l] = model->bodies[is->toScene[l]];
+    if (sub->bodies[l].fixed) continue;
+    sub->bodies[l].stateIndex = k;
+    sub->movingBodies[k++] = l;
+  }
+  sub->materials = pd_material_table_view(model->materials, is->toScene, n);
+  is->state = pd_state_create(sub);
+  return is;
+}
+
+// Sets island `is` up from the scene's state s at T: its bodies' numbers, the scene's contacts listed in
+// set->contactList[0 .. contacts), the stepper, onset mode and the smallest step its bodies last wanted.
+static void island_load(const pdModel* model, const pdState* s, struct pdIslandSet* set, island* is, int contacts) {
+  pdState* sub = is->state;
+  sub->stepper = s->stepper;
+  sub->onsets = s->onsets;
+  sub->t = s->t;
+  sub->nextSample = s->nextSample;
+  double h = INFINITY;
+  for (int j = 0; j < is->bodyCount; ++j) {
+    int k = is->bodies[j];
+    memcpy(sub->y + PD_BODY_STATE_SIZE * j, s->y + PD_BODY_STATE_SIZE * k, PD_BODY_STATE_SIZE * sizeof *s->y);
+    h = fmin(h, set->h[k]);
+  }
+  sub->h = h;
+  for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = l;
+  pd_contact_set_scatter(model, s, set->contactList, contacts, &is->model, sub, set->toSub);
+  for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = -1;
+}
+
+// The step hook of an island's pd_advance_hooked: each body's travel since T (centre displacement plus
+// radius × rotation angle), the largest so far kept.
+typedef struct travelProbe {
+  struct pdIslandSet* set;
+  const island* is;
+} travelProbe;
+
+static void measure_travel(const pdModel* sub, const pdState* state, void* user) {
+  const travelProbe* probe = user;
+  struct pdIslandSet* set = probe->set;
+  for (int j = 0; j < probe->is->bodyCount; ++j) {
+    int k = probe->is->bodies[j];
+    const double* y = state->y + PD_BODY_STATE_SIZE * j;
+    pdQuat q = pd_layout_q(y), q0 = set->q0[k];
+    double dot = fabs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z);
+    double norms =
+        sqrt((q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z));
+    double angle = 2.0 * acos(fmin(1.0, dot / norms));
+    const pdBody* b = &sub->bodies[sub->movingBodies[j]];
+    double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), set->x0[k])) + b->radius * angle;
+    set->travel[k] = fmax(set->travel[k], moved);
+  }
+}
+
+// Advances island `is` from T to tNext; false if it failed.
+static bool island_advance(struct pdIslandSet* set, island* is, double tNext) {
+  for (int j = 0; j < is->bodyCount; ++j) set->travel[is->bodies[j]] = 0.0;
+  travelProbe probe = {set, is};
+  is->advanced = true;
+  return pd_advance_hooked(&is->model, is->state, tNext, NULL, NULL, measure_travel, &probe);
+}
+
+// ---------------------------------------------------------------- counters
+
+static void add_counters(pdCounters* to, const pdCounters* c) {
+  to->accepted += c->accepted;
+  to->rejected += c->rejected;
+  to->derivatives += c->derivatives;
+  to->eventRetries += c->eventRetries;
+  to->onsetsInterpolated += c->onsetsInterpolated;
+  to->travelRetries += c->travelRetries;
+  to->refinements += c->refinements;
+  to->contactsMade += c->contactsMade;
+  to->contactsVirtual += c->contactsVirtual;
+  to->contactsTransferred += c->contactsTransferred;
+  to->breaksForce += c->breaksForce;
+  to->breaksGeometry += c->breaksGeometry;
+}
+
+static void retire(struct pdIslandSet* set, island* is) {
+  add_counters(&set->retired, &is->state->count);
+  for (int w = 0; w < pd_warnCount; ++w) set->retiredWarnings[w] += is->state->warnings[w];
+  for (int g = 0; g < pd_stageCount; ++g) set->retiredStages[g] += is->state->stageSeconds[g];
+  island_free(is);
+}
+
+// The scene state's counters, warnings and stage seconds: the freed islands' plus the live ones', in island
+// order (integers: the order does not matter; seconds are not reproducible anyway).
+static void compose_counters(struct pdIslandSet* set, pdState* s) {
+  long samples = s->count.samples;
+  s->count = set->retired;
+  memcpy(s->warnings, set->retiredWarnings, sizeof s->warnings);
+  memcpy(s->stageSeconds, set->retiredStages, sizeof s->stageSeconds);
+  for (int i = 0; i < set->islandCount; ++i) {
+    const pdState* sub = set->islands[i]->state;
+    add_counters(&s->count, &sub->count);
+    for (int w = 0; w < pd_warnCount; ++w) s->warnings[w] += sub->warnings[w];
+    for (int g = 0; g < pd_stageCount; ++g) s->stageSeconds[g] += sub->stageSeconds[g];
+  }
+  s->stageSeconds[pd_stageObserve] += set->observeSeconds;
+  s->count.samples = samples;
+  s->count.islandsFormed = set->formed;
+  s->count.islandsLargest = set->largest;
+  s->count.islandIntervals = set->intervals;
+  s->count.islandRedos = set->redos;
+}
+
+// ---------------------------------------------------------------- the set
+
+void pd_island_set_free(struct pdIslandSet* set) {
+  if (!set) return;
+  for (int i = 0; i < set->islandCount; ++i) island_free(set->islands[i]);
+  free(set->fixedBodies);
+  free(set->root);
+  free(set->islandOf);
+  free(set->islandOld);
+  free(set->members);
+  free(set->first);
+  free(set->bound);
+  free(set->travel);
+  free(set->h);
+  free(set->x0);
+  free(set->q0);
+  free(set->boxes);
+  pd_broad_phase_free(set->broad);
+  free(set->pairs);
+  free(set->toSub);
+  free(set->contactOf);
+  free(set->contactList);
+  free(set->islands);
+  free(set->next);
+  free(set->subModels);
+  free(set->subStates);
+  free(set->subMaps);
+  free(set);
+}
+
+static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
+  struct pdIslandSet* set = calloc(1, sizeof *set);
+  PD_ASSERT(set != NULL);
+  int m = model->movingCount, n = model->bodyCount;
+  set->movingCount = m;
+  set->bodyCount = n;
+  set->fixedBodies = grow(NULL, (size_t)n, sizeof *set->fixedBodies);
+  bool* fixed = grow(NULL, (size_t)n, sizeof *fixed);
+  set->boxes = grow(NULL, (size_t)n, sizeof *set->boxes);
+  set->toSub = grow(NULL, (size_t)n, sizeof *set->toSub);
+  for (int i = 0; i < n; ++i) {
+    const pdBody* b = &model->bodies[i];
+    fixed[i] = b->fixed;
+    if (b->fixed) set->fixedBodies[set->fixedCount++] = i;
+    pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(b->q0));
+    set->boxes[i] = pd_aabb_of(&b->shape, b->x0, &r);
+    set->toSub[i] = -1;
+  }
+  set->broad = pd_broad_phase_create(n, fixed, 0.0);
+  PD_ASSERT(set->broad != NULL);
+  free(fixed);
+  set->pairCapacity = 4 * m + 16;
+  set->pairs = grow(NULL, (size_t)set->pairCapacity, sizeof *set->pairs);
+  set->root = grow(NULL, (size_t)m, sizeof *set->root);
+  set->islandOf = grow(NULL, (size_t)m, sizeof *set->islandOf);
+  set->islandOld = grow(NULL, (size_t)m, sizeof *set->islandOld);
+  set->members = grow(NULL, (size_t)m, sizeof *set->members);
+  set->first = grow(NULL, (size_t)m + 1, sizeof *set->first);
+  set->bound = grow(NULL, (size_t)m, sizeof *set->bound);
+  set->travel = grow(NULL, (size_t)m, sizeof *set->travel);
+  set->h = grow(NULL, (size_t)m, sizeof *set->h);
+  set->x0 = grow(NULL, (size_t)m, sizeof *set->x0);
+  set->q0 = grow(NULL, (size_t)m, sizeof *set->q0);
+  for (int k = 0; k < m; ++k) {
+    set->islandOld[k] = -1;
+    set->h[k] = s->h;
+  }
+  set->islandCapacity = m > 0 ? m : 1;
+  set->islands = grow(NULL, (size_t)set->islandCapacity, sizeof *set->islands);
+  set->next = grow(NULL, (size_t)set->islandCapacity, sizeof *set->next);
+  set->subModels = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subModels);
+  set->subStates = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subStates);
+  set->subMaps = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subMaps);
+  return set;
+}
+
+// ---------------------------------------------------------------- partition
+
+static int find(int* root, int k) {
+  while (root[k] != k) {
+    root[k] = root[root[k]];
+    k = root[k];
+  }
+  return k;
+}
+
+static void join(int* root, int a, int b) {
+  a = find(root, a);
+  b = find(root, b);
+  if (a < b)
+    root[b] = a;
+  else if (b < a)
+    root[a] = b;
+}
+
+// How far body b's points can move over dt from state yb, m (design note): its speed's and gravity's (and an
+// applied force's) share, its spin's, and the slack.
+static double travel_bound(const pdModel* model, const pdBody* b, const double* yb, double t, double dt) {
+  double accel = pd_v3_norm(model->settings.gravity);
+  if (b->hasForce) accel += (pd_v3_norm(b->force0) + pd_v3_norm(b->forceRate) * (fabs(t) + dt)) * b->invMass;
+  double slack = (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
+  return pd_v3_norm(pd_layout_v(yb)) * dt + 0.5 * accel * dt * dt + pd_v3_norm(pd_layout_w(yb)) * b->radius * dt +
+         slack;
+}
+
+// The partition of the moving bodies at the scene's state s (T) with the bounds set->bound: islandOf,
+// members, first, partCount; and contactOf, the island of each contact of s.
+static void partition(const pdModel* model, const pdState* s, struct pdIslandSet* set) {
+  int m = set->movingCount;
+  for (int k = 0; k < m; ++k) {
+    int i = model->movingBodies[k];
+    const double* yb = s->y + PD_BODY_STATE_SIZE * k;
+    pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(pd_layout_q(yb)));
+    pdAabb box = pd_aabb_of(&model->bodies[i].shape, pd_layout_x(yb), &r);
+    for (int d = 0; d < 3; ++d) box.lo[d] -= set->bound[k], box.hi[d] += set->bound[k];
+    set->boxes[i] = box;
+    set->root[k] = k;
+  }
+  bool updated = pd_broad_phase_update(set->broad, set->boxes);
+  PD_ASSERT(updated);  // false only when memory runs out
+  int pairCount = pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
+  if (pairCount > set->pairCapacity) {
+    set->pairCapacity = 2 * pairCount;
+    set->pairs = grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
+    pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
+  }
+  for (int p = 0; p < pairCount; ++p) {
+    const pdBody *a = &model->bodies[set->pairs[p].a], *b = &model->bodies[set->pairs[p].b];
+    if (!a->fixed && !b->fixed) join(set->root, a->stateIndex, b->stateIndex);
+  }
+  int contacts = pd_state_contact_count(s);
+  for (int c = 0; c < contacts; ++c) {
+    int b1, b2;
+    pd_contact_set_bodies(s->contacts, c, &b1, &b2);
+    const pdBody *a = &model->bodies[b1], *b = &model->bodies[b2];
+    if (!a->fixed && !b->fixed) join(set->root, a->stateIndex, b->stateIndex);
+  }
+  // islands named by their lowest body, in that order; members grouped by a counting sort
+  set->partCount = 0;
+  for (int k = 0; k < m; ++k) {
+    int r = find(set->root, k);
+    set->islandOf[k] = r == k ? set->partCount++ : set->islandOf[r];
+  }
+  for (int j = 0; j <= set->partCount; ++j) set->first[j] = 0;
+  for (int k = 0; k < m; ++k) ++set->first[set->islandOf[k] + 1];
+  for (int j = 0; j < set->partCount; ++j) set->first[j + 1] += set->first[j];
+  for (int k = 0; k < m; ++k) set->members[set->first[set->islandOf[k]]++] = k;
+  for (int j = set->partCount; j > 0; --j) set->first[j] = set->first[j - 1];
+  set->first[0] = 0;
+  if (contacts > set->contactCapacity) {
+    set->contactCapacity = 2 * contacts;
+    set->contactOf = grow(set->contactOf, (size_t)set->contactCapacity, sizeof *set->contactOf);
+    set->contactList = grow(set->contactList, (size_t)set->contactCapacity, sizeof *set->contactList);
+  }
+  for (int c = 0; c < contacts; ++c) {
+    int b1, b2;
+    pd_contact_set_bodies(s->contacts, c, &b1, &b2);
+    int moving = model->bodies[b1].fixed ? b2 : b1;
+    set->contactOf[c] = set->islandOf[model->bodies[moving].stateIndex];
+  }
+}
+
+// Makes the live islands those of the partition: an island whose bodies did not change is kept as it is
+// (advanced or not); the others are freed and new ones set up from the scene's state at T. Returns the
+// number of islands set up.
+static int rebuild(const pdModel* model, const pdState* s, struct pdIslandSet* set) {
+  int built = 0;
+  int contacts = pd_state_contact_count(s);
+  for (int j = 0; j < set->partCount; ++j) {
+    const int* members = set->members + set->first[j];
+    int count = set->first[j + 1] - set->first[j];
+    int old = set->islandOld[members[0]];
+    bool same = old >= 0 && set->islands[old] != NULL && set->islands[old]->bodyCount == count;
+    for (int m = 1; m < count && same; ++m) same = set->islandOld[members[m]] == old;
+    if (same) {
+      set->next[j] = set->islands[old];
+      set->islands[old] = NULL;
+      continue;
+    }
+    island* is = island_create(model, set, members, count);
+    int listed = 0;
+    for (int c = 0; c < contacts; ++c)
+      if (set->contactOf[c] == j) set->contactList[listed++] = c;
+    island_load(model, s, set, is, listed);
+    set->next[j] = is;
+    ++built;
+    ++set->formed;
+    if (count > set->largest) set->largest = count;
+  }
+  for (int i = 0; i < set->islandCount; ++i)
+    if (set->islands[i]) retire(set, set->islands[i]);
+  island** t = set->islands;
+  set->islands = set->next;
+  set->next = t;
+  set->islandCount = set->partCount;
+  for (int j = 0; j < set->islandCount; ++j)
+    for (int m = 0; m < set->islands[j]->bodyCount; ++m) set->islandOld[set->islands[j]->bodies[m]] = j;
+  return built;
+}
+
+// ---------------------------------------------------------------- one interval
+
+// The islands from s (at T) to tNext, then the scene's state gathered at tNext. False if an island failed
+// (s keeps its state at T).
+static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSet* set, double tNext) {
+  double dt = tNext - s->t;
+  for (int k = 0; k < set->movingCount; ++k) {
+    const pdBody* b = &model->bodies[model->movingBodies[k]];
+    const double* yb = s->y + PD_BODY_STATE_SIZE * k;
+    set->x0[k] = pd_layout_x(yb);
+    set->q0[k] = pd_layout_q(yb);
+    set->bound[k] = travel_bound(model, b, yb, s->t, dt);
+    set->travel[k] = 0.0;
+  }
+  for (int j = 0; j < set->islandCount; ++j) set->islands[j]->advanced = false;
+  for (int round = 0;; ++round) {
+    partition(model, s, set);
+    int built = rebuild(model, s, set);
+    if (round > 0) set->redos += built;
+    for (int j = 0; j < set->islandCount; ++j) {
+      island* is = set->islands[j];
+      if (is->advanced) continue;
+      ++set->intervals;
+      if (!island_advance(set, is, tNext)) return false;
+    }
+    // a body that left its grown box could have met another island's body unseen: grow its bound and
+    // form the partition again; islands that change are redone from T
+    bool left = false;
+    for (int k = 0; k < set->movingCount; ++k)
+      if (set->travel[k] > set->bound[k]) {
+        set->bound[k] = PD_ISLAND_REDO_GROWTH * set->travel[k];
+        left = true;
+      }
+    if (!left) break;
+  }
+  // gather: bodies, then contacts (sorted by id), and each body's next step
+  for (int j = 0; j < set->islandCount; ++j) {
+    const island* is = set->islands[j];
+    for (int m = 0; m < is->bodyCount; ++m) {
+      int k = is->bodies[m];
+      memcpy(s->y + PD_BODY_STATE_SIZE * k, is->state->y + PD_BODY_STATE_SIZE * m, PD_BODY_STATE_SIZE * sizeof *s->y);
+      set->h[k] = is->state->h;
+    }
+    set->subModels[j] = &is->model;
+    set->subStates[j] = is->state;
+    set->subMaps[j] = is->toScene;
+  }
+  pd_contact_set_gather(model, s, set->islandCount, set->subModels, set->subStates, set->subMaps);
+  return true;
+}
+
+// ---------------------------------------------------------------- pd_advance with islands
+
+static double sample_time(const pdModel* model, long k) { return (double)k / model->settings.sampleRate; }
+
+static void observe(const pdModel* model, pdState* s, struct pdIslandSet* set, pdObserverFcn* observer, void* user) {
+  double t0 = pd_clock_seconds();
+  if (observer && !observer(model, s, user)) s->stopped = true;
+  ++s->count.samples;
+  ++s->nextSample;
+  double seconds = pd_clock_seconds() - t0;
+  set->observeSeconds += seconds;
+  s->stageSeconds[pd_stageObserve] += seconds;
+}
+
+bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
+  PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
+  if (s->failed) return false;
+  s->stopped = false;
+  if (!s->islandSet) s->islandSet = set_create(model, s);
+  struct pdIslandSet* set = s->islandSet;
+  while (sample_time(model, s->nextSample) < s->t) ++s->nextSample;
+  if (sample_time(model, s->nextSample) == s->t) observe(model, s, set, observer, user);
+  while (s->t < tEnd && !s->stopped) {
+    double tSample = sample_time(model, s->nextSample);
+    double target = fmin(tEnd, tSample);
+    bool ok = set->movingCount == 0 || advance_interval(model, s, set, target);
+    compose_counters(set, s);
+    if (!ok) {
+      s->failed = true;
+      return false;
+    }
+    s->t = target;
+    if (s->t == tSample) observe(model, s, set, observer, user);
+  }
+  return !s->stopped;
+}
