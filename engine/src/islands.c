@@ -260,6 +260,8 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
 
 // ---------------------------------------------------------------- the set
 
+int pd_island_count(const pdState* s) { return s->islandSet ? s->islandSet->islandCount : 0; }
+
 void pd_island_set_free(struct pdIslandSet* set) {
   if (!set) return;
   for (int i = 0; i < set->islandCount; ++i) island_free(set->islands[i]);

@@ -18,5 +18,8 @@ bool pd_advance_hooked(const pdModel* model, pdState* state, double tEnd, pdObse
 // pd_advance with state->islands == pd_islandsOn (contract of pd_advance, state.h).
 bool pd_islands_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
 
+// The number of islands of the state's last interval (0 before the first, or with islands off).
+int pd_island_count(const pdState* state);
+
 // Frees the islands' states (state reset and free); NULL is allowed.
 void pd_island_set_free(struct pdIslandSet* set);
