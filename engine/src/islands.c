@@ -2,39 +2,44 @@
 //
 // Design note. With islands off, one state vector carries every moving body and contact: one step size,
 // one error norm (a max over all of y), and every contact onset anywhere cuts every body's step. With
-// islands on, pd_advance goes from output sample to output sample (the sync interval [T, T'], T' the next
-// sample or tEnd); over each interval the moving bodies are partitioned into islands and each island
-// advances alone from T to T', in a pdState of its own over a model of its own, with its own step size,
-// error norm, contact events, onset retries and stability bound: the unchanged stepper of integrator.c.
+// islands on, pd_advance goes from sync time to sync time: the output samples, each sample interval cut into
+// equal parts (sync_parts: a body at the scene's vmax moves at most PD_ISLAND_SYNC_SIZE_FRACTION of the
+// smallest moving body's size over one; a function of the model and the interval only, never of the state).
+// Over each sync interval [T, T'] the moving bodies are partitioned into islands and each island advances
+// alone from T to T', in a pdState of its own over a model of its own, with its own step size, error norm,
+// contact events, onset retries and stability bound: the unchanged stepper of integrator.c.
 //
 // - An island's model holds its moving bodies and every fixed body, in scene order (bodies copied, their
 //   polyhedra and names shared, the material table a view with the classes remapped:
 //   pd_material_table_view). Fixed bodies carry no state, so every island may touch them without joining
 //   islands together. The order is scene order, so a contact's id sorts the same in the island and in
-//   the scene, and an island of the same bodies in another scene (same fixed bodies first) computes the
-//   same numbers bit for bit.
+//   the scene, and an island of the same bodies in another scene (same fixed bodies first, same sync times)
+//   computes the same numbers bit for bit.
 // - Partition at T (union-find over the moving bodies; each island named by its lowest body): two bodies
-//   join when they share an active contact, or when their boxes at T, each grown by a bound of how far its
-//   points can move before T' (travel_bound: |v|Δ + ½|g + F/m|Δ² + |ω| r Δ + slack), overlap. Islands are
-//   listed by their lowest body, so nothing depends on the order in which they are processed: each island
-//   reads only the scene's state at T and its own state, and writes only its own bodies' entries.
+//   join when they share an active contact, or when their grown boxes overlap. Gravity moves every body
+//   alike, so the boxes live in the frame that falls with it: body k's box at T, swept along v_k Δ and grown
+//   by its bound (travel_bound: slack + |ω| r Δ + ½ |F/m| Δ² for an applied force, and for a body touching
+//   anything at T or whose box may reach a fixed body's, 2 |v| Δ + |g| Δ² for a reversal of its velocity
+//   and support against gravity). Two bodies falling side by side thus stay apart. Islands are listed by
+//   their lowest body, so nothing depends on the order in which they are processed: each island reads only
+//   the scene's state at T and its own state, and writes only its own bodies' entries.
 // - Persistence: an island whose bodies are the same as the last interval's keeps its state (its contact
 //   list, caches, step size) and simply goes on; a new island is set up from the scene's state at T (its
 //   bodies' numbers and contacts copied, the contacts' springs, forces and modal dampers as they were:
 //   pd_contact_set_scatter) with the smallest step its bodies' islands last wanted.
-// - Safety: after every step an island takes, each of its bodies' travel since T (centre displacement +
-//   radius × rotation angle, the tunnelling guard's measure) is compared with its bound. A body that went
-//   farther could have met a body of another island unseen. After all islands reached T', the bound of
-//   every such body becomes twice its travel, the partition is formed again, and every island whose bodies
-//   changed is set up again from the state at T (still intact: the scene's state is written only at T')
-//   and redone (counted: islandRedos); islands whose bodies did not change keep their result (their bodies
-//   stayed in their boxes). This repeats until no body left its box, so at the end no two islands' boxes
-//   overlap while every body stayed in its box: no contact between islands can have been missed.
-//   (Between two step ends a body's path may leave the box by its curvature, |a| h²/8 at most: 1 µm for
-//   g and a 1 ms step, inside the slack.)
+// - Safety: after every step an island takes, each of its bodies' distance from its ballistic path
+//   (|x − x0 − v0 τ − ½ g τ²| + radius × rotation angle since T) is compared with its bound. Every point of
+//   the body then lies, in the falling frame, in its box at T moved by v0 τ and grown by that distance. A
+//   body that strayed farther could have met a body of another island unseen. After all islands reached T',
+//   the bound of every such body becomes twice its distance, the partition is formed again, and every island
+//   whose bodies changed is set up again from the state at T (still intact: the scene's state is written
+//   only at T') and redone (counted: islandRedos); islands whose bodies did not change keep their result.
+//   This repeats until no body strayed from its box, so at the end no two islands' swept boxes overlap
+//   while every body stayed in its own: no contact between islands can have been missed. (Between two step
+//   ends a body's path may leave the box by its curvature, |a − g| h²/8 at most, inside the slack.)
 // - At T' the islands' bodies and contacts are gathered into the scene's state (pd_contact_set_gather:
-//   sorted by id), the counters summed in island order, and the observer sees the whole scene.
-// One island of every body computes the same numbers as islands off: the same model, state and steps.
+//   sorted by id), the counters summed in island order, and the observer sees the whole scene at samples.
+// With the samples as the only sync times, one island of every body computes what islands off computes.
 //
 // Memory: islands are set up, grown and freed only at sync times; a step allocates nothing.
 #include "islands.h"
@@ -50,12 +55,20 @@
 #include "state_layout.h"
 
 // Slack of the travel bound, in the body's design deflections δ_max (deflection × size): a body resting in
-// contact moves by its springs' deflection as loads shift, which its speed at T does not show; two δ_max
+// contact moves by its springs' deflection as loads shift, which its velocity at T does not show; two δ_max
 // is also the most the tunnelling guard lets a pair sink within one step.
 #define PD_ISLAND_SLACK_DEFLECTIONS 2.0
 // ... plus this fraction of the body's size: what a push from a neighbour inside its island may add over
 // one interval. A tighter bound splits more islands but makes more of them redo their interval.
 #define PD_ISLAND_SLACK_SIZE 0.01
+// Sync times: a sample interval is cut into equal parts so that a body at the characteristic speed vmax travels
+// at most this fraction of the smallest moving body's size over one part, at most PD_ISLAND_SYNC_PARTS_MAX parts.
+// The bounds grow with the interval: with short ones, bodies that fall or bounce near each other stay in
+// islands of their own. Measured on cases/bench/pile_1000.scene (0.5 s, one run each): the samples alone
+// (10 ms) 140 s, 0.05 (11 parts) 41.9 s, 0.02 (16 parts) 38.9 s; pile_10 pays for it (0.065 s -> 0.094 s,
+// still below islands off), pile_100 is unchanged (0.74 s -> 0.69 s).
+#define PD_ISLAND_SYNC_SIZE_FRACTION 0.02
+#define PD_ISLAND_SYNC_PARTS_MAX 16
 // A body that moved farther than its bound gets this many times the distance it moved as its new bound.
 #define PD_ISLAND_REDO_GROWTH 2.0
 
@@ -81,7 +94,12 @@ struct pdIslandSet {
   double* travel;    // (movingCount) m: how far they moved at most, measured at the island's step ends
   double* h;         // (movingCount) s: the next step its island wanted at the last sync
   pdVec3* x0;        // (movingCount) centre of mass at T, m
+  pdVec3* v0;        // (movingCount) its velocity at T, m/s
   pdQuat* q0;        // (movingCount) orientation at T
+  pdAabb* box0;      // (movingCount) box at T
+  bool* touching;    // (movingCount) in a contact at T
+  double t0;         // s: T
+  double sizeMin;    // m: the smallest moving body's size
   pdAabb* boxes;     // (bodyCount) grown boxes (fixed bodies: their own)
   pdBroadPhase* broad;
   pdPair* pairs;
@@ -200,7 +218,10 @@ static void measure_travel(const pdModel* sub, const pdState* state, void* user)
         sqrt((q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z));
     double angle = 2.0 * acos(fmin(1.0, dot / norms));
     const pdBody* b = &sub->bodies[sub->movingBodies[j]];
-    double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), set->x0[k])) + b->radius * angle;
+    double tau = state->t - set->t0;
+    pdVec3 ballistic = pd_v3_add(
+        set->x0[k], pd_v3_add(pd_v3_scale(set->v0[k], tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
+    double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
     set->travel[k] = fmax(set->travel[k], moved);
   }
 }
@@ -275,6 +296,9 @@ void pd_island_set_free(struct pdIslandSet* set) {
   free(set->travel);
   free(set->h);
   free(set->x0);
+  free(set->v0);
+  free(set->box0);
+  free(set->touching);
   free(set->q0);
   free(set->boxes);
   pd_broad_phase_free(set->broad);
@@ -322,8 +346,13 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->travel = grow(NULL, (size_t)m, sizeof *set->travel);
   set->h = grow(NULL, (size_t)m, sizeof *set->h);
   set->x0 = grow(NULL, (size_t)m, sizeof *set->x0);
+  set->v0 = grow(NULL, (size_t)m, sizeof *set->v0);
+  set->box0 = grow(NULL, (size_t)m, sizeof *set->box0);
+  set->touching = grow(NULL, (size_t)m, sizeof *set->touching);
   set->q0 = grow(NULL, (size_t)m, sizeof *set->q0);
+  set->sizeMin = INFINITY;
   for (int k = 0; k < m; ++k) {
+    set->sizeMin = fmin(set->sizeMin, model->bodies[model->movingBodies[k]].size);
     set->islandOld[k] = -1;
     set->h[k] = s->h;
   }
@@ -355,27 +384,50 @@ static void join(int* root, int a, int b) {
     root[a] = b;
 }
 
-// How far body b's points can move over dt from state yb, m (design note): its speed's and gravity's (and an
-// applied force's) share, its spin's, and the slack.
-static double travel_bound(const pdModel* model, const pdBody* b, const double* yb, double t, double dt) {
-  double accel = pd_v3_norm(model->settings.gravity);
-  if (b->hasForce) accel += (pd_v3_norm(b->force0) + pd_v3_norm(b->forceRate) * (fabs(t) + dt)) * b->invMass;
-  double slack = (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
-  return pd_v3_norm(pd_layout_v(yb)) * dt + 0.5 * accel * dt * dt + pd_v3_norm(pd_layout_w(yb)) * b->radius * dt +
-         slack;
+static bool boxes_overlap(const pdAabb* a, const pdAabb* b) {
+  for (int d = 0; d < 3; ++d)
+    if (a->lo[d] > b->hi[d] || b->lo[d] > a->hi[d]) return false;
+  return true;
 }
 
-// The partition of the moving bodies at the scene's state s (T) with the bounds set->bound: islandOf,
-// members, first, partCount; and contactOf, the island of each contact of s.
-static void partition(const pdModel* model, const pdState* s, struct pdIslandSet* set) {
+// How far body k's points can stray over the interval from where its ballistic motion (its velocity at T and
+// gravity, which every body shares) takes them, m (design note): an applied force's share, its spin's
+// (r |ω| Δ), and the slack; a body touching anything at T, or whose box may reach a fixed body's, may also
+// reverse its velocity and be held against gravity (2 |v| Δ + |g| Δ²).
+static double travel_bound(const pdModel* model, const struct pdIslandSet* set, int k, const double* yb,
+                           const pdAabb* box, bool touching, double t, double dt) {
+  const pdBody* b = &model->bodies[model->movingBodies[k]];
+  double accel = 0.0;
+  if (b->hasForce) accel = (pd_v3_norm(b->force0) + pd_v3_norm(b->forceRate) * (fabs(t) + dt)) * b->invMass;
+  double slack = (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
+  double spin = pd_v3_norm(pd_layout_w(yb)) * b->radius * dt;
+  double bound = 0.5 * accel * dt * dt + spin + slack;
+  double g = pd_v3_norm(model->settings.gravity), v = pd_v3_norm(pd_layout_v(yb));
+  if (!touching) {
+    // may it reach a fixed body? (its box grown by all it can move, gravity included)
+    double reach = v * dt + 0.5 * (g + accel) * dt * dt + spin + slack;
+    pdAabb grown = *box;
+    for (int d = 0; d < 3; ++d) grown.lo[d] -= reach, grown.hi[d] += reach;
+    for (int f = 0; f < set->fixedCount && !touching; ++f)
+      touching = boxes_overlap(&grown, &set->boxes[set->fixedBodies[f]]);
+  }
+  if (touching) bound += 2.0 * v * dt + g * dt * dt;
+  return bound;
+}
+
+// The partition of the moving bodies at the scene's state s (T) with the bounds set->bound over the interval
+// dt: islandOf, members, first, partCount; and contactOf, the island of each contact of s. In the frame that
+// falls with gravity, body k's points stay within its box at T swept along v0 dt and grown by its bound.
+static void partition(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt) {
   int m = set->movingCount;
   for (int k = 0; k < m; ++k) {
-    int i = model->movingBodies[k];
-    const double* yb = s->y + PD_BODY_STATE_SIZE * k;
-    pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(pd_layout_q(yb)));
-    pdAabb box = pd_aabb_of(&model->bodies[i].shape, pd_layout_x(yb), &r);
-    for (int d = 0; d < 3; ++d) box.lo[d] -= set->bound[k], box.hi[d] += set->bound[k];
-    set->boxes[i] = box;
+    pdAabb box = set->box0[k];
+    double sweep[3] = {set->v0[k].x * dt, set->v0[k].y * dt, set->v0[k].z * dt};
+    for (int d = 0; d < 3; ++d) {
+      box.lo[d] += fmin(0.0, sweep[d]) - set->bound[k];
+      box.hi[d] += fmax(0.0, sweep[d]) + set->bound[k];
+    }
+    set->boxes[model->movingBodies[k]] = box;
     set->root[k] = k;
   }
   bool updated = pd_broad_phase_update(set->broad, set->boxes);
@@ -466,17 +518,28 @@ static int rebuild(const pdModel* model, const pdState* s, struct pdIslandSet* s
 // (s keeps its state at T).
 static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSet* set, double tNext) {
   double dt = tNext - s->t;
+  set->t0 = s->t;
+  for (int k = 0; k < set->movingCount; ++k) set->touching[k] = false;
+  for (int c = 0; c < pd_state_contact_count(s); ++c) {
+    int b1, b2;
+    pd_contact_set_bodies(s->contacts, c, &b1, &b2);
+    if (!model->bodies[b1].fixed) set->touching[model->bodies[b1].stateIndex] = true;
+    if (!model->bodies[b2].fixed) set->touching[model->bodies[b2].stateIndex] = true;
+  }
   for (int k = 0; k < set->movingCount; ++k) {
     const pdBody* b = &model->bodies[model->movingBodies[k]];
     const double* yb = s->y + PD_BODY_STATE_SIZE * k;
     set->x0[k] = pd_layout_x(yb);
+    set->v0[k] = pd_layout_v(yb);
     set->q0[k] = pd_layout_q(yb);
-    set->bound[k] = travel_bound(model, b, yb, s->t, dt);
+    pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(set->q0[k]));
+    set->box0[k] = pd_aabb_of(&b->shape, set->x0[k], &r);
+    set->bound[k] = travel_bound(model, set, k, yb, &set->box0[k], set->touching[k], s->t, dt);
     set->travel[k] = 0.0;
   }
   for (int j = 0; j < set->islandCount; ++j) set->islands[j]->advanced = false;
   for (int round = 0;; ++round) {
-    partition(model, s, set);
+    partition(model, s, set, dt);
     int built = rebuild(model, s, set);
     if (round > 0) set->redos += built;
     for (int j = 0; j < set->islandCount; ++j) {
@@ -513,6 +576,15 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
 
 // ---------------------------------------------------------------- pd_advance with islands
 
+// Into how many equal parts the interval dt is cut: the fewest that keep a body at the scene's characteristic
+// speed vmax from moving more than PD_ISLAND_SYNC_SIZE_FRACTION of the smallest moving body's size over one,
+// at most PD_ISLAND_SYNC_PARTS_MAX. A function of dt and the model only: the sync times do not depend on the
+// bodies' states, so a group of bodies computes the same numbers whatever moves elsewhere.
+static int sync_parts(const pdModel* model, const struct pdIslandSet* set, double dt) {
+  double parts = ceil(dt * model->settings.vmax / (PD_ISLAND_SYNC_SIZE_FRACTION * set->sizeMin));
+  return parts <= 1.0 ? 1 : (int)fmin(PD_ISLAND_SYNC_PARTS_MAX, parts);
+}
+
 static double sample_time(const pdModel* model, long k) { return (double)k / model->settings.sampleRate; }
 
 static void observe(const pdModel* model, pdState* s, struct pdIslandSet* set, pdObserverFcn* observer, void* user) {
@@ -536,13 +608,19 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
   while (s->t < tEnd && !s->stopped) {
     double tSample = sample_time(model, s->nextSample);
     double target = fmin(tEnd, tSample);
-    bool ok = set->movingCount == 0 || advance_interval(model, s, set, target);
-    compose_counters(set, s);
-    if (!ok) {
-      s->failed = true;
-      return false;
+    // the sync times: the interval to the sample cut into equal parts short enough for the fastest body
+    double t0 = s->t;
+    int parts = sync_parts(model, set, target - t0);
+    for (int j = 1; j <= parts; ++j) {
+      double tSync = j == parts ? target : t0 + (target - t0) * ((double)j / parts);
+      bool ok = set->movingCount == 0 || advance_interval(model, s, set, tSync);
+      compose_counters(set, s);
+      if (!ok) {
+        s->failed = true;
+        return false;
+      }
+      s->t = tSync;
     }
-    s->t = target;
     if (s->t == tSample) observe(model, s, set, observer, user);
   }
   return !s->stopped;
