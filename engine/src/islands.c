@@ -23,6 +23,13 @@
 //   and support against gravity). Two bodies falling side by side thus stay apart. Islands are listed by
 //   their lowest body, so nothing depends on the order in which they are processed: each island reads only
 //   the scene's state at T and its own state, and writes only its own bodies' entries.
+// - Free bodies: at the start T0 of each sample interval the partition is formed once over the whole interval
+//   (find_free). A body alone there, touching nothing and with no fixed body in reach, is free: with no
+//   contact it cannot leave its ballistic path (its spin bounded by its rotational energy, √(2 E_rot/I_min)),
+//   so its island is not cut at the sync times: it goes to the sample in free-flight steps of its own, its box
+//   over the sample interval standing for it in every sync partition. When another body's box over a sync
+//   interval reaches that box, the free body is brought to that sync time alone and joins the others from
+//   there; a free body found outside its box (never expected) is counted (islandStrays), not recovered.
 // - Persistence: an island whose bodies are the same as the last interval's keeps its state (its contact
 //   list, caches, step size) and simply goes on; a new island is set up from the scene's state at T (its
 //   bodies' numbers and contacts copied, the contacts' springs, forces and modal dampers as they were:
@@ -97,7 +104,17 @@ struct pdIslandSet {
   pdVec3* v0;        // (movingCount) its velocity at T, m/s
   pdQuat* q0;        // (movingCount) orientation at T
   pdAabb* box0;      // (movingCount) box at T
-  bool* touching;    // (movingCount) in a contact at T
+  bool* touching;    // (movingCount) in a contact at T, or its box may reach a fixed body's
+  // the sample interval [T0, Ts] as a whole (free bodies: see the design note)
+  double ct0;         // s: T0
+  bool* free;         // (movingCount) alone and ballistic over the whole sample interval
+  pdVec3 *cx0, *cv0;  // (movingCount) centre of mass and velocity at T0
+  pdQuat* cq0;        // (movingCount) orientation at T0
+  double* cbound;     // (movingCount) m: the bound over the sample interval
+  double* ctravel;    // (movingCount) m: how far a free body strayed from its ballistic path since T0
+  pdAabb* cbox;       // (movingCount) its box over the sample interval (swept and grown)
+  int* activate;      // (movingCount) free bodies a fine box reached (partition)
+  long strays;        // free bodies that strayed from their box (never expected: counted, not recovered)
   double t0;         // s: T
   double sizeMin;    // m: the smallest moving body's size
   pdAabb* boxes;     // (bodyCount) grown boxes (fixed bodies: their own)
@@ -204,6 +221,7 @@ static void island_load(const pdModel* model, const pdState* s, struct pdIslandS
 typedef struct travelProbe {
   struct pdIslandSet* set;
   const island* is;
+  bool coarse;  // a free body: against its path over the sample interval (cx0, cv0, cq0 from ct0; ctravel)
 } travelProbe;
 
 static void measure_travel(const pdModel* sub, const pdState* state, void* user) {
@@ -212,24 +230,28 @@ static void measure_travel(const pdModel* sub, const pdState* state, void* user)
   for (int j = 0; j < probe->is->bodyCount; ++j) {
     int k = probe->is->bodies[j];
     const double* y = state->y + PD_BODY_STATE_SIZE * j;
-    pdQuat q = pd_layout_q(y), q0 = set->q0[k];
+    pdQuat q = pd_layout_q(y), q0 = probe->coarse ? set->cq0[k] : set->q0[k];
     double dot = fabs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z);
     double norms =
         sqrt((q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z));
     double angle = 2.0 * acos(fmin(1.0, dot / norms));
     const pdBody* b = &sub->bodies[sub->movingBodies[j]];
-    double tau = state->t - set->t0;
-    pdVec3 ballistic = pd_v3_add(
-        set->x0[k], pd_v3_add(pd_v3_scale(set->v0[k], tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
+    double tau = state->t - (probe->coarse ? set->ct0 : set->t0);
+    pdVec3 x0 = probe->coarse ? set->cx0[k] : set->x0[k], v0 = probe->coarse ? set->cv0[k] : set->v0[k];
+    pdVec3 ballistic =
+        pd_v3_add(x0, pd_v3_add(pd_v3_scale(v0, tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
     double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
-    set->travel[k] = fmax(set->travel[k], moved);
+    double* travel = probe->coarse ? set->ctravel : set->travel;
+    travel[k] = fmax(travel[k], moved);
   }
 }
 
-// Advances island `is` from T to tNext; false if it failed.
-static bool island_advance(struct pdIslandSet* set, island* is, double tNext) {
-  for (int j = 0; j < is->bodyCount; ++j) set->travel[is->bodies[j]] = 0.0;
-  travelProbe probe = {set, is};
+// Advances island `is` to tNext; false if it failed. A free body's island (coarse) measures against its path
+// over the whole sample interval, and keeps what it measured since T0.
+static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool coarse) {
+  if (!coarse)
+    for (int j = 0; j < is->bodyCount; ++j) set->travel[is->bodies[j]] = 0.0;
+  travelProbe probe = {set, is, coarse};
   is->advanced = true;
   return pd_advance_hooked(&is->model, is->state, tNext, NULL, NULL, measure_travel, &probe);
 }
@@ -277,6 +299,7 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
   s->count.islandsLargest = set->largest;
   s->count.islandIntervals = set->intervals;
   s->count.islandRedos = set->redos;
+  s->count.islandStrays = set->strays;
 }
 
 // ---------------------------------------------------------------- the set
@@ -299,6 +322,14 @@ void pd_island_set_free(struct pdIslandSet* set) {
   free(set->v0);
   free(set->box0);
   free(set->touching);
+  free(set->free);
+  free(set->cx0);
+  free(set->cv0);
+  free(set->cq0);
+  free(set->cbound);
+  free(set->ctravel);
+  free(set->cbox);
+  free(set->activate);
   free(set->q0);
   free(set->boxes);
   pd_broad_phase_free(set->broad);
@@ -349,6 +380,15 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->v0 = grow(NULL, (size_t)m, sizeof *set->v0);
   set->box0 = grow(NULL, (size_t)m, sizeof *set->box0);
   set->touching = grow(NULL, (size_t)m, sizeof *set->touching);
+  set->free = calloc((size_t)(m > 0 ? m : 1), sizeof *set->free);
+  PD_ASSERT(set->free != NULL);
+  set->cx0 = grow(NULL, (size_t)m, sizeof *set->cx0);
+  set->cv0 = grow(NULL, (size_t)m, sizeof *set->cv0);
+  set->cq0 = grow(NULL, (size_t)m, sizeof *set->cq0);
+  set->cbound = grow(NULL, (size_t)m, sizeof *set->cbound);
+  set->ctravel = grow(NULL, (size_t)m, sizeof *set->ctravel);
+  set->cbox = grow(NULL, (size_t)m, sizeof *set->cbox);
+  set->activate = grow(NULL, (size_t)m, sizeof *set->activate);
   set->q0 = grow(NULL, (size_t)m, sizeof *set->q0);
   set->sizeMin = INFINITY;
   for (int k = 0; k < m; ++k) {
@@ -395,12 +435,18 @@ static bool boxes_overlap(const pdAabb* a, const pdAabb* b) {
 // (r |ω| Δ), and the slack; a body touching anything at T, or whose box may reach a fixed body's, may also
 // reverse its velocity and be held against gravity (2 |v| Δ + |g| Δ²).
 static double travel_bound(const pdModel* model, const struct pdIslandSet* set, int k, const double* yb,
-                           const pdAabb* box, bool touching, double t, double dt) {
+                           const pdAabb* box, bool* touchingOut, double t, double dt) {
   const pdBody* b = &model->bodies[model->movingBodies[k]];
+  bool touching = *touchingOut;
   double accel = 0.0;
   if (b->hasForce) accel = (pd_v3_norm(b->force0) + pd_v3_norm(b->forceRate) * (fabs(t) + dt)) * b->invMass;
   double slack = (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
-  double spin = pd_v3_norm(pd_layout_w(yb)) * b->radius * dt;
+  // the spin a torque-free body can reach keeps its rotational energy: |ω| <= √(2 E_rot / I_min)
+  pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(pd_layout_q(yb)));
+  pdVec3 wb = pd_mat3_tmulv(&r, pd_layout_w(yb));
+  double twiceEnergy = pd_v3_dot(wb, pd_mat3_mulv(&b->inertia, wb));
+  double spinMax = b->principal[0] > 0.0 ? sqrt(fmax(0.0, twiceEnergy) / b->principal[0]) : 0.0;
+  double spin = fmax(pd_v3_norm(pd_layout_w(yb)), spinMax) * b->radius * dt;
   double bound = 0.5 * accel * dt * dt + spin + slack;
   double g = pd_v3_norm(model->settings.gravity), v = pd_v3_norm(pd_layout_v(yb));
   if (!touching) {
@@ -412,15 +458,25 @@ static double travel_bound(const pdModel* model, const struct pdIslandSet* set, 
       touching = boxes_overlap(&grown, &set->boxes[set->fixedBodies[f]]);
   }
   if (touching) bound += 2.0 * v * dt + g * dt * dt;
+  *touchingOut = touching;
   return bound;
 }
 
 // The partition of the moving bodies at the scene's state s (T) with the bounds set->bound over the interval
 // dt: islandOf, members, first, partCount; and contactOf, the island of each contact of s. In the frame that
 // falls with gravity, body k's points stay within its box at T swept along v0 dt and grown by its bound.
-static void partition(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt) {
-  int m = set->movingCount;
+// With fine set (a sync interval), a free body keeps its box over the sample interval (cbox) and joins nothing:
+// a free body whose box another body's reaches is listed in set->activate instead, and the number of those is
+// returned (the partition is then incomplete: activate them and form it again). Without (the sample interval
+// as a whole), every body takes part.
+static int partition(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt, bool fine) {
+  int m = set->movingCount, activations = 0;
   for (int k = 0; k < m; ++k) {
+    set->root[k] = k;
+    if (fine && set->free[k]) {
+      set->boxes[model->movingBodies[k]] = set->cbox[k];
+      continue;
+    }
     pdAabb box = set->box0[k];
     double sweep[3] = {set->v0[k].x * dt, set->v0[k].y * dt, set->v0[k].z * dt};
     for (int d = 0; d < 3; ++d) {
@@ -428,7 +484,6 @@ static void partition(const pdModel* model, const pdState* s, struct pdIslandSet
       box.hi[d] += fmax(0.0, sweep[d]) + set->bound[k];
     }
     set->boxes[model->movingBodies[k]] = box;
-    set->root[k] = k;
   }
   bool updated = pd_broad_phase_update(set->broad, set->boxes);
   PD_ASSERT(updated);  // false only when memory runs out
@@ -440,8 +495,19 @@ static void partition(const pdModel* model, const pdState* s, struct pdIslandSet
   }
   for (int p = 0; p < pairCount; ++p) {
     const pdBody *a = &model->bodies[set->pairs[p].a], *b = &model->bodies[set->pairs[p].b];
-    if (!a->fixed && !b->fixed) join(set->root, a->stateIndex, b->stateIndex);
+    if (a->fixed || b->fixed) continue;
+    bool freeA = fine && set->free[a->stateIndex], freeB = fine && set->free[b->stateIndex];
+    if (freeA && freeB) continue;  // their boxes over the sample interval overlap no other body's (coarse partition)
+    if (freeA || freeB) {
+      int k = freeA ? a->stateIndex : b->stateIndex;
+      bool listed = false;
+      for (int i = 0; i < activations && !listed; ++i) listed = set->activate[i] == k;
+      if (!listed) set->activate[activations++] = k;
+      continue;
+    }
+    join(set->root, a->stateIndex, b->stateIndex);
   }
+  if (activations > 0) return activations;
   int contacts = pd_state_contact_count(s);
   for (int c = 0; c < contacts; ++c) {
     int b1, b2;
@@ -472,6 +538,7 @@ static void partition(const pdModel* model, const pdState* s, struct pdIslandSet
     int moving = model->bodies[b1].fixed ? b2 : b1;
     set->contactOf[c] = set->islandOf[model->bodies[moving].stateIndex];
   }
+  return 0;
 }
 
 // Makes the live islands those of the partition: an island whose bodies did not change is kept as it is
@@ -514,11 +581,21 @@ static int rebuild(const pdModel* model, const pdState* s, struct pdIslandSet* s
 
 // ---------------------------------------------------------------- one interval
 
-// The islands from s (at T) to tNext, then the scene's state gathered at tNext. False if an island failed
-// (s keeps its state at T).
-static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSet* set, double tNext) {
-  double dt = tNext - s->t;
-  set->t0 = s->t;
+// Body k's numbers at the scene's state s (its time T): start pose, box and bound over dt (fine: set->x0 …).
+static void set_start(const pdModel* model, const pdState* s, struct pdIslandSet* set, int k, double dt) {
+  const pdBody* b = &model->bodies[model->movingBodies[k]];
+  const double* yb = s->y + PD_BODY_STATE_SIZE * k;
+  set->x0[k] = pd_layout_x(yb);
+  set->v0[k] = pd_layout_v(yb);
+  set->q0[k] = pd_layout_q(yb);
+  pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(set->q0[k]));
+  set->box0[k] = pd_aabb_of(&b->shape, set->x0[k], &r);
+  set->bound[k] = travel_bound(model, set, k, yb, &set->box0[k], &set->touching[k], s->t, dt);
+  set->travel[k] = 0.0;
+}
+
+// Marks in set->touching the moving bodies of the scene's contacts.
+static void mark_touching(const pdModel* model, const pdState* s, struct pdIslandSet* set) {
   for (int k = 0; k < set->movingCount; ++k) set->touching[k] = false;
   for (int c = 0; c < pd_state_contact_count(s); ++c) {
     int b1, b2;
@@ -526,52 +603,106 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
     if (!model->bodies[b1].fixed) set->touching[model->bodies[b1].stateIndex] = true;
     if (!model->bodies[b2].fixed) set->touching[model->bodies[b2].stateIndex] = true;
   }
-  for (int k = 0; k < set->movingCount; ++k) {
-    const pdBody* b = &model->bodies[model->movingBodies[k]];
-    const double* yb = s->y + PD_BODY_STATE_SIZE * k;
-    set->x0[k] = pd_layout_x(yb);
-    set->v0[k] = pd_layout_v(yb);
-    set->q0[k] = pd_layout_q(yb);
-    pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(set->q0[k]));
-    set->box0[k] = pd_aabb_of(&b->shape, set->x0[k], &r);
-    set->bound[k] = travel_bound(model, set, k, yb, &set->box0[k], set->touching[k], s->t, dt);
-    set->travel[k] = 0.0;
+}
+
+// A free body's island goes on to tNext alone (coarse: against its path over the sample interval); its
+// numbers go to the scene's state. False if it failed.
+static bool free_advance(pdState* s, struct pdIslandSet* set, int k, double tNext) {
+  island* is = set->islands[set->islandOld[k]];
+  PD_ASSERT(is->bodyCount == 1 && is->bodies[0] == k);
+  if (is->state->t < tNext) {
+    ++set->intervals;
+    if (!island_advance(set, is, tNext, true)) return false;
   }
+  if (set->ctravel[k] > set->cbound[k]) ++set->strays;
+  memcpy(s->y + PD_BODY_STATE_SIZE * k, is->state->y, PD_BODY_STATE_SIZE * sizeof *s->y);
+  set->h[k] = is->state->h;
+  return true;
+}
+
+// The islands from s (at T) to tNext, then the scene's state gathered at tNext (free bodies' numbers only at
+// the sample, `last`). False if an island failed (s keeps its state at T).
+static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSet* set, double tNext, bool last) {
+  double dt = tNext - s->t;
+  set->t0 = s->t;
+  mark_touching(model, s, set);
+  for (int k = 0; k < set->movingCount; ++k)
+    if (!set->free[k]) set_start(model, s, set, k, dt);
   for (int j = 0; j < set->islandCount; ++j) set->islands[j]->advanced = false;
   for (int round = 0;; ++round) {
-    partition(model, s, set, dt);
+    // a free body another body may reach joins the others from here: it is brought to T first
+    for (int activations; (activations = partition(model, s, set, dt, true)) > 0;)
+      for (int i = 0; i < activations; ++i) {
+        int k = set->activate[i];
+        if (s->t > set->ct0 && !free_advance(s, set, k, s->t)) return false;
+        set->free[k] = false;
+        set_start(model, s, set, k, dt);
+      }
     int built = rebuild(model, s, set);
     if (round > 0) set->redos += built;
     for (int j = 0; j < set->islandCount; ++j) {
       island* is = set->islands[j];
-      if (is->advanced) continue;
+      if (is->advanced || set->free[is->bodies[0]]) continue;
       ++set->intervals;
-      if (!island_advance(set, is, tNext)) return false;
+      if (!island_advance(set, is, tNext, false)) return false;
     }
     // a body that left its grown box could have met another island's body unseen: grow its bound and
     // form the partition again; islands that change are redone from T
     bool left = false;
     for (int k = 0; k < set->movingCount; ++k)
-      if (set->travel[k] > set->bound[k]) {
+      if (!set->free[k] && set->travel[k] > set->bound[k]) {
         set->bound[k] = PD_ISLAND_REDO_GROWTH * set->travel[k];
         left = true;
       }
     if (!left) break;
   }
+  if (last)
+    for (int k = 0; k < set->movingCount; ++k)
+      if (set->free[k] && !free_advance(s, set, k, tNext)) return false;
   // gather: bodies, then contacts (sorted by id), and each body's next step
   for (int j = 0; j < set->islandCount; ++j) {
     const island* is = set->islands[j];
+    if (set->free[is->bodies[0]] && !last) continue;  // still at T0: the scene keeps its numbers from there
     for (int m = 0; m < is->bodyCount; ++m) {
       int k = is->bodies[m];
       memcpy(s->y + PD_BODY_STATE_SIZE * k, is->state->y + PD_BODY_STATE_SIZE * m, PD_BODY_STATE_SIZE * sizeof *s->y);
       set->h[k] = is->state->h;
     }
+  }
+  for (int j = 0; j < set->islandCount; ++j) {
+    const island* is = set->islands[j];
     set->subModels[j] = &is->model;
     set->subStates[j] = is->state;
     set->subMaps[j] = is->toScene;
   }
   pd_contact_set_gather(model, s, set->islandCount, set->subModels, set->subStates, set->subMaps);
   return true;
+}
+
+// At the start T0 of a sample interval of length dt: each body's path and bound over the whole interval, and
+// which bodies are free: alone in the partition of that interval (no contact, no box reaching another body's
+// or a fixed body's). A free body has no contact to leave its ballistic path by: it goes to the sample in
+// steps of its own, not cut at the sync times, unless another body's box over a sync interval reaches its
+// box over the sample interval.
+static void find_free(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt) {
+  set->ct0 = s->t;
+  mark_touching(model, s, set);
+  for (int k = 0; k < set->movingCount; ++k) {
+    set->free[k] = false;
+    set_start(model, s, set, k, dt);
+    set->cx0[k] = set->x0[k];
+    set->cv0[k] = set->v0[k];
+    set->cq0[k] = set->q0[k];
+    set->cbound[k] = set->bound[k];
+    set->ctravel[k] = 0.0;
+  }
+  partition(model, s, set, dt, false);
+  for (int j = 0; j < set->partCount; ++j) {
+    if (set->first[j + 1] - set->first[j] != 1) continue;
+    int k = set->members[set->first[j]];
+    set->free[k] = !set->touching[k];
+    set->cbox[k] = set->boxes[model->movingBodies[k]];
+  }
 }
 
 // ---------------------------------------------------------------- pd_advance with islands
@@ -611,9 +742,10 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
     // the sync times: the interval to the sample cut into equal parts short enough for the fastest body
     double t0 = s->t;
     int parts = sync_parts(model, set, target - t0);
+    if (set->movingCount > 0) find_free(model, s, set, target - t0);
     for (int j = 1; j <= parts; ++j) {
       double tSync = j == parts ? target : t0 + (target - t0) * ((double)j / parts);
-      bool ok = set->movingCount == 0 || advance_interval(model, s, set, tSync);
+      bool ok = set->movingCount == 0 || advance_interval(model, s, set, tSync, j == parts);
       compose_counters(set, s);
       if (!ok) {
         s->failed = true;

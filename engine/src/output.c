@@ -424,9 +424,9 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   if (state->islands == pd_islandsOn)
     fprintf(out,
             "  \"island_counts\": {\"islands_formed\": %ld, \"largest_island\": %ld, \"island_intervals\": %ld, "
-            "\"island_redos\": %ld},\n",
+            "\"island_redos\": %ld, \"island_strays\": %ld},\n",
             state->count.islandsFormed, state->count.islandsLargest, state->count.islandIntervals,
-            state->count.islandRedos);
+            state->count.islandRedos, state->count.islandStrays);
   fputs("  \"warnings\": {", out);
   for (int w = 0; w < pd_warnCount; ++w) fprintf(out, "%s\"%s\": %ld", w ? ", " : "", pdWarningNames[w], state->warnings[w]);
   fputs("},\n  \"t_reached\": ", out);

@@ -107,6 +107,8 @@ typedef struct pdCounters {
   long islandsLargest;   // moving bodies in the largest island formed
   long islandIntervals;  // sample intervals advanced (island by island)
   long islandRedos;      // islands whose interval was redone because a body moved farther than its grown box
+  long islandStrays;     // free bodies found outside their box over a sample interval (none expected: a free body
+                         // has no contact to leave its ballistic path by; counted, not recovered)
 } pdCounters;
 
 typedef struct pdState {
