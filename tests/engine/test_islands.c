@@ -10,6 +10,8 @@
 // - run to run: the same numbers bit for bit (a pile of ten boxes);
 // - merge: two cubes flying at each other start as two islands, become one and bounce with the requested
 //   restitution (closed form: exit speed / approach speed = e), within 0.01 as with islands off;
+// - free flight: two spinning cubes thrown far apart take, bit for bit, the steps each takes alone with islands
+//   off (a free body is not cut at the sync times);
 // - split: two cubes that start touching and fly apart start as one island and end as two, their free
 //   flight untouched (constant velocities, bit for bit);
 // - a pile of ten boxes (cases/bench/pile_10.scene): finite numbers, penetration below 3 δ_max, no energy
@@ -206,9 +208,42 @@ static void test_a_pile_keeps_its_physics(void** state) {
   assert_true(r->penetration < PENETRATION_MAX_DELTA);
   assert_true(gain <= ENERGY_GAIN_TOL);
   assert_true(s->count.islandsLargest > 1);  // boxes did meet
+  assert_int_equal(s->count.islandStrays, 0);
   pd_state_free(s);
   free(r);
   pd_model_free(m);
+}
+
+// ---------------------------------------------------------------- free flight
+
+// Two spinning cubes thrown far apart, far above a floor: each is free (alone, touching nothing, out of reach
+// of the floor) over every sample interval, so it takes the steps it takes alone with islands off, to the bit,
+// whatever the sync times.
+#define THROWN_SETTINGS "tend 0.3\nsample 100\nvmax 5\n"
+#define FAR_FLOOR "cube floor grey 20 20 0.2\nfixed\nloc 0 0 -10\n"
+#define THROWN_A "cube a red 0.1 0.1 0.1\nloc -2 0 1\nvel 1 0 3 400 1 2 3\n"
+#define THROWN_B "cube b blue 0.1 0.2 0.05\nloc 2 0 1\nvel -1 0.5 2 300 0 1 1\n"
+
+static void test_free_bodies_take_free_flight_steps(void** state) {
+  (void)state;
+  pdModel* both = compile_text(THROWN_SETTINGS FAR_FLOOR THROWN_A THROWN_B);
+  pdModel* a = compile_text(THROWN_SETTINGS FAR_FLOOR THROWN_A);
+  pdModel* b = compile_text(THROWN_SETTINGS FAR_FLOOR THROWN_B);
+  pdState *sOn = NULL, *sA = NULL, *sB = NULL;
+  trace* on = run_islands(both, pd_islandsOn, &sOn);
+  trace* offA = run_islands(a, pd_islandsOff, &sA);
+  trace* offB = run_islands(b, pd_islandsOff, &sB);
+  for (int k = 0; k < on->count; ++k) {
+    if (!same_body(&on->body[k][0], &offA->body[k][0])) fail_msg("sample %d: cube a differs from a alone", k);
+    if (!same_body(&on->body[k][1], &offB->body[k][0])) fail_msg("sample %d: cube b differs from b alone", k);
+  }
+  assert_int_equal(sOn->count.accepted, sA->count.accepted + sB->count.accepted);
+  assert_int_equal(sOn->count.islandStrays, 0);
+  print_message("two free cubes: %ld + %ld steps alone, %ld with islands on\n", sA->count.accepted, sB->count.accepted,
+                sOn->count.accepted);
+  pd_state_free(sOn), pd_state_free(sA), pd_state_free(sB);
+  free(on), free(offA), free(offB);
+  pd_model_free(both), pd_model_free(a), pd_model_free(b);
 }
 
 // ---------------------------------------------------------------- merge and split
@@ -271,6 +306,7 @@ int main(void) {
       cmocka_unit_test(test_one_island_is_islands_off_bit_for_bit),
       cmocka_unit_test(test_the_same_bits_run_after_run),
       cmocka_unit_test(test_a_pile_keeps_its_physics),
+      cmocka_unit_test(test_free_bodies_take_free_flight_steps),
       cmocka_unit_test(test_islands_merge_and_bounce_with_the_requested_e),
       cmocka_unit_test(test_an_island_splits_when_its_bodies_part),
   };
