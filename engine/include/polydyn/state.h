@@ -72,6 +72,9 @@ typedef enum pdOnsets {
                    // one corner of a pile does not send every body back. Others as pd_onsetsExact.
 } pdOnsets;
 
+// The onset mode of a new state (pd_state_reset) and of the commands' --onsets.
+#define PD_ONSETS_DEFAULT pd_onsetsExact
+
 // The onset mode's name in summary.json: "pair" or "exact".
 PD_API const char* pd_onsets_name(pdOnsets onsets);
 
