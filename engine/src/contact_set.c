@@ -12,7 +12,7 @@
 //     A new contact found deeper than the onset tolerance began inside the step: its onset fraction δ is
 //     interpolated (App. C) and the step retried to end there (t0 + δ·h); an onset within dt_min of the
 //     start makes it a virtual contact, added at t0 with its springs at 0 and the step restarted. With
-//     pd_onsetsPair (the default; README, "Contact onsets") a contact whose onset lies less than
+//     pd_onsetsPair (selectable; not the default: README, "Contact onsets") a contact whose onset lies less than
 //     PD_ONSET_PAIR_OMEGA_TAU / ω before the step's end (ω its undamped angular frequency) does not cut the step: the
 //     interpolation is applied to the pair alone at commit (start_late_contacts), so one onset does not send every body
 //     back.

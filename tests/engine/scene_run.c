@@ -44,7 +44,7 @@ static bool record_sample(const pdModel* model, const pdState* state, void* user
 record* run(const pdModel* model, pdState** stateOut) { return run_with(model, pd_stepperRK4Adaptive, stateOut); }
 
 record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut) {
-  return run_onsets(model, stepper, PD_ONSETS_DEFAULT, stateOut);
+  return run_onsets(model, stepper, pd_onsetsExact, stateOut);
 }
 
 record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdState** stateOut) {

@@ -25,7 +25,7 @@ pdModel* compile_text(const char* text);
 record* run(const pdModel* model, pdState** stateOut);
 // The same with the given stepper (run: the default, adaptive RK4 with step doubling).
 record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut);
-// The same with the given onset mode too (run_with: the default, PD_ONSETS_DEFAULT).
+// The same with the given onset mode too (run_with: pd_onsetsExact, the default).
 record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdState** stateOut);
 // The largest rise of the energy between any earlier and any later sample, relative to |E(0)|.
 double energy_gain(const record* r);

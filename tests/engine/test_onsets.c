@@ -1,7 +1,7 @@
 // Contact onsets (issue 16 item 5; README, "Contact onsets"): a contact that began inside a step either
 // cuts the whole step back to its onset (pd_onsetsExact) or, when it began within 1/ω of the step's end
 // and is still shallow, joins there with the motion its pair alone would have had since the onset
-// (pd_onsetsPair, the default). The pair mode must give the same closed forms as the exact one:
+// (pd_onsetsPair, selectable). The pair mode must give the same closed forms as the exact one:
 // - restitution of a cube landing face-first, at 24 heights (so that the onset falls anywhere in a step),
 //   within 0.01 of the requested e in both modes;
 // - the rest height of a cube dropped onto a floor: half its size less its static deflection m g/(4 k_s),

@@ -65,15 +65,15 @@ PD_API const char* pd_stepper_name(pdStepper stepper);
 
 // How a contact that began inside a step joins the list (paper App. C; README, "Contact onsets").
 typedef enum pdOnsets {
-  pd_onsetsExact,  // every onset found deeper than 1e-3 δ_max cuts the whole step back to it
-  pd_onsetsPair,   // default: a contact that began less than 1/ω before the step's end (ω of its pair) and is at
-                   // most ¼ δ_max deep joins there as if its pair had run alone since the onset (springs at that
+  pd_onsetsExact,  // default: every onset found deeper than 1e-3 δ_max cuts the whole step back to it
+  pd_onsetsPair,   // a contact that began less than 1/ω before the step's end (ω of its pair) and is at most
+                   // ¼ δ_max deep joins there as if its pair had run alone since the onset (springs at that
                    // deflection, the pair's impulse given to its two bodies); the step stands, so an onset in
                    // one corner of a pile does not send every body back. Others as pd_onsetsExact.
 } pdOnsets;
 
 // The onset mode of a new state (pd_state_reset) and of the commands' --onsets.
-#define PD_ONSETS_DEFAULT pd_onsetsPair
+#define PD_ONSETS_DEFAULT pd_onsetsExact
 
 // The onset mode's name in summary.json: "pair" or "exact".
 PD_API const char* pd_onsets_name(pdOnsets onsets);
@@ -98,7 +98,7 @@ typedef struct pdState {
   double t;          // s
   double h;          // next step to try, s
   pdStepper stepper;
-  pdOnsets onsets;   // how contacts that began inside a step join (PD_ONSETS_DEFAULT unless the caller sets it)
+  pdOnsets onsets;   // how contacts that began inside a step join (pd_onsetsExact unless the caller sets it)
   int n;             // length of y: 13 per moving body + 8 per active contact
   int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)
   double* y;         // (n) the state vector
@@ -126,7 +126,7 @@ typedef struct pdBodyState {
 // and be the model passed with it to every other call.
 PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to the adaptive one and onsets to PD_ONSETS_DEFAULT (set state->stepper, state->onsets after this call).
+// to the adaptive one and onsets to pd_onsetsExact (set state->stepper, state->onsets after this call).
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.
 PD_API void pd_state_free(pdState* state);
