@@ -84,7 +84,7 @@ int pd_cmd_run(int argc, char** argv) {
   pdCliOverrides overrides = {0};
   pdStepper stepper = pd_stepperRK4Adaptive;
   pdRefOptions ref = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
-  pdOnsets onsets = pd_onsetsExact;
+  pdOnsets onsets = PD_ONSETS_DEFAULT;
   pdIslands islands = pd_islandsOff;
   bool refOptionGiven = false, softOptionGiven = false;
   for (int i = 1; i < argc; ++i) {

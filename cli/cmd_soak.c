@@ -15,7 +15,7 @@
 
 static const char* const help =
     "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--engines soft,soft-islands,ode,bullet]\n"
-    "                    [--budget SECONDS] [--jobs N]\n"
+    "                    [--budget SECONDS] [--jobs N] [--onsets pair|exact]\n"
     "\n"
     "Generates N random scenes (campaign S: scene i is the same text on every machine) and runs each in\n"
     "every engine, in a child process per run, checking at every output sample: no NaN or Inf; for the soft\n"
@@ -33,6 +33,8 @@ static const char* const help =
     "  --engines LIST   soft, soft-islands (the soft engine with --islands on), ode, bullet (default soft)\n"
     "  --budget SECONDS wall-time budget of one run (default 20)\n"
     "  --jobs N         scenes in N worker processes (default 1; under mpirun or srun split over the ranks)\n"
+    "  --onsets MODE    soft engine: how a contact that began inside a step joins, pair or exact (default:\n"
+    "                   the engine's, as polydyn run --onsets; README \"Contact onsets\")\n"
     "\n"
     "Exit status: 0 no failure, 1 a run failed (or the results could not be written), 2 bad input,\n"
     "130 interrupted (nothing written).\n";
@@ -46,6 +48,7 @@ typedef struct soakJob {
   const char* engines[ENGINES_MAX];
   int engineCount;
   double budget;
+  pdOnsets onsets;  // the soft engine's
 } soakJob;
 
 static void soak_task(int task, pdBatchBuffer* result, void* user) {
@@ -53,7 +56,7 @@ static void soak_task(int task, pdBatchBuffer* result, void* user) {
   pdSoakScene scene = pd_soak_scene(job->seed, job->first + task);
   for (int e = 0; e < job->engineCount; ++e) {
     pdSoakResult r;
-    pd_soak_run(&scene, job->engines[e], job->budget, &r);
+    pd_soak_run(&scene, job->engines[e], job->onsets, job->budget, &r);
     pd_batch_append(result, &r, sizeof r);
   }
   pd_soak_scene_free(&scene);
@@ -80,7 +83,7 @@ static void csv_text(FILE* out, const char* s) {
 }
 
 // The scene file of a run that did not pass: the scene, headed by what happened.
-static bool write_scene_file(const char* dir, const char* sub, long index, const char* engine,
+static bool write_scene_file(const char* dir, const char* sub, long index, const char* engine, pdOnsets onsets,
                              const pdSoakScene* scene, const pdSoakResult* r) {
   char path[8192];
   snprintf(path, sizeof path, "%s/%s", dir, sub);
@@ -88,15 +91,16 @@ static bool write_scene_file(const char* dir, const char* sub, long index, const
   snprintf(path, sizeof path, "%s/%s/%06ld-%s.scene", dir, sub, index, engine);
   FILE* f = fopen(path, "w");
   if (!f) return false;
-  bool islands = strcmp(engine, "soft-islands") == 0;
-  fprintf(f, "# %s: %s\n# replay: polydyn run %06ld-%s.scene --engine %s\n%s", pdSoakStatusNames[r->status], r->message,
-          index, engine, islands ? "soft --islands on" : engine, scene->text);
+  bool islands = strcmp(engine, "soft-islands") == 0, soft = islands || strcmp(engine, "soft") == 0;
+  fprintf(f, "# %s: %s\n# replay: polydyn run %06ld-%s.scene --engine %s%s%s%s\n%s", pdSoakStatusNames[r->status],
+          r->message, index, engine, soft ? "soft" : engine, islands ? " --islands on" : "", soft ? " --onsets " : "",
+          soft ? pd_onsets_name(onsets) : "", scene->text);
   bool ok = !ferror(f);
   return fclose(f) == 0 && ok;
 }
 
 int pd_cmd_soak(int argc, char** argv) {
-  soakJob job = {.seed = 1, .budget = 20.0};
+  soakJob job = {.seed = 1, .budget = 20.0, .onsets = PD_ONSETS_DEFAULT};
   long scenes = 100;
   int jobs = 0;
   const char* out = NULL;
@@ -131,6 +135,13 @@ int pd_cmd_soak(int argc, char** argv) {
     } else if (strcmp(a, "--budget") == 0) {
       if (!pd_cli_positive(v, &job.budget) || job.budget > 86400)
         return pd_cli_usage_error("soak", "--budget needs seconds > 0 (at most a day)");
+    } else if (strcmp(a, "--onsets") == 0) {
+      if (strcmp(v, "pair") == 0)
+        job.onsets = pd_onsetsPair;
+      else if (strcmp(v, "exact") == 0)
+        job.onsets = pd_onsetsExact;
+      else
+        return pd_cli_usage_error("soak", "--onsets must be pair or exact");
     } else if (strcmp(a, "--jobs") == 0) {
       if (!pd_cli_jobs(v, &jobs))
         return pd_cli_usage_error("soak", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);
@@ -208,8 +219,10 @@ int pd_cmd_soak(int argc, char** argv) {
                 r.simulated, r.steps, r.penetration, r.energyGain, r.momentumError);
         csv_text(csv, r.message);
         fputc('\n', csv);
-        if (r.status == pd_soakFailed) ok = write_scene_file(tmp, "failures", index, job.engines[e], &scene, &r);
-        if (r.status == pd_soakOverBudget) ok = write_scene_file(tmp, "over-budget", index, job.engines[e], &scene, &r);
+        if (r.status == pd_soakFailed)
+          ok = write_scene_file(tmp, "failures", index, job.engines[e], job.onsets, &scene, &r);
+        if (r.status == pd_soakOverBudget)
+          ok = write_scene_file(tmp, "over-budget", index, job.engines[e], job.onsets, &scene, &r);
         if (r.status == pd_soakFailed) {
           status = PD_EXIT_FAILURE;
           printf("FAILED scene %ld (%s) in %s: %s\n", index, pdSoakKindNames[scene.kind], job.engines[e], r.message);

@@ -353,7 +353,7 @@ static bool observe(const pdModel* m, const pdState* s, void* user) {
 }
 
 // The run itself (in the child process).
-static void run_here(const pdSoakScene* scene, const char* engine, double budget, pdSoakResult* o) {
+static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budget, pdSoakResult* o) {
   pdError err = {0};
   pdScene* parsed = pd_scene_parse_buffer("soak.scene", scene->text, strlen(scene->text), &err);
   pdModel* m = parsed ? pd_model_compile(parsed, &err) : NULL;
@@ -376,6 +376,7 @@ static void run_here(const pdSoakScene* scene, const char* engine, double budget
   if (soft) {
     pdState* s = pd_state_create(m);
     if (strcmp(engine, "soft-islands") == 0) s->islands = pd_islandsOn;
+    s->onsets = onsets;
     completed = pd_advance(m, s, m->settings.tend, observe, &w);
     completed = completed && !s->failed;
     o->steps = s->count.accepted;
@@ -432,7 +433,8 @@ static void run_here(const pdSoakScene* scene, const char* engine, double budget
 // A hard limit over the budget (the observer sees only samples: one sample interval may not end).
 #define SOAK_HARD_LIMIT_FACTOR 3.0
 
-void pd_soak_run(const pdSoakScene* scene, const char* engine, double budgetSeconds, pdSoakResult* out) {
+void pd_soak_run(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budgetSeconds,
+                 pdSoakResult* out) {
   memset(out, 0, sizeof *out);
   int fds[2];
   if (pipe(fds) != 0) {
@@ -455,7 +457,7 @@ void pd_soak_run(const pdSoakScene* scene, const char* engine, double budgetSeco
     alarm((unsigned)ceil(SOAK_HARD_LIMIT_FACTOR * budgetSeconds + 1.0));
     pdSoakResult r;
     memset(&r, 0, sizeof r);
-    run_here(scene, engine, budgetSeconds, &r);
+    run_here(scene, engine, onsets, budgetSeconds, &r);
     const char* p = (const char*)&r;
     size_t left = sizeof r;
     while (left > 0) {

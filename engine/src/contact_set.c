@@ -28,6 +28,14 @@
 // springs at that deflection x and the two bodies given the impulse of those τ seconds (normal, and the
 // friction cone's when they slide), so its energy and phase are its own and its rest point sits d − x ≈
 // d (ωτ)²/6 deeper (d the depth reached without it).
+// A slip at the rounding of Δu (PD_ONSET_PAIR_SLIP_REL) counts as none. A flush stack (equal faces, edges
+// aligned) stays at rest only while it is exactly symmetric: its vertices sit on the edges below, and any offset
+// makes corner contacts come and go one corner at a time (vertex-face off the face, edge-edge off the edge, side
+// faces found); in soak seed 1 scene 147 one box set 1e-12 m aside makes another sink 60 δ_max in exact mode.
+// No contact force breaks that symmetry, but friction along the rounding of a slip did: four corners re-landing
+// at 17.8 ms had 8.7e-19 m/s of "slip" at 2.8e-3 m/s and got tangential impulses of ±6e-24 N·s; at 31 ms
+// edge-edge contacts appeared on the corners' vertex-face ones (exact mode never has them), at 50 ms three of
+// each pair's four broke under 0.5-15 N while the fourth held, and the stack fell apart (43 δ_max).
 #include "contact_set.h"
 
 #include <math.h>
@@ -61,6 +69,10 @@
 // spinning sliver's contacts, found up to 2 δ_max deep (the travel guard's bound), joined with their rest
 // points δ_max down (soak seed 1 scene 7: 4.0 δ_max of overlap).
 #define PD_ONSET_PAIR_DEPTH_REL 0.25
+// A pair onset's slip below this fraction of |Δu| at its point is none: removing the normal part leaves ~1e-16
+// |Δu| of rounding whose direction is noise, and friction along it breaks a flush stack's symmetry (design
+// note: soak seed 1 scene 147). The friction so dropped is at most 1e-9 m |Δu|.
+#define PD_ONSET_PAIR_SLIP_REL 1e-9
 // Steps containing a stick/slip change are halved down to this fraction of the shortest
 // contact period: the event is then located to ~5 % of the contact's own time scale. 1 % changed no
 // Gedanken result by more than 1e-4 of its tolerance and cost a pile of 10 boxes 27 % more derivative
@@ -724,6 +736,7 @@ static int start_late_contacts(const pdModel* model, pdContactSet* set, double* 
     double approach = -pd_v3_dot(du, n);
     pdVec3 slip = pd_v3_sub(du, pd_v3_scale(n, -approach));  // tangential relative velocity
     double slipSpeed = pd_v3_norm(slip);
+    if (slipSpeed <= PD_ONSET_PAIR_SLIP_REL * pd_v3_norm(du)) slipSpeed = 0.0;  // rounding, not slip
     c->onsetImpulse = (pdVec3){0, 0, 0};
     double mass = c->modalMass > 0.0 && isfinite(c->modalMass) ? c->modalMass : point_mass(model, set, poses, c);
     if (isfinite(mass) && approach > 0.0 && k > 0.0) {

@@ -28,7 +28,7 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   s->n = PD_BODY_STATE_SIZE * model->movingCount;
   pd_contact_set_clear(s->contacts);
   s->stepper = pd_stepperRK4Adaptive;
-  s->onsets = pd_onsetsExact;
+  s->onsets = PD_ONSETS_DEFAULT;
   s->islands = pd_islandsOff;
   pd_island_set_free(s->islandSet);
   s->islandSet = NULL;

@@ -7,7 +7,7 @@
 #   engine; the same command again gives the same rows but the measured times (scene i of campaign S is a
 #   function of S and i alone, and the runs are deterministic);
 # - regressions the soak found and that are fixed (README, Reliability): seed 2 scene 2945 (a stack of eight
-#   flush boxes sank 29 delta_max), seed 1 scenes 4, 7, 19 (inside the campaign: a sliver's sharp rim pressed
+#   flush boxes sank 29 delta_max), seed 1 scene 147 with --onsets pair (seven flush boxes fell apart), seed 1 scenes 4, 7, 19 (inside the campaign: a sliver's sharp rim pressed
 #   into a box found no edge-edge contact), seed 3 scene 1779 (such a sharp edge's pair was pruned before the
 #   contact search looked at it: two bodies sank 15 delta_max with no contact), seed 3 scenes 1931, 2429, 2707,
 #   8264 and seed 4 scene 325 (plates 0.4-0.9 delta_max thick, whose springs let vertices through them);
@@ -42,6 +42,10 @@ check "the same rows but the measured times" \
 run_pd "$SCRATCH/stack.out" "$SCRATCH/stack.err" soak --seed 2 --first 2945 --scenes 1 --budget "$BUDGET" --out "$SCRATCH/stack"
 check "regression: seed 2 scene 2945 (flush stack) passes" '[ $rc -eq 0 ] && grep -q "^2,2945,stack,.*,soft,ok," "$SCRATCH/stack/summary.csv"'
 
+# seven flush boxes at rest, which pair onsets toppled by friction along a slip of rounding (contact_set.c)
+run_pd "$SCRATCH/flush.out" "$SCRATCH/flush.err" soak --seed 1 --first 147 --scenes 1 --onsets pair --budget "$BUDGET" --out "$SCRATCH/flush"
+check "regression: seed 1 scene 147 (flush stack) passes with pair onsets" '[ $rc -eq 0 ] && grep -q "^1,147,stack,.*,soft,ok," "$SCRATCH/flush/summary.csv"'
+
 run_pd "$SCRATCH/edge.out" "$SCRATCH/edge.err" soak --seed 3 --first 1779 --scenes 1 --budget "$BUDGET" --out "$SCRATCH/edge"
 check "regression: seed 3 scene 1779 (a sharp edge's pair pruned unseen) passes" '[ $rc -eq 0 ] && grep -q "^3,1779,free,.*,soft,ok," "$SCRATCH/edge/summary.csv"'
 
@@ -61,7 +65,7 @@ check "over budget: it says why" 'head -1 "$SCRATCH/budget/over-budget/000013-so
 run_pd "$SCRATCH/replay.out" "$SCRATCH/replay.err" run "$SCRATCH/budget/over-budget/000013-soft.scene" --out "$SCRATCH/replay"
 check "over budget: the scene replays with polydyn run" '[ $rc -eq 0 ] && [ -f "$SCRATCH/replay/trajectory.csv" ]'
 
-for bad in "--scenes 0" "--scenes x" "--seed -1" "--engines soft,box" "--engines soft,soft" "--budget 0" "--jobs 0" "--frobnicate 1"; do
+for bad in "--scenes 0" "--scenes x" "--seed -1" "--engines soft,box" "--engines soft,soft" "--budget 0" "--jobs 0" "--onsets late" "--frobnicate 1"; do
   # shellcheck disable=SC2086
   run_pd "$SCRATCH/bad.out" "$SCRATCH/bad.err" soak $bad --out "$SCRATCH/bad"
   check "bad argument '$bad': exit 2 with a message, nothing written" \

@@ -74,6 +74,9 @@ typedef enum pdOnsets {
                    // one corner of a pile does not send every body back. Others as pd_onsetsExact.
 } pdOnsets;
 
+// The onset mode of a new state (pd_state_reset) and of the commands' --onsets.
+#define PD_ONSETS_DEFAULT pd_onsetsExact
+
 // The onset mode's name in summary.json: "pair" or "exact".
 PD_API const char* pd_onsets_name(pdOnsets onsets);
 
@@ -115,7 +118,7 @@ typedef struct pdState {
   double t;          // s
   double h;          // next step to try, s
   pdStepper stepper;
-  pdOnsets onsets;   // how contacts that began inside a step join (pd_onsetsExact unless the caller sets it)
+  pdOnsets onsets;   // how contacts that began inside a step join (PD_ONSETS_DEFAULT unless the caller sets it)
   pdIslands islands;  // one system or islands (pd_islandsOff unless the caller sets it)
   int n;             // length of y: 13 per moving body + 8 per active contact
   int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)
@@ -145,7 +148,7 @@ typedef struct pdBodyState {
 // and be the model passed with it to every other call.
 PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to the adaptive one, onsets to pd_onsetsExact and islands to pd_islandsOff (set state->stepper,
+// to the adaptive one, onsets to PD_ONSETS_DEFAULT and islands to pd_islandsOff (set state->stepper,
 // state->onsets, state->islands after this call).
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.

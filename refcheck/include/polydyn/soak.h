@@ -17,6 +17,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "polydyn/state.h"
+
 typedef enum pdSoakKind {
   pd_soakDrop,     // onto a fixed floor, from a loose grid, turned and moving
   pd_soakStack,    // set down touching on a floor, sometimes flush (equal widths, aligned)
@@ -76,5 +78,7 @@ typedef struct pdSoakResult {
 } pdSoakResult;
 
 // Runs the scene in `engine` ("soft", "ode", "bullet") in a child process with the wall-time budget and
-// checks the invariants. The result is filled in every case.
-void pd_soak_run(const pdSoakScene* scene, const char* engine, double budgetSeconds, pdSoakResult* out);
+// checks the invariants; the soft engine joins contact onsets as `onsets` says (README, "Contact onsets").
+// The result is filled in every case.
+void pd_soak_run(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budgetSeconds,
+                 pdSoakResult* out);
