@@ -15,7 +15,8 @@
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
     "                         [--stepper adaptive|fixed|embedded] [--variant native|matched]\n"
-    "                         [--onsets pair|exact] [--step H] [--ode-friction pyramid|aligned]\n"
+    "                         [--onsets pair|exact] [--islands on|off] [--step H]\n"
+    "                         [--ode-friction pyramid|aligned]\n"
     "\n"
     "Simulates SCENE and writes DIR/trajectory.csv and DIR/summary.json. DIR is written under a\n"
     "temporary name and renamed when complete; an existing run directory DIR is replaced.\n"
@@ -31,6 +32,9 @@ static const char* const help =
     "  --onsets MODE    soft engine, a contact that began inside a step: exact (default) cuts the whole\n"
     "                   step back to its onset; pair joins it at the step's end, run for that pair alone\n"
     "                   since its onset, when it began within 1/omega and is shallow (README \"Contact onsets\")\n"
+    "  --islands on|off soft engine: off (default) advances all bodies with one step size; on splits them\n"
+    "                   between output samples into islands (bodies in contact or whose boxes may meet\n"
+    "                   before the next sample), each with its own steps and contact events (README \"Islands\")\n"
     "  --variant NAME   ode, bullet: native (the engine's own hard contact, default) or matched (its\n"
     "                   soft contact set to polydyn's k and c)\n"
     "  --step H         ode, bullet: the fixed step, s (default 1e-3)\n"
@@ -81,6 +85,7 @@ int pd_cmd_run(int argc, char** argv) {
   pdStepper stepper = pd_stepperRK4Adaptive;
   pdRefOptions ref = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
   pdOnsets onsets = PD_ONSETS_DEFAULT;
+  pdIslands islands = pd_islandsOff;
   bool refOptionGiven = false, softOptionGiven = false;
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
@@ -90,7 +95,8 @@ int pd_cmd_run(int argc, char** argv) {
       return PD_EXIT_OK;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--engine") == 0 || strcmp(a, "--tend") == 0 ||
                strcmp(a, "--sample") == 0 || strcmp(a, "--stepper") == 0 || strcmp(a, "--variant") == 0 ||
-               strcmp(a, "--step") == 0 || strcmp(a, "--ode-friction") == 0 || strcmp(a, "--onsets") == 0) {
+               strcmp(a, "--step") == 0 || strcmp(a, "--ode-friction") == 0 || strcmp(a, "--onsets") == 0 ||
+               strcmp(a, "--islands") == 0) {
       if (!hasValue) return pd_cli_usage_error("run", "%s needs a value", a);
       const char* v = argv[++i];
       if (strcmp(a, "--out") == 0) {
@@ -114,6 +120,14 @@ int pd_cmd_run(int argc, char** argv) {
           onsets = pd_onsetsExact;
         else
           return pd_cli_usage_error("run", "--onsets must be pair or exact");
+      } else if (strcmp(a, "--islands") == 0) {
+        softOptionGiven = true;
+        if (strcmp(v, "on") == 0)
+          islands = pd_islandsOn;
+        else if (strcmp(v, "off") == 0)
+          islands = pd_islandsOff;
+        else
+          return pd_cli_usage_error("run", "--islands must be on or off, not '%s'", v);
       } else if (strcmp(a, "--variant") == 0) {
         refOptionGiven = true;
         if (strcmp(v, "native") == 0) ref.variant = pd_refNative;
@@ -151,7 +165,8 @@ int pd_cmd_run(int argc, char** argv) {
   bool soft = strcmp(engine, "soft") == 0;
   if (soft && refOptionGiven)
     return pd_cli_usage_error("run", "--variant, --step and --ode-friction are for --engine ode or bullet");
-  if (!soft && softOptionGiven) return pd_cli_usage_error("run", "--stepper and --onsets are for the soft engine");
+  if (!soft && softOptionGiven)
+    return pd_cli_usage_error("run", "--stepper, --onsets and --islands are for the soft engine");
   if (strcmp(engine, "bullet") == 0 && ref.odeFriction != pd_odeFrictionPyramid)
     return pd_cli_usage_error("run", "--ode-friction is for --engine ode");
   if (pd_cli_parse_only) return PD_EXIT_OK;
@@ -206,6 +221,7 @@ int pd_cmd_run(int argc, char** argv) {
   pdState* state = pd_state_create(model);
   state->stepper = stepper;
   state->onsets = onsets;
+  state->islands = islands;
   runObserver observer = {writer, isatty(STDERR_FILENO) == 1, pd_cli_wall_seconds()};
   double energyStart = pd_state_energy(model, state);
   double t0 = pd_cli_wall_seconds();

@@ -14,7 +14,7 @@
 #include "polydyn/soak.h"
 
 static const char* const help =
-    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--engines soft,ode,bullet]\n"
+    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--engines soft,soft-islands,ode,bullet]\n"
     "                    [--budget SECONDS] [--jobs N] [--onsets pair|exact]\n"
     "\n"
     "Generates N random scenes (campaign S: scene i is the same text on every machine) and runs each in\n"
@@ -30,7 +30,7 @@ static const char* const help =
     "  --scenes N       how many scenes (default 100)\n"
     "  --seed S         the campaign (default 1)\n"
     "  --first I        start at scene I (default 0): scenes I .. I+N-1\n"
-    "  --engines LIST   soft, ode, bullet (default soft)\n"
+    "  --engines LIST   soft, soft-islands (the soft engine with --islands on), ode, bullet (default soft)\n"
     "  --budget SECONDS wall-time budget of one run (default 20)\n"
     "  --jobs N         scenes in N worker processes (default 1; under mpirun or srun split over the ranks)\n"
     "  --onsets MODE    soft engine: how a contact that began inside a step joins, pair or exact (default:\n"
@@ -39,8 +39,8 @@ static const char* const help =
     "Exit status: 0 no failure, 1 a run failed (or the results could not be written), 2 bad input,\n"
     "130 interrupted (nothing written).\n";
 
-enum { ENGINES_MAX = 3 };
-static const char* const engineNames[ENGINES_MAX] = {"soft", "ode", "bullet"};
+enum { ENGINES_MAX = 4 };
+static const char* const engineNames[ENGINES_MAX] = {"soft", "soft-islands", "ode", "bullet"};
 
 typedef struct soakJob {
   unsigned long seed;
@@ -91,9 +91,10 @@ static bool write_scene_file(const char* dir, const char* sub, long index, const
   snprintf(path, sizeof path, "%s/%s/%06ld-%s.scene", dir, sub, index, engine);
   FILE* f = fopen(path, "w");
   if (!f) return false;
-  bool soft = strcmp(engine, "soft") == 0;
-  fprintf(f, "# %s: %s\n# replay: polydyn run %06ld-%s.scene --engine %s%s%s\n%s", pdSoakStatusNames[r->status],
-          r->message, index, engine, engine, soft ? " --onsets " : "", soft ? pd_onsets_name(onsets) : "", scene->text);
+  bool islands = strcmp(engine, "soft-islands") == 0, soft = islands || strcmp(engine, "soft") == 0;
+  fprintf(f, "# %s: %s\n# replay: polydyn run %06ld-%s.scene --engine %s%s%s%s\n%s", pdSoakStatusNames[r->status],
+          r->message, index, engine, soft ? "soft" : engine, islands ? " --islands on" : "", soft ? " --onsets " : "",
+          soft ? pd_onsets_name(onsets) : "", scene->text);
   bool ok = !ferror(f);
   return fclose(f) == 0 && ok;
 }
@@ -231,12 +232,12 @@ int pd_cmd_soak(int argc, char** argv) {
     }
     if (csv) ok = !ferror(csv) && fclose(csv) == 0 && ok;
     printf("polydyn soak: seed %lu, scenes %ld .. %ld\n", job.seed, job.first, job.first + scenes - 1);
-    printf("%-8s %8s %8s %12s %8s %10s\n", "engine", "ok", "refused", "over-budget", "failed", "not-built");
+    printf("%-12s %8s %8s %12s %8s %10s\n", "engine", "ok", "refused", "over-budget", "failed", "not-built");
     for (int e = 0; e < ENGINES_MAX; ++e) {
       bool used = false;
       for (int k = 0; k < job.engineCount; ++k) used = used || job.engines[k] == engineNames[e];
       if (!used) continue;
-      printf("%-8s %8ld %8ld %12ld %8ld %10ld\n", engineNames[e], counts[e][pd_soakOk], counts[e][pd_soakRefused],
+      printf("%-12s %8ld %8ld %12ld %8ld %10ld\n", engineNames[e], counts[e][pd_soakOk], counts[e][pd_soakRefused],
              counts[e][pd_soakOverBudget], counts[e][pd_soakFailed], counts[e][pd_soakNotBuilt]);
     }
     printf("%s by kind (%s):", job.engines[0], "ok/refused/over-budget/failed");

@@ -372,8 +372,10 @@ static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onse
   }
   watch w = {.scene = scene, .budget = budget, .wall0 = now(), .out = o};
   bool completed = false;
-  if (strcmp(engine, "soft") == 0) {
+  bool soft = strcmp(engine, "soft") == 0 || strcmp(engine, "soft-islands") == 0;
+  if (soft) {
     pdState* s = pd_state_create(m);
+    if (strcmp(engine, "soft-islands") == 0) s->islands = pd_islandsOn;
     s->onsets = onsets;
     completed = pd_advance(m, s, m->settings.tend, observe, &w);
     completed = completed && !s->failed;
@@ -403,7 +405,6 @@ static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onse
       snprintf(w.broke, sizeof w.broke, "%.180s", err.message[0] ? err.message : "the engine produced a non-finite state");
   }
   o->wallSeconds = now() - w.wall0;
-  bool soft = strcmp(engine, "soft") == 0;
   if (w.nonFinite) snprintf(w.broke, sizeof w.broke, "a non-finite number at t = %.6g s", o->simulated);
   // the invariants of the soft model (the reference engines' rigid contacts are shown, not judged)
   if (!w.broke[0] && soft && o->penetration > PD_SOAK_PENETRATION_LIMIT)

@@ -1132,3 +1132,69 @@ pdContactReport pd_state_contact(const pdState* s, int i) {
   r.slip = c->force.slip;
   return r;
 }
+
+// ---------------------------------------------------------------- islands (islands.c)
+
+void pd_contact_set_bodies(const pdContactSet* set, int i, int* body1, int* body2) {
+  PD_ASSERT(i >= 0 && i < set->count);
+  *body1 = set->items[i].id.body1;
+  *body2 = set->items[i].id.body2;
+}
+
+static int remap_body(const int* map, int body) {
+  int mapped = map[body];
+  PD_ASSERT(mapped >= 0);
+  return mapped;
+}
+
+void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int* contacts, int count,
+                            const pdModel* sub, pdState* to, const int* toSub) {
+  pdContactSet* set = to->contacts;
+  const pdContactSet* src = from->contacts;
+  int base = spring_base(model);
+  reserve_list(set, count);
+  for (int k = 0; k < count; ++k) {
+    int i = contacts[k];
+    PD_ASSERT(i >= 0 && i < src->count);
+    contactSlot c = src->items[i];
+    c.id.body1 = remap_body(toSub, c.id.body1);
+    c.id.body2 = remap_body(toSub, c.id.body2);
+    c.springs = springs_load(from->y + base + PD_CONTACT_STATE_SIZE * i);
+    set->next[k] = c;
+  }
+  set->candidateCount = 0;
+  set->onsetRetries = 0;
+  install(sub, to, count);
+  // what prepare_list derives from the bodies' poses; the slots (modal dampers, forces) come as they were
+  poses_from(sub, to->y, set->poses1);
+  for (int k = 0; k < sub->movingCount; ++k) {
+    int i = sub->movingBodies[k];
+    pdMat3 rt = pd_mat3_transpose(&set->poses1[i].R);
+    pdMat3 tmp = pd_mat3_mul(&sub->bodies[i].invInertia, &rt);
+    set->invInertiaWorld[i] = pd_mat3_mul(&set->poses1[i].R, &tmp);
+  }
+  stability_prepare(sub, set, set->poses1);
+}
+
+void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const pdModel* const* subs,
+                           const pdState* const* from, const int* const* toModel) {
+  pdContactSet* set = to->contacts;
+  int total = 0;
+  for (int p = 0; p < parts; ++p) total += from[p]->contacts->count;
+  reserve_list(set, total);
+  int count = 0;
+  for (int p = 0; p < parts; ++p) {
+    const pdContactSet* src = from[p]->contacts;
+    int base = spring_base(subs[p]);
+    for (int i = 0; i < src->count; ++i) {
+      contactSlot c = src->items[i];
+      c.id.body1 = toModel[p][c.id.body1];
+      c.id.body2 = toModel[p][c.id.body2];
+      c.springs = springs_load(from[p]->y + base + PD_CONTACT_STATE_SIZE * i);
+      set->next[count++] = c;
+    }
+  }
+  set->candidateCount = 0;
+  set->onsetRetries = 0;
+  install(model, to, count);  // sorted by id: the order of the parts does not matter
+}

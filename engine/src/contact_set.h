@@ -61,5 +61,23 @@ double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double
 // Grows the state's y, weight and work to hold `contacts` contacts (between steps only).
 void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contacts);
 
+// ---------------------------------------------------------------- islands (islands.c)
+// An island's state runs over a model of some of the scene's bodies (its moving bodies and every fixed body,
+// in scene order, so a contact's id orders the same in both); contacts move between the scene's state and
+// the islands' states at output samples only.
+
+// The bodies of contact i of the list (model body indices).
+void pd_contact_set_bodies(const pdContactSet* set, int i, int* body1, int* body2);
+// Makes contacts[0 .. count) of `from` (a state of `model`, in list order) the contact list of `to` (a state
+// of `sub`, whose body numbers are already in to->y): their ids remapped by toSub (model body → sub body, every
+// body of these contacts mapped), their springs, forces and dampers as they are in `from`. Grows `to`.
+void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int* contacts, int count,
+                            const pdModel* sub, pdState* to, const int* toSub);
+// Makes the union of the contact lists of from[0 .. parts) (states of subs[p], ids remapped by toModel[p]:
+// sub body → model body) the contact list of `to`, a state of `model`, sorted by id; the springs go into to->y
+// after the bodies' numbers, which the caller copies. Grows `to`.
+void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const pdModel* const* subs,
+                           const pdState* const* from, const int* const* toModel);
+
 // Spring energy ½ Σ k s² of the contacts whose springs are in y (J).
 double pd_contact_spring_energy(const pdContactSet* set, const double* y, int springBase);

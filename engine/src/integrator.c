@@ -33,6 +33,7 @@
 
 #include "clock.h"
 #include "contact_set.h"
+#include "islands.h"
 #include "polydyn/state.h"
 #include "state_layout.h"
 
@@ -239,6 +240,13 @@ static void observe(const pdModel* model, pdState* s, pdObserverFcn* observer, v
 
 bool pd_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
+  if (s->islands == pd_islandsOn) return pd_islands_advance(model, s, tEnd, observer, user);
+  return pd_advance_hooked(model, s, tEnd, observer, user, NULL, NULL);
+}
+
+bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user,
+                       pdStepHookFcn* hook, void* hookUser) {
+  PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
   if (s->failed) return false;
   s->stopped = false;
   // skip samples already behind us (a state advanced without an observer, then with one)
@@ -271,6 +279,7 @@ bool pd_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* ob
     double next = s->t + taken;
     bool lands = taken >= target - s->t || target - next <= TIME_SNAP_ULPS * DBL_EPSILON * fabs(target);
     s->t = lands ? target : next;
+    if (hook && taken > 0.0) hook(model, s, hookUser);
     if (s->t == tSample) observe(model, s, observer, user);
   }
   return !s->stopped;

@@ -19,3 +19,8 @@ double pd_model_contact_period_min(const pdModel* model);
 bool pd_model_build_materials(pdModel* model, const pdScene* scene, pdError* err);
 
 void pd_material_table_free(struct pdMaterialTable* table);
+
+// A table for a model made of some of `table`'s bodies (islands.c): body i of the new model is body bodies[i]
+// of the old (0 <= i < count), with its class and contact info; the classes, pair constants and adjustments
+// are shared with `table`, which must outlive the view. Freed by pd_material_table_free.
+struct pdMaterialTable* pd_material_table_view(const struct pdMaterialTable* table, const int* bodies, int count);

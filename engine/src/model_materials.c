@@ -47,12 +47,17 @@ struct pdMaterialTable {
   pdAdjustment* adj;          // (adjCount)
   int adjCount;
   int adjDropped;
+  bool view;  // a view of another table (pd_material_table_view): only info and classOf are its own
 };
 
 void pd_material_table_free(struct pdMaterialTable* t) {
   if (!t) return;
   free(t->info);
   free(t->classOf);
+  if (t->view) {
+    free(t);
+    return;
+  }
   free(t->classSide);
   free(t->classFirst);
   free(t->classSize);
@@ -254,6 +259,24 @@ bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
   }
   free(sides);
   return true;
+}
+
+// ---------------------------------------------------------------- views
+
+struct pdMaterialTable* pd_material_table_view(const struct pdMaterialTable* t, const int* bodies, int count) {
+  struct pdMaterialTable* v = calloc(1, sizeof *v);
+  PD_ASSERT(v != NULL);
+  *v = *t;  // classes, pair constants and adjustments shared: bodies keep their class
+  v->view = true;
+  v->bodyCount = count;
+  v->info = alloc_array((size_t)(count > 0 ? count : 1), sizeof *v->info);
+  v->classOf = alloc_array((size_t)(count > 0 ? count : 1), sizeof *v->classOf);
+  for (int i = 0; i < count; ++i) {
+    PD_ASSERT(bodies[i] >= 0 && bodies[i] < t->bodyCount);
+    v->info[i] = t->info[bodies[i]];
+    v->classOf[i] = t->classOf[bodies[i]];
+  }
+  return v;
 }
 
 // ---------------------------------------------------------------- queries

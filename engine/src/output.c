@@ -373,6 +373,8 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   if (!info->stepper) {  // the soft engine's own state: how contacts that begin inside a step join
     fputs(",\n  \"onsets\": ", out);
     write_json_string(out, pd_onsets_name(state->onsets));
+    fputs(",\n  \"islands\": ", out);
+    write_json_string(out, pd_islands_name(state->islands));
   }
   fputs(",\n", out);
   if (info->engineSettingsJson) fprintf(out, "  \"engine_settings\": %s,\n", info->engineSettingsJson);
@@ -419,6 +421,12 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
           state->count.refinements, state->count.contactsMade, state->count.contactsVirtual,
           state->count.contactsTransferred, state->count.breaksForce, state->count.breaksGeometry,
           pd_state_contact_count(state));
+  if (state->islands == pd_islandsOn)
+    fprintf(out,
+            "  \"island_counts\": {\"islands_formed\": %ld, \"largest_island\": %ld, \"island_intervals\": %ld, "
+            "\"island_redos\": %ld, \"island_strays\": %ld},\n",
+            state->count.islandsFormed, state->count.islandsLargest, state->count.islandIntervals,
+            state->count.islandRedos, state->count.islandStrays);
   fputs("  \"warnings\": {", out);
   for (int w = 0; w < pd_warnCount; ++w) fprintf(out, "%s\"%s\": %ld", w ? ", " : "", pdWarningNames[w], state->warnings[w]);
   fputs("},\n  \"t_reached\": ", out);

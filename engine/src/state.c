@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "contact_set.h"
+#include "islands.h"
 #include "state_layout.h"
 
 const char* const pdStageNames[pd_stageCount] = {"broad_phase", "interference", "contact_analysis", "forces",
@@ -28,6 +29,9 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   pd_contact_set_clear(s->contacts);
   s->stepper = pd_stepperRK4Adaptive;
   s->onsets = PD_ONSETS_DEFAULT;
+  s->islands = pd_islandsOff;
+  pd_island_set_free(s->islandSet);
+  s->islandSet = NULL;
   s->nextSample = 0;
   s->failed = false;
   s->stopped = false;
@@ -57,6 +61,7 @@ void pd_state_free(pdState* s) {
   free(s->weight);
   free(s->work);
   pd_contact_set_free(s->contacts);
+  pd_island_set_free(s->islandSet);
   free(s);
 }
 
@@ -92,3 +97,5 @@ const char* pd_stepper_name(pdStepper stepper) {
 }
 
 const char* pd_onsets_name(pdOnsets onsets) { return onsets == pd_onsetsExact ? "exact" : "pair"; }
+
+const char* pd_islands_name(pdIslands islands) { return islands == pd_islandsOn ? "on" : "off"; }

@@ -143,7 +143,8 @@ check "--tend 0.5 --sample 10 gives 6 x 3 rows" '[ "$(line_count "$RUN3/trajecto
 TIMES="0 0.10000000000000001 0.20000000000000001 0.29999999999999999 0.40000000000000002 0.5 "
 sample_times() { tail -n +2 "$1" | cut -d, -f1 | uniq | tr "\n" " "; }
 check "samples at 0, 0.1, ..., 0.5" '[ "$(sample_times "$RUN3/trajectory.csv")" = "$TIMES" ]'
-for bad in "--tend abc" "--tend -1" "--tend nan" "--sample 0" "--tend"; do
+for bad in "--tend abc" "--tend -1" "--tend nan" "--sample 0" "--tend" "--islands maybe" "--islands" \
+  "--engine ode --islands on"; do
   dir=$SCRATCH/out_badopt
   # shellcheck disable=SC2086
   run_pd "$OUT" "$ERR" run "$DEMO" --out "$dir" $bad

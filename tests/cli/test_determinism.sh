@@ -5,8 +5,8 @@
 # of oracle's summary on stdout). The second run of each pair writes to a differently named directory and
 # runs with MALLOC_PERTURB_ set (glibc then fills fresh and freed heap memory with a pattern), so an output
 # that depends on where it is written or on uninitialised memory shows up. Covered here:
-#   run       demo.scene, a hard case (the 10-box stack), the brick wall (short), the pile of ten boxes; the
-#             pile in ODE and Bullet; demo with the fixed stepper and with the embedded pair
+#   run       demo.scene, a hard case (the 10-box stack), the brick wall (short), the pile of ten boxes (also
+#             with --islands on); the pile in ODE and Bullet; demo with the fixed stepper and with the embedded pair
 #   check     the pile
 #   oracle    --random, a SCENE, --replay (its CSV and its summary)
 #   soak      --jobs 1 against --jobs 2, in the three engines
@@ -63,11 +63,12 @@ twice run_demo run "$SRC/cases/examples/demo.scene"
 twice run_stack run "$SRC/cases/hard/stack_10.scene"
 [ "$QUICK" = quick ] || twice run_bricks run "$SRC/cases/hard/brick_bond.scene" --tend $TEND_BRICKS
 twice run_pile run "$SRC/cases/sweep/pile_10.scene" --tend $TEND_PILE
+twice run_pile_islands run "$SRC/cases/sweep/pile_10.scene" --tend $TEND_PILE --islands on
 twice run_pile_ode run "$SRC/cases/sweep/pile_10.scene" --tend $TEND_PILE --engine ode
 twice run_pile_bullet run "$SRC/cases/sweep/pile_10.scene" --tend $TEND_PILE --engine bullet
 twice run_demo_fixed run "$SRC/cases/examples/demo.scene" --stepper fixed --tend 1
 twice run_demo_embedded run "$SRC/cases/examples/demo.scene" --stepper embedded --tend 1
-for R in run_demo run_stack run_bricks run_pile run_pile_ode run_pile_bullet run_demo_fixed run_demo_embedded; do
+for R in run_demo run_stack run_bricks run_pile run_pile_islands run_pile_ode run_pile_bullet run_demo_fixed run_demo_embedded; do
   [ -d "$SCRATCH/$R" ] || continue
   check "$R: trajectory.csv byte for byte" 'cmp -s "$SCRATCH/$R/first/trajectory.csv" "$SCRATCH/$R/second-run/trajectory.csv"'
   same_dirs $R

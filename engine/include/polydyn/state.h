@@ -13,8 +13,10 @@
 //
 // Reading a state: t, count, warnings, failed and stopped directly; poses with pd_state_body, contacts with
 // pd_state_contact_count and pd_state_contact (not from y, whose layout is internal to the stepper). The
-// fields are written by pd_advance and pd_state_reset; a caller writes only `stepper`, `onsets` (and `h`, the
-// first step to try), between pd_state_create or pd_state_reset and the first pd_advance.
+// fields are written by pd_advance and pd_state_reset; a caller writes only `stepper`, `onsets`, `islands` (and
+// `h`, the first step to try), between pd_state_create or pd_state_reset and the first pd_advance. With
+// pd_islandsOn, y, n and the contact list are those of the whole scene at every output sample (in the observer
+// and after pd_advance returns); between samples each island advances in a state of its own.
 //
 // Memory: pd_state_create allocates everything a step needs. A step never allocates; between two steps,
 // pd_advance grows the state's vectors (doubling) only when the contact list outgrows them.
@@ -78,6 +80,17 @@ typedef enum pdOnsets {
 // The onset mode's name in summary.json: "pair" or "exact".
 PD_API const char* pd_onsets_name(pdOnsets onsets);
 
+// Whether the moving bodies advance as one system or as islands (engine/src/islands.c; README, "Islands").
+typedef enum pdIslands {
+  pd_islandsOff,  // default: one state vector, one step size, every onset cuts every body's step
+  pd_islandsOn,   // between output samples, bodies joined by a contact or whose boxes, grown by how far they
+                  // can travel before the next sample, overlap form an island; each island takes its own
+                  // steps, error norm and contact events. Output at the common sample times.
+} pdIslands;
+
+// The island mode's name in summary.json: "on" or "off".
+PD_API const char* pd_islands_name(pdIslands islands);
+
 typedef struct pdCounters {
   long accepted;     // accepted steps
   long rejected;     // rejected trial steps
@@ -92,19 +105,28 @@ typedef struct pdCounters {
   long contactsTransferred;  // VF contacts whose sliding vertex moved on to an adjacent face (§4.4.3)
   long breaksForce;       // contacts dropped because the normal springs would pull
   long breaksGeometry;    // contacts dropped because a feature left the other (vertex off its face, EE off an edge)
+  // pd_islandsOn only (0 otherwise); the counts above are then summed over the islands
+  long islandsFormed;    // islands set up (at the start, and each time the bodies of an island changed)
+  long islandsLargest;   // moving bodies in the largest island formed
+  long islandIntervals;  // sample intervals advanced (island by island)
+  long islandRedos;      // islands whose interval was redone because a body moved farther than its grown box
+  long islandStrays;     // free bodies found outside their box over a sample interval (none expected: a free body
+                         // has no contact to leave its ballistic path by; counted, not recovered)
 } pdCounters;
 
 typedef struct pdState {
   double t;          // s
   double h;          // next step to try, s
   pdStepper stepper;
-  pdOnsets onsets;   // how contacts that began inside a step join (pd_onsetsExact unless the caller sets it)
+  pdOnsets onsets;   // how contacts that began inside a step join (PD_ONSETS_DEFAULT unless the caller sets it)
+  pdIslands islands;  // one system or islands (pd_islandsOff unless the caller sets it)
   int n;             // length of y: 13 per moving body + 8 per active contact
   int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)
   double* y;         // (n) the state vector
   double* weight;    // (n) error weight of each component (its characteristic scale)
   double* work;      // scratch for the stepper (owned)
   struct pdContactSet* contacts;  // the contact list and the contact search's scratch (internal)
+  struct pdIslandSet* islandSet;  // the islands' own states between samples (internal; NULL when off)
   long nextSample;   // index k of the next output sample, at t = k / sampleRate
   bool failed;       // the run could not continue (see warnings); pd_advance returns false
   bool stopped;      // the observer asked to stop; pd_advance returns false
@@ -126,7 +148,8 @@ typedef struct pdBodyState {
 // and be the model passed with it to every other call.
 PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to the adaptive one and onsets to pd_onsetsExact (set state->stepper, state->onsets after this call).
+// to the adaptive one, onsets to PD_ONSETS_DEFAULT and islands to pd_islandsOff (set state->stepper,
+// state->onsets, state->islands after this call).
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.
 PD_API void pd_state_free(pdState* state);

@@ -1,0 +1,759 @@
+// polydyn — islands (issue 16 item 2; pd_islandsOn; README, "Islands").
+//
+// Design note. With islands off, one state vector carries every moving body and contact: one step size,
+// one error norm (a max over all of y), and every contact onset anywhere cuts every body's step. With
+// islands on, pd_advance goes from sync time to sync time: the output samples, each sample interval cut into
+// equal parts (sync_parts: a body at the scene's vmax moves at most PD_ISLAND_SYNC_SIZE_FRACTION of the
+// smallest moving body's size over one; a function of the model and the interval only, never of the state).
+// Over each sync interval [T, T'] the moving bodies are partitioned into islands and each island advances
+// alone from T to T', in a pdState of its own over a model of its own, with its own step size, error norm,
+// contact events, onset retries and stability bound: the unchanged stepper of integrator.c.
+//
+// - An island's model holds its moving bodies and every fixed body, in scene order (bodies copied, their
+//   polyhedra and names shared, the material table a view with the classes remapped:
+//   pd_material_table_view). Fixed bodies carry no state, so every island may touch them without joining
+//   islands together. The order is scene order, so a contact's id sorts the same in the island and in
+//   the scene, and an island of the same bodies in another scene (same fixed bodies first, same sync times)
+//   computes the same numbers bit for bit.
+// - Partition at T (union-find over the moving bodies; each island named by its lowest body): two bodies
+//   join when they share an active contact, or when their grown boxes overlap. Gravity moves every body
+//   alike, so the boxes live in the frame that falls with it: body k's box at T, swept along v_k Δ and grown
+//   by its bound (travel_bound: slack + |ω| r Δ + ½ |F/m| Δ² for an applied force, and for a body touching
+//   anything at T or whose box may reach a fixed body's, 2 |v| Δ + |g| Δ² for a reversal of its velocity
+//   and support against gravity). Two bodies falling side by side thus stay apart. Islands are listed by
+//   their lowest body, so nothing depends on the order in which they are processed: each island reads only
+//   the scene's state at T and its own state, and writes only its own bodies' entries.
+// - Free bodies: at the start T0 of each sample interval the partition is formed once over the whole interval
+//   (find_free). A body alone there, touching nothing and with no fixed body in reach, is free: with no
+//   contact it cannot leave its ballistic path (its spin bounded by its rotational energy, √(2 E_rot/I_min)),
+//   so its island is not cut at the sync times: it goes to the sample in free-flight steps of its own, its box
+//   over the sample interval standing for it in every sync partition. When another body's box over a sync
+//   interval reaches that box, the free body is brought to that sync time alone and joins the others from
+//   there; a free body found outside its box (never expected) is counted (islandStrays), not recovered.
+// - Persistence: an island whose bodies are the same as the last interval's keeps its state (its contact
+//   list, caches, step size) and simply goes on; a new island is set up from the scene's state at T (its
+//   bodies' numbers and contacts copied, the contacts' springs, forces and modal dampers as they were:
+//   pd_contact_set_scatter) with the smallest step its bodies' islands last wanted.
+// - Safety: after every step an island takes, each of its bodies' distance from its ballistic path
+//   (|x − x0 − v0 τ − ½ g τ²| + radius × rotation angle since T) is compared with its bound. Every point of
+//   the body then lies, in the falling frame, in its box at T moved by v0 τ and grown by that distance. A
+//   body that strayed farther could have met a body of another island unseen. After all islands reached T',
+//   the bound of every such body becomes twice its distance, the partition is formed again, and every island
+//   whose bodies changed is set up again from the state at T (still intact: the scene's state is written
+//   only at T') and redone (counted: islandRedos); islands whose bodies did not change keep their result.
+//   This repeats until no body strayed from its box, so at the end no two islands' swept boxes overlap
+//   while every body stayed in its own: no contact between islands can have been missed. (Between two step
+//   ends a body's path may leave the box by its curvature, |a − g| h²/8 at most, inside the slack.)
+// - At T' the islands' bodies and contacts are gathered into the scene's state (pd_contact_set_gather:
+//   sorted by id), the counters summed in island order, and the observer sees the whole scene at samples.
+// With the samples as the only sync times, one island of every body computes what islands off computes.
+//
+// Memory: islands are set up, grown and freed only at sync times; a step allocates nothing.
+#include "islands.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "broad_phase.h"
+#include "clock.h"
+#include "contact_set.h"
+#include "model_contact.h"
+#include "state_layout.h"
+
+// Slack of the travel bound, in the body's design deflections δ_max (deflection × size): a body resting in
+// contact moves by its springs' deflection as loads shift, which its velocity at T does not show; two δ_max
+// is also the most the tunnelling guard lets a pair sink within one step.
+#define PD_ISLAND_SLACK_DEFLECTIONS 2.0
+// ... plus this fraction of the body's size: what a push from a neighbour inside its island may add over
+// one interval. A tighter bound splits more islands but makes more of them redo their interval.
+#define PD_ISLAND_SLACK_SIZE 0.01
+// Sync times: a sample interval is cut into equal parts so that a body at the characteristic speed vmax travels
+// at most this fraction of the smallest moving body's size over one part, at most PD_ISLAND_SYNC_PARTS_MAX parts.
+// The bounds grow with the interval: with short ones, bodies that fall or bounce near each other stay in
+// islands of their own. Measured on cases/bench/pile_1000.scene (0.5 s, one run each): the samples alone
+// (10 ms) 140 s, 0.05 (11 parts) 41.9 s, 0.02 (16 parts) 38.9 s; pile_10 pays for it (0.065 s -> 0.094 s,
+// still below islands off), pile_100 is unchanged (0.74 s -> 0.69 s).
+#define PD_ISLAND_SYNC_SIZE_FRACTION 0.02
+#define PD_ISLAND_SYNC_PARTS_MAX 16
+// A body that moved farther than its bound gets this many times the distance it moved as its new bound.
+#define PD_ISLAND_REDO_GROWTH 2.0
+
+typedef struct island {
+  int bodyCount;   // moving bodies
+  int* bodies;     // (bodyCount) their moving-body indices k (scene body model->movingBodies[k]), ascending
+  pdModel model;   // its moving bodies and every fixed body, scene order
+  int* toScene;    // (model.bodyCount) scene body index of each of its bodies
+  pdState* state;  // at T, or at T' once advanced
+  bool advanced;   // advanced over the interval under way
+} island;
+
+struct pdIslandSet {
+  int movingCount, bodyCount, fixedCount;
+  int* fixedBodies;  // (fixedCount) scene indices of the fixed bodies, ascending
+  int* root;         // (movingCount) union-find over moving-body indices; a root is its set's lowest index
+  int* islandOf;     // (movingCount) island of each moving body in the partition under way
+  int* islandOld;    // (movingCount) index in `islands` of the island holding the body (-1: none)
+  int* members;      // (movingCount) moving bodies grouped by island, ascending within each
+  int* first;        // (movingCount + 1) island j's members: members[first[j] .. first[j + 1])
+  int partCount;     // islands in the partition under way
+  double* bound;     // (movingCount) m: how far the body's points may move over the interval
+  double* travel;    // (movingCount) m: how far they moved at most, measured at the island's step ends
+  double* h;         // (movingCount) s: the next step its island wanted at the last sync
+  pdVec3* x0;        // (movingCount) centre of mass at T, m
+  pdVec3* v0;        // (movingCount) its velocity at T, m/s
+  pdQuat* q0;        // (movingCount) orientation at T
+  pdAabb* box0;      // (movingCount) box at T
+  bool* touching;    // (movingCount) in a contact at T, or its box may reach a fixed body's
+  // the sample interval [T0, Ts] as a whole (free bodies: see the design note)
+  double ct0;         // s: T0
+  bool* free;         // (movingCount) alone and ballistic over the whole sample interval
+  pdVec3 *cx0, *cv0;  // (movingCount) centre of mass and velocity at T0
+  pdQuat* cq0;        // (movingCount) orientation at T0
+  double* cbound;     // (movingCount) m: the bound over the sample interval
+  double* ctravel;    // (movingCount) m: how far a free body strayed from its ballistic path since T0
+  pdAabb* cbox;       // (movingCount) its box over the sample interval (swept and grown)
+  int* activate;      // (movingCount) free bodies a fine box reached (partition)
+  long strays;        // free bodies that strayed from their box (never expected: counted, not recovered)
+  double t0;         // s: T
+  double sizeMin;    // m: the smallest moving body's size
+  pdAabb* boxes;     // (bodyCount) grown boxes (fixed bodies: their own)
+  pdBroadPhase* broad;
+  pdPair* pairs;
+  int pairCapacity;
+  int* toSub;        // (bodyCount) scratch: scene body → island body (-1 elsewhere)
+  int* contactOf;    // (contactCapacity) island of each of the scene's contacts at T
+  int* contactList;  // (contactCapacity) scratch: one island's contacts
+  int contactCapacity;
+  island** islands;  // (islandCapacity) the live islands, listed by their lowest body
+  island** next;     // (islandCapacity) scratch: the list being formed
+  int islandCount, islandCapacity;
+  const pdModel** subModels;  // (islandCapacity) scratch for the gather
+  const pdState** subStates;
+  const int** subMaps;
+  // work of islands freed so far (summed in with the live ones' at every sync)
+  pdCounters retired;
+  long retiredWarnings[pd_warnCount];
+  double retiredStages[pd_stageCount];
+  double observeSeconds;  // the scene's observer calls
+  long formed, largest, intervals, redos;
+};
+
+static void* grow(void* p, size_t count, size_t size) {
+  void* q = realloc(p, (count > 0 ? count : 1) * size);
+  PD_ASSERT(q != NULL);
+  return q;
+}
+
+// ---------------------------------------------------------------- one island
+
+static void island_free(island* is) {
+  if (!is) return;
+  pd_state_free(is->state);
+  pd_material_table_free(is->model.materials);
+  free(is->model.bodies);
+  free(is->model.movingBodies);
+  free(is->toScene);
+  free(is->bodies);
+  free(is);
+}
+
+// The model of members[0 .. count) (moving-body indices, ascending) and every fixed body, scene order.
+static island* island_create(const pdModel* model, const struct pdIslandSet* set, const int* members, int count) {
+  island* is = calloc(1, sizeof *is);
+  PD_ASSERT(is != NULL);
+  is->bodyCount = count;
+  is->bodies = grow(NULL, (size_t)count, sizeof *is->bodies);
+  memcpy(is->bodies, members, (size_t)count * sizeof *members);
+  int n = count + set->fixedCount;
+  is->toScene = grow(NULL, (size_t)n, sizeof *is->toScene);
+  // merge the two ascending lists of scene indices
+  for (int m = 0, f = 0, l = 0; l < n; ++l) {
+    int moving = m < count ? model->movingBodies[members[m]] : model->bodyCount;
+    int fixed = f < set->fixedCount ? set->fixedBodies[f] : model->bodyCount;
+    if (moving < fixed) {
+      is->toScene[l] = moving;
+      ++m;
+    } else {
+      is->toScene[l] = fixed;
+      ++f;
+    }
+  }
+  pdModel* sub = &is->model;
+  *sub = *model;  // settings, scene path, length scale
+  sub->bodyCount = n;
+  sub->movingCount = count;
+  sub->bodies = grow(NULL, (size_t)n, sizeof *sub->bodies);
+  sub->movingBodies = grow(NULL, (size_t)count, sizeof *sub->movingBodies);
+  for (int l = 0, k = 0; l < n; ++l) {
+    sub->bodies[l] = model->bodies[is->toScene[l]];
+    if (sub->bodies[l].fixed) continue;
+    sub->bodies[l].stateIndex = k;
+    sub->movingBodies[k++] = l;
+  }
+  sub->materials = pd_material_table_view(model->materials, is->toScene, n);
+  is->state = pd_state_create(sub);
+  return is;
+}
+
+// Sets island `is` up from the scene's state s at T: its bodies' numbers, the scene's contacts listed in
+// set->contactList[0 .. contacts), the stepper, onset mode and the smallest step its bodies last wanted.
+static void island_load(const pdModel* model, const pdState* s, struct pdIslandSet* set, island* is, int contacts) {
+  pdState* sub = is->state;
+  sub->stepper = s->stepper;
+  sub->onsets = s->onsets;
+  sub->t = s->t;
+  sub->nextSample = s->nextSample;
+  double h = INFINITY;
+  for (int j = 0; j < is->bodyCount; ++j) {
+    int k = is->bodies[j];
+    memcpy(sub->y + PD_BODY_STATE_SIZE * j, s->y + PD_BODY_STATE_SIZE * k, PD_BODY_STATE_SIZE * sizeof *s->y);
+    h = fmin(h, set->h[k]);
+  }
+  sub->h = h;
+  for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = l;
+  pd_contact_set_scatter(model, s, set->contactList, contacts, &is->model, sub, set->toSub);
+  for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = -1;
+}
+
+// The step hook of an island's pd_advance_hooked: each body's travel since T (centre displacement plus
+// radius × rotation angle), the largest so far kept.
+typedef struct travelProbe {
+  struct pdIslandSet* set;
+  const island* is;
+  bool coarse;  // a free body: against its path over the sample interval (cx0, cv0, cq0 from ct0; ctravel)
+} travelProbe;
+
+static void measure_travel(const pdModel* sub, const pdState* state, void* user) {
+  const travelProbe* probe = user;
+  struct pdIslandSet* set = probe->set;
+  for (int j = 0; j < probe->is->bodyCount; ++j) {
+    int k = probe->is->bodies[j];
+    const double* y = state->y + PD_BODY_STATE_SIZE * j;
+    pdQuat q = pd_layout_q(y), q0 = probe->coarse ? set->cq0[k] : set->q0[k];
+    double dot = fabs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z);
+    double norms =
+        sqrt((q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z));
+    double angle = 2.0 * acos(fmin(1.0, dot / norms));
+    const pdBody* b = &sub->bodies[sub->movingBodies[j]];
+    double tau = state->t - (probe->coarse ? set->ct0 : set->t0);
+    pdVec3 x0 = probe->coarse ? set->cx0[k] : set->x0[k], v0 = probe->coarse ? set->cv0[k] : set->v0[k];
+    pdVec3 ballistic =
+        pd_v3_add(x0, pd_v3_add(pd_v3_scale(v0, tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
+    double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
+    double* travel = probe->coarse ? set->ctravel : set->travel;
+    travel[k] = fmax(travel[k], moved);
+  }
+}
+
+// Advances island `is` to tNext; false if it failed. A free body's island (coarse) measures against its path
+// over the whole sample interval, and keeps what it measured since T0.
+static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool coarse) {
+  if (!coarse)
+    for (int j = 0; j < is->bodyCount; ++j) set->travel[is->bodies[j]] = 0.0;
+  travelProbe probe = {set, is, coarse};
+  is->advanced = true;
+  return pd_advance_hooked(&is->model, is->state, tNext, NULL, NULL, measure_travel, &probe);
+}
+
+// ---------------------------------------------------------------- counters
+
+static void add_counters(pdCounters* to, const pdCounters* c) {
+  to->accepted += c->accepted;
+  to->rejected += c->rejected;
+  to->derivatives += c->derivatives;
+  to->eventRetries += c->eventRetries;
+  to->onsetsInterpolated += c->onsetsInterpolated;
+  to->travelRetries += c->travelRetries;
+  to->refinements += c->refinements;
+  to->contactsMade += c->contactsMade;
+  to->contactsVirtual += c->contactsVirtual;
+  to->contactsTransferred += c->contactsTransferred;
+  to->breaksForce += c->breaksForce;
+  to->breaksGeometry += c->breaksGeometry;
+}
+
+static void retire(struct pdIslandSet* set, island* is) {
+  add_counters(&set->retired, &is->state->count);
+  for (int w = 0; w < pd_warnCount; ++w) set->retiredWarnings[w] += is->state->warnings[w];
+  for (int g = 0; g < pd_stageCount; ++g) set->retiredStages[g] += is->state->stageSeconds[g];
+  island_free(is);
+}
+
+// The scene state's counters, warnings and stage seconds: the freed islands' plus the live ones', in island
+// order (integers: the order does not matter; seconds are not reproducible anyway).
+static void compose_counters(struct pdIslandSet* set, pdState* s) {
+  long samples = s->count.samples;
+  s->count = set->retired;
+  memcpy(s->warnings, set->retiredWarnings, sizeof s->warnings);
+  memcpy(s->stageSeconds, set->retiredStages, sizeof s->stageSeconds);
+  for (int i = 0; i < set->islandCount; ++i) {
+    const pdState* sub = set->islands[i]->state;
+    add_counters(&s->count, &sub->count);
+    for (int w = 0; w < pd_warnCount; ++w) s->warnings[w] += sub->warnings[w];
+    for (int g = 0; g < pd_stageCount; ++g) s->stageSeconds[g] += sub->stageSeconds[g];
+  }
+  s->stageSeconds[pd_stageObserve] += set->observeSeconds;
+  s->count.samples = samples;
+  s->count.islandsFormed = set->formed;
+  s->count.islandsLargest = set->largest;
+  s->count.islandIntervals = set->intervals;
+  s->count.islandRedos = set->redos;
+  s->count.islandStrays = set->strays;
+}
+
+// ---------------------------------------------------------------- the set
+
+int pd_island_count(const pdState* s) { return s->islandSet ? s->islandSet->islandCount : 0; }
+
+void pd_island_set_free(struct pdIslandSet* set) {
+  if (!set) return;
+  for (int i = 0; i < set->islandCount; ++i) island_free(set->islands[i]);
+  free(set->fixedBodies);
+  free(set->root);
+  free(set->islandOf);
+  free(set->islandOld);
+  free(set->members);
+  free(set->first);
+  free(set->bound);
+  free(set->travel);
+  free(set->h);
+  free(set->x0);
+  free(set->v0);
+  free(set->box0);
+  free(set->touching);
+  free(set->free);
+  free(set->cx0);
+  free(set->cv0);
+  free(set->cq0);
+  free(set->cbound);
+  free(set->ctravel);
+  free(set->cbox);
+  free(set->activate);
+  free(set->q0);
+  free(set->boxes);
+  pd_broad_phase_free(set->broad);
+  free(set->pairs);
+  free(set->toSub);
+  free(set->contactOf);
+  free(set->contactList);
+  free(set->islands);
+  free(set->next);
+  free(set->subModels);
+  free(set->subStates);
+  free(set->subMaps);
+  free(set);
+}
+
+static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
+  struct pdIslandSet* set = calloc(1, sizeof *set);
+  PD_ASSERT(set != NULL);
+  int m = model->movingCount, n = model->bodyCount;
+  set->movingCount = m;
+  set->bodyCount = n;
+  set->fixedBodies = grow(NULL, (size_t)n, sizeof *set->fixedBodies);
+  bool* fixed = grow(NULL, (size_t)n, sizeof *fixed);
+  set->boxes = grow(NULL, (size_t)n, sizeof *set->boxes);
+  set->toSub = grow(NULL, (size_t)n, sizeof *set->toSub);
+  for (int i = 0; i < n; ++i) {
+    const pdBody* b = &model->bodies[i];
+    fixed[i] = b->fixed;
+    if (b->fixed) set->fixedBodies[set->fixedCount++] = i;
+    pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(b->q0));
+    set->boxes[i] = pd_aabb_of(&b->shape, b->x0, &r);
+    set->toSub[i] = -1;
+  }
+  set->broad = pd_broad_phase_create(n, fixed, 0.0);
+  PD_ASSERT(set->broad != NULL);
+  free(fixed);
+  set->pairCapacity = 4 * m + 16;
+  set->pairs = grow(NULL, (size_t)set->pairCapacity, sizeof *set->pairs);
+  set->root = grow(NULL, (size_t)m, sizeof *set->root);
+  set->islandOf = grow(NULL, (size_t)m, sizeof *set->islandOf);
+  set->islandOld = grow(NULL, (size_t)m, sizeof *set->islandOld);
+  set->members = grow(NULL, (size_t)m, sizeof *set->members);
+  set->first = grow(NULL, (size_t)m + 1, sizeof *set->first);
+  set->bound = grow(NULL, (size_t)m, sizeof *set->bound);
+  set->travel = grow(NULL, (size_t)m, sizeof *set->travel);
+  set->h = grow(NULL, (size_t)m, sizeof *set->h);
+  set->x0 = grow(NULL, (size_t)m, sizeof *set->x0);
+  set->v0 = grow(NULL, (size_t)m, sizeof *set->v0);
+  set->box0 = grow(NULL, (size_t)m, sizeof *set->box0);
+  set->touching = grow(NULL, (size_t)m, sizeof *set->touching);
+  set->free = calloc((size_t)(m > 0 ? m : 1), sizeof *set->free);
+  PD_ASSERT(set->free != NULL);
+  set->cx0 = grow(NULL, (size_t)m, sizeof *set->cx0);
+  set->cv0 = grow(NULL, (size_t)m, sizeof *set->cv0);
+  set->cq0 = grow(NULL, (size_t)m, sizeof *set->cq0);
+  set->cbound = grow(NULL, (size_t)m, sizeof *set->cbound);
+  set->ctravel = grow(NULL, (size_t)m, sizeof *set->ctravel);
+  set->cbox = grow(NULL, (size_t)m, sizeof *set->cbox);
+  set->activate = grow(NULL, (size_t)m, sizeof *set->activate);
+  set->q0 = grow(NULL, (size_t)m, sizeof *set->q0);
+  set->sizeMin = INFINITY;
+  for (int k = 0; k < m; ++k) {
+    set->sizeMin = fmin(set->sizeMin, model->bodies[model->movingBodies[k]].size);
+    set->islandOld[k] = -1;
+    set->h[k] = s->h;
+  }
+  set->islandCapacity = m > 0 ? m : 1;
+  set->islands = grow(NULL, (size_t)set->islandCapacity, sizeof *set->islands);
+  set->next = grow(NULL, (size_t)set->islandCapacity, sizeof *set->next);
+  set->subModels = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subModels);
+  set->subStates = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subStates);
+  set->subMaps = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subMaps);
+  return set;
+}
+
+// ---------------------------------------------------------------- partition
+
+static int find(int* root, int k) {
+  while (root[k] != k) {
+    root[k] = root[root[k]];
+    k = root[k];
+  }
+  return k;
+}
+
+static void join(int* root, int a, int b) {
+  a = find(root, a);
+  b = find(root, b);
+  if (a < b)
+    root[b] = a;
+  else if (b < a)
+    root[a] = b;
+}
+
+static bool boxes_overlap(const pdAabb* a, const pdAabb* b) {
+  for (int d = 0; d < 3; ++d)
+    if (a->lo[d] > b->hi[d] || b->lo[d] > a->hi[d]) return false;
+  return true;
+}
+
+// How far body k's points can stray over the interval from where its ballistic motion (its velocity at T and
+// gravity, which every body shares) takes them, m (design note): an applied force's share, its spin's
+// (r |ω| Δ), and the slack; a body touching anything at T, or whose box may reach a fixed body's, may also
+// reverse its velocity and be held against gravity (2 |v| Δ + |g| Δ²).
+static double travel_bound(const pdModel* model, const struct pdIslandSet* set, int k, const double* yb,
+                           const pdAabb* box, bool* touchingOut, double t, double dt) {
+  const pdBody* b = &model->bodies[model->movingBodies[k]];
+  bool touching = *touchingOut;
+  double accel = 0.0;
+  if (b->hasForce) accel = (pd_v3_norm(b->force0) + pd_v3_norm(b->forceRate) * (fabs(t) + dt)) * b->invMass;
+  double slack = (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
+  // the spin a torque-free body can reach keeps its rotational energy: |ω| <= √(2 E_rot / I_min)
+  pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(pd_layout_q(yb)));
+  pdVec3 wb = pd_mat3_tmulv(&r, pd_layout_w(yb));
+  double twiceEnergy = pd_v3_dot(wb, pd_mat3_mulv(&b->inertia, wb));
+  double spinMax = b->principal[0] > 0.0 ? sqrt(fmax(0.0, twiceEnergy) / b->principal[0]) : 0.0;
+  double spin = fmax(pd_v3_norm(pd_layout_w(yb)), spinMax) * b->radius * dt;
+  double bound = 0.5 * accel * dt * dt + spin + slack;
+  double g = pd_v3_norm(model->settings.gravity), v = pd_v3_norm(pd_layout_v(yb));
+  if (!touching) {
+    // may it reach a fixed body? (its box grown by all it can move, gravity included)
+    double reach = v * dt + 0.5 * (g + accel) * dt * dt + spin + slack;
+    pdAabb grown = *box;
+    for (int d = 0; d < 3; ++d) grown.lo[d] -= reach, grown.hi[d] += reach;
+    for (int f = 0; f < set->fixedCount && !touching; ++f)
+      touching = boxes_overlap(&grown, &set->boxes[set->fixedBodies[f]]);
+  }
+  if (touching) bound += 2.0 * v * dt + g * dt * dt;
+  *touchingOut = touching;
+  return bound;
+}
+
+// The partition of the moving bodies at the scene's state s (T) with the bounds set->bound over the interval
+// dt: islandOf, members, first, partCount; and contactOf, the island of each contact of s. In the frame that
+// falls with gravity, body k's points stay within its box at T swept along v0 dt and grown by its bound.
+// With fine set (a sync interval), a free body keeps its box over the sample interval (cbox) and joins nothing:
+// a free body whose box another body's reaches is listed in set->activate instead, and the number of those is
+// returned (the partition is then incomplete: activate them and form it again). Without (the sample interval
+// as a whole), every body takes part.
+static int partition(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt, bool fine) {
+  int m = set->movingCount, activations = 0;
+  for (int k = 0; k < m; ++k) {
+    set->root[k] = k;
+    if (fine && set->free[k]) {
+      set->boxes[model->movingBodies[k]] = set->cbox[k];
+      continue;
+    }
+    pdAabb box = set->box0[k];
+    double sweep[3] = {set->v0[k].x * dt, set->v0[k].y * dt, set->v0[k].z * dt};
+    for (int d = 0; d < 3; ++d) {
+      box.lo[d] += fmin(0.0, sweep[d]) - set->bound[k];
+      box.hi[d] += fmax(0.0, sweep[d]) + set->bound[k];
+    }
+    set->boxes[model->movingBodies[k]] = box;
+  }
+  bool updated = pd_broad_phase_update(set->broad, set->boxes);
+  PD_ASSERT(updated);  // false only when memory runs out
+  int pairCount = pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
+  if (pairCount > set->pairCapacity) {
+    set->pairCapacity = 2 * pairCount;
+    set->pairs = grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
+    pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
+  }
+  for (int p = 0; p < pairCount; ++p) {
+    const pdBody *a = &model->bodies[set->pairs[p].a], *b = &model->bodies[set->pairs[p].b];
+    if (a->fixed || b->fixed) continue;
+    bool freeA = fine && set->free[a->stateIndex], freeB = fine && set->free[b->stateIndex];
+    if (freeA && freeB) continue;  // their boxes over the sample interval overlap no other body's (coarse partition)
+    if (freeA || freeB) {
+      int k = freeA ? a->stateIndex : b->stateIndex;
+      bool listed = false;
+      for (int i = 0; i < activations && !listed; ++i) listed = set->activate[i] == k;
+      if (!listed) set->activate[activations++] = k;
+      continue;
+    }
+    join(set->root, a->stateIndex, b->stateIndex);
+  }
+  if (activations > 0) return activations;
+  int contacts = pd_state_contact_count(s);
+  for (int c = 0; c < contacts; ++c) {
+    int b1, b2;
+    pd_contact_set_bodies(s->contacts, c, &b1, &b2);
+    const pdBody *a = &model->bodies[b1], *b = &model->bodies[b2];
+    if (!a->fixed && !b->fixed) join(set->root, a->stateIndex, b->stateIndex);
+  }
+  // islands named by their lowest body, in that order; members grouped by a counting sort
+  set->partCount = 0;
+  for (int k = 0; k < m; ++k) {
+    int r = find(set->root, k);
+    set->islandOf[k] = r == k ? set->partCount++ : set->islandOf[r];
+  }
+  for (int j = 0; j <= set->partCount; ++j) set->first[j] = 0;
+  for (int k = 0; k < m; ++k) ++set->first[set->islandOf[k] + 1];
+  for (int j = 0; j < set->partCount; ++j) set->first[j + 1] += set->first[j];
+  for (int k = 0; k < m; ++k) set->members[set->first[set->islandOf[k]]++] = k;
+  for (int j = set->partCount; j > 0; --j) set->first[j] = set->first[j - 1];
+  set->first[0] = 0;
+  if (contacts > set->contactCapacity) {
+    set->contactCapacity = 2 * contacts;
+    set->contactOf = grow(set->contactOf, (size_t)set->contactCapacity, sizeof *set->contactOf);
+    set->contactList = grow(set->contactList, (size_t)set->contactCapacity, sizeof *set->contactList);
+  }
+  for (int c = 0; c < contacts; ++c) {
+    int b1, b2;
+    pd_contact_set_bodies(s->contacts, c, &b1, &b2);
+    int moving = model->bodies[b1].fixed ? b2 : b1;
+    set->contactOf[c] = set->islandOf[model->bodies[moving].stateIndex];
+  }
+  return 0;
+}
+
+// Makes the live islands those of the partition: an island whose bodies did not change is kept as it is
+// (advanced or not); the others are freed and new ones set up from the scene's state at T. Returns the
+// number of islands set up.
+static int rebuild(const pdModel* model, const pdState* s, struct pdIslandSet* set) {
+  int built = 0;
+  int contacts = pd_state_contact_count(s);
+  for (int j = 0; j < set->partCount; ++j) {
+    const int* members = set->members + set->first[j];
+    int count = set->first[j + 1] - set->first[j];
+    int old = set->islandOld[members[0]];
+    bool same = old >= 0 && set->islands[old] != NULL && set->islands[old]->bodyCount == count;
+    for (int m = 1; m < count && same; ++m) same = set->islandOld[members[m]] == old;
+    if (same) {
+      set->next[j] = set->islands[old];
+      set->islands[old] = NULL;
+      continue;
+    }
+    island* is = island_create(model, set, members, count);
+    int listed = 0;
+    for (int c = 0; c < contacts; ++c)
+      if (set->contactOf[c] == j) set->contactList[listed++] = c;
+    island_load(model, s, set, is, listed);
+    set->next[j] = is;
+    ++built;
+    ++set->formed;
+    if (count > set->largest) set->largest = count;
+  }
+  for (int i = 0; i < set->islandCount; ++i)
+    if (set->islands[i]) retire(set, set->islands[i]);
+  island** t = set->islands;
+  set->islands = set->next;
+  set->next = t;
+  set->islandCount = set->partCount;
+  for (int j = 0; j < set->islandCount; ++j)
+    for (int m = 0; m < set->islands[j]->bodyCount; ++m) set->islandOld[set->islands[j]->bodies[m]] = j;
+  return built;
+}
+
+// ---------------------------------------------------------------- one interval
+
+// Body k's numbers at the scene's state s (its time T): start pose, box and bound over dt (fine: set->x0 …).
+static void set_start(const pdModel* model, const pdState* s, struct pdIslandSet* set, int k, double dt) {
+  const pdBody* b = &model->bodies[model->movingBodies[k]];
+  const double* yb = s->y + PD_BODY_STATE_SIZE * k;
+  set->x0[k] = pd_layout_x(yb);
+  set->v0[k] = pd_layout_v(yb);
+  set->q0[k] = pd_layout_q(yb);
+  pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(set->q0[k]));
+  set->box0[k] = pd_aabb_of(&b->shape, set->x0[k], &r);
+  set->bound[k] = travel_bound(model, set, k, yb, &set->box0[k], &set->touching[k], s->t, dt);
+  set->travel[k] = 0.0;
+}
+
+// Marks in set->touching the moving bodies of the scene's contacts.
+static void mark_touching(const pdModel* model, const pdState* s, struct pdIslandSet* set) {
+  for (int k = 0; k < set->movingCount; ++k) set->touching[k] = false;
+  for (int c = 0; c < pd_state_contact_count(s); ++c) {
+    int b1, b2;
+    pd_contact_set_bodies(s->contacts, c, &b1, &b2);
+    if (!model->bodies[b1].fixed) set->touching[model->bodies[b1].stateIndex] = true;
+    if (!model->bodies[b2].fixed) set->touching[model->bodies[b2].stateIndex] = true;
+  }
+}
+
+// A free body's island goes on to tNext alone (coarse: against its path over the sample interval); its
+// numbers go to the scene's state. False if it failed.
+static bool free_advance(pdState* s, struct pdIslandSet* set, int k, double tNext) {
+  island* is = set->islands[set->islandOld[k]];
+  PD_ASSERT(is->bodyCount == 1 && is->bodies[0] == k);
+  if (is->state->t < tNext) {
+    ++set->intervals;
+    if (!island_advance(set, is, tNext, true)) return false;
+  }
+  if (set->ctravel[k] > set->cbound[k]) ++set->strays;
+  memcpy(s->y + PD_BODY_STATE_SIZE * k, is->state->y, PD_BODY_STATE_SIZE * sizeof *s->y);
+  set->h[k] = is->state->h;
+  return true;
+}
+
+// The islands from s (at T) to tNext, then the scene's state gathered at tNext (free bodies' numbers only at
+// the sample, `last`). False if an island failed (s keeps its state at T).
+static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSet* set, double tNext, bool last) {
+  double dt = tNext - s->t;
+  set->t0 = s->t;
+  mark_touching(model, s, set);
+  for (int k = 0; k < set->movingCount; ++k)
+    if (!set->free[k]) set_start(model, s, set, k, dt);
+  for (int j = 0; j < set->islandCount; ++j) set->islands[j]->advanced = false;
+  for (int round = 0;; ++round) {
+    // a free body another body may reach joins the others from here: it is brought to T first
+    for (int activations; (activations = partition(model, s, set, dt, true)) > 0;)
+      for (int i = 0; i < activations; ++i) {
+        int k = set->activate[i];
+        if (s->t > set->ct0 && !free_advance(s, set, k, s->t)) return false;
+        set->free[k] = false;
+        set_start(model, s, set, k, dt);
+      }
+    int built = rebuild(model, s, set);
+    if (round > 0) set->redos += built;
+    for (int j = 0; j < set->islandCount; ++j) {
+      island* is = set->islands[j];
+      if (is->advanced || set->free[is->bodies[0]]) continue;
+      ++set->intervals;
+      if (!island_advance(set, is, tNext, false)) return false;
+    }
+    // a body that left its grown box could have met another island's body unseen: grow its bound and
+    // form the partition again; islands that change are redone from T
+    bool left = false;
+    for (int k = 0; k < set->movingCount; ++k)
+      if (!set->free[k] && set->travel[k] > set->bound[k]) {
+        set->bound[k] = PD_ISLAND_REDO_GROWTH * set->travel[k];
+        left = true;
+      }
+    if (!left) break;
+  }
+  if (last)
+    for (int k = 0; k < set->movingCount; ++k)
+      if (set->free[k] && !free_advance(s, set, k, tNext)) return false;
+  // gather: bodies, then contacts (sorted by id), and each body's next step
+  for (int j = 0; j < set->islandCount; ++j) {
+    const island* is = set->islands[j];
+    if (set->free[is->bodies[0]] && !last) continue;  // still at T0: the scene keeps its numbers from there
+    for (int m = 0; m < is->bodyCount; ++m) {
+      int k = is->bodies[m];
+      memcpy(s->y + PD_BODY_STATE_SIZE * k, is->state->y + PD_BODY_STATE_SIZE * m, PD_BODY_STATE_SIZE * sizeof *s->y);
+      set->h[k] = is->state->h;
+    }
+  }
+  for (int j = 0; j < set->islandCount; ++j) {
+    const island* is = set->islands[j];
+    set->subModels[j] = &is->model;
+    set->subStates[j] = is->state;
+    set->subMaps[j] = is->toScene;
+  }
+  pd_contact_set_gather(model, s, set->islandCount, set->subModels, set->subStates, set->subMaps);
+  return true;
+}
+
+// At the start T0 of a sample interval of length dt: each body's path and bound over the whole interval, and
+// which bodies are free: alone in the partition of that interval (no contact, no box reaching another body's
+// or a fixed body's). A free body has no contact to leave its ballistic path by: it goes to the sample in
+// steps of its own, not cut at the sync times, unless another body's box over a sync interval reaches its
+// box over the sample interval.
+static void find_free(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt) {
+  set->ct0 = s->t;
+  mark_touching(model, s, set);
+  for (int k = 0; k < set->movingCount; ++k) {
+    set->free[k] = false;
+    set_start(model, s, set, k, dt);
+    set->cx0[k] = set->x0[k];
+    set->cv0[k] = set->v0[k];
+    set->cq0[k] = set->q0[k];
+    set->cbound[k] = set->bound[k];
+    set->ctravel[k] = 0.0;
+  }
+  partition(model, s, set, dt, false);
+  for (int j = 0; j < set->partCount; ++j) {
+    if (set->first[j + 1] - set->first[j] != 1) continue;
+    int k = set->members[set->first[j]];
+    set->free[k] = !set->touching[k];
+    set->cbox[k] = set->boxes[model->movingBodies[k]];
+  }
+}
+
+// ---------------------------------------------------------------- pd_advance with islands
+
+// Into how many equal parts the interval dt is cut: the fewest that keep a body at the scene's characteristic
+// speed vmax from moving more than PD_ISLAND_SYNC_SIZE_FRACTION of the smallest moving body's size over one,
+// at most PD_ISLAND_SYNC_PARTS_MAX. A function of dt and the model only: the sync times do not depend on the
+// bodies' states, so a group of bodies computes the same numbers whatever moves elsewhere.
+static int sync_parts(const pdModel* model, const struct pdIslandSet* set, double dt) {
+  double parts = ceil(dt * model->settings.vmax / (PD_ISLAND_SYNC_SIZE_FRACTION * set->sizeMin));
+  return parts <= 1.0 ? 1 : (int)fmin(PD_ISLAND_SYNC_PARTS_MAX, parts);
+}
+
+static double sample_time(const pdModel* model, long k) { return (double)k / model->settings.sampleRate; }
+
+static void observe(const pdModel* model, pdState* s, struct pdIslandSet* set, pdObserverFcn* observer, void* user) {
+  double t0 = pd_clock_seconds();
+  if (observer && !observer(model, s, user)) s->stopped = true;
+  ++s->count.samples;
+  ++s->nextSample;
+  double seconds = pd_clock_seconds() - t0;
+  set->observeSeconds += seconds;
+  s->stageSeconds[pd_stageObserve] += seconds;
+}
+
+bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
+  PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
+  if (s->failed) return false;
+  s->stopped = false;
+  if (!s->islandSet) s->islandSet = set_create(model, s);
+  struct pdIslandSet* set = s->islandSet;
+  while (sample_time(model, s->nextSample) < s->t) ++s->nextSample;
+  if (sample_time(model, s->nextSample) == s->t) observe(model, s, set, observer, user);
+  while (s->t < tEnd && !s->stopped) {
+    double tSample = sample_time(model, s->nextSample);
+    double target = fmin(tEnd, tSample);
+    // the sync times: the interval to the sample cut into equal parts short enough for the fastest body
+    double t0 = s->t;
+    int parts = sync_parts(model, set, target - t0);
+    if (set->movingCount > 0) find_free(model, s, set, target - t0);
+    for (int j = 1; j <= parts; ++j) {
+      double tSync = j == parts ? target : t0 + (target - t0) * ((double)j / parts);
+      bool ok = set->movingCount == 0 || advance_interval(model, s, set, tSync, j == parts);
+      compose_counters(set, s);
+      if (!ok) {
+        s->failed = true;
+        return false;
+      }
+      s->t = tSync;
+    }
+    if (s->t == tSample) observe(model, s, set, observer, user);
+  }
+  return !s->stopped;
+}

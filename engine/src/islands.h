@@ -1,0 +1,25 @@
+// polydyn (internal) — islands: groups of moving bodies that advance alone between output samples
+// (pd_islandsOn; design note at the top of islands.c).
+#pragma once
+
+#include <stdbool.h>
+
+#include "polydyn/state.h"
+
+// Called by pd_advance_hooked after every step it takes (accepted or a jump to the next sample), with the
+// state at its new time.
+typedef void pdStepHookFcn(const pdModel* model, const pdState* state, void* user);
+
+// pd_advance without the islands' dispatch, calling `hook` (nullable) with `hookUser` after each step
+// (integrator.c). pd_advance is pd_advance_hooked with no hook when islands are off.
+bool pd_advance_hooked(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user,
+                       pdStepHookFcn* hook, void* hookUser);
+
+// pd_advance with state->islands == pd_islandsOn (contract of pd_advance, state.h).
+bool pd_islands_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
+
+// The number of islands of the state's last interval (0 before the first, or with islands off).
+int pd_island_count(const pdState* state);
+
+// Frees the islands' states (state reset and free); NULL is allowed.
+void pd_island_set_free(struct pdIslandSet* set);

@@ -1,0 +1,314 @@
+// Islands (issue 16 item 2; engine/src/islands.c; README, "Islands"): with pd_islandsOn the moving bodies
+// advance between output samples in islands, each with its own steps and contact events.
+// - two groups far apart (a resting stack in one corner, a bouncing cube in the other) give, body for body,
+//   the same numbers bit for bit as each group run alone with islands on (an island's model holds its own
+//   bodies and the fixed ones, in scene order, so the same bodies compute the same numbers whatever else
+//   the scene holds), and stay within a stated tolerance of each group alone with islands off (measured: 0,
+//   each group being one island throughout);
+// - every body in one island from start to end, with the samples as the only sync times: the same numbers
+//   bit for bit as islands off;
+// - run to run: the same numbers bit for bit (a pile of ten boxes);
+// - merge: two cubes flying at each other start as two islands, become one and bounce with the requested
+//   restitution (closed form: exit speed / approach speed = e), within 0.01 as with islands off;
+// - free flight: two spinning cubes thrown far apart take, bit for bit, the steps each takes alone with islands
+//   off (a free body is not cut at the sync times);
+// - split: two cubes that start touching and fly apart start as one island and end as two, their free
+//   flight untouched (constant velocities, bit for bit);
+// - a pile of ten boxes (cases/bench/pile_10.scene): finite numbers, penetration below 3 δ_max, no energy
+//   gained beyond the integration error.
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "islands.h"
+#include "polydyn/model.h"
+#include "polydyn/scene.h"
+#include "polydyn/state.h"
+#include "scene_run.h"
+
+#define RESTITUTION_TOL 0.01       // absolute, on e (issue 13's, as tests/engine/test_onsets.c)
+#define PENETRATION_MAX_DELTA 3.0  // of the pair's δ_max (the soak's limit)
+#define ENERGY_GAIN_TOL 1e-6       // relative to |E(0)|: integration error only (tol 1e-6 of the scene)
+// Islands on against islands off for a group alone: both are adaptive RK4 at the scene's tol (1e-6 of the
+// body size per step), with different step sequences (samples cut the steps the same way, islands' error
+// norms see fewer components); a resting stack and a bounce then agree to well below 1e-4 of a body size.
+#define GROUP_OFF_TOL_REL 1e-4
+
+enum { MAX_BODIES = 16, MAX_SAMPLES = 1001 };
+
+typedef struct trace {
+  int count, bodies;
+  double t[MAX_SAMPLES];
+  pdBodyState body[MAX_SAMPLES][MAX_BODIES];  // by moving-body order
+  int islands[MAX_SAMPLES];                   // pd_island_count at the sample
+  double energy[MAX_SAMPLES];
+  double penetration;  // deepest contact over all samples, in its pair's δ_max
+  bool finite;
+} trace;
+
+static bool record_trace(const pdModel* model, const pdState* s, void* user) {
+  trace* r = user;
+  if (r->count == MAX_SAMPLES) return false;
+  int k = r->count++;
+  r->t[k] = s->t;
+  r->bodies = model->movingCount < MAX_BODIES ? model->movingCount : MAX_BODIES;
+  for (int j = 0; j < r->bodies; ++j) {
+    pdBodyState b = pd_state_body(model, s, model->movingBodies[j]);
+    r->body[k][j] = b;
+    r->finite = r->finite && pd_v3_isfinite(b.x) && pd_v3_isfinite(b.v) && pd_v3_isfinite(b.w) && isfinite(b.q.w);
+  }
+  r->islands[k] = pd_island_count(s);
+  r->energy[k] = pd_state_energy(model, s);
+  for (int c = 0; c < pd_state_contact_count(s); ++c) {
+    pdContactReport rep = pd_state_contact(s, c);
+    r->penetration = fmax(r->penetration, rep.depth / pd_model_pair_delta_max(model, rep.bodyA, rep.bodyB));
+  }
+  return true;
+}
+
+// Runs `model` to its tend with the given island mode; the final state to *stateOut when not NULL.
+static trace* run_islands(const pdModel* model, pdIslands islands, pdState** stateOut) {
+  trace* r = calloc(1, sizeof *r);
+  assert_non_null(r);
+  r->finite = true;
+  pdState* s = pd_state_create(model);
+  s->islands = islands;
+  bool done = pd_advance(model, s, model->settings.tend, record_trace, r);
+  assert_true(done);
+  assert_false(s->failed);
+  if (stateOut)
+    *stateOut = s;
+  else
+    pd_state_free(s);
+  return r;
+}
+
+static bool same_body(const pdBodyState* a, const pdBodyState* b) { return memcmp(a, b, sizeof *a) == 0; }
+
+static double max_abs(double a, double b, double c) { return fmax(fabs(a), fmax(fabs(b), fabs(c))); }
+
+// ---------------------------------------------------------------- two groups far apart
+
+#define SETTINGS "tend 0.6\nsample 100\nvmax 4\n"
+#define FLOOR "cube floor grey 6 6 0.2\nfixed\nloc 0 0 -0.1\nmu 0.5\nrestitution 0.5\n"
+// a stack of two 0.2 m boxes in one corner, 1 mm gaps, settling
+#define STACK                                                           \
+  "cube s1 tan 0.2 0.2 0.2\nloc -2 -2 0.101\nmu 0.5\nrestitution 0.5\n" \
+  "cube s2 tan 0.2 0.2 0.2\nloc -2 -2 0.302\nmu 0.5\nrestitution 0.5\n"
+// a tilted 0.2 m cube dropped from 0.5 m in the other corner, bouncing (e 0.8); the same size as the stack's,
+// so that the sync times (a function of vmax and the smallest moving body) are the same in all three scenes
+#define BOUNCER "cube b red 0.2 0.2 0.2\nloc 2 2 0.5 20 1 1 0\nmu 0.5\nrestitution 0.8\n"
+
+static void test_far_groups_compute_as_if_alone(void** state) {
+  (void)state;
+  pdModel* both = compile_text(SETTINGS FLOOR STACK BOUNCER);
+  pdModel* stack = compile_text(SETTINGS FLOOR STACK);
+  pdModel* bouncer = compile_text(SETTINGS FLOOR BOUNCER);
+  trace* on = run_islands(both, pd_islandsOn, NULL);
+  trace* stackOn = run_islands(stack, pd_islandsOn, NULL);
+  trace* bouncerOn = run_islands(bouncer, pd_islandsOn, NULL);
+  trace* stackOff = run_islands(stack, pd_islandsOff, NULL);
+  trace* bouncerOff = run_islands(bouncer, pd_islandsOff, NULL);
+  assert_int_equal(on->count, stackOn->count);
+  assert_int_equal(on->count, bouncerOn->count);
+  assert_int_equal(on->count, stackOff->count);
+  double worstOff = 0.0;
+  bool bounced = false;
+  for (int k = 0; k < on->count; ++k) {
+    assert_true(on->islands[k] >= 2 || k == 0);  // the groups never join
+    for (int j = 0; j < 2; ++j) {
+      if (!same_body(&on->body[k][j], &stackOn->body[k][j]))
+        fail_msg("sample %d, stack body %d: not the same bits as the stack alone", k, j);
+      const pdBodyState *a = &on->body[k][j], *b = &stackOff->body[k][j];
+      worstOff = fmax(worstOff, max_abs(a->x.x - b->x.x, a->x.y - b->x.y, a->x.z - b->x.z) / 0.2);
+    }
+    if (!same_body(&on->body[k][2], &bouncerOn->body[k][0]))
+      fail_msg("sample %d, bouncer: not the same bits as the bouncer alone", k);
+    const pdBodyState *a = &on->body[k][2], *b = &bouncerOff->body[k][0];
+    worstOff = fmax(worstOff, max_abs(a->x.x - b->x.x, a->x.y - b->x.y, a->x.z - b->x.z) / 0.2);
+    bounced = bounced || on->body[k][2].v.z > 0.5;
+  }
+  assert_true(bounced);  // the case is what it says: the cube bounced while the stack settled
+  print_message("groups: %d samples bit for bit as alone; against islands off alone: %.3g of a body size\n", on->count,
+                worstOff);
+  assert_true(worstOff < GROUP_OFF_TOL_REL);
+  free(on), free(stackOn), free(bouncerOn), free(stackOff), free(bouncerOff);
+  pd_model_free(both), pd_model_free(stack), pd_model_free(bouncer);
+}
+
+// ---------------------------------------------------------------- one island = islands off
+
+static void test_one_island_is_islands_off_bit_for_bit(void** state) {
+  (void)state;
+  // vmax 0.3 m/s: a body at vmax moves less than 2 % of the boxes' size in a sample interval, so the sync times
+  // are the samples (islands.c, sync_parts), where islands off cuts its steps too
+  pdModel* m = compile_text("tend 0.6\nsample 100\nvmax 0.3\n" FLOOR STACK);
+  trace* on = run_islands(m, pd_islandsOn, NULL);
+  trace* off = run_islands(m, pd_islandsOff, NULL);
+  assert_int_equal(on->count, off->count);
+  for (int k = 1; k < on->count; ++k) {
+    assert_int_equal(on->islands[k], 1);  // the two boxes never part
+    for (int j = 0; j < on->bodies; ++j)
+      if (!same_body(&on->body[k][j], &off->body[k][j])) fail_msg("sample %d, body %d differs from islands off", k, j);
+  }
+  free(on), free(off);
+  pd_model_free(m);
+}
+
+// ---------------------------------------------------------------- run to run, and a pile's physics
+
+static pdModel* load_pile(void) {
+  pdError err;
+  memset(&err, 0, sizeof err);
+  pdScene* scene = pd_scene_parse_file(PD_SOURCE_DIR "/cases/bench/pile_10.scene", &err);
+  if (!scene) fail_msg("parse: %d:%d: %s", err.line, err.col, err.message);
+  pdModel* m = pd_model_compile(scene, &err);
+  pd_scene_free(scene);
+  if (!m) fail_msg("compile: %s", err.message);
+  return m;
+}
+
+static void test_the_same_bits_run_after_run(void** state) {
+  (void)state;
+  pdModel* m = load_pile();
+  pdState *s1 = NULL, *s2 = NULL;
+  trace* a = run_islands(m, pd_islandsOn, &s1);
+  trace* b = run_islands(m, pd_islandsOn, &s2);
+  assert_int_equal(a->count, b->count);
+  assert_true(memcmp(a->body, b->body, sizeof a->body) == 0);
+  assert_true(memcmp(&s1->count, &s2->count, sizeof s1->count) == 0);
+  assert_true(s1->count.islandsFormed > 1);
+  pd_state_free(s1), pd_state_free(s2);
+  free(a), free(b);
+  pd_model_free(m);
+}
+
+static void test_a_pile_keeps_its_physics(void** state) {
+  (void)state;
+  pdModel* m = load_pile();
+  pdState* s = NULL;
+  trace* r = run_islands(m, pd_islandsOn, &s);
+  assert_true(r->finite);
+  double gain = 0.0, lowest = r->energy[0];
+  for (int k = 1; k < r->count; ++k) {
+    gain = fmax(gain, (r->energy[k] - lowest) / fabs(r->energy[0]));
+    lowest = fmin(lowest, r->energy[k]);
+  }
+  print_message(
+      "pile_10, islands on: %ld islands formed (largest %ld), %ld redos; penetration %.3f delta_max, "
+      "energy gain %.3g of |E(0)|\n",
+      s->count.islandsFormed, s->count.islandsLargest, s->count.islandRedos, r->penetration, gain);
+  assert_true(r->penetration < PENETRATION_MAX_DELTA);
+  assert_true(gain <= ENERGY_GAIN_TOL);
+  assert_true(s->count.islandsLargest > 1);  // boxes did meet
+  assert_int_equal(s->count.islandStrays, 0);
+  pd_state_free(s);
+  free(r);
+  pd_model_free(m);
+}
+
+// ---------------------------------------------------------------- free flight
+
+// Two spinning cubes thrown far apart, far above a floor: each is free (alone, touching nothing, out of reach
+// of the floor) over every sample interval, so it takes the steps it takes alone with islands off, to the bit,
+// whatever the sync times.
+#define THROWN_SETTINGS "tend 0.3\nsample 100\nvmax 5\n"
+#define FAR_FLOOR "cube floor grey 20 20 0.2\nfixed\nloc 0 0 -10\n"
+#define THROWN_A "cube a red 0.1 0.1 0.1\nloc -2 0 1\nvel 1 0 3 400 1 2 3\n"
+#define THROWN_B "cube b blue 0.1 0.2 0.05\nloc 2 0 1\nvel -1 0.5 2 300 0 1 1\n"
+
+static void test_free_bodies_take_free_flight_steps(void** state) {
+  (void)state;
+  pdModel* both = compile_text(THROWN_SETTINGS FAR_FLOOR THROWN_A THROWN_B);
+  pdModel* a = compile_text(THROWN_SETTINGS FAR_FLOOR THROWN_A);
+  pdModel* b = compile_text(THROWN_SETTINGS FAR_FLOOR THROWN_B);
+  pdState *sOn = NULL, *sA = NULL, *sB = NULL;
+  trace* on = run_islands(both, pd_islandsOn, &sOn);
+  trace* offA = run_islands(a, pd_islandsOff, &sA);
+  trace* offB = run_islands(b, pd_islandsOff, &sB);
+  for (int k = 0; k < on->count; ++k) {
+    if (!same_body(&on->body[k][0], &offA->body[k][0])) fail_msg("sample %d: cube a differs from a alone", k);
+    if (!same_body(&on->body[k][1], &offB->body[k][0])) fail_msg("sample %d: cube b differs from b alone", k);
+  }
+  assert_int_equal(sOn->count.accepted, sA->count.accepted + sB->count.accepted);
+  assert_int_equal(sOn->count.islandStrays, 0);
+  print_message("two free cubes: %ld + %ld steps alone, %ld with islands on\n", sA->count.accepted, sB->count.accepted,
+                sOn->count.accepted);
+  pd_state_free(sOn), pd_state_free(sA), pd_state_free(sB);
+  free(on), free(offA), free(offB);
+  pd_model_free(both), pd_model_free(a), pd_model_free(b);
+}
+
+// ---------------------------------------------------------------- merge and split
+
+// Two 0.1 m cubes, gravity off, μ 0, e 0.5, face to face along x at ±x0 with speeds ±v.
+static pdModel* two_cubes(double x0, double v, double tend) {
+  char text[1024];
+  snprintf(text, sizeof text,
+           "gravity 0 0 0\ntend %.17g\nsample 100\nvmax 2\n"
+           "cube a red 0.1 0.1 0.1\nloc %.17g 0 0\nvel %.17g 0 0\nmu 0\nrestitution 0.5\n"
+           "cube b blue 0.1 0.1 0.1\nloc %.17g 0 0\nvel %.17g 0 0\nmu 0\nrestitution 0.5\n",
+           tend, -x0, v, x0, -v);
+  return compile_text(text);
+}
+
+static void test_islands_merge_and_bounce_with_the_requested_e(void** state) {
+  (void)state;
+  pdModel* m = two_cubes(0.3, 1.0, 0.5);  // they meet at t = 0.2 s
+  double e[2];
+  for (int mode = 0; mode < 2; ++mode) {
+    trace* r = run_islands(m, mode ? pd_islandsOn : pd_islandsOff, NULL);
+    int last = r->count - 1;
+    e[mode] = (r->body[last][1].v.x - r->body[last][0].v.x) / 2.0;
+    if (mode) {
+      assert_int_equal(r->islands[1], 2);  // apart at first
+      bool merged = false;
+      for (int k = 0; k < r->count; ++k) merged = merged || r->islands[k] == 1;
+      assert_true(merged);
+      assert_int_equal(r->islands[last], 2);  // apart again
+    }
+    free(r);
+  }
+  print_message("two cubes meeting at 2 m/s: e = %.5f islands off, %.5f islands on (requested 0.5)\n", e[0], e[1]);
+  assert_true(fabs(e[0] - 0.5) <= RESTITUTION_TOL);
+  assert_true(fabs(e[1] - 0.5) <= RESTITUTION_TOL);
+  pd_model_free(m);
+}
+
+static void test_an_island_splits_when_its_bodies_part(void** state) {
+  (void)state;
+  pdModel* m = two_cubes(0.05, -0.5, 0.3);  // touching faces at x = 0, flying apart at 1 m/s
+  pdState* s = NULL;
+  trace* r = run_islands(m, pd_islandsOn, &s);
+  // one island at first (their boxes touch), then one each: three formed, the largest of two
+  assert_int_equal(s->count.islandsFormed, 3);
+  assert_int_equal(s->count.islandsLargest, 2);
+  assert_int_equal(r->islands[r->count - 1], 2);
+  pd_state_free(s);
+  for (int k = 0; k < r->count; ++k) {
+    assert_true(r->body[k][0].v.x == -0.5 && r->body[k][1].v.x == 0.5);  // no contact ever pushed
+    assert_true(fabs(r->body[k][0].x.x - (-0.05 - 0.5 * r->t[k])) < 1e-12);
+  }
+  free(r);
+  pd_model_free(m);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_far_groups_compute_as_if_alone),
+      cmocka_unit_test(test_one_island_is_islands_off_bit_for_bit),
+      cmocka_unit_test(test_the_same_bits_run_after_run),
+      cmocka_unit_test(test_a_pile_keeps_its_physics),
+      cmocka_unit_test(test_free_bodies_take_free_flight_steps),
+      cmocka_unit_test(test_islands_merge_and_bounce_with_the_requested_e),
+      cmocka_unit_test(test_an_island_splits_when_its_bodies_part),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
