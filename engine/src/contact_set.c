@@ -36,6 +36,11 @@
 // at 17.8 ms had 8.7e-19 m/s of "slip" at 2.8e-3 m/s and got tangential impulses of ±6e-24 N·s; at 31 ms
 // edge-edge contacts appeared on the corners' vertex-face ones (exact mode never has them), at 50 ms three of
 // each pair's four broke under 0.5-15 N while the fourth held, and the stack fell apart (43 δ_max).
+// Both came from the corners: a vertex rocked by rounding just outside a shared side plane stopped being a VF
+// contact and an edge-edge pair took the corner until its closest point crossed the edge's end under load.
+// find_vf now holds such a vertex on the plane within the flush tolerance and find_ee leaves a crossing at a
+// vertex in VF contact to it (contact_analysis.c, EE_AT_VF_VERTEX_DEFLECTIONS): the 1e-15 … 1e-9 m offsets and
+// a 1e-6 rad twist of scene 147 stay up (0.02 δ_max) in both onset modes.
 #include "contact_set.h"
 
 #include <math.h>
