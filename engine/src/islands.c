@@ -47,11 +47,20 @@
 // - At T' the islands' bodies and contacts are gathered into the scene's state (pd_contact_set_gather:
 //   sorted by id), the counters summed in island order, and the observer sees the whole scene at samples.
 // With the samples as the only sync times, one island of every body computes what islands off computes.
+// - Threads (pdState.threads): the islands an interval advances (and the free bodies brought to the sample)
+//   are listed, then run on the set's pool of threads, each island whole on one thread. The split is fixed
+//   before the interval from the islands' sizes (bodies + contacts, largest first, each to the least-loaded
+//   thread; ties to the lower index), never from timing. While they run, a thread writes only its islands'
+//   states and its bodies' entries of travel/ctravel; everything else (partition, rebuild, activations, the
+//   redo decision, the gather, the counters in island order) stays on the calling thread. An island computes
+//   the same numbers on any thread, so every thread count gives the same results bit for bit.
 //
-// Memory: islands are set up, grown and freed only at sync times; a step allocates nothing.
+// Memory: islands are set up, grown and freed only at sync times; a step allocates nothing. The pool's
+// threads are created with the set (or when pdState.threads changes) and joined when it is freed.
 #include "islands.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -78,6 +87,9 @@
 #define PD_ISLAND_SYNC_PARTS_MAX 16
 // A body that moved farther than its bound gets this many times the distance it moved as its new bound.
 #define PD_ISLAND_REDO_GROWTH 2.0
+// An island's weight in the threads' split: its moving bodies plus its contacts, a contact counted as this
+// many bodies (a contact's force and events cost about what a body's motion costs: a rough, fixed guess).
+#define PD_ISLAND_CONTACT_WEIGHT 1
 
 typedef struct island {
   int bodyCount;   // moving bodies
@@ -137,6 +149,25 @@ struct pdIslandSet {
   double retiredStages[pd_stageCount];
   double observeSeconds;  // the scene's observer calls
   long formed, largest, intervals, redos;
+  // the pool (design note, "Threads"): thread 0 is the caller, workers 1 .. threadCount - 1
+  int threadCount;
+  pthread_t* workers;    // (threadCount - 1)
+  struct poolArg* args;  // (threadCount - 1) each worker's index
+  pthread_mutex_t lock;
+  pthread_cond_t wake;  // a new batch (generation) or quit
+  pthread_cond_t done;  // pending reached 0
+  long generation;      // batches handed out so far
+  int pending;          // workers still running the batch
+  bool quit;
+  // the batch: jobCount islands, all to jobTime
+  int jobCount;
+  double jobTime;
+  island** jobs;           // (islandCapacity)
+  bool* jobCoarse;         // (islandCapacity) a free body's island (island_advance's coarse)
+  bool* jobOk;             // (islandCapacity) written by the job's thread
+  int* jobThread;          // (islandCapacity) the thread of each job: the fixed split
+  struct jobOrder* order;  // (islandCapacity) scratch: the jobs by weight
+  long* load;              // (threadCount) scratch: each thread's weight
 };
 
 static void* grow(void* p, size_t count, size_t size) {
@@ -256,6 +287,137 @@ static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bo
   return pd_advance_hooked(&is->model, is->state, tNext, NULL, NULL, measure_travel, &probe);
 }
 
+// ---------------------------------------------------------------- the pool
+
+typedef struct poolArg {
+  struct pdIslandSet* set;
+  int thread;
+} poolArg;
+
+typedef struct jobOrder {
+  long weight;
+  int job;
+} jobOrder;
+
+// Heaviest first; equal weights in job order (a total order: the split does not depend on qsort).
+static int compare_jobs(const void* a, const void* b) {
+  const jobOrder *x = a, *y = b;
+  if (x->weight != y->weight) return x->weight > y->weight ? -1 : 1;
+  return (x->job > y->job) - (x->job < y->job);
+}
+
+// Runs the batch's jobs of thread `thread`, in job order.
+static void run_jobs(struct pdIslandSet* set, int thread) {
+  for (int i = 0; i < set->jobCount; ++i)
+    if (set->jobThread[i] == thread) set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobCoarse[i]);
+}
+
+static void* worker_main(void* user) {
+  const poolArg* arg = user;
+  struct pdIslandSet* set = arg->set;
+  long seen = 0;
+  pthread_mutex_lock(&set->lock);
+  for (;;) {
+    while (!set->quit && set->generation == seen) pthread_cond_wait(&set->wake, &set->lock);
+    if (set->quit) break;
+    seen = set->generation;
+    pthread_mutex_unlock(&set->lock);
+    run_jobs(set, arg->thread);
+    pthread_mutex_lock(&set->lock);
+    if (--set->pending == 0) pthread_cond_signal(&set->done);
+  }
+  pthread_mutex_unlock(&set->lock);
+  return NULL;
+}
+
+static void pool_stop(struct pdIslandSet* set) {
+  if (set->threadCount > 1) {
+    pthread_mutex_lock(&set->lock);
+    set->quit = true;
+    pthread_cond_broadcast(&set->wake);
+    pthread_mutex_unlock(&set->lock);
+    for (int w = 0; w < set->threadCount - 1; ++w) pthread_join(set->workers[w], NULL);
+    pthread_cond_destroy(&set->wake);
+    pthread_cond_destroy(&set->done);
+    pthread_mutex_destroy(&set->lock);
+  }
+  free(set->workers);
+  free(set->args);
+  free(set->load);
+  set->workers = NULL;
+  set->args = NULL;
+  set->load = NULL;
+  set->threadCount = 0;
+}
+
+// `threads` threads in all (the caller and threads - 1 workers, waiting for batches).
+static void pool_start(struct pdIslandSet* set, int threads) {
+  set->threadCount = threads;
+  set->quit = false;
+  set->generation = 0;
+  set->pending = 0;
+  set->load = grow(NULL, (size_t)threads, sizeof *set->load);
+  if (threads == 1) return;
+  set->workers = grow(NULL, (size_t)threads - 1, sizeof *set->workers);
+  set->args = grow(NULL, (size_t)threads - 1, sizeof *set->args);
+  PD_ASSERT(pthread_mutex_init(&set->lock, NULL) == 0 && pthread_cond_init(&set->wake, NULL) == 0 &&
+            pthread_cond_init(&set->done, NULL) == 0);
+  for (int w = 0; w < threads - 1; ++w) {
+    set->args[w] = (poolArg){set, w + 1};
+    PD_ASSERT(pthread_create(&set->workers[w], NULL, worker_main, &set->args[w]) == 0);
+  }
+}
+
+// Adds island `is` (to the batch's time) to the batch.
+static void add_job(struct pdIslandSet* set, island* is, bool coarse) {
+  set->jobs[set->jobCount] = is;
+  set->jobCoarse[set->jobCount] = coarse;
+  set->jobOk[set->jobCount] = false;
+  ++set->jobCount;
+}
+
+// Runs the batch to tNext: the fixed split (heaviest island first, each to the least-loaded thread), the
+// workers woken, the caller's own share, then a wait for the rest. False if an island failed; every job runs
+// either way, so the islands' states do not depend on the thread count.
+static bool run_batch(struct pdIslandSet* set, double tNext) {
+  set->jobTime = tNext;
+  if (set->threadCount == 1 || set->jobCount == 1) {
+    for (int i = 0; i < set->jobCount; ++i) set->jobThread[i] = 0;
+  } else {
+    for (int i = 0; i < set->jobCount; ++i) {
+      const island* is = set->jobs[i];
+      set->order[i] = (jobOrder){is->bodyCount + PD_ISLAND_CONTACT_WEIGHT * (long)pd_state_contact_count(is->state), i};
+    }
+    qsort(set->order, (size_t)set->jobCount, sizeof *set->order, compare_jobs);
+    for (int w = 0; w < set->threadCount; ++w) set->load[w] = 0;
+    for (int i = 0; i < set->jobCount; ++i) {
+      int least = 0;
+      for (int w = 1; w < set->threadCount; ++w)
+        if (set->load[w] < set->load[least]) least = w;
+      set->jobThread[set->order[i].job] = least;
+      set->load[least] += set->order[i].weight;
+    }
+  }
+  bool parallel = set->threadCount > 1 && set->jobCount > 1;
+  if (parallel) {
+    pthread_mutex_lock(&set->lock);
+    set->pending = set->threadCount - 1;
+    ++set->generation;
+    pthread_cond_broadcast(&set->wake);
+    pthread_mutex_unlock(&set->lock);
+  }
+  run_jobs(set, 0);
+  if (parallel) {
+    pthread_mutex_lock(&set->lock);
+    while (set->pending > 0) pthread_cond_wait(&set->done, &set->lock);
+    pthread_mutex_unlock(&set->lock);
+  }
+  bool ok = true;
+  for (int i = 0; i < set->jobCount; ++i) ok = ok && set->jobOk[i];
+  set->jobCount = 0;
+  return ok;
+}
+
 // ---------------------------------------------------------------- counters
 
 static void add_counters(pdCounters* to, const pdCounters* c) {
@@ -308,6 +470,12 @@ int pd_island_count(const pdState* s) { return s->islandSet ? s->islandSet->isla
 
 void pd_island_set_free(struct pdIslandSet* set) {
   if (!set) return;
+  pool_stop(set);
+  free(set->jobs);
+  free(set->jobCoarse);
+  free(set->jobOk);
+  free(set->jobThread);
+  free(set->order);
   for (int i = 0; i < set->islandCount; ++i) island_free(set->islands[i]);
   free(set->fixedBodies);
   free(set->root);
@@ -402,6 +570,12 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->subModels = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subModels);
   set->subStates = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subStates);
   set->subMaps = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subMaps);
+  set->jobs = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobs);
+  set->jobCoarse = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobCoarse);
+  set->jobOk = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobOk);
+  set->jobThread = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobThread);
+  set->order = grow(NULL, (size_t)set->islandCapacity, sizeof *set->order);
+  pool_start(set, s->threads);
   return set;
 }
 
@@ -644,8 +818,9 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
       island* is = set->islands[j];
       if (is->advanced || set->free[is->bodies[0]]) continue;
       ++set->intervals;
-      if (!island_advance(set, is, tNext, false)) return false;
+      add_job(set, is, false);
     }
+    if (!run_batch(set, tNext)) return false;
     // a body that left its grown box could have met another island's body unseen: grow its bound and
     // form the partition again; islands that change are redone from T
     bool left = false;
@@ -656,9 +831,19 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
       }
     if (!left) break;
   }
-  if (last)
+  if (last) {
+    // the free bodies to the sample: their islands run as one batch, then their numbers go to the scene
+    for (int k = 0; k < set->movingCount; ++k) {
+      island* is = set->free[k] ? set->islands[set->islandOld[k]] : NULL;
+      if (is && is->state->t < tNext) {
+        ++set->intervals;
+        add_job(set, is, true);
+      }
+    }
+    if (!run_batch(set, tNext)) return false;
     for (int k = 0; k < set->movingCount; ++k)
       if (set->free[k] && !free_advance(s, set, k, tNext)) return false;
+  }
   // gather: bodies, then contacts (sorted by id), and each body's next step
   for (int j = 0; j < set->islandCount; ++j) {
     const island* is = set->islands[j];
@@ -732,8 +917,13 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
   if (s->failed) return false;
   s->stopped = false;
+  PD_ASSERT(s->threads >= 1 && s->threads <= PD_THREADS_MAX);
   if (!s->islandSet) s->islandSet = set_create(model, s);
   struct pdIslandSet* set = s->islandSet;
+  if (set->threadCount != s->threads) {
+    pool_stop(set);
+    pool_start(set, s->threads);
+  }
   while (sample_time(model, s->nextSample) < s->t) ++s->nextSample;
   if (sample_time(model, s->nextSample) == s->t) observe(model, s, set, observer, user);
   while (s->t < tEnd && !s->stopped) {

@@ -30,6 +30,7 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   s->stepper = pd_stepperRK4Adaptive;
   s->onsets = PD_ONSETS_DEFAULT;
   s->islands = pd_islandsOff;
+  s->threads = 1;
   pd_island_set_free(s->islandSet);
   s->islandSet = NULL;
   s->nextSample = 0;

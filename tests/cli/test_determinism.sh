@@ -6,7 +6,8 @@
 # runs with MALLOC_PERTURB_ set (glibc then fills fresh and freed heap memory with a pattern), so an output
 # that depends on where it is written or on uninitialised memory shows up. Covered here:
 #   run       demo.scene, a hard case (the 10-box stack), the brick wall (short), the pile of ten boxes (also
-#             with --islands on); the pile in ODE and Bullet; demo with the fixed stepper and with the embedded pair
+#             with --islands on); the pile in ODE and Bullet; demo with the fixed stepper and with the embedded pair;
+#             the pile of 100 boxes (short) with --islands on, --threads 1 against --threads 2
 #   check     the pile
 #   oracle    --random, a SCENE, --replay (its CSV and its summary)
 #   soak      --jobs 1 against --jobs 2, in the three engines
@@ -75,6 +76,24 @@ for R in run_demo run_stack run_bricks run_pile run_pile_islands run_pile_ode ru
 done
 check "run_pile: the soft run's trajectory has every sample (the comparison is not of empty files)" \
   '[ "$(wc -l <"$SCRATCH/run_pile/first/trajectory.csv")" -gt 100 ]'
+
+# --- run --islands on: --threads 1 against --threads 2 (a fixed split of the islands: the same bytes) ---------
+TEND_THREADS=0.5
+if [ "$QUICK" = quick ]; then TEND_THREADS=0.15; fi
+T=run_pile_threads
+mkdir -p "$SCRATCH/$T"
+"$PD" run "$SRC/cases/bench/pile_100.scene" --tend $TEND_THREADS --islands on --threads 1 \
+  --out "$SCRATCH/$T/first" >"$SCRATCH/$T/first.out" 2>"$SCRATCH/$T/first.err"
+rc1=$?
+MALLOC_PERTURB_=165 "$PD" run "$SRC/cases/bench/pile_100.scene" --tend $TEND_THREADS --islands on --threads 2 \
+  --out "$SCRATCH/$T/second-run" >"$SCRATCH/$T/second.out" 2>"$SCRATCH/$T/second.err"
+rc2=$?
+check "$T: both runs exit 0" '[ $rc1 -eq 0 ] && [ $rc2 -eq 0 ]' || cat "$SCRATCH/$T/first.err" "$SCRATCH/$T/second.err"
+check "$T: trajectory.csv byte for byte" 'cmp -s "$SCRATCH/$T/first/trajectory.csv" "$SCRATCH/$T/second-run/trajectory.csv"'
+check "$T: contacts.csv byte for byte" 'cmp -s "$SCRATCH/$T/first/contacts.csv" "$SCRATCH/$T/second-run/contacts.csv"'
+same_dirs $T
+check "$T: the boxes met (islands of more than one body: the comparison covers contacts)" \
+  'grep -q "\"largest_island\": [2-9]" "$SCRATCH/$T/first/summary.json"'
 
 # --- check ------------------------------------------------------------------------------------------------
 "$PD" check "$SRC/cases/sweep/pile_10.scene" >"$SCRATCH/check1.out" 2>&1

@@ -15,7 +15,10 @@
 // - split: two cubes that start touching and fly apart start as one island and end as two, their free
 //   flight untouched (constant velocities, bit for bit);
 // - a pile of ten boxes (cases/bench/pile_10.scene): finite numbers, penetration below 3 δ_max, no energy
-//   gained beyond the integration error.
+//   gained beyond the integration error;
+// - threads (pdState.threads): a pile of 30 boxes in two layers gives, with 2 and 3 threads, every body's x, q,
+//   v, ω at every sample, the contact counts and every counter bit for bit as with 1 thread (each island's
+//   computation is its own: the split only decides which thread runs it).
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -41,13 +44,14 @@
 // norms see fewer components); a resting stack and a bounce then agree to well below 1e-4 of a body size.
 #define GROUP_OFF_TOL_REL 1e-4
 
-enum { MAX_BODIES = 16, MAX_SAMPLES = 1001 };
+enum { MAX_BODIES = 32, MAX_SAMPLES = 1001 };
 
 typedef struct trace {
   int count, bodies;
   double t[MAX_SAMPLES];
   pdBodyState body[MAX_SAMPLES][MAX_BODIES];  // by moving-body order
   int islands[MAX_SAMPLES];                   // pd_island_count at the sample
+  int contacts[MAX_SAMPLES];                  // pd_state_contact_count at the sample
   double energy[MAX_SAMPLES];
   double penetration;  // deepest contact over all samples, in its pair's δ_max
   bool finite;
@@ -65,6 +69,7 @@ static bool record_trace(const pdModel* model, const pdState* s, void* user) {
     r->finite = r->finite && pd_v3_isfinite(b.x) && pd_v3_isfinite(b.v) && pd_v3_isfinite(b.w) && isfinite(b.q.w);
   }
   r->islands[k] = pd_island_count(s);
+  r->contacts[k] = pd_state_contact_count(s);
   r->energy[k] = pd_state_energy(model, s);
   for (int c = 0; c < pd_state_contact_count(s); ++c) {
     pdContactReport rep = pd_state_contact(s, c);
@@ -73,13 +78,14 @@ static bool record_trace(const pdModel* model, const pdState* s, void* user) {
   return true;
 }
 
-// Runs `model` to its tend with the given island mode; the final state to *stateOut when not NULL.
-static trace* run_islands(const pdModel* model, pdIslands islands, pdState** stateOut) {
+// Runs `model` to its tend with the given island mode and threads; the final state to *stateOut when not NULL.
+static trace* run_threads(const pdModel* model, pdIslands islands, int threads, pdState** stateOut) {
   trace* r = calloc(1, sizeof *r);
   assert_non_null(r);
   r->finite = true;
   pdState* s = pd_state_create(model);
   s->islands = islands;
+  s->threads = threads;
   bool done = pd_advance(model, s, model->settings.tend, record_trace, r);
   assert_true(done);
   assert_false(s->failed);
@@ -88,6 +94,11 @@ static trace* run_islands(const pdModel* model, pdIslands islands, pdState** sta
   else
     pd_state_free(s);
   return r;
+}
+
+// The same on one thread.
+static trace* run_islands(const pdModel* model, pdIslands islands, pdState** stateOut) {
+  return run_threads(model, islands, 1, stateOut);
 }
 
 static bool same_body(const pdBodyState* a, const pdBodyState* b) { return memcmp(a, b, sizeof *a) == 0; }
@@ -300,6 +311,61 @@ static void test_an_island_splits_when_its_bodies_part(void** state) {
   pd_model_free(m);
 }
 
+// ---------------------------------------------------------------- threads
+
+enum { PILE_BOXES = 30, PILE_ROW = 5, PILE_LAYER = 15 };  // 30 boxes: two layers of 3 rows of 5
+#define PILE_PITCH 0.3        // m between neighbours in a layer (the boxes are 0.2 m long: apart at first)
+#define PILE_LAYER_RISE 0.35  // m between the layers: the upper one lands on the lower one
+enum { PILE_TEXT = 8192 };
+
+// A pile of 30 boxes dropped in two layers onto a floor, each turned its own way: islands form, merge and
+// split, and some boxes fly free at first.
+static pdModel* pile_30(void) {
+  char text[PILE_TEXT];
+  int used = snprintf(text, sizeof text, "tend 0.3\nsample 100\n" FLOOR);
+  for (int k = 0; k < PILE_BOXES; ++k) {
+    int layer = k / PILE_LAYER, row = k % PILE_LAYER / PILE_ROW, col = k % PILE_ROW;
+    double x = PILE_PITCH * (col - 2) + 0.07 * layer, y = PILE_PITCH * (row - 1) + 0.05 * layer;
+    double z = 0.15 + PILE_LAYER_RISE * layer, angle = (13 + 37 * k) % 90;
+    used += snprintf(text + used, sizeof text - (size_t)used,
+                     "cube b%d tan 0.2 0.15 0.1\nloc %.4f %.4f %.4f %.1f 1 %.1f 0.5\nmu 0.5\nrestitution 0.5\n", k, x,
+                     y, z, angle, 0.3 * (k % 3));
+    assert_true(used < PILE_TEXT);
+  }
+  return compile_text(text);
+}
+
+static void test_threads_give_the_same_bits(void** state) {
+  (void)state;
+  pdModel* m = pile_30();
+  assert_int_equal(m->movingCount, PILE_BOXES);
+  pdState* one = NULL;
+  trace* a = run_threads(m, pd_islandsOn, 1, &one);
+  print_message("pile_30, islands on: %ld islands formed (largest %ld), %ld intervals, %ld redos, %ld steps\n",
+                one->count.islandsFormed, one->count.islandsLargest, one->count.islandIntervals, one->count.islandRedos,
+                one->count.accepted);
+  assert_true(one->count.islandsFormed > PILE_BOXES);  // islands formed and changed: the threads had work
+  assert_true(one->count.islandsLargest > 1);
+  for (int threads = 2; threads <= 3; ++threads) {
+    pdState* s = NULL;
+    trace* b = run_threads(m, pd_islandsOn, threads, &s);
+    assert_int_equal(a->count, b->count);
+    assert_true(memcmp(a->t, b->t, sizeof a->t) == 0);
+    assert_true(memcmp(a->body, b->body, sizeof a->body) == 0);
+    assert_true(memcmp(a->contacts, b->contacts, sizeof a->contacts) == 0);
+    assert_true(memcmp(a->islands, b->islands, sizeof a->islands) == 0);
+    assert_true(memcmp(&one->count, &s->count, sizeof one->count) == 0);  // steps, retries, islands: all integers
+    assert_true(memcmp(one->warnings, s->warnings, sizeof one->warnings) == 0);
+    assert_int_equal(one->n, s->n);
+    assert_true(memcmp(one->y, s->y, (size_t)one->n * sizeof *one->y) == 0);  // contact springs included
+    pd_state_free(s);
+    free(b);
+  }
+  pd_state_free(one);
+  free(a);
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_far_groups_compute_as_if_alone),
@@ -309,6 +375,7 @@ int main(void) {
       cmocka_unit_test(test_free_bodies_take_free_flight_steps),
       cmocka_unit_test(test_islands_merge_and_bounce_with_the_requested_e),
       cmocka_unit_test(test_an_island_splits_when_its_bodies_part),
+      cmocka_unit_test(test_threads_give_the_same_bits),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -13,8 +13,9 @@
 //
 // Reading a state: t, count, warnings, failed and stopped directly; poses with pd_state_body, contacts with
 // pd_state_contact_count and pd_state_contact (not from y, whose layout is internal to the stepper). The
-// fields are written by pd_advance and pd_state_reset; a caller writes only `stepper`, `onsets`, `islands` (and
-// `h`, the first step to try), between pd_state_create or pd_state_reset and the first pd_advance. With
+// fields are written by pd_advance and pd_state_reset; a caller writes only `stepper`, `onsets`, `islands`,
+// `threads` (and `h`, the first step to try), between pd_state_create or pd_state_reset and the first
+// pd_advance. With
 // pd_islandsOn, y, n and the contact list are those of the whole scene at every output sample (in the observer
 // and after pd_advance returns); between samples each island advances in a state of its own.
 //
@@ -88,6 +89,10 @@ typedef enum pdIslands {
                   // steps, error norm and contact events. Output at the common sample times.
 } pdIslands;
 
+// The most threads pdState.threads may ask for (a sanity bound: the islands of an interval are the only work
+// split, and more threads than cores only adds switching).
+#define PD_THREADS_MAX 64
+
 // The island mode's name in summary.json: "on" or "off".
 PD_API const char* pd_islands_name(pdIslands islands);
 
@@ -120,6 +125,10 @@ typedef struct pdState {
   pdStepper stepper;
   pdOnsets onsets;   // how contacts that began inside a step join (PD_ONSETS_DEFAULT unless the caller sets it)
   pdIslands islands;  // one system or islands (pd_islandsOff unless the caller sets it)
+  int threads;        // 1 .. PD_THREADS_MAX, 1 unless the caller sets it. With pd_islandsOn, the islands of each
+                      // interval run on this many threads (the caller's and threads - 1 of the state's own, created
+                      // at the first pd_advance and joined by pd_state_free/reset); the results are bit-identical
+                      // for every count. Ignored with pd_islandsOff (one system: one thread).
   int n;             // length of y: 13 per moving body + 8 per active contact
   int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)
   double* y;         // (n) the state vector
@@ -148,8 +157,8 @@ typedef struct pdBodyState {
 // and be the model passed with it to every other call.
 PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to the adaptive one, onsets to PD_ONSETS_DEFAULT and islands to pd_islandsOff (set state->stepper,
-// state->onsets, state->islands after this call).
+// to the adaptive one, onsets to PD_ONSETS_DEFAULT, islands to pd_islandsOff and threads to 1 (set
+// state->stepper, state->onsets, state->islands, state->threads after this call).
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.
 PD_API void pd_state_free(pdState* state);
