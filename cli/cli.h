@@ -7,6 +7,7 @@
 
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
+#include "polydyn/state.h"
 
 // Exit statuses (DESIGN §4.3).
 enum { PD_EXIT_OK = 0, PD_EXIT_FAILURE = 1, PD_EXIT_BAD_INPUT = 2 };
@@ -69,6 +70,9 @@ bool pd_cli_list_has(const char* list, const char* word);
 
 // Parses a finite number > 0 from an option value; false when it is not one.
 bool pd_cli_positive(const char* text, double* value);
+
+// Parses --onsets' value, "pair" or "exact"; false when it is neither.
+bool pd_cli_onsets(const char* text, pdOnsets* onsets);
 
 // True when argv[i] is -h or --help.
 bool pd_cli_is_help(const char* arg);

@@ -117,12 +117,7 @@ int pd_cmd_run(int argc, char** argv) {
         if (!pd_cli_positive(v, &overrides.sample)) return pd_cli_usage_error("run", "--sample needs a number > 0");
       } else if (strcmp(a, "--onsets") == 0) {
         softOptionGiven = true;
-        if (strcmp(v, "pair") == 0)
-          onsets = pd_onsetsPair;
-        else if (strcmp(v, "exact") == 0)
-          onsets = pd_onsetsExact;
-        else
-          return pd_cli_usage_error("run", "--onsets must be pair or exact");
+        if (!pd_cli_onsets(v, &onsets)) return pd_cli_usage_error("run", "--onsets must be pair or exact");
       } else if (strcmp(a, "--islands") == 0) {
         softOptionGiven = true;
         if (strcmp(v, "on") == 0)

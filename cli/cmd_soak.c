@@ -136,12 +136,7 @@ int pd_cmd_soak(int argc, char** argv) {
       if (!pd_cli_positive(v, &job.budget) || job.budget > 86400)
         return pd_cli_usage_error("soak", "--budget needs seconds > 0 (at most a day)");
     } else if (strcmp(a, "--onsets") == 0) {
-      if (strcmp(v, "pair") == 0)
-        job.onsets = pd_onsetsPair;
-      else if (strcmp(v, "exact") == 0)
-        job.onsets = pd_onsetsExact;
-      else
-        return pd_cli_usage_error("soak", "--onsets must be pair or exact");
+      if (!pd_cli_onsets(v, &job.onsets)) return pd_cli_usage_error("soak", "--onsets must be pair or exact");
     } else if (strcmp(a, "--jobs") == 0) {
       if (!pd_cli_jobs(v, &jobs))
         return pd_cli_usage_error("soak", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);

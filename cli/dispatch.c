@@ -86,6 +86,16 @@ bool pd_cli_jobs(const char* text, int* jobs) {
   return true;
 }
 
+bool pd_cli_onsets(const char* text, pdOnsets* onsets) {
+  if (strcmp(text, "pair") == 0)
+    *onsets = pd_onsetsPair;
+  else if (strcmp(text, "exact") == 0)
+    *onsets = pd_onsetsExact;
+  else
+    return false;
+  return true;
+}
+
 int pd_cli_default_jobs(int given, int serialDefault) {
   if (given > 0) return given;
   return pd_batch_ranks() > 1 ? 1 : serialDefault;

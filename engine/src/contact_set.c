@@ -28,19 +28,8 @@
 // springs at that deflection x and the two bodies given the impulse of those τ seconds (normal, and the
 // friction cone's when they slide), so its energy and phase are its own and its rest point sits d − x ≈
 // d (ωτ)²/6 deeper (d the depth reached without it).
-// A slip at the rounding of Δu (PD_ONSET_PAIR_SLIP_REL) counts as none. A flush stack (equal faces, edges
-// aligned) stays at rest only while it is exactly symmetric: its vertices sit on the edges below, and any offset
-// makes corner contacts come and go one corner at a time (vertex-face off the face, edge-edge off the edge, side
-// faces found); in soak seed 1 scene 147 one box set 1e-12 m aside makes another sink 60 δ_max in exact mode.
-// No contact force breaks that symmetry, but friction along the rounding of a slip did: four corners re-landing
-// at 17.8 ms had 8.7e-19 m/s of "slip" at 2.8e-3 m/s and got tangential impulses of ±6e-24 N·s; at 31 ms
-// edge-edge contacts appeared on the corners' vertex-face ones (exact mode never has them), at 50 ms three of
-// each pair's four broke under 0.5-15 N while the fourth held, and the stack fell apart (43 δ_max).
-// Both came from the corners: a vertex rocked by rounding just outside a shared side plane stopped being a VF
-// contact and an edge-edge pair took the corner until its closest point crossed the edge's end under load.
-// find_vf now holds such a vertex on the plane within the flush tolerance and find_ee leaves a crossing at a
-// vertex in VF contact to it (contact_analysis.c, EE_AT_VF_VERTEX_DEFLECTIONS): the 1e-15 … 1e-9 m offsets and
-// a 1e-6 rad twist of scene 147 stay up (0.02 δ_max) in both onset modes.
+// A slip at the rounding of Δu (PD_ONSET_PAIR_SLIP_REL) counts as none: its direction is noise, and friction
+// along it broke a flush stack's bitwise symmetry (README, "Contact onsets").
 #include "contact_set.h"
 
 #include <math.h>
@@ -75,8 +64,8 @@
 // points δ_max down (soak seed 1 scene 7: 4.0 δ_max of overlap).
 #define PD_ONSET_PAIR_DEPTH_REL 0.25
 // A pair onset's slip below this fraction of |Δu| at its point is none: removing the normal part leaves ~1e-16
-// |Δu| of rounding whose direction is noise, and friction along it breaks a flush stack's symmetry (design
-// note: soak seed 1 scene 147). The friction so dropped is at most 1e-9 m |Δu|.
+// |Δu| of rounding whose direction is noise, and friction along it broke a flush stack's symmetry (soak seed 1
+// scene 147: README, "Contact onsets"). The friction so dropped is at most 1e-9 m |Δu|.
 #define PD_ONSET_PAIR_SLIP_REL 1e-9
 // Steps containing a stick/slip change are halved down to this fraction of the shortest
 // contact period: the event is then located to ~5 % of the contact's own time scale. 1 % changed no
@@ -791,13 +780,18 @@ static int start_late_contacts(const pdModel* model, pdContactSet* set, double* 
 // modal dampers, the pair onsets' springs and impulses (start_late_contacts), each contact's geometry and
 // force (record), and the stability bound, in that order (the bound reads which contacts slip). Returns the
 // number of pair onsets started.
-static int prepare_list(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
+// Each moving body's inverse inertia in the world frame, R I⁻¹ Rᵀ, at `poses`.
+static void world_inverse_inertias(const pdModel* model, pdContactSet* set, const pdPose* poses) {
   for (int k = 0; k < model->movingCount; ++k) {
     int i = model->movingBodies[k];
     pdMat3 rt = pd_mat3_transpose(&poses[i].R);
     pdMat3 tmp = pd_mat3_mul(&model->bodies[i].invInertia, &rt);
     set->invInertiaWorld[i] = pd_mat3_mul(&poses[i].R, &tmp);
   }
+}
+
+static int prepare_list(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
+  world_inverse_inertias(model, set, poses);
   set_modal_dampers(model, set, poses);
   int started = start_late_contacts(model, set, y, poses);
   record(model, set, y, poses);
@@ -1172,12 +1166,7 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
   install(sub, to, count);
   // what prepare_list derives from the bodies' poses; the slots (modal dampers, forces) come as they were
   poses_from(sub, to->y, set->poses1);
-  for (int k = 0; k < sub->movingCount; ++k) {
-    int i = sub->movingBodies[k];
-    pdMat3 rt = pd_mat3_transpose(&set->poses1[i].R);
-    pdMat3 tmp = pd_mat3_mul(&sub->bodies[i].invInertia, &rt);
-    set->invInertiaWorld[i] = pd_mat3_mul(&set->poses1[i].R, &tmp);
-  }
+  world_inverse_inertias(sub, set, set->poses1);
   stability_prepare(sub, set, set->poses1);
 }
 

@@ -135,7 +135,8 @@ struct pdIslandSet {
   int pairCapacity;
   int* toSub;        // (bodyCount) scratch: scene body → island body (-1 elsewhere)
   int* contactOf;    // (contactCapacity) island of each of the scene's contacts at T
-  int* contactList;  // (contactCapacity) scratch: one island's contacts
+  int* contacts;     // (contactCapacity) the scene's contacts grouped by island, ascending within each
+  int* contactFirst;  // (movingCount + 1) island j's contacts: contacts[contactFirst[j] .. contactFirst[j + 1])
   int contactCapacity;
   island** islands;  // (islandCapacity) the live islands, listed by their lowest body
   island** next;     // (islandCapacity) scratch: the list being formed
@@ -228,8 +229,10 @@ static island* island_create(const pdModel* model, const struct pdIslandSet* set
 }
 
 // Sets island `is` up from the scene's state s at T: its bodies' numbers, the scene's contacts listed in
-// set->contactList[0 .. contacts), the stepper, onset mode and the smallest step its bodies last wanted.
-static void island_load(const pdModel* model, const pdState* s, struct pdIslandSet* set, island* is, int contacts) {
+// contacts[0 .. count) (scene contact indices), the stepper, onset mode and the smallest step its bodies last
+// wanted.
+static void island_load(const pdModel* model, const pdState* s, struct pdIslandSet* set, island* is,
+                        const int* contacts, int count) {
   pdState* sub = is->state;
   sub->stepper = s->stepper;
   sub->onsets = s->onsets;
@@ -243,37 +246,36 @@ static void island_load(const pdModel* model, const pdState* s, struct pdIslandS
   }
   sub->h = h;
   for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = l;
-  pd_contact_set_scatter(model, s, set->contactList, contacts, &is->model, sub, set->toSub);
+  pd_contact_set_scatter(model, s, contacts, count, &is->model, sub, set->toSub);
   for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = -1;
 }
 
 // The step hook of an island's pd_advance_hooked: each body's travel since T (centre displacement plus
 // radius × rotation angle), the largest so far kept.
 typedef struct travelProbe {
-  struct pdIslandSet* set;
   const island* is;
-  bool coarse;  // a free body: against its path over the sample interval (cx0, cv0, cq0 from ct0; ctravel)
+  double t0;              // s: when the paths start (T; a free body: T0 of the sample interval)
+  const pdVec3 *x0, *v0;  // (movingCount) centre of mass and velocity at t0
+  const pdQuat* q0;       // (movingCount) orientation at t0
+  double* travel;         // (movingCount) the largest distance from the path so far, m
 } travelProbe;
 
 static void measure_travel(const pdModel* sub, const pdState* state, void* user) {
   const travelProbe* probe = user;
-  struct pdIslandSet* set = probe->set;
+  double tau = state->t - probe->t0;
   for (int j = 0; j < probe->is->bodyCount; ++j) {
     int k = probe->is->bodies[j];
     const double* y = state->y + PD_BODY_STATE_SIZE * j;
-    pdQuat q = pd_layout_q(y), q0 = probe->coarse ? set->cq0[k] : set->q0[k];
+    pdQuat q = pd_layout_q(y), q0 = probe->q0[k];
     double dot = fabs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z);
     double norms =
         sqrt((q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z));
     double angle = 2.0 * acos(fmin(1.0, dot / norms));
     const pdBody* b = &sub->bodies[sub->movingBodies[j]];
-    double tau = state->t - (probe->coarse ? set->ct0 : set->t0);
-    pdVec3 x0 = probe->coarse ? set->cx0[k] : set->x0[k], v0 = probe->coarse ? set->cv0[k] : set->v0[k];
-    pdVec3 ballistic =
-        pd_v3_add(x0, pd_v3_add(pd_v3_scale(v0, tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
+    pdVec3 ballistic = pd_v3_add(
+        probe->x0[k], pd_v3_add(pd_v3_scale(probe->v0[k], tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
     double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
-    double* travel = probe->coarse ? set->ctravel : set->travel;
-    travel[k] = fmax(travel[k], moved);
+    probe->travel[k] = fmax(probe->travel[k], moved);
   }
 }
 
@@ -282,7 +284,8 @@ static void measure_travel(const pdModel* sub, const pdState* state, void* user)
 static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool coarse) {
   if (!coarse)
     for (int j = 0; j < is->bodyCount; ++j) set->travel[is->bodies[j]] = 0.0;
-  travelProbe probe = {set, is, coarse};
+  travelProbe probe = coarse ? (travelProbe){is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel}
+                             : (travelProbe){is, set->t0, set->x0, set->v0, set->q0, set->travel};
   is->advanced = true;
   return pd_advance_hooked(&is->model, is->state, tNext, NULL, NULL, measure_travel, &probe);
 }
@@ -504,7 +507,8 @@ void pd_island_set_free(struct pdIslandSet* set) {
   free(set->pairs);
   free(set->toSub);
   free(set->contactOf);
-  free(set->contactList);
+  free(set->contacts);
+  free(set->contactFirst);
   free(set->islands);
   free(set->next);
   free(set->subModels);
@@ -541,6 +545,10 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->islandOld = grow(NULL, (size_t)m, sizeof *set->islandOld);
   set->members = grow(NULL, (size_t)m, sizeof *set->members);
   set->first = grow(NULL, (size_t)m + 1, sizeof *set->first);
+  set->contactFirst = grow(NULL, (size_t)m + 1, sizeof *set->contactFirst);
+  set->contactCapacity = 4 * m + 16;  // grown in partition when the list outgrows it
+  set->contactOf = grow(NULL, (size_t)set->contactCapacity, sizeof *set->contactOf);
+  set->contacts = grow(NULL, (size_t)set->contactCapacity, sizeof *set->contacts);
   set->bound = grow(NULL, (size_t)m, sizeof *set->bound);
   set->travel = grow(NULL, (size_t)m, sizeof *set->travel);
   set->h = grow(NULL, (size_t)m, sizeof *set->h);
@@ -643,6 +651,17 @@ static double travel_bound(const pdModel* model, const struct pdIslandSet* set, 
 // a free body whose box another body's reaches is listed in set->activate instead, and the number of those is
 // returned (the partition is then incomplete: activate them and form it again). Without (the sample interval
 // as a whole), every body takes part.
+// Counting sort: items 0 .. n) grouped by group[i] (0 .. groups), ascending within each group, into
+// out[first[j] .. first[j + 1]).
+static void group_by(const int* group, int n, int groups, int* first, int* out) {
+  for (int j = 0; j <= groups; ++j) first[j] = 0;
+  for (int i = 0; i < n; ++i) ++first[group[i] + 1];
+  for (int j = 0; j < groups; ++j) first[j + 1] += first[j];
+  for (int i = 0; i < n; ++i) out[first[group[i]]++] = i;
+  for (int j = groups; j > 0; --j) first[j] = first[j - 1];
+  first[0] = 0;
+}
+
 static int partition(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt, bool fine) {
   int m = set->movingCount, activations = 0;
   for (int k = 0; k < m; ++k) {
@@ -695,16 +714,11 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
     int r = find(set->root, k);
     set->islandOf[k] = r == k ? set->partCount++ : set->islandOf[r];
   }
-  for (int j = 0; j <= set->partCount; ++j) set->first[j] = 0;
-  for (int k = 0; k < m; ++k) ++set->first[set->islandOf[k] + 1];
-  for (int j = 0; j < set->partCount; ++j) set->first[j + 1] += set->first[j];
-  for (int k = 0; k < m; ++k) set->members[set->first[set->islandOf[k]]++] = k;
-  for (int j = set->partCount; j > 0; --j) set->first[j] = set->first[j - 1];
-  set->first[0] = 0;
+  group_by(set->islandOf, m, set->partCount, set->first, set->members);
   if (contacts > set->contactCapacity) {
     set->contactCapacity = 2 * contacts;
     set->contactOf = grow(set->contactOf, (size_t)set->contactCapacity, sizeof *set->contactOf);
-    set->contactList = grow(set->contactList, (size_t)set->contactCapacity, sizeof *set->contactList);
+    set->contacts = grow(set->contacts, (size_t)set->contactCapacity, sizeof *set->contacts);
   }
   for (int c = 0; c < contacts; ++c) {
     int b1, b2;
@@ -712,6 +726,7 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
     int moving = model->bodies[b1].fixed ? b2 : b1;
     set->contactOf[c] = set->islandOf[model->bodies[moving].stateIndex];
   }
+  group_by(set->contactOf, contacts, set->partCount, set->contactFirst, set->contacts);
   return 0;
 }
 
@@ -720,7 +735,6 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
 // number of islands set up.
 static int rebuild(const pdModel* model, const pdState* s, struct pdIslandSet* set) {
   int built = 0;
-  int contacts = pd_state_contact_count(s);
   for (int j = 0; j < set->partCount; ++j) {
     const int* members = set->members + set->first[j];
     int count = set->first[j + 1] - set->first[j];
@@ -733,10 +747,8 @@ static int rebuild(const pdModel* model, const pdState* s, struct pdIslandSet* s
       continue;
     }
     island* is = island_create(model, set, members, count);
-    int listed = 0;
-    for (int c = 0; c < contacts; ++c)
-      if (set->contactOf[c] == j) set->contactList[listed++] = c;
-    island_load(model, s, set, is, listed);
+    island_load(model, s, set, is, set->contacts + set->contactFirst[j],
+                set->contactFirst[j + 1] - set->contactFirst[j]);
     set->next[j] = is;
     ++built;
     ++set->formed;
