@@ -32,10 +32,11 @@ static const char* const help =
     "  --onsets MODE    soft engine, a contact that began inside a step: exact (default) cuts the whole\n"
     "                   step back to its onset; pair joins it at the step's end, run for that pair alone\n"
     "                   since its onset, when it began within 1/omega and is shallow (README \"Contact onsets\")\n"
-    "  --islands on|off soft engine: off (default) advances all bodies with one step size; on splits them\n"
-    "                   between output samples into islands (bodies in contact or whose boxes may meet\n"
-    "                   before the next sample), each with its own steps and contact events (README \"Islands\")\n"
-    "  --threads N      soft engine with --islands on: advance the islands on N threads, 1..64 (default 1);\n"
+    "  --islands on|off soft engine: on (default) splits the bodies between output samples into islands\n"
+    "                   (bodies in contact or whose boxes may meet before the next sample), each with its\n"
+    "                   own steps and contact events; off advances all bodies with one step size\n"
+    "                   (README \"Islands\")\n"
+    "  --threads N      soft engine with islands on: advance the islands on N threads, 1..64 (default 1);\n"
     "                   a fixed split, so the outputs are bit-identical for every N\n"
     "  --variant NAME   ode, bullet: native (the engine's own hard contact, default) or matched (its\n"
     "                   soft contact set to polydyn's k and c)\n"
@@ -87,7 +88,7 @@ int pd_cmd_run(int argc, char** argv) {
   pdStepper stepper = pd_stepperRK4Adaptive;
   pdRefOptions ref = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
   pdOnsets onsets = PD_ONSETS_DEFAULT;
-  pdIslands islands = pd_islandsOff;
+  pdIslands islands = PD_ISLANDS_DEFAULT;
   int threads = 1;  // one unless asked: a run's CPU time stays its own, and batch commands fill the cores
   bool refOptionGiven = false, softOptionGiven = false;
   for (int i = 1; i < argc; ++i) {

@@ -14,7 +14,7 @@
 #include "polydyn/soak.h"
 
 static const char* const help =
-    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--engines soft,soft-islands,ode,bullet]\n"
+    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--engines soft,soft-islands-off,ode,bullet]\n"
     "                    [--budget SECONDS] [--jobs N] [--onsets pair|exact]\n"
     "\n"
     "Generates N random scenes (campaign S: scene i is the same text on every machine) and runs each in\n"
@@ -30,7 +30,7 @@ static const char* const help =
     "  --scenes N       how many scenes (default 100)\n"
     "  --seed S         the campaign (default 1)\n"
     "  --first I        start at scene I (default 0): scenes I .. I+N-1\n"
-    "  --engines LIST   soft, soft-islands (the soft engine with --islands on), ode, bullet (default soft)\n"
+    "  --engines LIST   soft, soft-islands-off (the soft engine with --islands off), ode, bullet (default soft)\n"
     "  --budget SECONDS wall-time budget of one run (default 20)\n"
     "  --jobs N         scenes in N worker processes (default 1; under mpirun or srun split over the ranks)\n"
     "  --onsets MODE    soft engine: how a contact that began inside a step joins, pair or exact (default:\n"
@@ -40,7 +40,7 @@ static const char* const help =
     "130 interrupted (nothing written).\n";
 
 enum { ENGINES_MAX = 4 };
-static const char* const engineNames[ENGINES_MAX] = {"soft", "soft-islands", "ode", "bullet"};
+static const char* const engineNames[ENGINES_MAX] = {"soft", "soft-islands-off", "ode", "bullet"};
 
 typedef struct soakJob {
   unsigned long seed;
@@ -91,9 +91,9 @@ static bool write_scene_file(const char* dir, const char* sub, long index, const
   snprintf(path, sizeof path, "%s/%s/%06ld-%s.scene", dir, sub, index, engine);
   FILE* f = fopen(path, "w");
   if (!f) return false;
-  bool islands = strcmp(engine, "soft-islands") == 0, soft = islands || strcmp(engine, "soft") == 0;
+  bool whole = strcmp(engine, "soft-islands-off") == 0, soft = whole || strcmp(engine, "soft") == 0;
   fprintf(f, "# %s: %s\n# replay: polydyn run %06ld-%s.scene --engine %s%s%s%s\n%s", pdSoakStatusNames[r->status],
-          r->message, index, engine, soft ? "soft" : engine, islands ? " --islands on" : "", soft ? " --onsets " : "",
+          r->message, index, engine, soft ? "soft" : engine, whole ? " --islands off" : "", soft ? " --onsets " : "",
           soft ? pd_onsets_name(onsets) : "", scene->text);
   bool ok = !ferror(f);
   return fclose(f) == 0 && ok;

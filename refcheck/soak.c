@@ -372,10 +372,10 @@ static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onse
   }
   watch w = {.scene = scene, .budget = budget, .wall0 = now(), .out = o};
   bool completed = false;
-  bool soft = strcmp(engine, "soft") == 0 || strcmp(engine, "soft-islands") == 0;
+  bool soft = strcmp(engine, "soft") == 0 || strcmp(engine, "soft-islands-off") == 0;
   if (soft) {
     pdState* s = pd_state_create(m);
-    if (strcmp(engine, "soft-islands") == 0) s->islands = pd_islandsOn;
+    if (strcmp(engine, "soft-islands-off") == 0) s->islands = pd_islandsOff;
     s->onsets = onsets;
     completed = pd_advance(m, s, m->settings.tend, observe, &w);
     completed = completed && !s->failed;

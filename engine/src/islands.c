@@ -4,7 +4,9 @@
 // one error norm (a max over all of y), and every contact onset anywhere cuts every body's step. With
 // islands on, pd_advance goes from sync time to sync time: the output samples, each sample interval cut into
 // equal parts (sync_parts: a body at the scene's vmax moves at most PD_ISLAND_SYNC_SIZE_FRACTION of the
-// smallest moving body's size over one; a function of the model and the interval only, never of the state).
+// smallest moving body's size over one; a function of the model and the interval only) where that splits an
+// island (cuts_split_islands: the partition over the first part has more islands than over the whole sample
+// interval); otherwise the samples are the sync times, and one island of every body is islands off, bit for bit.
 // Over each sync interval [T, T'] the moving bodies are partitioned into islands and each island advances
 // alone from T to T', in a pdState of its own over a model of its own, with its own step size, error norm,
 // contact events, onset retries and stability bound: the unchanged stepper of integrator.c.
@@ -902,6 +904,21 @@ static void find_free(const pdModel* model, const pdState* s, struct pdIslandSet
   }
 }
 
+// Whether cutting the sample interval at the sync times (each of length dt) would split an island of the
+// partition over the whole interval (find_free's, set->partCount islands): the partition over the first sync
+// interval, formed at T0, has more islands. If not, the sync times would only cut every island's steps and
+// add a partition, a rebuild and a gather each: the islands go to the sample in one interval (a single body,
+// a stack, a pile at rest). The partition over the whole interval holds at least as many bodies together as
+// any over a part of it (each box grows with the interval), so a part's count is never lower.
+static bool cuts_split_islands(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt) {
+  int whole = set->partCount;
+  mark_touching(model, s, set);
+  for (int k = 0; k < set->movingCount; ++k)
+    if (!set->free[k]) set_start(model, s, set, k, dt);
+  int activations = partition(model, s, set, dt, true);
+  return activations > 0 || set->partCount > whole;
+}
+
 // ---------------------------------------------------------------- pd_advance with islands
 
 // Into how many equal parts the interval dt is cut: the fewest that keep a body at the scene's characteristic
@@ -944,7 +961,10 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
     // the sync times: the interval to the sample cut into equal parts short enough for the fastest body
     double t0 = s->t;
     int parts = sync_parts(model, set, target - t0);
-    if (set->movingCount > 0) find_free(model, s, set, target - t0);
+    if (set->movingCount > 0) {
+      find_free(model, s, set, target - t0);
+      if (parts > 1 && !cuts_split_islands(model, s, set, (target - t0) / parts)) parts = 1;
+    }
     for (int j = 1; j <= parts; ++j) {
       double tSync = j == parts ? target : t0 + (target - t0) * ((double)j / parts);
       bool ok = set->movingCount == 0 || advance_interval(model, s, set, tSync, j == parts);

@@ -29,7 +29,7 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   pd_contact_set_clear(s->contacts);
   s->stepper = pd_stepperRK4Adaptive;
   s->onsets = PD_ONSETS_DEFAULT;
-  s->islands = pd_islandsOff;
+  s->islands = PD_ISLANDS_DEFAULT;
   s->threads = 1;
   pd_island_set_free(s->islandSet);
   s->islandSet = NULL;

@@ -145,7 +145,7 @@ sample_times() { tail -n +2 "$1" | cut -d, -f1 | uniq | tr "\n" " "; }
 check "samples at 0, 0.1, ..., 0.5" '[ "$(sample_times "$RUN3/trajectory.csv")" = "$TIMES" ]'
 for bad in "--tend abc" "--tend -1" "--tend nan" "--sample 0" "--tend" "--islands maybe" "--islands" \
   "--engine ode --islands on" "--islands on --threads 0" "--islands on --threads 65" "--islands on --threads 2x" \
-  "--islands on --threads" "--threads 2" "--engine ode --threads 1"; do
+  "--islands on --threads" "--islands off --threads 2" "--engine ode --threads 1"; do
   dir=$SCRATCH/out_badopt
   # shellcheck disable=SC2086
   run_pd "$OUT" "$ERR" run "$DEMO" --out "$dir" $bad

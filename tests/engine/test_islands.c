@@ -6,7 +6,8 @@
 //   the scene holds), and stay within a stated tolerance of each group alone with islands off (measured: 0,
 //   each group being one island throughout);
 // - every body in one island from start to end, with the samples as the only sync times: the same numbers
-//   bit for bit as islands off;
+//   bit for bit as islands off; also with a vmax that would cut the samples, when cutting splits no island
+//   (a bouncing cube alone, a stack);
 // - run to run: the same numbers bit for bit (a pile of ten boxes);
 // - merge: two cubes flying at each other start as two islands, become one and bounce with the requested
 //   restitution (closed form: exit speed / approach speed = e), within 0.01 as with islands off;
@@ -156,21 +157,31 @@ static void test_far_groups_compute_as_if_alone(void** state) {
 
 // ---------------------------------------------------------------- one island = islands off
 
-static void test_one_island_is_islands_off_bit_for_bit(void** state) {
-  (void)state;
-  // vmax 0.3 m/s: a body at vmax moves less than 2 % of the boxes' size in a sample interval, so the sync times
-  // are the samples (islands.c, sync_parts), where islands off cuts its steps too
-  pdModel* m = compile_text("tend 0.6\nsample 100\nvmax 0.3\n" FLOOR STACK);
+static void expect_islands_off_bits(const char* text, const char* what) {
+  pdModel* m = compile_text(text);
   trace* on = run_islands(m, pd_islandsOn, NULL);
   trace* off = run_islands(m, pd_islandsOff, NULL);
   assert_int_equal(on->count, off->count);
   for (int k = 1; k < on->count; ++k) {
-    assert_int_equal(on->islands[k], 1);  // the two boxes never part
+    assert_int_equal(on->islands[k], 1);  // the bodies never part
     for (int j = 0; j < on->bodies; ++j)
-      if (!same_body(&on->body[k][j], &off->body[k][j])) fail_msg("sample %d, body %d differs from islands off", k, j);
+      if (!same_body(&on->body[k][j], &off->body[k][j]))
+        fail_msg("%s: sample %d, body %d differs from islands off", what, k, j);
   }
+  print_message("%s: %d samples bit for bit as islands off\n", what, on->count);
   free(on), free(off);
   pd_model_free(m);
+}
+
+static void test_one_island_is_islands_off_bit_for_bit(void** state) {
+  (void)state;
+  // vmax 0.3 m/s: a body at vmax moves less than 2 % of the boxes' size in a sample interval, so the sync times
+  // are the samples (islands.c, sync_parts), where islands off cuts its steps too
+  expect_islands_off_bits("tend 0.6\nsample 100\nvmax 0.3\n" FLOOR STACK, "stack, samples only");
+  // vmax 4 m/s would cut each sample interval into 16 parts, but cutting splits no island (one body; a stack whose
+  // boxes touch), so the samples stay the only sync times (islands.c, cuts_split_islands)
+  expect_islands_off_bits(SETTINGS FLOOR STACK, "stack, vmax 4");
+  expect_islands_off_bits(SETTINGS FLOOR BOUNCER, "bouncing cube, vmax 4");
 }
 
 // ---------------------------------------------------------------- run to run, and a pile's physics

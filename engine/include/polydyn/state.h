@@ -83,8 +83,8 @@ PD_API const char* pd_onsets_name(pdOnsets onsets);
 
 // Whether the moving bodies advance as one system or as islands (engine/src/islands.c; README, "Islands").
 typedef enum pdIslands {
-  pd_islandsOff,  // default: one state vector, one step size, every onset cuts every body's step
-  pd_islandsOn,   // between output samples, bodies joined by a contact or whose boxes, grown by how far they
+  pd_islandsOff,  // one state vector, one step size, every onset cuts every body's step
+  pd_islandsOn,   // default: between output samples, bodies joined by a contact or whose boxes, grown by how far they
                   // can travel before the next sample, overlap form an island; each island takes its own
                   // steps, error norm and contact events. Output at the common sample times.
 } pdIslands;
@@ -92,6 +92,9 @@ typedef enum pdIslands {
 // The most threads pdState.threads may ask for (a sanity bound: the islands of an interval are the only work
 // split, and more threads than cores only adds switching).
 #define PD_THREADS_MAX 64
+
+// The island mode of a new state (pd_state_reset) and of the commands' --islands.
+#define PD_ISLANDS_DEFAULT pd_islandsOn
 
 // The island mode's name in summary.json: "on" or "off".
 PD_API const char* pd_islands_name(pdIslands islands);
@@ -124,7 +127,7 @@ typedef struct pdState {
   double h;          // next step to try, s
   pdStepper stepper;
   pdOnsets onsets;   // how contacts that began inside a step join (PD_ONSETS_DEFAULT unless the caller sets it)
-  pdIslands islands;  // one system or islands (pd_islandsOff unless the caller sets it)
+  pdIslands islands;  // one system or islands (PD_ISLANDS_DEFAULT unless the caller sets it)
   int threads;        // 1 .. PD_THREADS_MAX, 1 unless the caller sets it. With pd_islandsOn, the islands of each
                       // interval run on this many threads (the caller's and threads - 1 of the state's own, created
                       // at the first pd_advance and joined by pd_state_free/reset); the results are bit-identical
@@ -157,7 +160,7 @@ typedef struct pdBodyState {
 // and be the model passed with it to every other call.
 PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to the adaptive one, onsets to PD_ONSETS_DEFAULT, islands to pd_islandsOff and threads to 1 (set
+// to the adaptive one, onsets to PD_ONSETS_DEFAULT, islands to PD_ISLANDS_DEFAULT and threads to 1 (set
 // state->stepper, state->onsets, state->islands, state->threads after this call).
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.
