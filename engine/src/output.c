@@ -438,7 +438,10 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   // the energy is kinetic + gravitational + springs: the work of an applied force is not in it
   if (pd_model_has_applied_force(model)) fputs(", \"excludes_applied_work\": true", out);
   // timing last: the only part of a run directory that differs between two identical runs
-  fputs("},\n  \"timing\": {\"wall_seconds\": ", out);
+  fputs("},\n  \"timing\": {", out);
+  // the soft engine's threads change its wall time, never its numbers (islands.c, "Threads"): they belong here
+  if (!info->stepper) fprintf(out, "\"threads\": %d, ", state->islands == pd_islandsOn ? state->threads : 1);
+  fputs("\"wall_seconds\": ", out);
   write_number(out, info->wallSeconds);
   fputs(", \"stages\": {", out);
   for (int k = 0; k < pd_stageCount; ++k) {
