@@ -421,7 +421,7 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
           state->count.refinements, state->count.contactsMade, state->count.contactsVirtual,
           state->count.contactsTransferred, state->count.breaksForce, state->count.breaksGeometry,
           pd_state_contact_count(state));
-  if (state->islands == pd_islandsOn)
+  if (!info->stepper && state->islands == pd_islandsOn)  // the soft engine's islands only
     fprintf(out,
             "  \"island_counts\": {\"islands_formed\": %ld, \"largest_island\": %ld, \"island_intervals\": %ld, "
             "\"island_redos\": %ld, \"island_strays\": %ld},\n",
