@@ -8,3 +8,15 @@ static inline double pd_clock_seconds(void) {
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+
+// What one clock read adds to an interval timed with two, s: the least difference of consecutive reads out of a
+// few (sampled stage timers scale their intervals up, and that read with them: dynamics.c subtracts it).
+static inline double pd_clock_read_seconds(void) {
+  double least = 1.0;
+  for (int i = 0; i < 16; ++i) {
+    double a = pd_clock_seconds();
+    double b = pd_clock_seconds();
+    if (b - a < least) least = b - a;
+  }
+  return least;
+}

@@ -2,20 +2,31 @@
 // kinematics, gravity, the scene's applied forces, and the contact forces with their spring rates
 // (contact_set.c).
 
+#include "dynamics.h"
+
+#include <math.h>
+
 #include "clock.h"
 #include "contact_set.h"
 #include "polydyn/state.h"
 #include "state_layout.h"
 
 void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt) {
-  double t0 = pd_clock_seconds();
+  pd_state_derivative_sampled(model, state, t, y, dydt, 1.0);
+}
+
+void pd_state_derivative_sampled(const pdModel* model, pdState* state, double t, const double* y, double* dydt,
+                                 double timedScale) {
+  bool timed = timedScale > 0.0;
+  double t0 = timed ? pd_clock_seconds() : 0.0;
   pdContactSet* set = state->contacts;
   pd_contact_forces(model, set, y, dydt);
   const pdPose* poses = pd_contact_set_poses(set);
   const pdVec3* contactForce = pd_contact_set_force(set);
   const pdVec3* contactTorque = pd_contact_set_torque(set);
-  double t1 = pd_clock_seconds();
-  state->stageSeconds[pd_stageForces] += t1 - t0;
+  double t1 = timed ? pd_clock_seconds() : 0.0;
+  // a timed interval holds about one clock read, which the scale would multiply too
+  if (timed) state->stageSeconds[pd_stageForces] += timedScale * fmax(0.0, t1 - t0 - state->clockReadSeconds);
 
   const pdVec3 g = model->settings.gravity;
   for (int k = 0; k < model->movingCount; ++k) {
@@ -48,5 +59,7 @@ void pd_state_derivative(const pdModel* model, pdState* state, double t, const d
     pdQuat dq = pd_quat_mul((pdQuat){0.0, w.x, w.y, w.z}, q);
     pd_layout_store(d, a, alpha, v, (pdQuat){0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z});
   }
-  state->stageSeconds[pd_stageDerivative] += pd_clock_seconds() - t1;
+  if (timed)
+    state->stageSeconds[pd_stageDerivative] +=
+        timedScale * fmax(0.0, pd_clock_seconds() - t1 - state->clockReadSeconds);
 }

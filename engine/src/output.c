@@ -446,7 +446,8 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   fputs(", \"stages\": {", out);
   for (int k = 0; k < pd_stageCount; ++k) {
     fprintf(out, "%s\"%s\": ", k ? ", " : "", pdStageNames[k]);
-    write_number(out, state->stageSeconds[k]);
+    // the integration stage is the step's time less a sampled estimate of the derivative's: never below zero
+    write_number(out, fmax(0.0, state->stageSeconds[k]));
   }
   fputs("}}\n}\n", out);
 }

@@ -145,6 +145,7 @@ typedef struct pdState {
   pdCounters count;
   long warnings[pd_warnCount];
   double stageSeconds[pd_stageCount];
+  double clockReadSeconds;  // what one clock read adds to a timed interval, s (internal: the sampled stage timers)
 } pdState;
 
 // Pose and velocity of one body (fixed bodies report their initial pose and zero velocity).
