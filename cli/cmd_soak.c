@@ -14,8 +14,9 @@
 #include "polydyn/soak.h"
 
 static const char* const help =
-    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--engines soft,soft-islands-off,ode,bullet]\n"
-    "                    [--budget SECONDS] [--jobs N] [--onsets pair|exact]\n"
+    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I]\n"
+    "                    [--engines soft,soft-islands-off,ode,bullet] [--budget SECONDS] [--jobs N]\n"
+    "                    [--onsets pair|exact]\n"
     "\n"
     "Generates N random scenes (campaign S: scene i is the same text on every machine) and runs each in\n"
     "every engine, in a child process per run, checking at every output sample: no NaN or Inf; for the soft\n"
@@ -91,7 +92,8 @@ static bool write_scene_file(const char* dir, const char* sub, long index, const
   snprintf(path, sizeof path, "%s/%s/%06ld-%s.scene", dir, sub, index, engine);
   FILE* f = fopen(path, "w");
   if (!f) return false;
-  bool whole = strcmp(engine, "soft-islands-off") == 0, soft = whole || strcmp(engine, "soft") == 0;
+  pdIslands islands;
+  bool soft = pd_soak_engine_is_soft(engine, &islands), whole = islands == pd_islandsOff;
   fprintf(f, "# %s: %s\n# replay: polydyn run %06ld-%s.scene --engine %s%s%s%s\n%s", pdSoakStatusNames[r->status],
           r->message, index, engine, soft ? "soft" : engine, whole ? " --islands off" : "", soft ? " --onsets " : "",
           soft ? pd_onsets_name(onsets) : "", scene->text);

@@ -352,6 +352,12 @@ static bool observe(const pdModel* m, const pdState* s, void* user) {
   return true;
 }
 
+bool pd_soak_engine_is_soft(const char* engine, pdIslands* islands) {
+  *islands = PD_ISLANDS_DEFAULT;
+  if (strcmp(engine, "soft-islands-off") == 0) *islands = pd_islandsOff;
+  return *islands == pd_islandsOff || strcmp(engine, "soft") == 0;
+}
+
 // The run itself (in the child process).
 static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budget, pdSoakResult* o) {
   pdError err = {0};
@@ -372,10 +378,11 @@ static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onse
   }
   watch w = {.scene = scene, .budget = budget, .wall0 = now(), .out = o};
   bool completed = false;
-  bool soft = strcmp(engine, "soft") == 0 || strcmp(engine, "soft-islands-off") == 0;
+  pdIslands islands;
+  bool soft = pd_soak_engine_is_soft(engine, &islands);
   if (soft) {
     pdState* s = pd_state_create(m);
-    if (strcmp(engine, "soft-islands-off") == 0) s->islands = pd_islandsOff;
+    s->islands = islands;
     s->onsets = onsets;
     completed = pd_advance(m, s, m->settings.tend, observe, &w);
     completed = completed && !s->failed;

@@ -776,10 +776,6 @@ static int start_late_contacts(const pdModel* model, pdContactSet* set, double* 
   return started;
 }
 
-// After a new list is installed at state y (poses those of y): the bodies' world inverse inertias, the
-// modal dampers, the pair onsets' springs and impulses (start_late_contacts), each contact's geometry and
-// force (record), and the stability bound, in that order (the bound reads which contacts slip). Returns the
-// number of pair onsets started.
 // Each moving body's inverse inertia in the world frame, R I⁻¹ Rᵀ, at `poses`.
 static void world_inverse_inertias(const pdModel* model, pdContactSet* set, const pdPose* poses) {
   for (int k = 0; k < model->movingCount; ++k) {
@@ -790,6 +786,10 @@ static void world_inverse_inertias(const pdModel* model, pdContactSet* set, cons
   }
 }
 
+// After a new list is installed at state y (poses those of y): the bodies' world inverse inertias, the
+// modal dampers, the pair onsets' springs and impulses (start_late_contacts), each contact's geometry and
+// force (record), and the stability bound, in that order (the bound reads which contacts slip). Returns the
+// number of pair onsets started.
 static int prepare_list(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
   world_inverse_inertias(model, set, poses);
   set_modal_dampers(model, set, poses);
@@ -1146,24 +1146,32 @@ static int remap_body(const int* map, int body) {
   return mapped;
 }
 
+// Contact i of `from` (a state of `fromModel`) as a slot of another model's list: its bodies renumbered by
+// `map` (fromModel body → the other's), its springs read from from->y.
+static contactSlot remapped_slot(const pdModel* fromModel, const pdState* from, int i, const int* map) {
+  contactSlot c = from->contacts->items[i];
+  c.id.body1 = remap_body(map, c.id.body1);
+  c.id.body2 = remap_body(map, c.id.body2);
+  c.springs = springs_load(from->y + spring_base(fromModel) + PD_CONTACT_STATE_SIZE * i);
+  return c;
+}
+
+// Installs next[0 .. count) as the list of `to` (a state of `model`), with no candidates or retries pending.
+static void install_moved(const pdModel* model, pdState* to, int count) {
+  to->contacts->candidateCount = 0;
+  to->contacts->onsetRetries = 0;
+  install(model, to, count);  // sorted by id: the order the slots came in does not matter
+}
+
 void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int* contacts, int count,
                             const pdModel* sub, pdState* to, const int* toSub) {
   pdContactSet* set = to->contacts;
-  const pdContactSet* src = from->contacts;
-  int base = spring_base(model);
   reserve_list(set, count);
   for (int k = 0; k < count; ++k) {
-    int i = contacts[k];
-    PD_ASSERT(i >= 0 && i < src->count);
-    contactSlot c = src->items[i];
-    c.id.body1 = remap_body(toSub, c.id.body1);
-    c.id.body2 = remap_body(toSub, c.id.body2);
-    c.springs = springs_load(from->y + base + PD_CONTACT_STATE_SIZE * i);
-    set->next[k] = c;
+    PD_ASSERT(contacts[k] >= 0 && contacts[k] < from->contacts->count);
+    set->next[k] = remapped_slot(model, from, contacts[k], toSub);
   }
-  set->candidateCount = 0;
-  set->onsetRetries = 0;
-  install(sub, to, count);
+  install_moved(sub, to, count);
   // what prepare_list derives from the bodies' poses; the slots (modal dampers, forces) come as they were
   poses_from(sub, to->y, set->poses1);
   world_inverse_inertias(sub, set, set->poses1);
@@ -1177,18 +1185,8 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
   for (int p = 0; p < parts; ++p) total += from[p]->contacts->count;
   reserve_list(set, total);
   int count = 0;
-  for (int p = 0; p < parts; ++p) {
-    const pdContactSet* src = from[p]->contacts;
-    int base = spring_base(subs[p]);
-    for (int i = 0; i < src->count; ++i) {
-      contactSlot c = src->items[i];
-      c.id.body1 = toModel[p][c.id.body1];
-      c.id.body2 = toModel[p][c.id.body2];
-      c.springs = springs_load(from[p]->y + base + PD_CONTACT_STATE_SIZE * i);
-      set->next[count++] = c;
-    }
-  }
-  set->candidateCount = 0;
-  set->onsetRetries = 0;
-  install(model, to, count);  // sorted by id: the order of the parts does not matter
+  for (int p = 0; p < parts; ++p)
+    for (int i = 0; i < from[p]->contacts->count; ++i)
+      set->next[count++] = remapped_slot(subs[p], from[p], i, toModel[p]);
+  install_moved(model, to, count);
 }

@@ -5,11 +5,17 @@
 #include "dynamics.h"
 
 #include <math.h>
+#include <pthread.h>
 
 #include "clock.h"
 #include "contact_set.h"
 #include "polydyn/state.h"
 #include "state_layout.h"
+
+// What one clock read adds to a timed interval, s: a property of the machine, measured once per process.
+static double clockRead;
+static pthread_once_t clockReadOnce = PTHREAD_ONCE_INIT;
+static void measure_clock_read(void) { clockRead = pd_clock_read_seconds(); }
 
 void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt) {
   pd_state_derivative_sampled(model, state, t, y, dydt, 1.0);
@@ -18,6 +24,7 @@ void pd_state_derivative(const pdModel* model, pdState* state, double t, const d
 void pd_state_derivative_sampled(const pdModel* model, pdState* state, double t, const double* y, double* dydt,
                                  double timedScale) {
   bool timed = timedScale > 0.0;
+  if (timed) pthread_once(&clockReadOnce, measure_clock_read);
   double t0 = timed ? pd_clock_seconds() : 0.0;
   pdContactSet* set = state->contacts;
   pd_contact_forces(model, set, y, dydt);
@@ -26,7 +33,7 @@ void pd_state_derivative_sampled(const pdModel* model, pdState* state, double t,
   const pdVec3* contactTorque = pd_contact_set_torque(set);
   double t1 = timed ? pd_clock_seconds() : 0.0;
   // a timed interval holds about one clock read, which the scale would multiply too
-  if (timed) state->stageSeconds[pd_stageForces] += timedScale * fmax(0.0, t1 - t0 - state->clockReadSeconds);
+  if (timed) state->stageSeconds[pd_stageForces] += timedScale * fmax(0.0, t1 - t0 - clockRead);
 
   const pdVec3 g = model->settings.gravity;
   for (int k = 0; k < model->movingCount; ++k) {
@@ -59,7 +66,5 @@ void pd_state_derivative_sampled(const pdModel* model, pdState* state, double t,
     pdQuat dq = pd_quat_mul((pdQuat){0.0, w.x, w.y, w.z}, q);
     pd_layout_store(d, a, alpha, v, (pdQuat){0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z});
   }
-  if (timed)
-    state->stageSeconds[pd_stageDerivative] +=
-        timedScale * fmax(0.0, pd_clock_seconds() - t1 - state->clockReadSeconds);
+  if (timed) state->stageSeconds[pd_stageDerivative] += timedScale * fmax(0.0, pd_clock_seconds() - t1 - clockRead);
 }

@@ -4,7 +4,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "clock.h"
 #include "contact_set.h"
 #include "islands.h"
 #include "state_layout.h"
@@ -32,7 +31,6 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   s->onsets = PD_ONSETS_DEFAULT;
   s->islands = PD_ISLANDS_DEFAULT;
   s->threads = 1;
-  s->clockReadSeconds = pd_clock_read_seconds();
   pd_island_set_free(s->islandSet);
   s->islandSet = NULL;
   s->nextSample = 0;

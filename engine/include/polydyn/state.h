@@ -15,9 +15,8 @@
 // pd_state_contact_count and pd_state_contact (not from y, whose layout is internal to the stepper). The
 // fields are written by pd_advance and pd_state_reset; a caller writes only `stepper`, `onsets`, `islands`,
 // `threads` (and `h`, the first step to try), between pd_state_create or pd_state_reset and the first
-// pd_advance. With
-// pd_islandsOn, y, n and the contact list are those of the whole scene at every output sample (in the observer
-// and after pd_advance returns); between samples each island advances in a state of its own.
+// pd_advance. With pd_islandsOn, y, n and the contact list are those of the whole scene at every output sample
+// (in the observer and after pd_advance returns); between samples each island advances in a state of its own.
 //
 // Memory: pd_state_create allocates everything a step needs. A step never allocates; between two steps,
 // pd_advance grows the state's vectors (doubling) only when the contact list outgrows them.
@@ -116,7 +115,7 @@ typedef struct pdCounters {
   // pd_islandsOn only (0 otherwise); the counts above are then summed over the islands
   long islandsFormed;    // islands set up (at the start, and each time the bodies of an island changed)
   long islandsLargest;   // moving bodies in the largest island formed
-  long islandIntervals;  // sample intervals advanced (island by island)
+  long islandIntervals;  // sync intervals advanced (island by island; islands.c, design note)
   long islandRedos;      // islands whose interval was redone because a body moved farther than its grown box
   long islandStrays;     // free bodies found outside their box over a sample interval (none expected: a free body
                          // has no contact to leave its ballistic path by; counted, not recovered)
@@ -145,7 +144,6 @@ typedef struct pdState {
   pdCounters count;
   long warnings[pd_warnCount];
   double stageSeconds[pd_stageCount];
-  double clockReadSeconds;  // what one clock read adds to a timed interval, s (internal: the sampled stage timers)
 } pdState;
 
 // Pose and velocity of one body (fixed bodies report their initial pose and zero velocity).

@@ -77,8 +77,12 @@ typedef struct pdSoakResult {
   double momentumError;      // max |P(t) − P(0)| / Σ m|v(0)| (free scenes), else 0
 } pdSoakResult;
 
-// Runs the scene in `engine` ("soft", "ode", "bullet") in a child process with the wall-time budget and
-// checks the invariants; the soft engine joins contact onsets as `onsets` says (README, "Contact onsets").
-// The result is filled in every case.
+// Whether `engine` is the soft engine: "soft" (islands as the engine's default) or "soft-islands-off"
+// (--islands off); *islands gets its island mode.
+bool pd_soak_engine_is_soft(const char* engine, pdIslands* islands);
+
+// Runs the scene in `engine` ("soft", "soft-islands-off", "ode", "bullet") in a child process with the wall-time budget
+// and checks the invariants; the soft engine joins contact onsets as `onsets` says (README, "Contact onsets"). The
+// result is filled in every case.
 void pd_soak_run(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budgetSeconds,
                  pdSoakResult* out);
