@@ -15,6 +15,9 @@
 //   off (a free body is not cut at the sync times);
 // - split: two cubes that start touching and fly apart start as one island and end as two, their free
 //   flight untouched (constant velocities, bit for bit);
+// - apart: two cubes turned 45° resting side by side, their boxes overlapping but their faces 0.083 m apart,
+//   are two islands at every sample (the separating-axis test), and agree with islands off within
+//   GROUP_OFF_TOL_REL;
 // - a pile of ten boxes (cases/bench/pile_10.scene): finite numbers, penetration below 3 δ_max, no energy
 //   gained beyond the integration error;
 // - threads (pdState.threads): a pile of 30 boxes in two layers gives, with 2 and 3 threads, every body's x, q,
@@ -322,6 +325,38 @@ static void test_an_island_splits_when_its_bodies_part(void** state) {
   pd_model_free(m);
 }
 
+// Two cubes turned 45° about z resting side by side on the floor: their boxes overlap (centres 0.2 m apart in x
+// and y, box half-widths 0.141 m) but their facing faces are 0.083 m apart, far more than they can close over a
+// sample interval at rest. The separating-axis test keeps them in islands of their own from start to end; the
+// box test alone made them one.
+static void test_turned_bodies_apart_whose_boxes_overlap_are_two_islands(void** state) {
+  (void)state;
+  pdModel* m = compile_text("tend 0.3\nsample 100\n" FLOOR
+                            "cube a red 0.2 0.2 0.2\nloc -0.1 -0.1 0.1 45 0 0 1\nmu 0.5\nrestitution 0.5\n"
+                            "cube b blue 0.2 0.2 0.2\nloc 0.1 0.1 0.1 45 0 0 1\nmu 0.5\nrestitution 0.5\n");
+  pdState* s = NULL;
+  trace* on = run_islands(m, pd_islandsOn, &s);
+  trace* off = run_islands(m, pd_islandsOff, NULL);
+  assert_int_equal(s->count.islandsLargest, 1);
+  for (int k = 1; k < on->count; ++k) assert_int_equal(on->islands[k], 2);  // (none at t = 0: none formed yet)
+  pd_state_free(s);
+  // each cube alone against both in one step sequence: resting, they agree to the integration tolerance
+  double worst = 0.0;
+  for (int k = 0; k < on->count; ++k)
+    for (int j = 0; j < 2; ++j) {
+      pdVec3 a = on->body[k][j].x, b = off->body[k][j].x;
+      worst = fmax(worst, max_abs(a.x - b.x, a.y - b.y, a.z - b.z) / 0.2);
+    }
+  print_message(
+      "turned cubes side by side: two islands at every sample; position difference to islands off %.2e "
+      "of the size\n",
+      worst);
+  assert_true(worst <= GROUP_OFF_TOL_REL);
+  free(on);
+  free(off);
+  pd_model_free(m);
+}
+
 // ---------------------------------------------------------------- threads
 
 enum { PILE_BOXES = 30, PILE_ROW = 5, PILE_LAYER = 15 };  // 30 boxes: two layers of 3 rows of 5
@@ -386,6 +421,7 @@ int main(void) {
       cmocka_unit_test(test_free_bodies_take_free_flight_steps),
       cmocka_unit_test(test_islands_merge_and_bounce_with_the_requested_e),
       cmocka_unit_test(test_an_island_splits_when_its_bodies_part),
+      cmocka_unit_test(test_turned_bodies_apart_whose_boxes_overlap_are_two_islands),
       cmocka_unit_test(test_threads_give_the_same_bits),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
