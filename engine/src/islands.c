@@ -98,6 +98,12 @@
 // many bodies (a contact's force and events cost about what a body's motion costs: a rough, fixed guess).
 #define PD_ISLAND_CONTACT_WEIGHT 1
 
+// A pair of scene bodies and the last separating feature the partition found for them.
+typedef struct pairSat {
+  int a, b;
+  pdSatCache cache;
+} pairSat;
+
 typedef struct island {
   int bodyCount;   // moving bodies
   int* bodies;     // (bodyCount) their moving-body indices k (scene body model->movingBodies[k]), ascending
@@ -140,6 +146,9 @@ struct pdIslandSet {
   pdBroadPhase* broad;
   pdPair* pairs;
   int pairCapacity;
+  // may_meet's separating feature of each pair it tested at the last partition, sorted by (a, b) (a hint)
+  pairSat *sat, *satNext;  // (pairCapacity)
+  int satCount;
   int* toSub;        // (bodyCount) scratch: scene body → island body (-1 elsewhere)
   int* contactOf;    // (contactCapacity) island of each of the scene's contacts at T
   int* contacts;     // (contactCapacity) the scene's contacts grouped by island, ascending within each
@@ -512,6 +521,8 @@ void pd_island_set_free(struct pdIslandSet* set) {
   free(set->boxes);
   pd_broad_phase_free(set->broad);
   free(set->pairs);
+  free(set->sat);
+  free(set->satNext);
   free(set->toSub);
   free(set->contactOf);
   free(set->contacts);
@@ -547,6 +558,8 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   free(fixed);
   set->pairCapacity = 4 * m + 16;
   set->pairs = grow(NULL, (size_t)set->pairCapacity, sizeof *set->pairs);
+  set->sat = grow(NULL, (size_t)set->pairCapacity, sizeof *set->sat);
+  set->satNext = grow(NULL, (size_t)set->pairCapacity, sizeof *set->satNext);
   set->root = grow(NULL, (size_t)m, sizeof *set->root);
   set->islandOf = grow(NULL, (size_t)m, sizeof *set->islandOf);
   set->islandOld = grow(NULL, (size_t)m, sizeof *set->islandOld);
@@ -656,16 +669,23 @@ static double travel_bound(const pdModel* model, const struct pdIslandSet* set, 
 // body k stays, in the frame that falls with gravity, within bound_k of where v0_k τ takes it (design note), so
 // along u the gap shrinks by at most max(0, u·(v0_a − v0_b)) dt + bound_a + bound_b. Boxes of turned bodies
 // overlap long before the bodies do: in a settling pile, the box test alone joins bodies lying side by side
-// into islands of hundreds.
-static bool may_meet(const struct pdIslandSet* set, const pdBody* a, const pdBody* b, double dt) {
+// into islands of hundreds. The pair's separating feature from the last partition (cache) is tried first (the
+// same bodies, moved a little since); only when its axis does not keep them apart are all axes searched for the
+// widest gap. Either answer is safe, and the cache is a function of the pair's own past: still deterministic.
+static bool may_meet(const struct pdIslandSet* set, const pdBody* a, const pdBody* b, double dt, pdSatCache* cache) {
   int ka = a->stateIndex, kb = b->stateIndex;
   pdMat3 ra = pd_quat_to_mat3(pd_quat_normalize(set->q0[ka]));
   pdMat3 rb = pd_quat_to_mat3(pd_quat_normalize(set->q0[kb]));
+  double bounds = set->bound[ka] + set->bound[kb];
+  pdVec3 dv = pd_v3_sub(set->v0[ka], set->v0[kb]);
   pdSatResult sat;
-  if (pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_MIN_DEPTH, NULL, &sat))
+  if (cache->kind != PD_SAT_NONE &&
+      !pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_FIRST_SEPARATING, cache, &sat) &&
+      -sat.depth > fmax(0.0, pd_v3_dot(sat.axis, dv)) * dt + bounds)
+    return false;
+  if (pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_MIN_DEPTH, cache, &sat))
     return true;
-  double closing = fmax(0.0, pd_v3_dot(sat.axis, pd_v3_sub(set->v0[ka], set->v0[kb]))) * dt;
-  return -sat.depth <= closing + set->bound[ka] + set->bound[kb];
+  return -sat.depth <= fmax(0.0, pd_v3_dot(sat.axis, dv)) * dt + bounds;
 }
 
 // The partition of the moving bodies at the scene's state s (T) with the bounds set->bound over the interval
@@ -708,6 +728,8 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
   if (pairCount > set->pairCapacity) {
     set->pairCapacity = 2 * pairCount;
     set->pairs = grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
+    set->sat = grow(set->sat, (size_t)set->pairCapacity, sizeof *set->sat);
+    set->satNext = grow(set->satNext, (size_t)set->pairCapacity, sizeof *set->satNext);
     pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
   }
   // bodies in contact first: a pair already in one island needs no separation test
@@ -718,6 +740,7 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
     const pdBody *a = &model->bodies[b1], *b = &model->bodies[b2];
     if (!a->fixed && !b->fixed) join(set->root, a->stateIndex, b->stateIndex);
   }
+  int cached = 0, tested = 0;
   for (int p = 0; p < pairCount; ++p) {
     const pdBody *a = &model->bodies[set->pairs[p].a], *b = &model->bodies[set->pairs[p].b];
     if (a->fixed || b->fixed) continue;
@@ -731,8 +754,18 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
       continue;
     }
     if (find(set->root, a->stateIndex) == find(set->root, b->stateIndex)) continue;
-    if (may_meet(set, a, b, dt)) join(set->root, a->stateIndex, b->stateIndex);
+    int ia = set->pairs[p].a, ib = set->pairs[p].b;
+    while (cached < set->satCount && (set->sat[cached].a < ia || (set->sat[cached].a == ia && set->sat[cached].b < ib)))
+      ++cached;
+    pairSat* entry = &set->satNext[tested++];
+    *entry = (pairSat){ia, ib, {PD_SAT_NONE, -1, -1}};
+    if (cached < set->satCount && set->sat[cached].a == ia && set->sat[cached].b == ib) entry->cache = set->sat[cached].cache;
+    if (may_meet(set, a, b, dt, &entry->cache)) join(set->root, a->stateIndex, b->stateIndex);
   }
+  pairSat* t = set->sat;
+  set->sat = set->satNext;
+  set->satNext = t;
+  set->satCount = tested;
   if (activations > 0) return activations;
   // islands named by their lowest body, in that order; members grouped by a counting sort
   set->partCount = 0;
