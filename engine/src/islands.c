@@ -672,6 +672,11 @@ static double travel_bound(const pdModel* model, const struct pdIslandSet* set, 
 // into islands of hundreds. The pair's separating feature from the last partition (cache) is tried first (the
 // same bodies, moved a little since); only when its axis does not keep them apart are all axes searched for the
 // widest gap. Either answer is safe, and the cache is a function of the pair's own past: still deterministic.
+// Whether the axis of `sat` keeps two bodies apart over dt: its gap wider than they can close along it.
+static bool kept_apart(const pdSatResult* sat, pdVec3 relativeVelocity, double dt, double bounds) {
+  return sat->separated && -sat->depth > fmax(0.0, pd_v3_dot(sat->axis, relativeVelocity)) * dt + bounds;
+}
+
 static bool may_meet(const struct pdIslandSet* set, const pdBody* a, const pdBody* b, double dt, pdSatCache* cache) {
   int ka = a->stateIndex, kb = b->stateIndex;
   pdMat3 ra = pd_quat_to_mat3(pd_quat_normalize(set->q0[ka]));
@@ -679,13 +684,12 @@ static bool may_meet(const struct pdIslandSet* set, const pdBody* a, const pdBod
   double bounds = set->bound[ka] + set->bound[kb];
   pdVec3 dv = pd_v3_sub(set->v0[ka], set->v0[kb]);
   pdSatResult sat;
-  if (cache->kind != PD_SAT_NONE &&
-      !pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_FIRST_SEPARATING, cache, &sat) &&
-      -sat.depth > fmax(0.0, pd_v3_dot(sat.axis, dv)) * dt + bounds)
-    return false;
-  if (pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_MIN_DEPTH, cache, &sat))
-    return true;
-  return -sat.depth <= fmax(0.0, pd_v3_dot(sat.axis, dv)) * dt + bounds;
+  if (cache->kind != PD_SAT_NONE) {
+    pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_FIRST_SEPARATING, cache, &sat);
+    if (kept_apart(&sat, dv, dt, bounds)) return false;
+  }
+  pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_MIN_DEPTH, cache, &sat);
+  return !kept_apart(&sat, dv, dt, bounds);
 }
 
 // The partition of the moving bodies at the scene's state s (T) with the bounds set->bound over the interval
