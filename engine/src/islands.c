@@ -763,7 +763,8 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
       ++cached;
     pairSat* entry = &set->satNext[tested++];
     *entry = (pairSat){ia, ib, {PD_SAT_NONE, -1, -1}};
-    if (cached < set->satCount && set->sat[cached].a == ia && set->sat[cached].b == ib) entry->cache = set->sat[cached].cache;
+    if (cached < set->satCount && set->sat[cached].a == ia && set->sat[cached].b == ib)
+      entry->cache = set->sat[cached].cache;
     if (may_meet(set, a, b, dt, &entry->cache)) join(set->root, a->stateIndex, b->stateIndex);
   }
   pairSat* t = set->sat;
