@@ -87,10 +87,13 @@
 // Sync times: a sample interval is cut into equal parts so that a body at the characteristic speed vmax travels
 // at most this fraction of the smallest moving body's size over one part, at most PD_ISLAND_SYNC_PARTS_MAX parts.
 // The bounds grow with the interval: with short ones, bodies that fall or bounce near each other stay in
-// islands of their own. Measured on cases/bench/pile_1000.scene (0.5 s, one run each): the samples alone
-// (10 ms) 140 s, 0.05 (11 parts) 41.9 s, 0.02 (16 parts) 38.9 s; pile_10 pays for it (0.065 s -> 0.094 s,
-// still below islands off), pile_100 is unchanged (0.74 s -> 0.69 s).
-#define PD_ISLAND_SYNC_SIZE_FRACTION 0.02
+// islands of their own; each cut also cuts every island's step. With boxes only (before the separating-axis
+// test in the partition), on cases/bench/pile_1000.scene (0.5 s, one run each): the samples alone (10 ms)
+// 140 s, 0.05 (11 parts) 41.9 s, 0.02 (16 parts) 38.9 s. With the separating-axis test the islands stay small
+// with fewer cuts: 0.05 against 0.02 (farm-bench, CPU time) cases/sweep/pile_10.scene 0.90x,
+// cases/bench/pile_1000.scene 0.96x, pile_100, the bin of 100 and the demo 1.00x; 0.1 the same on pile_10,
+// 0.2 1.01x (the samples alone: pile_1000 10x slower, its largest island 751 boxes).
+#define PD_ISLAND_SYNC_SIZE_FRACTION 0.05
 #define PD_ISLAND_SYNC_PARTS_MAX 16
 // A body that moved farther than its bound gets this many times the distance it moved as its new bound.
 #define PD_ISLAND_REDO_GROWTH 2.0
