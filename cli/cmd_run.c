@@ -15,7 +15,7 @@
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
     "                         [--stepper adaptive|fixed|embedded] [--variant native|matched]\n"
-    "                         [--onsets pair|exact] [--islands on|off] [--threads N] [--step H]\n"
+    "                         [--onsets pair|exact|auto] [--islands on|off] [--threads N] [--step H]\n"
     "                         [--ode-friction pyramid|aligned]\n"
     "\n"
     "Simulates SCENE and writes DIR/trajectory.csv and DIR/summary.json. DIR is written under a\n"
@@ -29,9 +29,10 @@ static const char* const help =
     "  --stepper NAME   adaptive: RK4 with step-doubling error control (default);\n"
     "                   fixed: RK4 with the scene's dt, no error control;\n"
     "                   embedded: RK4 with its embedded third-order error estimate (soft engine)\n"
-    "  --onsets MODE    soft engine, a contact that began inside a step: exact (default) cuts the whole\n"
-    "                   step back to its onset; pair joins it at the step's end, run for that pair alone\n"
-    "                   since its onset, when it began within 1/omega and is shallow (README \"Contact onsets\")\n"
+    "  --onsets MODE    soft engine, a contact that began inside a step: exact cuts the whole step back\n"
+    "                   to its onset; pair joins it at the step's end, run for that pair alone since its\n"
+    "                   onset, when it began within 1/omega and is shallow; auto (default) pair in an island\n"
+    "                   of more than 16 moving bodies, exact in smaller ones (README \"Contact onsets\")\n"
     "  --islands on|off soft engine: on (default) splits the bodies between output samples into islands\n"
     "                   (bodies in contact or whose boxes may meet before the next sample), each with its\n"
     "                   own steps and contact events; off advances all bodies with one step size\n"
@@ -118,7 +119,7 @@ int pd_cmd_run(int argc, char** argv) {
         if (!pd_cli_positive(v, &overrides.sample)) return pd_cli_usage_error("run", "--sample needs a number > 0");
       } else if (strcmp(a, "--onsets") == 0) {
         softOptionGiven = true;
-        if (!pd_cli_onsets(v, &onsets)) return pd_cli_usage_error("run", "--onsets must be pair or exact");
+        if (!pd_cli_onsets(v, &onsets)) return pd_cli_usage_error("run", "--onsets must be pair, exact or auto");
       } else if (strcmp(a, "--islands") == 0) {
         softOptionGiven = true;
         if (strcmp(v, "on") == 0)

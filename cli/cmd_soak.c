@@ -16,7 +16,7 @@
 static const char* const help =
     "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I]\n"
     "                    [--engines soft,soft-islands-off,ode,bullet] [--budget SECONDS] [--jobs N]\n"
-    "                    [--onsets pair|exact]\n"
+    "                    [--onsets pair|exact|auto]\n"
     "\n"
     "Generates N random scenes (campaign S: scene i is the same text on every machine) and runs each in\n"
     "every engine, in a child process per run, checking at every output sample: no NaN or Inf; for the soft\n"
@@ -34,7 +34,7 @@ static const char* const help =
     "  --engines LIST   soft, soft-islands-off (the soft engine with --islands off), ode, bullet (default soft)\n"
     "  --budget SECONDS wall-time budget of one run (default 20)\n"
     "  --jobs N         scenes in N worker processes (default 1; under mpirun or srun split over the ranks)\n"
-    "  --onsets MODE    soft engine: how a contact that began inside a step joins, pair or exact (default:\n"
+    "  --onsets MODE    soft engine: how a contact that began inside a step joins, pair, exact or auto (default:\n"
     "                   the engine's, as polydyn run --onsets; README \"Contact onsets\")\n"
     "\n"
     "Exit status: 0 no failure, 1 a run failed (or the results could not be written), 2 bad input,\n"
@@ -138,7 +138,7 @@ int pd_cmd_soak(int argc, char** argv) {
       if (!pd_cli_positive(v, &job.budget) || job.budget > 86400)
         return pd_cli_usage_error("soak", "--budget needs seconds > 0 (at most a day)");
     } else if (strcmp(a, "--onsets") == 0) {
-      if (!pd_cli_onsets(v, &job.onsets)) return pd_cli_usage_error("soak", "--onsets must be pair or exact");
+      if (!pd_cli_onsets(v, &job.onsets)) return pd_cli_usage_error("soak", "--onsets must be pair, exact or auto");
     } else if (strcmp(a, "--jobs") == 0) {
       if (!pd_cli_jobs(v, &jobs))
         return pd_cli_usage_error("soak", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);

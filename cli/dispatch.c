@@ -91,6 +91,8 @@ bool pd_cli_onsets(const char* text, pdOnsets* onsets) {
     *onsets = pd_onsetsPair;
   else if (strcmp(text, "exact") == 0)
     *onsets = pd_onsetsExact;
+  else if (strcmp(text, "auto") == 0)
+    *onsets = pd_onsetsAuto;
   else
     return false;
   return true;

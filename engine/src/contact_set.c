@@ -12,7 +12,8 @@
 //     A new contact found deeper than the onset tolerance began inside the step: its onset fraction δ is
 //     interpolated (App. C) and the step retried to end there (t0 + δ·h); an onset within dt_min of the
 //     start makes it a virtual contact, added at t0 with its springs at 0 and the step restarted. With
-//     pd_onsetsPair (selectable; not the default: README, "Contact onsets") a contact whose onset lies less than
+//     pair onsets (pd_onsetsPair, or pd_onsetsAuto in a system of more than PD_ONSETS_CROWD_BODIES moving bodies:
+//     README, "Contact onsets") a contact whose onset lies less than
 //     PD_ONSET_PAIR_OMEGA_TAU / ω before the step's end (ω its undamped angular frequency) does not cut the step: the
 //     interpolation is applied to the pair alone at commit (start_late_contacts), so one onset does not send every body
 //     back.
@@ -1002,11 +1003,12 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   // pair onset close enough to the step's end joins there instead)
   double t2 = pd_clock_seconds();
   double earliest = 2.0;
+  bool pairOnsets = pd_onsets_effective(s->onsets, model->movingCount) == pd_onsetsPair;
   for (int k = 0; k < set->candidateCount; ++k) {
     candidate* c = &set->candidates[k];
     if (!c->approaching || c->inherit >= 0) continue;
     double age = (1.0 - c->onset) * h;
-    if (s->onsets == pd_onsetsPair && joins_as_pair(model, &c->geom, age)) {
+    if (pairOnsets && joins_as_pair(model, &c->geom, age)) {
       c->onsetAge = age;
       continue;
     }

@@ -97,6 +97,13 @@ const char* pd_stepper_name(pdStepper stepper) {
   return "rk4-adaptive";
 }
 
-const char* pd_onsets_name(pdOnsets onsets) { return onsets == pd_onsetsExact ? "exact" : "pair"; }
+const char* pd_onsets_name(pdOnsets onsets) {
+  return onsets == pd_onsetsExact ? "exact" : onsets == pd_onsetsPair ? "pair" : "auto";
+}
+
+pdOnsets pd_onsets_effective(pdOnsets onsets, int movingBodies) {
+  if (onsets != pd_onsetsAuto) return onsets;
+  return movingBodies > PD_ONSETS_CROWD_BODIES ? pd_onsetsPair : pd_onsetsExact;
+}
 
 const char* pd_islands_name(pdIslands islands) { return islands == pd_islandsOn ? "on" : "off"; }

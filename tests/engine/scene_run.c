@@ -47,13 +47,15 @@ record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut) {
   return run_onsets(model, stepper, pd_onsetsExact, stateOut);
 }
 
-record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdState** stateOut) {
+static record* run_state(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdIslands islands,
+                         pdState** stateOut) {
   record* r = calloc(1, sizeof *r);
   assert_non_null(r);
   r->finite = true;
   pdState* s = pd_state_create(model);
   s->stepper = stepper;
   s->onsets = onsets;
+  s->islands = islands;
   assert_true(pd_advance(model, s, model->settings.tend, record_sample, r));
   assert_true(r->finite);
   assert_int_equal(s->warnings[pd_warnNonFinite], 0);
@@ -62,6 +64,14 @@ record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdS
   else
     pd_state_free(s);
   return r;
+}
+
+record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdState** stateOut) {
+  return run_state(model, stepper, onsets, PD_ISLANDS_DEFAULT, stateOut);
+}
+
+record* run_onsets_islands(const pdModel* model, pdOnsets onsets, pdIslands islands, pdState** stateOut) {
+  return run_state(model, pd_stepperRK4Adaptive, onsets, islands, stateOut);
 }
 
 double energy_gain(const record* r) {

@@ -25,8 +25,11 @@ pdModel* compile_text(const char* text);
 record* run(const pdModel* model, pdState** stateOut);
 // The same with the given stepper (run: the default, adaptive RK4 with step doubling).
 record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut);
-// The same with the given onset mode too (run_with: pd_onsetsExact, the default).
+// The same with the given onset mode too (run_with: pd_onsetsExact, which the default pd_onsetsAuto is in
+// systems of at most PD_ONSETS_CROWD_BODIES moving bodies).
 record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdState** stateOut);
+// The same with adaptive RK4, the given onset mode and islands on or off.
+record* run_onsets_islands(const pdModel* model, pdOnsets onsets, pdIslands islands, pdState** stateOut);
 // The largest rise of the energy between any earlier and any later sample, relative to |E(0)|.
 double energy_gain(const record* r);
 // Index of the body called `name`; fails the test when there is none.

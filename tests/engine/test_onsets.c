@@ -10,6 +10,9 @@
 //   and re-lands a few times, each landing located to 1e-3 δ_max);
 // - a column of boxes dropped onto a floor: no energy gained at any sample, and fewer onset retries than
 //   the exact mode (the point of the pair mode).
+// - auto (the default): exact onsets in a system of at most PD_ONSETS_CROWD_BODIES moving bodies, pair onsets in
+//   a larger one, bit for bit (islands off), and pair onsets inside an island of more (islands on), no energy
+//   gained.
 // Every case asserts first that pair onsets did happen, so the test cannot pass on the exact path alone.
 #include <math.h>
 #include <setjmp.h>
@@ -18,6 +21,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <cmocka.h>
 
@@ -146,11 +150,77 @@ static void test_a_falling_column_gains_no_energy_and_retries_less(void** state)
   pd_model_free(m);
 }
 
+// A column of `boxes` 0.2 × 0.2 × 0.1 m boxes, each turned 30° from the one below, 2 mm apart, dropped onto a
+// floor: they land one on another and form one island.
+static pdModel* column_of(int boxes) {
+  enum { COLUMN_TEXT = 8192 };
+  char text[COLUMN_TEXT];
+  int used =
+      snprintf(text, sizeof text, "tend 0.15\ncube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nmu 0.5\nrestitution 0.5\n");
+  for (int k = 0; k < boxes; ++k) {
+    used += snprintf(text + used, sizeof text - (size_t)used,
+                     "cube b%d tan 0.2 0.2 0.1\nloc 0 0 %.4f %d 0 0 1\nmu 0.5\nrestitution 0.5\n", k, 0.052 + 0.102 * k,
+                     30 * k % 90);
+    assert_true(used < COLUMN_TEXT);
+  }
+  return compile_text(text);
+}
+
+static bool same_record(const record* a, const record* b) {
+  if (a->count != b->count) return false;
+  for (int k = 0; k < a->count; ++k) {
+    if (a->energy[k] != b->energy[k] || a->contacts[k] != b->contacts[k]) return false;
+    for (int j = 0; j < SCENE_RUN_TRACKED; ++j)
+      if (memcmp(&a->body[j][k], &b->body[j][k], sizeof a->body[j][k]) != 0) return false;
+  }
+  return true;
+}
+
+// pd_onsetsAuto (the default): a system of at most PD_ONSETS_CROWD_BODIES moving bodies takes exact onsets, a
+// larger one pair onsets, bit for bit (islands off: the scene is the system). With islands on, a column of
+// more than that many boxes becomes one island and joins onsets as pairs there, gaining no energy.
+static void test_auto_onsets_are_exact_in_small_systems_and_pairs_in_crowds(void** state) {
+  (void)state;
+  int sizes[2] = {4, PD_ONSETS_CROWD_BODIES + 2};
+  for (int i = 0; i < 2; ++i) {
+    pdModel* m = column_of(sizes[i]);
+    pdOnsets expected = sizes[i] > PD_ONSETS_CROWD_BODIES ? pd_onsetsPair : pd_onsetsExact;
+    assert_int_equal(pd_onsets_effective(pd_onsetsAuto, m->movingCount), expected);
+    pdState *sa = NULL, *se = NULL;
+    record* a = run_onsets_islands(m, pd_onsetsAuto, pd_islandsOff, &sa);
+    record* e = run_onsets_islands(m, expected, pd_islandsOff, &se);
+    print_message("column of %d, islands off: auto onsets %s %s's (%ld pair onsets, %ld steps)\n", sizes[i],
+                  same_record(a, e) ? "are" : "ARE NOT", pd_onsets_name(expected), sa->count.onsetsInterpolated,
+                  sa->count.accepted);
+    assert_true(same_record(a, e));
+    assert_int_equal(sa->count.accepted, se->count.accepted);
+    assert_int_equal(sa->count.derivatives, se->count.derivatives);
+    assert_int_equal(sa->count.onsetsInterpolated > 0, expected == pd_onsetsPair);
+    pd_state_free(sa);
+    pd_state_free(se);
+    free(a);
+    free(e);
+    if (expected == pd_onsetsPair) {
+      pdState* s = NULL;
+      record* r = run_onsets_islands(m, pd_onsetsAuto, pd_islandsOn, &s);
+      print_message("column of %d, islands on: largest island %ld, %ld pair onsets, energy rise %.2e of |E(0)|\n",
+                    sizes[i], s->count.islandsLargest, s->count.onsetsInterpolated, energy_gain(r));
+      assert_true(s->count.islandsLargest > PD_ONSETS_CROWD_BODIES);
+      assert_true(s->count.onsetsInterpolated > 0);
+      assert_true(energy_gain(r) <= ENERGY_GAIN_TOL);
+      pd_state_free(s);
+      free(r);
+    }
+    pd_model_free(m);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_landings_bounce_with_the_requested_e_in_both_modes),
       cmocka_unit_test(test_a_dropped_cube_rests_at_its_static_deflection),
       cmocka_unit_test(test_a_falling_column_gains_no_energy_and_retries_less),
+      cmocka_unit_test(test_auto_onsets_are_exact_in_small_systems_and_pairs_in_crowds),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
