@@ -139,11 +139,6 @@ typedef struct stabilityTerms {
   double overdamp;      // ζ + √(ζ² − 1) for the most over-damped direction (1 when ζ ≤ 1)
 } stabilityTerms;
 
-typedef struct pairCache {
-  int a, b;
-  pdSatCache sat;
-} pairCache;
-
 struct pdContactSet {
   int count, capacity;
   contactSlot* items;      // (capacity) sorted by id
@@ -162,7 +157,7 @@ struct pdContactSet {
   pdBroadPhase* broad;
   pdPair* pairs;
   int pairCapacity;
-  pairCache *cache, *cacheNext;
+  pdPairSatCache *cache, *cacheNext;
   int cacheCount, cacheCapacity;
   pdVec3 *force, *torque;  // (movingCount) contact force and moment on each moving body, world
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
@@ -885,12 +880,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
   double tInterference = 0.0;
   for (int p = 0; p < pairCount; ++p) {
     int a = set->pairs[p].a, b = set->pairs[p].b;
-    while (cached < set->cacheCount &&
-           (set->cache[cached].a < a || (set->cache[cached].a == a && set->cache[cached].b < b)))
-      ++cached;
-    pairCache entry = {a, b, {PD_SAT_NONE, -1, -1}};
-    if (cached < set->cacheCount && set->cache[cached].a == a && set->cache[cached].b == b)
-      entry.sat = set->cache[cached].sat;
+    pdPairSatCache entry = {a, b, pd_pair_sat_cache_find(set->cache, set->cacheCount, &cached, a, b)};
     double ti = pd_clock_seconds();
     pdSatResult sat;
     const pdBody *A = &model->bodies[a], *B = &model->bodies[b];
@@ -938,7 +928,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
   }
   // C0 contacts whose pair no longer overlaps were not visited: nothing to do, they break on commit
   // if they no longer track or pull; swap in the new cache
-  pairCache* t = set->cache;
+  pdPairSatCache* t = set->cache;
   set->cache = set->cacheNext;
   set->cacheNext = t;
   set->cacheCount = pairCount;

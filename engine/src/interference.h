@@ -47,6 +47,23 @@ typedef struct pdSatCache {
   int a, b;  // face or edge index in A (FACE_A, EDGES), face or edge index in B (FACE_B, EDGES); else -1
 } pdSatCache;
 
+// The cached feature of one pair of bodies (a < b), kept from one query to the next in a list sorted by (a, b)
+// (contact_set.c's contact search, islands.c's partition).
+typedef struct pdPairSatCache {
+  int a, b;
+  pdSatCache sat;
+} pdPairSatCache;
+
+// The cached feature of pair (a, b) in list[0 .. count), sorted by (a, b), an empty cache when the pair is not
+// listed. The pairs are asked in ascending order: the search goes on from *cursor, which it advances (a merge).
+static inline pdSatCache pd_pair_sat_cache_find(const pdPairSatCache* list, int count, int* cursor, int a, int b) {
+  int i = *cursor;
+  while (i < count && (list[i].a < a || (list[i].a == a && list[i].b < b))) ++i;
+  *cursor = i;
+  if (i < count && list[i].a == a && list[i].b == b) return list[i].sat;
+  return (pdSatCache){PD_SAT_NONE, -1, -1};
+}
+
 typedef enum pdSatMode {
   // Stop at the first separating axis, trying the cached feature first: the fast verdict for a
   // simulation step. When separated, depth < 0 is that axis's overlap (not necessarily the minimum).

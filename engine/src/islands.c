@@ -101,12 +101,6 @@
 // many bodies (a contact's force and events cost about what a body's motion costs: a rough, fixed guess).
 #define PD_ISLAND_CONTACT_WEIGHT 1
 
-// A pair of scene bodies and the last separating feature the partition found for them.
-typedef struct pairSat {
-  int a, b;
-  pdSatCache cache;
-} pairSat;
-
 typedef struct island {
   int bodyCount;   // moving bodies
   int* bodies;     // (bodyCount) their moving-body indices k (scene body model->movingBodies[k]), ascending
@@ -131,6 +125,7 @@ struct pdIslandSet {
   pdVec3* x0;        // (movingCount) centre of mass at T, m
   pdVec3* v0;        // (movingCount) its velocity at T, m/s
   pdQuat* q0;        // (movingCount) orientation at T
+  pdMat3* r0;        // (movingCount) its rotation matrix (normalised)
   pdAabb* box0;      // (movingCount) box at T
   bool* touching;    // (movingCount) in a contact at T, or its box may reach a fixed body's
   // the sample interval [T0, Ts] as a whole (free bodies: see the design note)
@@ -150,7 +145,7 @@ struct pdIslandSet {
   pdPair* pairs;
   int pairCapacity;
   // may_meet's separating feature of each pair it tested at the last partition, sorted by (a, b) (a hint)
-  pairSat *sat, *satNext;  // (pairCapacity)
+  pdPairSatCache *sat, *satNext;  // (pairCapacity)
   int satCount;
   int* toSub;        // (bodyCount) scratch: scene body → island body (-1 elsewhere)
   int* contactOf;    // (contactCapacity) island of each of the scene's contacts at T
@@ -521,6 +516,7 @@ void pd_island_set_free(struct pdIslandSet* set) {
   free(set->cbox);
   free(set->activate);
   free(set->q0);
+  free(set->r0);
   free(set->boxes);
   pd_broad_phase_free(set->broad);
   free(set->pairs);
@@ -589,6 +585,7 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->cbox = grow(NULL, (size_t)m, sizeof *set->cbox);
   set->activate = grow(NULL, (size_t)m, sizeof *set->activate);
   set->q0 = grow(NULL, (size_t)m, sizeof *set->q0);
+  set->r0 = grow(NULL, (size_t)m, sizeof *set->r0);
   set->sizeMin = INFINITY;
   for (int k = 0; k < m; ++k) {
     set->sizeMin = fmin(set->sizeMin, model->bodies[model->movingBodies[k]].size);
@@ -667,6 +664,11 @@ static double travel_bound(const pdModel* model, const struct pdIslandSet* set, 
   return bound;
 }
 
+// Whether the axis of `sat` keeps two bodies apart over dt: its gap wider than they can close along it.
+static bool kept_apart(const pdSatResult* sat, pdVec3 relativeVelocity, double dt, double bounds) {
+  return sat->separated && -sat->depth > fmax(0.0, pd_v3_dot(sat->axis, relativeVelocity)) * dt + bounds;
+}
+
 // Whether moving bodies a and b, whose grown boxes overlap, may meet over the interval dt: unless the separating
 // axis test at T finds an axis u (from a to b) with a gap wider than all they can close along it. Each point of
 // body k stays, in the frame that falls with gravity, within bound_k of where v0_k τ takes it (design note), so
@@ -675,23 +677,17 @@ static double travel_bound(const pdModel* model, const struct pdIslandSet* set, 
 // into islands of hundreds. The pair's separating feature from the last partition (cache) is tried first (the
 // same bodies, moved a little since); only when its axis does not keep them apart are all axes searched for the
 // widest gap. Either answer is safe, and the cache is a function of the pair's own past: still deterministic.
-// Whether the axis of `sat` keeps two bodies apart over dt: its gap wider than they can close along it.
-static bool kept_apart(const pdSatResult* sat, pdVec3 relativeVelocity, double dt, double bounds) {
-  return sat->separated && -sat->depth > fmax(0.0, pd_v3_dot(sat->axis, relativeVelocity)) * dt + bounds;
-}
-
 static bool may_meet(const struct pdIslandSet* set, const pdBody* a, const pdBody* b, double dt, pdSatCache* cache) {
   int ka = a->stateIndex, kb = b->stateIndex;
-  pdMat3 ra = pd_quat_to_mat3(pd_quat_normalize(set->q0[ka]));
-  pdMat3 rb = pd_quat_to_mat3(pd_quat_normalize(set->q0[kb]));
+  const pdMat3 *ra = &set->r0[ka], *rb = &set->r0[kb];
   double bounds = set->bound[ka] + set->bound[kb];
   pdVec3 dv = pd_v3_sub(set->v0[ka], set->v0[kb]);
   pdSatResult sat;
   if (cache->kind != PD_SAT_NONE) {
-    pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_FIRST_SEPARATING, cache, &sat);
+    pd_interference(&a->shape, set->x0[ka], ra, &b->shape, set->x0[kb], rb, PD_SAT_FIRST_SEPARATING, cache, &sat);
     if (kept_apart(&sat, dv, dt, bounds)) return false;
   }
-  pd_interference(&a->shape, set->x0[ka], &ra, &b->shape, set->x0[kb], &rb, PD_SAT_MIN_DEPTH, cache, &sat);
+  pd_interference(&a->shape, set->x0[ka], ra, &b->shape, set->x0[kb], rb, PD_SAT_MIN_DEPTH, cache, &sat);
   return !kept_apart(&sat, dv, dt, bounds);
 }
 
@@ -762,15 +758,11 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
     }
     if (find(set->root, a->stateIndex) == find(set->root, b->stateIndex)) continue;
     int ia = set->pairs[p].a, ib = set->pairs[p].b;
-    while (cached < set->satCount && (set->sat[cached].a < ia || (set->sat[cached].a == ia && set->sat[cached].b < ib)))
-      ++cached;
-    pairSat* entry = &set->satNext[tested++];
-    *entry = (pairSat){ia, ib, {PD_SAT_NONE, -1, -1}};
-    if (cached < set->satCount && set->sat[cached].a == ia && set->sat[cached].b == ib)
-      entry->cache = set->sat[cached].cache;
-    if (may_meet(set, a, b, dt, &entry->cache)) join(set->root, a->stateIndex, b->stateIndex);
+    pdPairSatCache* entry = &set->satNext[tested++];
+    *entry = (pdPairSatCache){ia, ib, pd_pair_sat_cache_find(set->sat, set->satCount, &cached, ia, ib)};
+    if (may_meet(set, a, b, dt, &entry->sat)) join(set->root, a->stateIndex, b->stateIndex);
   }
-  pairSat* t = set->sat;
+  pdPairSatCache* t = set->sat;
   set->sat = set->satNext;
   set->satNext = t;
   set->satCount = tested;
@@ -841,8 +833,8 @@ static void set_start(const pdModel* model, const pdState* s, struct pdIslandSet
   set->x0[k] = pd_layout_x(yb);
   set->v0[k] = pd_layout_v(yb);
   set->q0[k] = pd_layout_q(yb);
-  pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(set->q0[k]));
-  set->box0[k] = pd_aabb_of(&b->shape, set->x0[k], &r);
+  set->r0[k] = pd_quat_to_mat3(pd_quat_normalize(set->q0[k]));
+  set->box0[k] = pd_aabb_of(&b->shape, set->x0[k], &set->r0[k]);
   set->bound[k] = travel_bound(model, set, k, yb, &set->box0[k], &set->touching[k], s->t, dt);
   set->travel[k] = 0.0;
 }
