@@ -116,8 +116,10 @@ static void print_contact_pairs(const pdModel* m) {
     else
       printf("    normal damper given: cn %.6g N s/m per contact (damping ratio %.4f at m_pair)\n", p.cn, p.zetaN);
     if (p.modalT)
-      printf("    tang. damper  modal: damping ratio %.4f (critical; ct %.6g N s/m for one contact at m_pair)\n",
-             p.zetaT, p.ct);
+      printf(
+          "    tang. damper  modal: damping ratio %.4f (a face's twist critical; ct %.6g N s/m for one contact "
+          "at m_pair)\n",
+          p.zetaT, p.ct);
     else
       printf("    tang. damper  given: ct %.6g N s/m per contact\n", p.ct);
     printf("    time scales   period 2 pi sqrt(m_pair/kn) %.4g s, min eff. mass of the pair %.6g kg\n", p.period,

@@ -310,7 +310,7 @@ const pdGkExperiment pd_gk_d3_tumbling_cube = {
 #define D3_CT 2e4  // N·s/m per body: the pair's 1e4 gives ζ_t = 1e4/(2 √(1e6 × 1 kg)) = 5, overdamped
 
 static void d3_landing_scene(double e, pdGkText* out) {
-  // the tangential dampers overdamped too (the default is critical, ζ_t = 1): a tangential spring that gives
+  // the tangential dampers overdamped too (the default is ζ_t = 1/√3): a tangential spring that gives
   // back what it stored would spin the cube up after the landing, which rigid theory's plastic landing does not
   // have (with the default dampers the soft cube leaves its landing spinning at ~1/3 of ω⁻ instead of 1/4)
   char material[160];

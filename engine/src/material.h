@@ -6,7 +6,7 @@
 // - Per body (pd_material_side): μ; the restitution e (requested, or PD_DEFAULT_RESTITUTION); explicit
 //   kn, kt, cn, ct when the scene gives them; mass, minimum effective mass and size.
 // - Per pair (pd_contact_params_pair):
-//   μ = √(μ₁μ₂); e = √(e₁e₂); ζ_n from eq. (15) for that e; ζ_t = PD_TANGENTIAL_DAMPING_RATIO (critical).
+//   μ = √(μ₁μ₂); e = √(e₁e₂); ζ_n from eq. (15) for that e; ζ_t = PD_TANGENTIAL_DAMPING_RATIO (1/√3).
 //   Stiffness (eq. (11) for the pair): the relative kinetic energy ½ m_pair v_max² is stored at
 //   δ_max = deflection × the SMALLER body's size, m_pair = m₁m₂/(m₁+m₂) (a fixed body: infinite mass), so
 //   the series stiffness is k_s = m_pair v_max²/δ_max², and each side without an explicit kn gets 2 k_s
@@ -56,8 +56,16 @@ double pd_restitution_from_damping_ratio(double zeta);
 // The restitution a body without `restitution` has: a hard, moderately lossy material (wood, plastic,
 // stone on stone are 0.3–0.7); never 1, which would leave contacts ringing forever.
 #define PD_DEFAULT_RESTITUTION 0.5
-// The tangential springs are critically damped: a sticking contact settles in one period, no ringing.
-#define PD_TANGENTIAL_DAMPING_RATIO 1.0
+// The tangential dampers' damping ratio, for the mass each contact carries in the pair's joint sliding (modal
+// dampers: m/4 per contact on a face). On the same springs a body resting on a face also twists about the
+// normal, and for the corners of any rectangular face m r²/I_n = 3, so the twist's damping ratio is √3 ζ_t.
+// With ζ_t = 1 the twist was overdamped (ζ 1.73): its fast real root, 3.1 times its frequency, lay beyond the
+// stability bound (which takes ζ <= 1 per contact at its Gershgorin ω_max), so steps at the bound grew the
+// twist's error until rejected: cases/hard/stack_10.scene took 6 557 derivative evaluations, a box sliding to
+// rest on a floor had 23 % of its steps rejected. 1/√3 makes the twist critically damped and sliding 0.577 (a
+// sticking contact's ringing falls to 1.2 % within one period): the stack 3 595 evaluations (one step per 1 ms
+// sample), the box 0.2 % of its steps rejected.
+#define PD_TANGENTIAL_DAMPING_RATIO 0.57735026918962576
 
 // ---------------------------------------------------------------- effective mass (App. A, B)
 

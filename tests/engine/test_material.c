@@ -202,7 +202,7 @@ static void test_pair_stiffness_from_eq_11(void** state) {
 
 static void test_pair_dampers_are_modal_and_proportional_by_default(void** state) {
   (void)state;
-  // e = √(e₁e₂) = √(0.3 · 0.8); ζ_n from eq. (15); ζ_t critical; both sides one c/k
+  // e = √(e₁e₂) = √(0.3 · 0.8); ζ_n from eq. (15); ζ_t the default; both sides one c/k
   pdMaterialRequest r1 = {.mu = 0.5, .restitution = 0.3, .setMask = PD_SET_RESTITUTION};
   pdMaterialRequest r2 = {.mu = 0.5, .restitution = 0.8, .setMask = PD_SET_RESTITUTION};
   pdMaterialSide s1 = side_of(&BODY, &r1), s2 = side_of(&FLOOR, &r2);
@@ -218,7 +218,8 @@ static void test_pair_dampers_are_modal_and_proportional_by_default(void** state
   // one contact carrying the pair's mass until the contact set says more
   expect_rel(series(p.c1n, p.c2n), 2.0 * zeta * sqrt(ks * 2.0), 1e-13, "c_s at m_pair");
   expect_rel(p.c1n / p.k1n, p.c2n / p.k2n, FORMULA_TOL_REL, "one c/k");
-  expect_rel(series(p.c1t, p.c2t), 2.0 * sqrt(series(p.k1t, p.k2t) * 2.0), 1e-13, "c_t critical");
+  expect_rel(series(p.c1t, p.c2t), 2.0 * PD_TANGENTIAL_DAMPING_RATIO * sqrt(series(p.k1t, p.k2t) * 2.0), 1e-13,
+             "c_t at the default ζ_t");
   // four contacts of a face: m_c = m/4 each, ζ per contact as requested
   pd_contact_modal_damping(&p, 0.5, 0.5);
   expect_rel(series(p.c1n, p.c2n), 2.0 * zeta * sqrt(ks * 0.5), 1e-13, "c_s at m/4");

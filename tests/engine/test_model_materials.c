@@ -108,12 +108,13 @@ static void test_stiffness_of_a_cube_on_a_floor_follows_eq_11_for_the_pair(void*
     expect_rel(p.kn, 2.25e6, FORMULA_TOL_REL, "k_s of 1 kg at 3 m/s over 2 mm");
     assert_true(p.kt == p.kn && p.massPair == b->mass);
     expect_rel(p.deltaMax, 0.002, FORMULA_TOL_REL, "δ_max of the smaller body");
-    // the default restitution, modal dampers, ζ_t critical
+    // the default restitution, modal dampers, ζ_t the default
     assert_true(p.restitution == PD_DEFAULT_RESTITUTION && strcmp(p.restitutionSource, "default") == 0);
     assert_true(p.modalN && p.modalT && p.zetaT == PD_TANGENTIAL_DAMPING_RATIO);
     assert_true(fabs(p.zetaN - 0.2553) <= ZETA_TABLE_TOL);
     expect_rel(p.cn, 2.0 * p.zetaN * sqrt(p.kn * p.massPair), FORMULA_TOL_REL, "c_n at m_pair");
-    expect_rel(p.ct, 2.0 * sqrt(p.kt * p.massPair), FORMULA_TOL_REL, "c_t critical");
+    expect_rel(p.ct, 2.0 * PD_TANGENTIAL_DAMPING_RATIO * sqrt(p.kt * p.massPair), FORMULA_TOL_REL,
+               "c_t at the default ζ_t");
     // per body: what the scene left to the pair is reported as derived (-1)
     assert_true(b->used.kn == -1.0 && b->used.cn == -1.0 && b->used.restitution == PD_DEFAULT_RESTITUTION);
     assert_true(b->requested.kn == -1.0 && b->requested.cn == -1.0 && b->requested.restitution == -1.0);
