@@ -37,7 +37,7 @@
 #define RAMP_ACCEL_REL_TOL 0.01
 #define LATERAL_DRIFT 1e-6             // m
 // A box twisting to rest on a floor: with the tangential dampers overdamping its twist (ζ_t = 1 before issue 13's
-// second round) 23 % of its trial steps were rejected; with the twist critically damped, under 1 %.
+// second round) 10.5 % of its trial steps were rejected; with the twist critically damped, under 1 %.
 #define TWIST_REJECTED_SHARE_MAX 0.02
 // ... and at rest to round-off from 0.25 s: its corners' speed below this (the overdamped twist kept it jittering at
 // 2e-6 m/s, the error control's level: steps at the stability bound grew the twist's error until rejected).
