@@ -136,7 +136,7 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
       double d = face_depth(sf, f, q);
       if (d <= flushTol && d >= -flushTol && !crosses_face_plane(sv, &rel, off, sf, f, flushTol)) continue;
       outside = d < -tol;
-      penetration = fmin(penetration, d);
+      if (d < penetration) penetration = d;  // fmin but inline (only compared with tol below)
     }
     if (outside || !(penetration > tol)) continue;
     int face = previous_face(previous, previousCount, iv, i, jf);
@@ -189,10 +189,26 @@ static bool line_closest(pdVec3 P, pdVec3 u, pdVec3 Q, pdVec3 v, double* s, doub
 // face planes) must not exceed the bodies' overlap along the faces around the two edges; otherwise the
 // faces are far apart across an overlap that is shallow along another axis (see edge_contact_is_shallow).
 #define ARC_TOUCH_TOL 1e-9
+// Absolute rounding margin of a triple product of unit vectors: ~100 ulps of 1.
+#define ARC_TRIPLE_ROUNDING 1e-14
+
+// Are u and v (triple products of unit vectors, u = c · (b × a), …) of one sign and both beyond
+// 2 slack |b × a| + ARC_TRIPLE_ROUNDING in size (norm2 = |b × a|²)?
+static bool same_side_beyond(double u, double v, double norm2, double slack) {
+  if (!(u * v > 0.0)) return false;
+  double m = fmin(fabs(u), fabs(v)) - ARC_TRIPLE_ROUNDING;
+  return m > 0.0 && m * m > 4.0 * slack * slack * norm2;
+}
 typedef enum arcMeeting { arcsApart = 0, arcsCross, arcsTouch } arcMeeting;
 static arcMeeting arcs_meet(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d, double slack) {
   pdVec3 bxa = pd_v3_cross(b, a), dxc = pd_v3_cross(d, c);
   double cba = pd_v3_dot(c, bxa), dba = pd_v3_dot(d, bxa), adc = pd_v3_dot(a, dxc), bdc = pd_v3_dot(b, dxc);
+  // Apart for certain, and cheaply (most edge pairs): both ends of one arc on the same side of the other's
+  // great circle, each by a sine beyond twice the slack (plus a margin for the rounding of the triple
+  // products: the sine is cba/|b × a|). The arc between them is then on that side too, and so is every point
+  // within the slack of it, so the touch test below, whose point lies on that great circle, would find none.
+  if (same_side_beyond(cba, dba, pd_v3_dot(bxa, bxa), slack) || same_side_beyond(adc, bdc, pd_v3_dot(dxc, dxc), slack))
+    return arcsApart;
   // a crossing by a roundoff (an end of one arc within ARC_TOUCH_TOL of the other's great circle, as
   // when two faces are parallel) is a touch: it gets the touch's depth check, whatever the roundoff's sign
   bool nearEnd = fmin(fmin(fabs(cba), fabs(dba)), fmin(fabs(adc), fabs(bdc))) <= ARC_TOUCH_TOL;

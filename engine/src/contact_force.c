@@ -211,13 +211,20 @@ void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pd
   PD_ASSERT(p->k1n >= 0.0 && p->k2n >= 0.0 && p->k1t >= 0.0 && p->k2t >= 0.0);
   PD_ASSERT(p->c1n >= 0.0 && p->c2n >= 0.0 && p->c1t >= 0.0 && p->c2t >= 0.0 && p->mu >= 0.0);
   const pdVec3 zero = {0, 0, 0};
-  *out = (pdContactForce){.ft = zero, .force = zero, .dw = zero, .rate = {.s1t = zero, .s2t = zero}};
+  // field by field: a compound literal of the whole struct compiles to `rep stos`, 10 % of this function (perf)
+  out->fn = 0.0;
+  out->ft = out->force = out->dw = zero;
+  out->slip = false;
+  out->lambda = 0.0;
+  out->rate.s1n = out->rate.s2n = 0.0;
+  out->rate.s1t = out->rate.s2t = zero;
 
   double du_n = pd_v3_dot(du, n);
   normal_force(p, s->s1n, s->s2n, du_n, out);
 
   if (p->mu > 0.0 && p->k1t + p->k2t > 0.0) {
-    double limit = p->mu * fmax(out->fn, 0.0);
+    // fn > 0 ? fn : 0 equals fmax(fn, 0) for every fn (NaN and −0 included), without fmax's libm call
+    double limit = p->mu * (out->fn > 0.0 ? out->fn : 0.0);
     pdVec3 dut = in_plane(du, n), s1 = in_plane(s->s1t, n), s2 = in_plane(s->s2t, n);
     const double c1 = p->c1t, c2 = p->c2t;
     if (c1 > 0.0 && c2 > 0.0)

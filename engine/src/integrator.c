@@ -117,6 +117,10 @@ static void renormalise_quaternions(const pdModel* model, double* y) {
 // function returns the error norm (max over components of |error estimate| / weight).
 typedef double trialFcn(const pdModel* model, pdState* s, stepperWork* w, double h);
 
+// fmax(norm, x) for norm >= 0 not NaN, as the error norms below use it (a NaN component is skipped: the
+// non-finite check of the stepper catches it), without a libm call per state component.
+static inline double max_skipping_nan(double norm, double x) { return x > norm ? x : norm; }
+
 // Step doubling: one step of h and two of h/2; err = (y_half − y_full)/15 estimates the error of the two
 // half steps, which are kept. 11 derivative evaluations.
 static double trial_doubling(const pdModel* model, pdState* s, stepperWork* w, double h) {
@@ -125,7 +129,7 @@ static double trial_doubling(const pdModel* model, pdState* s, stepperWork* w, d
   derivative(model, s, s->t + 0.5 * h, w->half, w->k1half);
   rk4(model, s, w, s->t + 0.5 * h, w->half, w->k1half, 0.5 * h, w->trial);
   double norm = 0.0;
-  for (int i = 0; i < s->n; ++i) norm = fmax(norm, fabs(w->trial[i] - w->full[i]) / (15.0 * s->weight[i]));
+  for (int i = 0; i < s->n; ++i) norm = max_skipping_nan(norm, fabs(w->trial[i] - w->full[i]) / (15.0 * s->weight[i]));
   return norm;
 }
 
@@ -138,7 +142,8 @@ static double trial_embedded(const pdModel* model, pdState* s, stepperWork* w, d
   rk4(model, s, w, s->t, s->y, w->k1, h, w->trial);  // leaves k4 in w->ktmp
   derivative(model, s, s->t + h, w->trial, w->k1half);
   double norm = 0.0;
-  for (int i = 0; i < s->n; ++i) norm = fmax(norm, fabs(h * (w->ktmp[i] - w->k1half[i])) / (6.0 * s->weight[i]));
+  for (int i = 0; i < s->n; ++i)
+    norm = max_skipping_nan(norm, fabs(h * (w->ktmp[i] - w->k1half[i])) / (6.0 * s->weight[i]));
   return norm;
 }
 

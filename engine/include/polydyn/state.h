@@ -34,7 +34,7 @@ enum { PD_BODY_STATE_SIZE = 13 };
 typedef enum pdStage {
   pd_stageBroadPhase,       // boxes of the moving bodies, sweep and prune
   pd_stageInterference,     // separating-axis test of each box-overlapping pair
-  pd_stageContactAnalysis,  // VF/EE contacts of interfering pairs, tracking, onsets, breaks, the contact list
+  pd_stageContactAnalysis,  // VF/EE contacts of interfering pairs, tracking, onsets, breaks, contact list, travel limit
   pd_stageForces,           // contact forces and spring rates inside the state derivative
   pd_stageDerivative,       // the rest of the state derivative: Newton–Euler, quaternion kinematics
   pd_stageIntegrate,        // Runge–Kutta combination, error estimate, step control
