@@ -964,24 +964,24 @@ static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double a
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
 
-pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, const double* y1, double* hRetry) {
+pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, const double* y1, double* hRetry,
+                                 pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
   int base = spring_base(model);
   poses_from(model, s->y, set->poses0);
   poses_from(model, y1, set->poses1);
-  // the stages one after the other: broad phase, contact analysis (the travel limit included), interference,
-  // contact analysis
-  pdStopwatch watch = pd_stopwatch_start();
+  // the stages one after the other: broad phase (the poses above included), contact analysis (the travel
+  // limit included), interference, contact analysis
   double* analysisSeconds = &s->stageSeconds[pd_stageContactAnalysis];
 
   // 0. no tunnelling: bodies that may meet must not pass through each other's thinnest width in one step
   int pairCount = broad_phase(model, s, set->poses0, set->poses1);
-  pd_stopwatch_lap(&watch, &s->stageSeconds[pd_stageBroadPhase]);
+  pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageBroadPhase]);
   double limit = travel_limit(model, set, pairCount);
   if (limit < 1.0 && limit * h > model->settings.dtmin) {
     ++s->count.travelRetries;
     *hRetry = fmax(model->settings.dtmin, PD_TRAVEL_RETRY_SAFETY * limit * h);
-    pd_stopwatch_lap(&watch, analysisSeconds);
+    pd_stopwatch_lap(watch, analysisSeconds);
     return pd_eventRetry;
   }
 
@@ -996,7 +996,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     e->transferred = false;
     if (changes_mode(c, &e->force)) refineStep = fmax(refineStep, refine_step(model, &c->params));
   }
-  pd_stopwatch_lap(&watch, analysisSeconds);
+  pd_stopwatch_lap(watch, analysisSeconds);
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
   if (refineStep > 0.0 && s->stepper != pd_stepperRK4Fixed && 0.5 * h >= refineStep) {
     ++s->count.refinements;
@@ -1005,7 +1005,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   }
 
   // 2. the contacts at y1 that C0 does not have
-  search(model, s, y1, pairCount, set->poses0, set->poses1, &watch);
+  search(model, s, y1, pairCount, set->poses0, set->poses1, watch);
 
   // 3. onsets: the earliest new contact that began inside the step and went deeper than its tolerance (a
   // pair onset close enough to the step's end joins there instead)
@@ -1063,13 +1063,12 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     }
   }
   if (verdict == pd_eventAccept && earliest <= 1.0) ++s->warnings[pd_warnLateOnset];
-  pd_stopwatch_lap(&watch, analysisSeconds);  // the contact search after the interference, and the onsets
+  pd_stopwatch_lap(watch, analysisSeconds);  // the contact search after the interference, and the onsets
   return verdict;
 }
 
-void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1) {
+void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1, pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
-  double t0 = pd_clock_seconds();
   int base = spring_base(model);
   reserve_list(set, set->count + set->candidateCount);
   int count = 0;
@@ -1115,7 +1114,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
   install(model, s, count);
   poses_from(model, s->y, set->poses1);
   s->count.onsetsInterpolated += prepare_list(model, set, s->y, set->poses1);
-  s->stageSeconds[pd_stageContactAnalysis] += pd_clock_seconds() - t0;
+  pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageContactAnalysis]);
 }
 
 // ---------------------------------------------------------------- read-out

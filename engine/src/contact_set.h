@@ -8,6 +8,7 @@
 
 #include <stdbool.h>
 
+#include "clock.h"
 #include "contact_analysis.h"
 #include "contact_force.h"
 #include "polydyn/state.h"
@@ -45,12 +46,15 @@ typedef enum pdEventVerdict {
 // whether a contact onset or a reversal inside the step asks for a shorter step (Retry), whether
 // contacts must be added at the start (Restart: state->y and state->n are updated), or whether the step
 // stands (Accept). Onset retries are bounded per step, refinements by the refinement step. May grow the
-// state's vectors (Restart only: pointers into the stepper's scratch are then stale).
-pdEventVerdict pd_contact_events(const pdModel* model, pdState* state, double h, const double* y1, double* hRetry);
+// state's vectors (Restart only: pointers into the stepper's scratch are then stale). Its stages are timed as
+// laps of `watch`, running since the caller's last lap.
+pdEventVerdict pd_contact_events(const pdModel* model, pdState* state, double h, const double* y1, double* hRetry,
+                                 pdStopwatch* watch);
 // Accepts the step analysed by the last pd_contact_events: copies y1 into state->y with the new contact
 // list (breaks, transfers, new contacts with springs at 0), realigns the springs of continuing contacts
-// (§3.4) and records each contact's force for output. Grows the state's vectors if needed.
-void pd_contact_events_commit(const pdModel* model, pdState* state, const double* y1);
+// (§3.4) and records each contact's force for output. Grows the state's vectors if needed. Timed as one lap
+// of `watch` (contact analysis), which must have run since pd_contact_events' last.
+void pd_contact_events_commit(const pdModel* model, pdState* state, const double* y1, pdStopwatch* watch);
 
 // min(h, fraction × the largest step the adaptive stepper may take with the committed contact list), that
 // step satisfying (step/2) ω_max ≤ 2.5 for the fastest contact mode (contact_set.c, stable_step_exact;

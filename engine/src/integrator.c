@@ -43,7 +43,8 @@
 // few boxes make an evaluation cheap. One evaluation in this many is timed and counted this many times, so the
 // forces and derivative stages are estimates; a prime, so that the timed ones fall on each of the step
 // doubling's 11 (10 on a retry) evaluations in turn. The count depends on the state alone: no output changes.
-#define PD_DERIVATIVE_TIMING_STRIDE 13
+// 31, not 13 as first: at 13 the reads were still ~1 % of cases/sweep/pile_10's run.
+#define PD_DERIVATIVE_TIMING_STRIDE 31
 
 static void derivative(const pdModel* model, pdState* s, double t, const double* y, double* dydt) {
   bool timed = s->count.derivatives % PD_DERIVATIVE_TIMING_STRIDE == 0;
@@ -54,6 +55,14 @@ static void derivative(const pdModel* model, pdState* s, double t, const double*
 // Seconds spent inside derivative evaluations so far (subtracted from the integration stage).
 static double derivative_seconds(const pdState* s) {
   return s->stageSeconds[pd_stageForces] + s->stageSeconds[pd_stageDerivative];
+}
+
+// The integration stage of a trial step: the lap's time less the derivative evaluations' inside it
+// (tDerivative: derivative_seconds at the trial's start). The derivative stages are sampled estimates
+// (derivative()): a trial's share may come out below zero, the sum over a run does not.
+static void integrate_lap(pdState* s, pdStopwatch* watch, double tDerivative) {
+  pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageIntegrate]);
+  s->stageSeconds[pd_stageIntegrate] -= derivative_seconds(s) - tDerivative;
 }
 
 // Scratch vectors inside state->work.
@@ -161,14 +170,13 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     bool cut = hMax < s->h;
     double h = cut ? hMax : s->h;
     bool atMinimum = h <= set->dtmin;
-    double t0 = pd_clock_seconds();
+    // the trial, then the contact events and the commit, timed as consecutive laps
+    pdStopwatch watch = pd_stopwatch_start();
     double tDerivative = derivative_seconds(s);
 
     double norm = trial(model, s, &w, h);
     bool finite = isfinite(norm) && all_finite(w.trial, s->n);
-    // the derivative stages are sampled estimates (derivative()): a trial's share may come out below zero, the sum
-    // over a run does not
-    s->stageSeconds[pd_stageIntegrate] += (pd_clock_seconds() - t0) - (derivative_seconds(s) - tDerivative);
+    integrate_lap(s, &watch, tDerivative);
 
     if (!finite) {
       ++s->warnings[pd_warnNonFinite];
@@ -189,7 +197,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     // contact events (Fig. 8): a new contact's onset or a reversal inside the step may shorten it; a
     // virtual contact restarts it with the contact list grown
     double hRetry = h;
-    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry);
+    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry, &watch);
     if (verdict == pd_eventRetry) {
       hMax = hRetry;
       continue;
@@ -200,7 +208,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       continue;
     }
     if (norm > set->tol) ++s->warnings[pd_warnStepAtMinimum];
-    pd_contact_events_commit(model, s, w.trial);
+    pd_contact_events_commit(model, s, w.trial, &watch);
     renormalise_quaternions(model, s->y);
     ++s->count.accepted;
     if (!cut) {
@@ -218,20 +226,19 @@ static double fixed_step(const pdModel* model, pdState* s, double hMax) {
   stepperWork w = work_of(s);
   double h = fmin(model->settings.dt, hMax);
   derivative(model, s, s->t, s->y, w.k1);
+  pdStopwatch watch;
   for (;;) {
-    double t0 = pd_clock_seconds();
+    watch = pd_stopwatch_start();
     double tDerivative = derivative_seconds(s);
     rk4(model, s, &w, s->t, s->y, w.k1, h, w.trial);
-    // the derivative stages are sampled estimates (derivative()): a trial's share may come out below zero, the sum
-    // over a run does not
-    s->stageSeconds[pd_stageIntegrate] += (pd_clock_seconds() - t0) - (derivative_seconds(s) - tDerivative);
+    integrate_lap(s, &watch, tDerivative);
     if (!all_finite(w.trial, s->n)) {
       ++s->warnings[pd_warnNonFinite];
       s->failed = true;
       return 0.0;
     }
     double hRetry = h;
-    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry);
+    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry, &watch);
     if (verdict == pd_eventAccept) break;
     if (verdict == pd_eventRestart) {
       w = work_of(s);
@@ -240,7 +247,7 @@ static double fixed_step(const pdModel* model, pdState* s, double hMax) {
       h = hRetry;
     }
   }
-  pd_contact_events_commit(model, s, w.trial);
+  pd_contact_events_commit(model, s, w.trial, &watch);
   renormalise_quaternions(model, s->y);
   ++s->count.accepted;
   return h;
