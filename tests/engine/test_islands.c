@@ -22,7 +22,10 @@
 //   gained beyond the integration error;
 // - threads (pdState.threads): a pile of 30 boxes in two layers gives, with 2 and 3 threads, every body's x, q,
 //   v, ω at every sample, the contact counts and every counter bit for bit as with 1 thread (each island's
-//   computation is its own: the split only decides which thread runs it).
+//   computation is its own: the split only decides which thread runs it);
+// - stage timers (pdState.stageSeconds): on one thread, the stages timed whole (broad phase, interference,
+//   contact analysis, observe; laps of one stopwatch or intervals of their own, never overlapping) each ran and
+//   add up to no more than the time spent in pd_advance.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -31,6 +34,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include <cmocka.h>
 
@@ -412,6 +416,37 @@ static void test_threads_give_the_same_bits(void** state) {
   pd_model_free(m);
 }
 
+// The stages timed whole are disjoint parts of pd_advance's interval: on one thread their sum cannot exceed it
+// (forces, derivative and integrate are left out: they are scaled-up samples and the remainders of them).
+static double wall_seconds(void) {
+  struct timespec ts;
+  assert_int_equal(timespec_get(&ts, TIME_UTC), TIME_UTC);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void test_whole_stages_add_up_to_at_most_the_run(void** state) {
+  (void)state;
+  pdModel* m = pile_30();
+  trace* r = calloc(1, sizeof *r);
+  assert_non_null(r);
+  pdState* s = pd_state_create(m);
+  double t0 = wall_seconds();
+  assert_true(pd_advance(m, s, m->settings.tend, record_trace, r));
+  double wall = wall_seconds() - t0;
+  const pdStage whole[] = {pd_stageBroadPhase, pd_stageInterference, pd_stageContactAnalysis, pd_stageObserve};
+  double sum = 0.0;
+  for (size_t i = 0; i < sizeof whole / sizeof *whole; ++i) {
+    print_message("%s %.4f s\n", pdStageNames[whole[i]], s->stageSeconds[whole[i]]);
+    assert_true(s->stageSeconds[whole[i]] > 0.0);
+    sum += s->stageSeconds[whole[i]];
+  }
+  print_message("whole stages %.4f s of %.4f s in pd_advance\n", sum, wall);
+  assert_true(sum <= wall);
+  pd_state_free(s);
+  free(r);
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_far_groups_compute_as_if_alone),
@@ -423,6 +458,7 @@ int main(void) {
       cmocka_unit_test(test_an_island_splits_when_its_bodies_part),
       cmocka_unit_test(test_turned_bodies_apart_whose_boxes_overlap_are_two_islands),
       cmocka_unit_test(test_threads_give_the_same_bits),
+      cmocka_unit_test(test_whole_stages_add_up_to_at_most_the_run),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
