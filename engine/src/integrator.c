@@ -42,7 +42,7 @@
 // of every derivative evaluation were 14 % of cases/bench/pile_100's run (perf, 913bad4), whose islands of a
 // few boxes make an evaluation cheap. One evaluation in this many is timed and counted this many times, so the
 // forces and derivative stages are estimates; a prime, so that the timed ones fall on each of the step
-// doubling's 11 (10 on a retry) evaluations in turn. The count depends on the state alone: no output changes.
+// doubling's 11 (10 or 7 on a retry) evaluations in turn. The count depends on the state alone: no output changes.
 // 31, not 13 as first: at 13 the reads were still ~1 % of cases/sweep/pile_10's run.
 #define PD_DERIVATIVE_TIMING_STRIDE 31
 
@@ -65,15 +65,17 @@ static void integrate_lap(pdState* s, pdStopwatch* watch, double tDerivative) {
   s->stageSeconds[pd_stageIntegrate] -= derivative_seconds(s) - tDerivative;
 }
 
-// Scratch vectors inside state->work.
+// Scratch vectors inside state->work, and what `half` holds.
 typedef struct stepperWork {
   double *k1, *ktmp, *ytmp, *acc, *full, *half, *k1half, *trial;
+  double halfStep;  // s: `half` is the RK4 step of this size from the step's start (k1 and y as now); 0: none
 } stepperWork;
 
+// The scratch of a step from the state as it is now (nothing in it yet).
 static stepperWork work_of(pdState* s) {
   double* w = s->work;
   size_t n = (size_t)s->capacity;
-  return (stepperWork){w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n};
+  return (stepperWork){w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n, 0.0};
 }
 
 // One classic RK4 step of size h from (t, y) whose derivative k1 is known; result in `out`.
@@ -131,10 +133,17 @@ typedef double trialFcn(const pdModel* model, pdState* s, stepperWork* w, double
 static inline double max_skipping_nan(double norm, double x) { return x > norm ? x : norm; }
 
 // Step doubling: one step of h and two of h/2; err = (y_half − y_full)/15 estimates the error of the two
-// half steps, which are kept. 11 derivative evaluations.
+// half steps, which are kept. 11 derivative evaluations (k1 included; 10 on a retry, 7 on a retry at half
+// the step).
 static double trial_doubling(const pdModel* model, pdState* s, stepperWork* w, double h) {
-  rk4(model, s, w, s->t, s->y, w->k1, h, w->full);
+  // a retry at half the last trial's step from the same start (a stick–slip refinement halves it) has that
+  // trial's first half step as its full step: the same numbers, 3 derivative evaluations fewer
+  if (h == w->halfStep)
+    memcpy(w->full, w->half, (size_t)s->n * sizeof *w->full);
+  else
+    rk4(model, s, w, s->t, s->y, w->k1, h, w->full);
   rk4(model, s, w, s->t, s->y, w->k1, 0.5 * h, w->half);
+  w->halfStep = 0.5 * h;
   derivative(model, s, s->t + 0.5 * h, w->half, w->k1half);
   rk4(model, s, w, s->t + 0.5 * h, w->half, w->k1half, 0.5 * h, w->trial);
   double norm = 0.0;
