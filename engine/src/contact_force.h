@@ -69,8 +69,11 @@ static inline bool pd_contact_force_pulls(const pdContactForce* f) { return f->f
 // After an accepted step (paper §3.4): rotates the tangential springs from the old tangent plane (⊥ nOld)
 // into the new one (⊥ nNew) by the smallest rotation taking nOld to nNew, keeping each spring's length
 // exactly (a residual out-of-plane part is removed and the length restored); in a proportional direction
-// the two sides are put back exactly on k1 s1 + k2 s2 = 0 keeping their difference; then clips each tangential
-// spring to the friction cone, |k_it s_it| <= mu max(fn, 0) (shortened along itself; a spring with
-// k_it = 0 carries no force and is left alone), and clamps the normal springs out of tension
-// (s1n <= 0 <= s2n). nOld and nNew must be unit vectors; fn is the normal force at the accepted state, N.
+// the two sides are put back exactly on k1 s1 + k2 s2 = 0 keeping their difference; then, where a tangential
+// damper is zero (the spring-determined branches, whose force is the spring's), clips each tangential spring
+// to the friction cone, |k_it s_it| <= mu max(fn, 0) (shortened along itself; a spring with k_it = 0 carries
+// no force and is left alone), and clamps the normal springs out of tension (s1n <= 0 <= s2n). With both
+// tangential dampers > 0 the springs are not clipped: the force is on the cone by eq. (9) whatever their
+// length, and a spring beyond it relaxes through slip on the contact's own time scale (contact_force.c).
+// nOld and nNew must be unit vectors; fn is the normal force at the accepted state, N.
 void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const pdContactParams* p, double fn);
