@@ -195,8 +195,9 @@ static bool line_closest(pdVec3 P, pdVec3 u, pdVec3 Q, pdVec3 v, double* s, doub
 // Are u and v (triple products of unit vectors, u = c · (b × a), …) of one sign and both beyond
 // 2 slack |b × a| + ARC_TRIPLE_ROUNDING in size (norm2 = |b × a|²)?
 static bool same_side_beyond(double u, double v, double norm2, double slack) {
-  if (!(u * v > 0.0)) return false;
-  double m = fmin(fabs(u), fabs(v)) - ARC_TRIPLE_ROUNDING;
+  if (!(u * v > 0.0)) return false;  // also false for a NaN, so the sizes below are numbers
+  double au = fabs(u), av = fabs(v);
+  double m = (au < av ? au : av) - ARC_TRIPLE_ROUNDING;
   return m > 0.0 && m * m > 4.0 * slack * slack * norm2;
 }
 typedef enum arcMeeting { arcsApart = 0, arcsCross, arcsTouch } arcMeeting;

@@ -87,6 +87,10 @@ static void normal_force(const pdContactParams* p, double s1, double s2, double 
 
 static pdVec3 in_plane(pdVec3 v, pdVec3 n) { return pd_v3_muladd(v, -pd_v3_dot(v, n), n); }
 
+// Both tangential dampers > 0: the damper-determined branch (tangential_damped), whose force is on the cone by
+// eq. (9) whatever the springs' length; otherwise one of the spring-determined ones (design note).
+static bool tangential_damper_determined(const pdContactParams* p) { return p->c1t > 0.0 && p->c2t > 0.0; }
+
 // Both tangential dampers > 0 (§3.1.4). Same algebra as the normal direction with Δu_n replaced by
 // Δu_t − Δw_t:
 //   F_t = −b_t + c* Δw_t, c* = c1 c2/(c1 + c2), b_t = (c2 k1 s1 − c1 k2 s2 + c1 c2 Δu_t)/(c1 + c2)   (5), (6)
@@ -232,12 +236,11 @@ void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pd
     // fn > 0 ? fn : 0 equals fmax(fn, 0) for every fn (NaN and −0 included), without fmax's libm call
     double limit = p->mu * (out->fn > 0.0 ? out->fn : 0.0);
     pdVec3 dut = in_plane(du, n), s1 = in_plane(s->s1t, n), s2 = in_plane(s->s2t, n);
-    const double c1 = p->c1t, c2 = p->c2t;
-    if (c1 > 0.0 && c2 > 0.0)
+    if (tangential_damper_determined(p))
       tangential_damped(p, s1, s2, dut, limit, out);
-    else if (c1 == 0.0 && c2 == 0.0)
+    else if (p->c1t == 0.0 && p->c2t == 0.0)
       tangential_undamped(p, s1, dut, limit, out);
-    else if (c1 == 0.0)
+    else if (p->c1t == 0.0)
       tangential_mixed1(p, s1, s2, dut, limit, out);
     else
       tangential_mixed2(p, s1, s2, dut, limit, out);
@@ -300,7 +303,7 @@ void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const
     rebalance(p->k1t, p->k2t, &s->s1t.y, &s->s2t.y);
     rebalance(p->k1t, p->k2t, &s->s1t.z, &s->s2t.z);
   }
-  if (!(p->c1t > 0.0 && p->c2t > 0.0)) {  // spring-determined: the spring's force is the contact's (design note)
+  if (!tangential_damper_determined(p)) {  // spring-determined: the spring's force is the contact's (design note)
     double limit = mu * fmax(fn, 0.0);
     s->s1t = clip_to_cone(s->s1t, p->k1t, limit);
     s->s2t = clip_to_cone(s->s2t, p->k2t, limit);
