@@ -51,12 +51,16 @@
 //   sorted by id), the counters summed in island order, and the observer sees the whole scene at samples.
 // With the samples as the only sync times, one island of every body computes what islands off computes.
 // - Threads (pdState.threads): the islands an interval advances (and the free bodies brought to the sample)
-//   are listed, then run on the set's pool of threads, each island whole on one thread. The split is fixed
-//   before the interval from the islands' sizes (bodies + contacts, largest first, each to the least-loaded
-//   thread; ties to the lower index), never from timing. While they run, a thread writes only its islands'
-//   states and its bodies' entries of travel/ctravel; everything else (partition, rebuild, activations, the
-//   redo decision, the gather, the counters in island order) stays on the calling thread. An island computes
-//   the same numbers on any thread, so every thread count gives the same results bit for bit.
+//   are listed, then run on the set's pool of threads, each island whole on one thread. The islands are
+//   ordered by size (bodies + contacts, largest first, ties in job order) and each thread takes the next one
+//   from a shared counter when it is free: which thread runs an island depends on timing, what the island
+//   computes does not. A split fixed in advance from the sizes left the busier thread 0.25-0.35 s of 3.1 s of
+//   island work on the pile of 1 000 (cases/bench/pile_1000.scene) after the other had finished, because size
+//   predicts an island's cost poorly (a falling island is cheap, a colliding one dear); taken in turn, the
+//   last island is all that is left over. While they run, a thread writes only its islands' states, their
+//   jobOk entries and its bodies' entries of travel/ctravel; everything else (partition, rebuild,
+//   activations, the redo decision, the gather, the counters in island order) stays on the calling thread. An
+//   island computes the same numbers on any thread, so every thread count gives the same results bit for bit.
 //
 // Memory: islands are set up, grown and freed only at sync times; a step allocates nothing. The pool's
 // threads are created with the set (or when pdState.threads changes) and joined when it is freed.
@@ -64,6 +68,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -97,8 +102,9 @@
 #define PD_ISLAND_SYNC_PARTS_MAX 16
 // A body that moved farther than its bound gets this many times the distance it moved as its new bound.
 #define PD_ISLAND_REDO_GROWTH 2.0
-// An island's weight in the threads' split: its moving bodies plus its contacts, a contact counted as this
-// many bodies (a contact's force and events cost about what a body's motion costs: a rough, fixed guess).
+// An island's weight in the order the threads take the islands in: its moving bodies plus its contacts, a
+// contact counted as this many bodies (a contact's force and events cost about what a body's motion costs: a
+// rough guess; the heaviest go first, so that the last ones taken are small).
 #define PD_ISLAND_CONTACT_WEIGHT 1
 
 typedef struct island {
@@ -164,10 +170,9 @@ struct pdIslandSet {
   double retiredStages[pd_stageCount];
   double observeSeconds;  // the scene's observer calls
   long formed, largest, intervals, redos;
-  // the pool (design note, "Threads"): thread 0 is the caller, workers 1 .. threadCount - 1
+  // the pool (design note, "Threads"): the caller and threadCount - 1 workers
   int threadCount;
-  pthread_t* workers;    // (threadCount - 1)
-  struct poolArg* args;  // (threadCount - 1) each worker's index
+  pthread_t* workers;  // (threadCount - 1)
   pthread_mutex_t lock;
   pthread_cond_t wake;  // a new batch (generation) or quit
   pthread_cond_t done;  // pending reached 0
@@ -180,9 +185,8 @@ struct pdIslandSet {
   island** jobs;           // (islandCapacity)
   bool* jobCoarse;         // (islandCapacity) a free body's island (island_advance's coarse)
   bool* jobOk;             // (islandCapacity) written by the job's thread
-  int* jobThread;          // (islandCapacity) the thread of each job: the fixed split
-  struct jobOrder* order;  // (islandCapacity) scratch: the jobs by weight
-  long* load;              // (threadCount) scratch: each thread's weight
+  struct jobOrder* order;  // (islandCapacity) the jobs by weight, heaviest first: the order they are taken in
+  atomic_int nextJob;      // the next entry of `order` to take
 };
 
 static void* grow(void* p, size_t count, size_t size) {
@@ -306,11 +310,6 @@ static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bo
 
 // ---------------------------------------------------------------- the pool
 
-typedef struct poolArg {
-  struct pdIslandSet* set;
-  int thread;
-} poolArg;
-
 typedef struct jobOrder {
   long weight;
   int job;
@@ -323,15 +322,16 @@ static int compare_jobs(const void* a, const void* b) {
   return (x->job > y->job) - (x->job < y->job);
 }
 
-// Runs the batch's jobs of thread `thread`, in job order.
-static void run_jobs(struct pdIslandSet* set, int thread) {
-  for (int i = 0; i < set->jobCount; ++i)
-    if (set->jobThread[i] == thread) set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobCoarse[i]);
+// Takes the batch's jobs in `order`, one at a time, until none is left.
+static void run_jobs(struct pdIslandSet* set) {
+  for (int n; (n = atomic_fetch_add(&set->nextJob, 1)) < set->jobCount;) {
+    int i = set->order[n].job;
+    set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobCoarse[i]);
+  }
 }
 
 static void* worker_main(void* user) {
-  const poolArg* arg = user;
-  struct pdIslandSet* set = arg->set;
+  struct pdIslandSet* set = user;
   long seen = 0;
   pthread_mutex_lock(&set->lock);
   for (;;) {
@@ -339,7 +339,7 @@ static void* worker_main(void* user) {
     if (set->quit) break;
     seen = set->generation;
     pthread_mutex_unlock(&set->lock);
-    run_jobs(set, arg->thread);
+    run_jobs(set);
     pthread_mutex_lock(&set->lock);
     if (--set->pending == 0) pthread_cond_signal(&set->done);
   }
@@ -359,11 +359,7 @@ static void pool_stop(struct pdIslandSet* set) {
     pthread_mutex_destroy(&set->lock);
   }
   free(set->workers);
-  free(set->args);
-  free(set->load);
   set->workers = NULL;
-  set->args = NULL;
-  set->load = NULL;
   set->threadCount = 0;
 }
 
@@ -373,15 +369,12 @@ static void pool_start(struct pdIslandSet* set, int threads) {
   set->quit = false;
   set->generation = 0;
   set->pending = 0;
-  set->load = grow(NULL, (size_t)threads, sizeof *set->load);
   if (threads == 1) return;
   set->workers = grow(NULL, (size_t)threads - 1, sizeof *set->workers);
-  set->args = grow(NULL, (size_t)threads - 1, sizeof *set->args);
   PD_ASSERT(pthread_mutex_init(&set->lock, NULL) == 0 && pthread_cond_init(&set->wake, NULL) == 0 &&
             pthread_cond_init(&set->done, NULL) == 0);
   for (int w = 0; w < threads - 1; ++w) {
-    set->args[w] = (poolArg){set, w + 1};
-    PD_ASSERT(pthread_create(&set->workers[w], NULL, worker_main, &set->args[w]) == 0);
+    PD_ASSERT(pthread_create(&set->workers[w], NULL, worker_main, set) == 0);
   }
 }
 
@@ -393,28 +386,17 @@ static void add_job(struct pdIslandSet* set, island* is, bool coarse) {
   ++set->jobCount;
 }
 
-// Runs the batch to tNext: the fixed split (heaviest island first, each to the least-loaded thread), the
-// workers woken, the caller's own share, then a wait for the rest. False if an island failed; every job runs
-// either way, so the islands' states do not depend on the thread count.
+// Runs the batch to tNext: the jobs ordered heaviest first, the workers woken, the caller taking jobs too,
+// then a wait for the rest. False if an island failed; every job runs either way, so the islands' states do
+// not depend on the thread count.
 static bool run_batch(struct pdIslandSet* set, double tNext) {
   set->jobTime = tNext;
-  if (set->threadCount == 1 || set->jobCount == 1) {
-    for (int i = 0; i < set->jobCount; ++i) set->jobThread[i] = 0;
-  } else {
-    for (int i = 0; i < set->jobCount; ++i) {
-      const island* is = set->jobs[i];
-      set->order[i] = (jobOrder){is->bodyCount + PD_ISLAND_CONTACT_WEIGHT * (long)pd_state_contact_count(is->state), i};
-    }
-    qsort(set->order, (size_t)set->jobCount, sizeof *set->order, compare_jobs);
-    for (int w = 0; w < set->threadCount; ++w) set->load[w] = 0;
-    for (int i = 0; i < set->jobCount; ++i) {
-      int least = 0;
-      for (int w = 1; w < set->threadCount; ++w)
-        if (set->load[w] < set->load[least]) least = w;
-      set->jobThread[set->order[i].job] = least;
-      set->load[least] += set->order[i].weight;
-    }
+  for (int i = 0; i < set->jobCount; ++i) {
+    const island* is = set->jobs[i];
+    set->order[i] = (jobOrder){is->bodyCount + PD_ISLAND_CONTACT_WEIGHT * (long)pd_state_contact_count(is->state), i};
   }
+  if (set->threadCount > 1) qsort(set->order, (size_t)set->jobCount, sizeof *set->order, compare_jobs);
+  atomic_store(&set->nextJob, 0);
   bool parallel = set->threadCount > 1 && set->jobCount > 1;
   if (parallel) {
     pthread_mutex_lock(&set->lock);
@@ -423,7 +405,7 @@ static bool run_batch(struct pdIslandSet* set, double tNext) {
     pthread_cond_broadcast(&set->wake);
     pthread_mutex_unlock(&set->lock);
   }
-  run_jobs(set, 0);
+  run_jobs(set);
   if (parallel) {
     pthread_mutex_lock(&set->lock);
     while (set->pending > 0) pthread_cond_wait(&set->done, &set->lock);
@@ -491,7 +473,6 @@ void pd_island_set_free(struct pdIslandSet* set) {
   free(set->jobs);
   free(set->jobCoarse);
   free(set->jobOk);
-  free(set->jobThread);
   free(set->order);
   for (int i = 0; i < set->islandCount; ++i) island_free(set->islands[i]);
   free(set->fixedBodies);
@@ -601,7 +582,6 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->jobs = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobs);
   set->jobCoarse = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobCoarse);
   set->jobOk = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobOk);
-  set->jobThread = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobThread);
   set->order = grow(NULL, (size_t)set->islandCapacity, sizeof *set->order);
   pool_start(set, s->threads);
   return set;
