@@ -77,7 +77,7 @@ done
 check "run_pile: the soft run's trajectory has every sample (the comparison is not of empty files)" \
   '[ "$(wc -l <"$SCRATCH/run_pile/first/trajectory.csv")" -gt 100 ]'
 
-# --- run --islands on: --threads 1 against --threads 2 (a fixed split of the islands: the same bytes) ---------
+# --- run --islands on: --threads 1 against --threads 2 (an island computes the same numbers on any thread) ---------
 TEND_THREADS=0.5
 # quick (ASan): 0.2 s, the first window in which two boxes share an island since islands are split by the
 # separating-axis test (at 0.15 s every island still holds one box)
