@@ -120,6 +120,7 @@ static void run_soft(const char* scene, const pdCliOverrides* overrides, const c
   softObserver o = {writer, r->trajectory};
   double e0 = pd_state_energy(model, state), t0 = pd_cli_wall_seconds();
   bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
+  pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
   r->wallSeconds = pd_cli_wall_seconds() - t0;
   r->steps = state->count.accepted;
   pdRunInfo info = {.engine = "polydyn-soft", .energyStart = e0, .energyEnd = pd_state_energy(model, state),

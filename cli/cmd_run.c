@@ -234,6 +234,7 @@ int pd_cmd_run(int argc, char** argv) {
   double energyStart = pd_state_energy(model, state);
   double t0 = pd_cli_wall_seconds();
   bool completed = pd_advance(model, state, model->settings.tend, observe, &observer);
+  pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
   double wall = pd_cli_wall_seconds() - t0;
   if (observer.progress) fputs("\r\033[K", stderr);
 

@@ -185,6 +185,7 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
     softObserver o = {writer, trajectory};
     double e0 = pd_state_energy(model, state), t0 = wall_now();
     bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
+    if (writer) pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
     r->wallSeconds = wall_now() - t0;
     r->cpuSeconds = cpu_now() - cpu0;
     r->steps = state->count.accepted;

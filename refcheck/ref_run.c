@@ -111,6 +111,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
     if (writer && !pd_run_observe(model, state, writer)) stopped = true;
     if (observer && !observer(model, state, user)) stopped = true;
   }
+  if (writer) pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
   stats->wallSeconds = wall_seconds() - wall0;
   stats->completed = ok && !stopped;
   state->count.accepted = stats->steps;

@@ -1,9 +1,24 @@
 // polydyn — run directories: trajectory.csv, contacts.csv and summary.json, written atomically.
+//
+// Design note. Printing the samples (17 significant digits per number, engine/src/number_format.h) and writing
+// them to the files was up to 40 % of a small scene's run (reports/bench/cost.md: the 10-box stack, one cube on
+// a vertex), all of it on the simulation's thread. pd_run_observe therefore only copies a sample's numbers
+// (time, each moving body's pose and velocities, each contact's ids and force) into a block of a small ring;
+// a writer thread, started by pd_run_open, takes the filled blocks in order and prints them with the same
+// functions as pd_write_trajectory_rows and pd_write_contact_rows, so the files hold the same bytes, and the
+// simulation goes on meanwhile (on a second core, if there is one). The observer waits only when every block
+// is full. pd_run_drain waits until everything observed is written (`polydyn run` times the run up to there,
+// so its wall_seconds includes the printing not hidden behind the simulation); pd_run_finish drains and joins
+// the thread; pd_run_abort stops it. A write error seen by the writer makes the next pd_run_observe return
+// false. Blocks grow (at the first samples) to hold the largest sample seen; after that nothing is allocated.
 #include "polydyn/output.h"
 
 #include <errno.h>
 #include <ftw.h>
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -12,12 +27,34 @@
 #include "model_contact.h"
 #include "number_format.h"
 
+// The ring: this many blocks of at least this many bytes. Four of 256 KiB: a 10-box stack's sample is ~8 KiB,
+// so the writer works on 32 samples at a time while the simulation fills the next blocks.
+#define PD_OUTPUT_BLOCKS 4
+#define PD_OUTPUT_BLOCK_BYTES (256 * 1024)
+
+typedef struct outputBlock {
+  unsigned char* data;
+  size_t used, capacity;
+} outputBlock;
+
 struct pdRunWriter {
   char* dir;         // final name
   char* tmp;         // temporary directory being written
   FILE* trajectory;  // tmp/trajectory.csv
   FILE* contacts;    // tmp/contacts.csv
-  bool ioError;      // a write failed
+  atomic_bool ioError;  // a write failed (set by the writer thread)
+  // the ring (design note): blocks filled = produced − consumed, in order
+  const pdModel* model;  // the model of the samples (the same for every one; the writer reads its names)
+  outputBlock blocks[PD_OUTPUT_BLOCKS];
+  long produced;  // blocks handed to the writer so far
+  long consumed;  // blocks the writer has printed so far
+  bool quit;      // the writer stops when the ring is empty (finish) or at once (abort, with `discard`)
+  bool discard;
+  bool threadStarted;
+  pthread_t thread;
+  pthread_mutex_t lock;
+  pthread_cond_t filled;  // produced grew, or quit
+  pthread_cond_t freed;   // consumed grew
 };
 
 static char* join(const char* a, const char* b) {
@@ -90,36 +127,175 @@ void pd_write_contacts_header(FILE* out) {
   fputs("t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode\n", out);
 }
 
+// One contact's numbers as a sample record holds them (pd_run_observe) and as contacts.csv prints them.
+typedef struct contactRecord {
+  int32_t bodyA, bodyB, featureA, featureB;
+  int32_t edgeEdge, slip;
+  double row[10];  // point, normal, fn, ft
+} contactRecord;
+
+static contactRecord contact_record(const pdContactReport* c) {
+  contactRecord r = {c->bodyA, c->bodyB, c->featureA, c->featureB, c->edgeEdge, c->slip, {0}};
+  const double row[10] = {c->point.x, c->point.y, c->point.z, c->normal.x, c->normal.y, c->normal.z,
+                          c->fn,      c->ft.x,    c->ft.y,    c->ft.z};
+  memcpy(r.row, row, sizeof row);
+  return r;
+}
+
+static void write_contact_row(FILE* out, const pdModel* model, double t, const contactRecord* c) {
+  write_number(out, t);
+  fputc(',', out);
+  write_csv_text(out, model->bodies[c->bodyA].name);
+  fputc(',', out);
+  write_csv_text(out, model->bodies[c->bodyB].name);
+  fprintf(out, ",%s,%d,%d", c->edgeEdge ? "EE" : "VF", (int)c->featureA, (int)c->featureB);
+  write_number_list(out, c->row, 10);
+  fputs(c->slip ? ",slip\n" : ",stick\n", out);
+}
+
 void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state) {
   int count = pd_state_contact_count(state);
   for (int i = 0; i < count; ++i) {
     pdContactReport c = pd_state_contact(state, i);
-    write_number(out, state->t);
-    fputc(',', out);
-    write_csv_text(out, model->bodies[c.bodyA].name);
-    fputc(',', out);
-    write_csv_text(out, model->bodies[c.bodyB].name);
-    fprintf(out, ",%s,%d,%d", c.edgeEdge ? "EE" : "VF", c.featureA, c.featureB);
-    const double row[10] = {c.point.x, c.point.y, c.point.z, c.normal.x, c.normal.y, c.normal.z,
-                            c.fn, c.ft.x, c.ft.y, c.ft.z};
-    write_number_list(out, row, 10);
-    fputs(c.slip ? ",slip\n" : ",stick\n", out);
+    contactRecord r = contact_record(&c);
+    write_contact_row(out, model, state->t, &r);
   }
 }
 
 void pd_write_trajectory_header(FILE* out) { fputs("t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", out); }
 
+// A moving body's 13 numbers in trajectory.csv's order: x, q, v, ω.
+static void body_row(const pdModel* model, const pdState* state, int i, double row[13]) {
+  pdBodyState b = pd_state_body(model, state, i);
+  const double r[13] = {b.x.x, b.x.y, b.x.z, b.q.w, b.q.x, b.q.y, b.q.z, b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z};
+  memcpy(row, r, sizeof r);
+}
+
+static void write_trajectory_row(FILE* out, const pdModel* model, double t, int i, const double row[13]) {
+  write_number(out, t);
+  fputc(',', out);
+  write_csv_text(out, model->bodies[i].name);
+  write_number_list(out, row, 13);
+  fputc('\n', out);
+}
+
 void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state) {
   for (int k = 0; k < model->movingCount; ++k) {
     int i = model->movingBodies[k];
-    pdBodyState b = pd_state_body(model, state, i);
-    const double row[13] = {b.x.x, b.x.y, b.x.z, b.q.w, b.q.x, b.q.y, b.q.z, b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z};
-    write_number(out, state->t);
-    fputc(',', out);
-    write_csv_text(out, model->bodies[i].name);
-    write_number_list(out, row, 13);
-    fputc('\n', out);
+    double row[13];
+    body_row(model, state, i, row);
+    write_trajectory_row(out, model, state->t, i, row);
   }
+}
+
+// ---------------------------------------------------------------- the writer thread (design note)
+
+// A sample record: t, the contact count, then each moving body's 13 numbers (scene order), then the contacts.
+typedef struct sampleHead {
+  double t;
+  int32_t contacts;
+  int32_t pad;
+} sampleHead;
+
+static size_t sample_bytes(const pdModel* model, int contacts) {
+  return sizeof(sampleHead) + (size_t)model->movingCount * 13 * sizeof(double) +
+         (size_t)contacts * sizeof(contactRecord);
+}
+
+// Prints one block's samples; returns false on a write error.
+static bool print_block(pdRunWriter* run, const outputBlock* b) {
+  const pdModel* model = run->model;
+  size_t at = 0;
+  while (at < b->used) {
+    sampleHead h;
+    memcpy(&h, b->data + at, sizeof h);
+    at += sizeof h;
+    for (int k = 0; k < model->movingCount; ++k) {
+      double row[13];
+      memcpy(row, b->data + at, sizeof row);
+      at += sizeof row;
+      write_trajectory_row(run->trajectory, model, h.t, model->movingBodies[k], row);
+    }
+    for (int i = 0; i < h.contacts; ++i) {
+      contactRecord c;
+      memcpy(&c, b->data + at, sizeof c);
+      at += sizeof c;
+      write_contact_row(run->contacts, model, h.t, &c);
+    }
+  }
+  return !ferror(run->trajectory) && !ferror(run->contacts);
+}
+
+static void* writer_main(void* user) {
+  pdRunWriter* run = user;
+  pthread_mutex_lock(&run->lock);
+  for (;;) {
+    while (!run->quit && run->consumed == run->produced) pthread_cond_wait(&run->filled, &run->lock);
+    if (run->discard || run->consumed == run->produced) break;  // aborted, or finished and empty
+    outputBlock* b = &run->blocks[run->consumed % PD_OUTPUT_BLOCKS];
+    pthread_mutex_unlock(&run->lock);
+    if (!atomic_load(&run->ioError) && !print_block(run, b)) atomic_store(&run->ioError, true);
+    pthread_mutex_lock(&run->lock);
+    b->used = 0;
+    ++run->consumed;
+    pthread_cond_signal(&run->freed);
+  }
+  pthread_mutex_unlock(&run->lock);
+  return NULL;
+}
+
+// Hands the block being filled to the writer (if it holds anything).
+static void hand_over(pdRunWriter* run) {
+  outputBlock* b = &run->blocks[run->produced % PD_OUTPUT_BLOCKS];
+  if (b->used == 0) return;
+  pthread_mutex_lock(&run->lock);
+  ++run->produced;
+  pthread_cond_signal(&run->filled);
+  pthread_mutex_unlock(&run->lock);
+}
+
+// The block to fill next, with room for `bytes`: the current one, or the next once the writer has freed it.
+static outputBlock* block_with_room(pdRunWriter* run, size_t bytes) {
+  outputBlock* b = &run->blocks[run->produced % PD_OUTPUT_BLOCKS];
+  if (b->used > 0 && b->used + bytes > b->capacity) {
+    hand_over(run);
+    pthread_mutex_lock(&run->lock);
+    while (run->produced - run->consumed >= PD_OUTPUT_BLOCKS) pthread_cond_wait(&run->freed, &run->lock);
+    pthread_mutex_unlock(&run->lock);
+    b = &run->blocks[run->produced % PD_OUTPUT_BLOCKS];
+  }
+  if (bytes > b->capacity) {  // a sample larger than any so far (the first samples only)
+    size_t capacity = bytes > PD_OUTPUT_BLOCK_BYTES ? bytes : PD_OUTPUT_BLOCK_BYTES;
+    unsigned char* data = realloc(b->data, capacity);
+    PD_ASSERT(data != NULL);
+    b->data = data;
+    b->capacity = capacity;
+  }
+  return b;
+}
+
+void pd_run_drain(pdRunWriter* run) {
+  hand_over(run);
+  pthread_mutex_lock(&run->lock);
+  while (run->consumed < run->produced) pthread_cond_wait(&run->freed, &run->lock);
+  pthread_mutex_unlock(&run->lock);
+}
+
+// Stops the writer thread: after printing what it holds (finish), or at once (abort).
+static void writer_stop(pdRunWriter* run, bool discard) {
+  if (!run->threadStarted) return;
+  if (!discard) hand_over(run);
+  pthread_mutex_lock(&run->lock);
+  run->quit = true;
+  run->discard = discard;
+  pthread_cond_signal(&run->filled);
+  pthread_mutex_unlock(&run->lock);
+  pthread_join(run->thread, NULL);
+  pthread_cond_destroy(&run->filled);
+  pthread_cond_destroy(&run->freed);
+  pthread_mutex_destroy(&run->lock);
+  run->threadStarted = false;
+  for (int k = 0; k < PD_OUTPUT_BLOCKS; ++k) free(run->blocks[k].data);
 }
 
 pdRunWriter* pd_run_open(const char* dir, pdError* err) {
@@ -166,15 +342,37 @@ pdRunWriter* pd_run_open(const char* dir, pdError* err) {
   setvbuf(run->contacts, NULL, _IOFBF, 1 << 20);
   pd_write_trajectory_header(run->trajectory);
   pd_write_contacts_header(run->contacts);
+  atomic_init(&run->ioError, false);
+  PD_ASSERT(pthread_mutex_init(&run->lock, NULL) == 0 && pthread_cond_init(&run->filled, NULL) == 0 &&
+            pthread_cond_init(&run->freed, NULL) == 0);
+  PD_ASSERT(pthread_create(&run->thread, NULL, writer_main, run) == 0);
+  run->threadStarted = true;
   return run;
 }
 
 bool pd_run_observe(const pdModel* model, const pdState* state, void* user) {
   pdRunWriter* run = user;
-  pd_write_trajectory_rows(run->trajectory, model, state);
-  pd_write_contact_rows(run->contacts, model, state);
-  if (ferror(run->trajectory) || ferror(run->contacts)) run->ioError = true;
-  return !run->ioError;
+  PD_ASSERT(run->model == NULL || run->model == model);  // one run directory holds one model's samples
+  if (atomic_load(&run->ioError)) return false;
+  if (!run->model) run->model = model;  // set before the first block is handed over, read-only after
+  int contacts = pd_state_contact_count(state);
+  outputBlock* b = block_with_room(run, sample_bytes(model, contacts));
+  sampleHead h = {state->t, contacts, 0};
+  memcpy(b->data + b->used, &h, sizeof h);
+  b->used += sizeof h;
+  for (int k = 0; k < model->movingCount; ++k) {
+    double row[13];
+    body_row(model, state, model->movingBodies[k], row);
+    memcpy(b->data + b->used, row, sizeof row);
+    b->used += sizeof row;
+  }
+  for (int i = 0; i < contacts; ++i) {
+    pdContactReport c = pd_state_contact(state, i);
+    contactRecord r = contact_record(&c);
+    memcpy(b->data + b->used, &r, sizeof r);
+    b->used += sizeof r;
+  }
+  return true;
 }
 
 static void write_json_string(FILE* out, const char* s) {
@@ -453,7 +651,8 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
 }
 
 bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state, const pdRunInfo* info, pdError* err) {
-  bool ok = !run->ioError && !ferror(run->trajectory) && !ferror(run->contacts);
+  writer_stop(run, false);
+  bool ok = !atomic_load(&run->ioError) && !ferror(run->trajectory) && !ferror(run->contacts);
   ok = (fclose(run->trajectory) == 0) && ok;
   ok = (fclose(run->contacts) == 0) && ok;
   run->trajectory = NULL;
@@ -495,6 +694,7 @@ bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state,
 
 void pd_run_abort(pdRunWriter* run) {
   if (!run) return;
+  writer_stop(run, true);
   if (run->trajectory) fclose(run->trajectory);
   if (run->contacts) fclose(run->contacts);
   remove_tree(run->tmp);

@@ -25,8 +25,14 @@ typedef struct pdRunWriter pdRunWriter;
 // and fills err on failure (nothing left behind).
 PD_API pdRunWriter* pd_run_open(const char* dir, pdError* err);
 
-// Observer that appends the current sample to trajectory.csv; `user` is the pdRunWriter.
+// Observer that appends the current sample to trajectory.csv and contacts.csv; `user` is the pdRunWriter.
+// It copies the sample's numbers; a thread of the writer prints them (output.c, design note), so the files
+// are complete only after pd_run_drain or pd_run_finish. Returns false once a write has failed. Every sample
+// of one writer must come from the same model.
 PD_API bool pd_run_observe(const pdModel* model, const pdState* state, void* user);
+
+// Waits until every sample observed so far is in the files (their stdio buffers): for timing a run whole.
+PD_API void pd_run_drain(pdRunWriter* run);
 
 // Writes one trajectory row per moving body at the state's time.
 PD_API void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state);
