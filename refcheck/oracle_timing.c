@@ -27,12 +27,12 @@
 
 const char* const pdOracleTimingModeNames[pd_oracleTimingModeCount] = {
     "ours_first",  "ours_cached", "ours_min_depth",     "ccd_gjk",
-    "ccd_gjk_epa", "ccd_mpr",     "ours_first_overlap", "ccd_gjk_epa_overlap",
+    "ccd_gjk_epa", "ccd_mpr",     "ours_first_overlap", "ccd_gjk_epa_overlap", "ours_verdict", "ours_verdict_overlap",
 };
 
 // column heads of the printed table
 static const char* const modeLabels[pd_oracleTimingModeCount] = {
-    "first", "cached", "min_depth", "gjk", "gjk+epa", "mpr", "first(ov)", "gjk+epa(ov)",
+    "first", "cached", "min_depth", "gjk", "gjk+epa", "mpr", "first(ov)", "gjk+epa(ov)", "verdict", "verdict(ov)",
 };
 
 const char* const pdOracleTimingGroupNames[pd_oracleTimingGroupCount] = {
@@ -98,6 +98,10 @@ static double run_batch(timedPair* pairs, const int* idx, int n, int mode, const
       case pd_oracleTimingMinDepth:
         sum += ours(t, PD_SAT_MIN_DEPTH, NULL, &r);
         break;
+      case pd_oracleTimingVerdict:
+      case pd_oracleTimingVerdictOverlap:
+        sum += ours(t, PD_SAT_VERDICT, NULL, &r);
+        break;
       case pd_oracleTimingGjk:
         sum += ccdGJKIntersect(&t->A, &t->B, ccd);
         break;
@@ -114,7 +118,8 @@ static double run_batch(timedPair* pairs, const int* idx, int n, int mode, const
 }
 
 static bool overlap_mode(int mode) {
-  return mode == pd_oracleTimingFirstOverlap || mode == pd_oracleTimingGjkEpaOverlap;
+  return mode == pd_oracleTimingFirstOverlap || mode == pd_oracleTimingGjkEpaOverlap ||
+         mode == pd_oracleTimingVerdictOverlap;
 }
 
 bool pd_oracle_timing(long n, uint64_t seed, int repeats, pdOracleTiming* out) {
@@ -153,14 +158,15 @@ bool pd_oracle_timing(long n, uint64_t seed, int repeats, pdOracleTiming* out) {
   uint64_t hash = 1469598103934665603ull;
   for (long i = 0; i < n; ++i) {
     timedPair* t = &pairs[i];
-    pdSatResult first, cached, min;
-    pdSatCache c = {PD_SAT_NONE, -1, -1};
+    pdSatResult first, cached, min, verdict;
+    pdSatCache c = {PD_SAT_NONE, -1, -1, {0, 0, 0}};
     bool hit = ours(t, PD_SAT_FIRST_SEPARATING, NULL, &first);
     ours(t, PD_SAT_FIRST_SEPARATING, &c, &cached);  // fills the cache (the same result as `first`)
     t->cache = c;
     ours(t, PD_SAT_FIRST_SEPARATING, &c, &cached);  // from the warm cache
     ours(t, PD_SAT_MIN_DEPTH, NULL, &min);
-    if (first.separated != min.separated || cached.separated != min.separated ||
+    ours(t, PD_SAT_VERDICT, NULL, &verdict);
+    if (first.separated != min.separated || cached.separated != min.separated || verdict.separated != first.separated ||
         (!min.separated && (first.depth != min.depth || cached.depth != min.depth)))
       agree = false;
     hash = hash_result(hash_result(hash_result(hash, &first), &cached), &min);
@@ -236,13 +242,14 @@ void pd_oracle_timing_print(const pdOracleTiming* t, FILE* out) {
           t->pairCount, t->repeats);
   fprintf(out, "overlapping: ours %ld, GJK %ld; libccd stalled %ld (support-call cap)\n", t->oursOverlap, t->gjkOverlap,
           t->ccdStalled);
-  fprintf(out, "our modes agree (verdicts, and depths of overlapping pairs): %s; result hash %016llx\n",
+  fprintf(out, "our modes agree (verdicts, and depths of overlapping pairs): %s; result hash %016llx (first, cached, min_depth)\n",
           t->oursAgree ? "yes" : "NO", (unsigned long long)t->resultHash);
   fprintf(out,
           "groups by the larger body's vertex count V: cube-cube (both cubes), small V <= 32 (other), medium\n"
           "V <= 162, large V > 162 (geodesic spheres of level 3); (ov): only the pairs GJK calls overlapping;\n"
           "first: ours as the engine calls it (first separating axis), cached: the same from a warm cache,\n"
-          "min_depth: every axis; gjk, gjk+epa, mpr: libccd's ccdGJKIntersect, ccdGJKPenetration, ccdMPRIntersect\n");
+          "min_depth: every axis; verdict: ours as the contact search calls it (GJK's certificates, then the\n"
+          "search); gjk, gjk+epa, mpr: libccd's ccdGJKIntersect, ccdGJKPenetration, ccdMPRIntersect\n");
   fprintf(out, "%-16s %6s %6s %6s", "group", "pairs", "mean V", "mean E");
   for (int m = 0; m < pd_oracleTimingModeCount; ++m) fprintf(out, " %11s", modeLabels[m]);
   fputc('\n', out);
@@ -254,8 +261,8 @@ void pd_oracle_timing_print(const pdOracleTiming* t, FILE* out) {
     fputc('\n', out);
   }
   fprintf(out, "ratios to GJK alone (ccd_gjk) and, for our first-separating mode, to GJK + EPA:\n");
-  fprintf(out, "%-16s %11s %11s %11s %11s %11s %11s\n", "group", "first/gjk", "cached/gjk", "min/gjk", "mpr/gjk",
-          "first/g+epa", "(ov)");
+  fprintf(out, "%-16s %11s %11s %11s %11s %11s %11s %11s\n", "group", "first/gjk", "cached/gjk", "min/gjk", "mpr/gjk",
+          "first/g+epa", "(ov)", "verdict/gjk");
   for (int k = 0; k < pd_oracleTimingGroupCount; ++k) {
     const pdOracleTimingGroup* g = &t->groups[k];
     if (g->pairs == 0) continue;
@@ -263,9 +270,10 @@ void pd_oracle_timing_print(const pdOracleTiming* t, FILE* out) {
     double gjk = u[pd_oracleTimingGjk];
     double ov =
         u[pd_oracleTimingGjkEpaOverlap] > 0.0 ? u[pd_oracleTimingFirstOverlap] / u[pd_oracleTimingGjkEpaOverlap] : NAN;
-    fprintf(out, "%-16s %11.2f %11.2f %11.2f %11.2f %11.2f %11.2f\n", pdOracleTimingGroupNames[k],
+    fprintf(out, "%-16s %11.2f %11.2f %11.2f %11.2f %11.2f %11.2f %11.2f\n", pdOracleTimingGroupNames[k],
             u[pd_oracleTimingFirst] / gjk, u[pd_oracleTimingCached] / gjk, u[pd_oracleTimingMinDepth] / gjk,
-            u[pd_oracleTimingMpr] / gjk, u[pd_oracleTimingFirst] / u[pd_oracleTimingGjkEpa], ov);
+            u[pd_oracleTimingMpr] / gjk, u[pd_oracleTimingFirst] / u[pd_oracleTimingGjkEpa], ov,
+            u[pd_oracleTimingVerdict] / gjk);
   }
 }
 

@@ -881,8 +881,9 @@ static int compare_to_pair(const pdContactId* id, int a, int b) {
   return hi < b ? -1 : hi > b;
 }
 
-// Interference of the pairs at poses1 (cache of the last separating feature per pair, merged by the sorted
-// pair order), then the contact search of the interfering ones. Fills candidates. Times the interference
+// Interference of the pairs at poses1 (the verdict only, PD_SAT_VERDICT: GJK's certificates, then the
+// separating-axis search; cache of the last separating feature per pair, merged by the sorted pair order), then
+// the contact search of the interfering ones. Fills candidates. Times the interference
 // (a lap of `watch`), not the search after it.
 static void search(const pdModel* model, pdState* s, const double* y1, int pairCount, const pdPose* poses0,
                    const pdPose* poses1, pdStopwatch* watch) {
@@ -895,7 +896,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
     pdSatResult sat;
     const pdBody *A = &model->bodies[a], *B = &model->bodies[b];
     set->touching[p] = pd_interference(&A->shape, poses1[a].x, &poses1[a].R, &B->shape, poses1[b].x, &poses1[b].R,
-                                       PD_SAT_FIRST_SEPARATING, &entry.sat, &sat);
+                                       PD_SAT_VERDICT, &entry.sat, &sat);
     set->cacheNext[p] = entry;
   }
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageInterference]);

@@ -37,6 +37,7 @@ typedef enum pdSatFeature {
   PD_SAT_FACE_A = 1,  // face `a` of A: u = n_A
   PD_SAT_FACE_B = 2,  // face `b` of B: u = −n_B
   PD_SAT_EDGES = 3,   // edge `a` of A and edge `b` of B: u ∝ e_A × e_B
+  PD_SAT_APART = 4,   // in a cache only (PD_SAT_VERDICT): the direction along which GJK last proved them apart
 } pdSatFeature;
 
 // Per-pair cache (zero-initialised = empty): the feature of the last call's result axis. A stale or
@@ -44,7 +45,9 @@ typedef enum pdSatFeature {
 // verdict; changes the reported depth of a separated pair only in PD_SAT_FIRST_SEPARATING mode.
 typedef struct pdSatCache {
   pdSatFeature kind;
-  int a, b;  // face or edge index in A (FACE_A, EDGES), face or edge index in B (FACE_B, EDGES); else -1
+  int a, b;        // face or edge index in A (FACE_A, EDGES), face or edge index in B (FACE_B, EDGES); else -1
+  pdVec3 apart;    // PD_SAT_APART: that direction in A's body frame (GJK's d, pointing from B − A's points to
+                   // the origin); read only by PD_SAT_VERDICT, ignored by the other modes
 } pdSatCache;
 
 // The cached feature of one pair of bodies (a < b), kept from one query to the next in a list sorted by (a, b)
@@ -61,7 +64,7 @@ static inline pdSatCache pd_pair_sat_cache_find(const pdPairSatCache* list, int 
   while (i < count && (list[i].a < a || (list[i].a == a && list[i].b < b))) ++i;
   *cursor = i;
   if (i < count && list[i].a == a && list[i].b == b) return list[i].sat;
-  return (pdSatCache){PD_SAT_NONE, -1, -1};
+  return (pdSatCache){PD_SAT_NONE, -1, -1, {0, 0, 0}};
 }
 
 typedef enum pdSatMode {
@@ -71,6 +74,16 @@ typedef enum pdSatMode {
   // Evaluate every candidate axis: depth is the minimum whether separated or not. The cache is not used
   // to shorten the search (it is still updated), so the result does not depend on it.
   PD_SAT_MIN_DEPTH = 1,
+  // The verdict alone, the same as PD_SAT_FIRST_SEPARATING's for every pair (what the contact search asks:
+  // touching or not). After the cached feature, a GJK search over the Minkowski difference looks for one of
+  // two certificates (interference.c, "Certificates"): a tetrahedron of difference points holding a ball of
+  // radius PD_SAT_CULL_MARGIN × the pair's size about the origin (overlap), or a direction along which the
+  // bodies are apart by more than that (separation). Where GJK finds neither, the PD_SAT_FIRST_SEPARATING search
+  // runs. A certified result has kind PD_SAT_NONE and a = b = -1; its depth is a lower bound on the penetration
+  // (overlap) or the gap along its axis, negated (separation), and its axis is zero when overlapping. The cache
+  // is left as it was after a certified overlap and holds the separating direction (PD_SAT_APART) after a
+  // certified separation, tried first next time (as a cached feature is).
+  PD_SAT_VERDICT = 2,
 } pdSatMode;
 
 typedef struct pdSatResult {

@@ -137,10 +137,10 @@ usage_error "--repeats 0" --random 10 --seed 1 --timing --repeats 0
 usage_error "--repeats too many" --random 10 --seed 1 --timing --repeats 102
 run_pd "$OUT" "$ERR" oracle --random 200 --seed 3 --timing --repeats 1 --out "$SCRATCH/timing/t.csv"
 check "--timing exits 0" '[ $rc -eq 0 ]'
-check "--timing: our modes agree" 'grep -q "^our modes agree .*: yes; result hash [0-9a-f]\{16\}$" "$OUT"'
+check "--timing: our modes agree" 'grep -q "^our modes agree .*: yes; result hash [0-9a-f]\{16\} (first, cached, min_depth)$" "$OUT"'
 check "--timing prints the all row" 'grep -q "^all  *200 " "$OUT"'
 check "--timing CSV header" '[ "$(head -n 1 "$SCRATCH/timing/t.csv")" = "group,mode,pairs,repeats,us_per_pair_median,us_per_pair_min,us_per_pair_max,ratio_to_gjk" ]'
-check "--timing CSV: 8 modes for all pairs" '[ "$(grep -c "^all," "$SCRATCH/timing/t.csv")" -eq 8 ]'
+check "--timing CSV: 10 modes for all pairs" '[ "$(grep -c "^all," "$SCRATCH/timing/t.csv")" -eq 10 ]'
 check "--timing CSV: GJK's ratio is 1" 'grep -q "^all,ccd_gjk,200,1,.*,1.0000$" "$SCRATCH/timing/t.csv"'
 run_pd "$OUT" "$ERR" oracle --random 200 --seed 3 --timing --repeats 1
 H1=$(sed -n "s/.*result hash //p" "$OUT")

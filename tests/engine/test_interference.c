@@ -146,7 +146,7 @@ static bool interferes(const shape* a, const pose* pa, const shape* b, const pos
 static double touching_distance(const shape* a, const pose* pa, const shape* b, pose* pb, pdVec3 w) {
   double lo = 0.0, hi = 1.01 * (a->radius + b->radius);  // overlapping at lo (both contain their origin)
   double s = hi;
-  pdSatCache cache = {PD_SAT_NONE, -1, -1};
+  pdSatCache cache = {PD_SAT_NONE, -1, -1, {0, 0, 0}};
   for (int i = 0; i < 40; ++i) {
     pb->x = pd_v3_muladd(pa->x, s, w);
     pdSatResult r;
@@ -415,6 +415,53 @@ static void test_pruned_sat_equals_brute_force_on_20000_random_pairs_near_touchi
   free_pool(pool);
 }
 
+// PD_SAT_VERDICT (GJK's certificates, then the search) gives PD_SAT_FIRST_SEPARATING's verdict on every pair,
+// pairs within 1e-10 of touching included, with or without a warm cache; a certified overlap's depth is a lower
+// bound on the penetration (PD_SAT_MIN_DEPTH's depth); a certified separation's axis really has the reported
+// negative overlap; and the certificates settle most pairs (else the mode would be the search plus GJK).
+static void test_verdict_mode_gives_the_search_verdict_and_its_certificates_hold(void** state) {
+  (void)state;
+  enum { PAIRS = 20000 };
+  shape* pool = make_pool(0x5a7ull);
+  lcg g = {0xfe11c7ull};
+  long certifiedOverlap = 0, certifiedSeparation = 0, searched = 0;
+  double maxAxisDiff = 0.0;
+  for (int n = 0; n < PAIRS; ++n) {
+    const shape* a = &pool[(int)(lcg_uniform(&g) * POOL)];
+    const shape* b = &pool[(int)(lcg_uniform(&g) * POOL)];
+    pose pa, pb;
+    random_poses(&g, a, &pa, b, &pb);
+    double tol = DEPTH_TOL_REL * pair_scale(a, &pa, b, &pb);
+    pdSatCache cache = {PD_SAT_NONE, -1, -1, {0, 0, 0}};
+    pdSatResult first = sat(a, &pa, b, &pb, PD_SAT_FIRST_SEPARATING, &cache);
+    pdSatResult min = sat(a, &pa, b, &pb, PD_SAT_MIN_DEPTH, NULL);
+    pdSatResult v, warm;
+    bool hit = pd_interference(&a->p, pa.x, &pa.R, &b->p, pb.x, &pb.R, PD_SAT_VERDICT, NULL, &v);
+    pd_interference(&a->p, pa.x, &pa.R, &b->p, pb.x, &pb.R, PD_SAT_VERDICT, &cache, &warm);
+    if (hit == first.separated || v.separated != first.separated || warm.separated != first.separated)
+      fail_msg("pair %d (%s / %s): first-separating %s (min depth %.17g), verdict %s, verdict from a warm cache %s", n,
+               a->label, b->label, first.separated ? "separated" : "overlapping", min.depth,
+               v.separated ? "separated" : "overlapping", warm.separated ? "separated" : "overlapping");
+    assert_true(v.separated == (v.depth < 0.0));
+    if (v.kind != PD_SAT_NONE) {
+      ++searched;
+    } else if (!v.separated) {
+      ++certifiedOverlap;
+      if (!(v.depth > 0.0 && v.depth <= min.depth + tol))
+        fail_msg("pair %d (%s / %s): certified depth %.17g, penetration %.17g", n, a->label, b->label, v.depth,
+                 min.depth);
+    } else {
+      ++certifiedSeparation;
+      assert_true(fabs(pd_v3_norm(v.axis) - 1.0) < 1e-12);
+      check_axis(a, &pa, b, &pb, &v, tol, &maxAxisDiff);
+    }
+  }
+  print_message("%d pairs: overlap certified %ld, separation certified %ld, left to the search %ld\n", PAIRS,
+                certifiedOverlap, certifiedSeparation, searched);
+  assert_true(certifiedOverlap > PAIRS / 5 && certifiedSeparation > PAIRS / 5);
+  free_pool(pool);
+}
+
 static shape unit_cube(void) {
   shape s;
   char why[64];
@@ -522,7 +569,8 @@ static void test_cache_changes_no_verdict_and_no_min_depth_along_coherent_motion
     pdVec3 v = pd_v3_scale(lcg_direction(&g), 0.01 * sum);
     pdMat3 wa = pd_quat_to_mat3(pd_quat_from_axis_angle(lcg_direction(&g), 0.02));
     pdMat3 wb = pd_quat_to_mat3(pd_quat_from_axis_angle(lcg_direction(&g), 0.03));
-    pdSatCache warmFast = {PD_SAT_NONE, -1, -1}, warmMin = {PD_SAT_NONE, -1, -1};
+    pdSatCache warmFast = {PD_SAT_NONE, -1, -1, {0, 0, 0}}, warmMin = {PD_SAT_NONE, -1, -1, {0, 0, 0}};
+    pdSatCache warmVerdict = {PD_SAT_NONE, -1, -1, {0, 0, 0}};  // PD_SAT_VERDICT's own: features and directions
     for (int s = 0; s < STEPS; ++s) {
       pb.x = pd_v3_add(pb.x, v);
       pa.R = pd_mat3_mul(&wa, &pa.R);
@@ -532,8 +580,11 @@ static void test_cache_changes_no_verdict_and_no_min_depth_along_coherent_motion
       pdSatResult coldFast = sat(a, &pa, b, &pb, PD_SAT_FIRST_SEPARATING, NULL);
       pdSatResult hotMin = sat(a, &pa, b, &pb, PD_SAT_MIN_DEPTH, &warmMin);
       pdSatResult hot = sat(a, &pa, b, &pb, PD_SAT_FIRST_SEPARATING, &warmFast);
+      pdSatResult verdict;
+      pd_interference(&a->p, pa.x, &pa.R, &b->p, pb.x, &pb.R, PD_SAT_VERDICT, &warmVerdict, &verdict);
       assert_true(same_result(&cold, &hotMin));  // MIN_DEPTH: identical, bit for bit
       assert_true(hot.separated == cold.separated && coldFast.separated == cold.separated);
+      assert_true(verdict.separated == cold.separated);
       if (!cold.separated) {
         assert_true(same_result(&cold, &hot));  // overlapping: the full search, bit for bit
       } else {
@@ -548,8 +599,8 @@ static void test_cache_changes_no_verdict_and_no_min_depth_along_coherent_motion
     }
   }
   print_message(
-      "%ld steps (%ld separated): verdicts identical with and without the cache; the cached axis "
-      "still separated on %ld (%.1f%%)\n",
+      "%ld steps (%ld separated): verdicts identical with and without the cache, and in verdict mode with its "
+      "own; the cached axis still separated on %ld (%.1f%%)\n",
       steps, separatedSteps, cacheReused, 100.0 * (double)cacheReused / (double)separatedSteps);
   assert_true(separatedSteps > steps / 4 && cacheReused > separatedSteps / 2);
   free_pool(pool);
@@ -568,20 +619,25 @@ static void test_stale_or_foreign_cache_entries_are_harmless(void** state) {
     random_poses(&g, a, &pa, b, &pb);
     random_poses(&g, c, &qa, b, &qb);
     pdSatResult cold = sat(a, &pa, b, &pb, PD_SAT_MIN_DEPTH, NULL);
-    pdSatCache caches[4];
+    pdSatCache caches[5];
     // from the same pair at an unrelated pose; from another pair (indices may be out of range);
     // garbage indices; an edge pair that is not a Minkowski face here
     sat(a, &qa, b, &qb, PD_SAT_MIN_DEPTH, &caches[0]);
     sat(c, &qa, b, &qb, PD_SAT_MIN_DEPTH, &caches[1]);
     caches[2] = (pdSatCache){(pdSatFeature)(1 + (int)(lcg_uniform(&g) * 3)), (int)lcg_range(&g, -5, 500),
-                             (int)lcg_range(&g, -5, 500)};
-    caches[3] =
-        (pdSatCache){PD_SAT_EDGES, (int)(lcg_uniform(&g) * a->p.edgeCount), (int)(lcg_uniform(&g) * b->p.edgeCount)};
-    for (int k = 0; k < 4; ++k) {
-      pdSatCache c1 = caches[k], c2 = caches[k];
+                             (int)lcg_range(&g, -5, 500), {0, 0, 0}};
+    caches[3] = (pdSatCache){PD_SAT_EDGES, (int)(lcg_uniform(&g) * a->p.edgeCount),
+                             (int)(lcg_uniform(&g) * b->p.edgeCount), {0, 0, 0}};
+    // and a separating direction of GJK's (PD_SAT_VERDICT's cache) from nowhere
+    caches[4] = (pdSatCache){PD_SAT_APART, -1, -1, lcg_direction(&g)};
+    for (int k = 0; k < 5; ++k) {
+      pdSatCache c1 = caches[k], c2 = caches[k], c3 = caches[k];
       pdSatResult hot = sat(a, &pa, b, &pb, PD_SAT_FIRST_SEPARATING, &c1);
       pdSatResult hotMin = sat(a, &pa, b, &pb, PD_SAT_MIN_DEPTH, &c2);
+      pdSatResult verdict;
+      pd_interference(&a->p, pa.x, &pa.R, &b->p, pb.x, &pb.R, PD_SAT_VERDICT, &c3, &verdict);
       assert_true(hot.separated == cold.separated);
+      assert_true(verdict.separated == cold.separated);
       assert_true(same_result(&hotMin, &cold));
       if (!cold.separated) assert_true(same_result(&hot, &cold));
       double ignored = 0.0;
@@ -659,6 +715,7 @@ int main(void) {
       cmocka_unit_test(test_edge_faces_follow_the_convention_the_gauss_map_test_uses),
       cmocka_unit_test(test_closed_cases_face_face_crossed_edges_vertex_face),
       cmocka_unit_test(test_pruned_sat_equals_brute_force_on_20000_random_pairs_near_touching),
+      cmocka_unit_test(test_verdict_mode_gives_the_search_verdict_and_its_certificates_hold),
       cmocka_unit_test(test_search_structures_change_no_result),
       cmocka_unit_test(test_cache_changes_no_verdict_and_no_min_depth_along_coherent_motion),
       cmocka_unit_test(test_stale_or_foreign_cache_entries_are_harmless),

@@ -165,6 +165,8 @@ typedef enum pdOracleTimingMode {
   pd_oracleTimingMpr,            // ccdMPRIntersect
   pd_oracleTimingFirstOverlap,   // ours, first-separating, over the pairs GJK calls overlapping only
   pd_oracleTimingGjkEpaOverlap,  // ccdGJKPenetration over those pairs only
+  pd_oracleTimingVerdict,        // ours as the contact search calls it: PD_SAT_VERDICT, no cache
+  pd_oracleTimingVerdictOverlap,  // the same over the pairs GJK calls overlapping only
   pd_oracleTimingModeCount
 } pdOracleTimingMode;
 extern const char* const pdOracleTimingModeNames[pd_oracleTimingModeCount];  // "ours_first", ...
@@ -191,7 +193,8 @@ typedef struct pdOracleTiming {
   long pairCount;
   int repeats;
   long oursOverlap, gjkOverlap, ccdStalled;
-  bool oursAgree;       // our three modes give the same verdicts (and depths where overlapping)
+  bool oursAgree;       // our four modes give the same verdicts (and the three searches the same depths where
+                        // overlapping)
   uint64_t resultHash;  // FNV-1a over every field of our three modes' results but the work counter
   double checksum;      // a sum of all timed answers (keeps them from being optimised away)
   pdOracleTimingGroup groups[pd_oracleTimingGroupCount];
