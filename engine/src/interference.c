@@ -60,7 +60,8 @@
 //   and the search would find a separating axis. Either way the verdict is the search's to the bit. GJK's own
 //   bookkeeping (which sub-simplex is kept, the next direction) only steers the search for a proof: a
 //   degenerate simplex, no progress or PD_GJK_ITERATIONS_MAX iterations hand the pair to the search, which
-//   then costs what it always did. The support points come from the vertex scans or walks of min_projection's
+//   then skips every axis that cannot separate: whose culling bound is above 0, or (a face axis u) along which
+//   a support point p that GJK found gives −u·p above the margin (gjkTrail). The support points come from the vertex scans or walks of min_projection's
 //   kind, warm-started from the last support of each body.
 #include "interference.h"
 
@@ -517,6 +518,21 @@ static int simplex_triangle(pdVec3* s, pdVec3 C, pdVec3 B, pdVec3 A, pdVec3* d) 
 // The points GJK may hold: the tetrahedron and the points added to fatten it (enclosed_certificate).
 #define PD_GJK_POINTS_MAX 8
 
+// Every support point of M that GJK found (design note): where GJK leaves the verdict to the search, an axis u
+// along which one of them gives −u·p above the margin overlaps by at least that (M holds p), so it cannot
+// separate and is skipped.
+#define PD_GJK_TRAIL_MAX (PD_GJK_ITERATIONS_MAX + PD_GJK_POINTS_MAX)
+typedef struct gjkTrail {
+  pdVec3 p[PD_GJK_TRAIL_MAX];
+  int n;
+} gjkTrail;
+
+static bool trail_keeps_overlapping(const gjkTrail* trail, pdVec3 u, double margin) {
+  for (int k = 0; k < trail->n; ++k)
+    if (-pd_v3_dot(u, trail->p[k]) > margin) return true;
+  return false;
+}
+
 // The depth of the origin inside the hull of p[0..n) (the origin inside it), m, and the outward unit normal and
 // offset of the face plane nearest to it. Every plane through three of the points with every point on its inner
 // side (to within `slack`, the rounding of these small sums) bounds the hull, and every face plane is one of
@@ -550,7 +566,7 @@ static double hull_depth(const pdVec3* p, int n, double slack, pdVec3* normal, d
 // (as EPA does), up to PD_GJK_POINTS_MAX points; when that face is M's own (the support does not pass it), the
 // origin is within the margin of M's boundary and the search decides. +1 (certified, b->depth the depth) or −1.
 static int enclosed_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const relPose* f, double margin,
-                                pdVec3* s, best* b) {
+                                pdVec3* s, best* b, gjkTrail* trail) {
   double slack = 1e-6 * margin;
   for (int n = 4;; ++n) {
     pdVec3 normal = {0, 0, 0};
@@ -561,6 +577,7 @@ static int enclosed_certificate(const pdPolyhedron* A, const pdPolyhedron* B, co
     }
     if (n == PD_GJK_POINTS_MAX || !(depth > -margin)) return -1;
     pdVec3 w = difference_support(A, B, f, normal);
+    trail->p[trail->n++] = w;
     if (!(pd_v3_dot(w, normal) > offset + 1e-3 * margin)) return -1;  // that face is on M's boundary
     s[n] = w;
   }
@@ -585,7 +602,7 @@ static int simplex_tetrahedron(pdVec3* s, pdVec3 D, pdVec3 C, pdVec3 B, pdVec3 A
 // depth), 0 separation (b->depth the gap along b->axis, negated), −1 neither (the search decides).
 // `start`: the first direction (a cached one, PD_SAT_APART), or zero for the one from B's centre to A's.
 static int gjk_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const relPose* f, const cullBounds* cull,
-                           pdVec3 start, best* b) {
+                           pdVec3 start, best* b, gjkTrail* trail) {
   double margin = PD_GJK_MARGIN_REL * cull->margin / PD_SAT_CULL_MARGIN;
   pdVec3 d = start;
   if (!(pd_v3_dot(d, d) > 0.0)) d = pd_v3_sub(A->satIndex->centre, cull->cB);  // from inside M to the origin
@@ -596,6 +613,7 @@ static int gjk_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const r
     double dn = pd_v3_norm(d);
     if (!(dn > 0.0) || !isfinite(dn)) return -1;  // the origin on the simplex: within rounding of M's boundary
     pdVec3 p = difference_support(A, B, f, d);
+    trail->p[trail->n++] = p;
     double along = pd_v3_dot(p, d) / dn;  // M's extent along d: the overlap along −d
     if (along < -margin) {
       *b = (best){along, pd_v3_scale(d, -1.0 / dn), PD_SAT_NONE, -1, -1};
@@ -618,7 +636,7 @@ static int gjk_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const r
         break;
       default:
         n = simplex_tetrahedron(s, s[0], s[1], s[2], s[3], &d);
-        if (n == 4) return enclosed_certificate(A, B, f, margin, s, b);
+        if (n == 4) return enclosed_certificate(A, B, f, margin, s, b, trail);
     }
   }
   return -1;
@@ -674,9 +692,11 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
 
   cullBounds cull;
   cull_bounds(A, B, &f, &cull);
+  gjkTrail trail;
+  trail.n = 0;
   if (mode == PD_SAT_VERDICT && cull.on) {
     pdVec3 start = cache && cache->kind == PD_SAT_APART ? cache->apart : (pdVec3){0, 0, 0};
-    int verdict = gjk_certificate(A, B, &f, &cull, start, &b);
+    int verdict = gjk_certificate(A, B, &f, &cull, start, &b, &trail);
     if (verdict == 1) {  // overlap: the cache keeps what it holds
       *out = (pdSatResult){false, b.depth, {0, 0, 0}, PD_SAT_NONE, -1, -1, 0};
       return true;
@@ -698,6 +718,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
     cullAbove = verdictOnly ? 0.0 : b.depth;
     if (cullFacesA && A->faces[i].offset - pd_v3_dot(A->faces[i].normal, cull.cB) + cull.rB - cull.margin > cullAbove)
       continue;
+    if (verdictOnly && trail_keeps_overlapping(&trail, A->faces[i].normal, cull.margin)) continue;
     double d = face_A_overlap(A, i, B, &f, &supportB);
     if (d < b.depth) {
       b = (best){d, A->faces[i].normal, PD_SAT_FACE_A, i, -1};
@@ -707,6 +728,9 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   for (int i = 0; i < B->faceCount; ++i) {
     cullAbove = verdictOnly ? 0.0 : b.depth;
     if (cullFacesB && B->faces[i].offset - pd_v3_dot(B->faces[i].normal, cull.cAinB) + cull.rA - cull.margin > cullAbove)
+      continue;
+    if (verdictOnly && trail_keeps_overlapping(&trail, pd_v3_scale(pd_mat3_mulv(&f.R, B->faces[i].normal), -1.0),
+                                               cull.margin))
       continue;
     pdVec3 axis;
     double d = face_B_overlap(A, B, i, &f, &axis, &supportA);
