@@ -51,18 +51,18 @@
 //   GJK (Gilbert, Johnson and Keerthi) proves it with a few support points of the Minkowski difference
 //   M = B − A, and proves a separation with one direction. libccd's GJK (the oracle's) answers with its own
 //   tolerance and returns neither proof, so the verdict mode runs a GJK of its own as a search for proofs
-//   that are then checked on their own terms, with a margin m = PD_SAT_CULL_MARGIN × the pair's coordinate
-//   size (as the culling bounds): (1) four difference points whose tetrahedron holds the ball of radius m
-//   about the origin: then M holds it, the overlap along every axis is at least m, and every candidate axis
-//   as computed (off by at most ~1e-8 of the size, for the sliver edge pairs) overlaps, so the search would
-//   find no separating axis; (2) a direction d whose support point s of M has s·d < −m |d|: the bodies are
-//   apart by more than m along d, so M lies beyond one of its own face planes (one of the candidate axes)
-//   and the search would find a separating axis. Either way the verdict is the search's to the bit. GJK's own
-//   bookkeeping (which sub-simplex is kept, the next direction) only steers the search for a proof: a
-//   degenerate simplex, no progress or PD_GJK_ITERATIONS_MAX iterations hand the pair to the search, which
-//   then skips every axis that cannot separate: whose culling bound is above 0, or (a face axis u) along which
-//   a support point p that GJK found gives −u·p above the margin (gjkTrail). The support points come from the vertex scans or walks of min_projection's
-//   kind, warm-started from the last support of each body.
+//   that are then checked on their own terms, with a margin m = PD_GJK_MARGIN_REL × the pair's coordinate
+//   size (the size of the culling bounds): (1) difference points whose hull (GJK's tetrahedron, fattened as
+//   EPA does when it is thin) holds the ball of radius m about the origin: then M holds it, the overlap along
+//   every axis is at least m, and every candidate axis as computed (off by at most ~1e-8 of the size, for the
+//   sliver edge pairs) overlaps, so the search would find no separating axis; (2) a direction d whose support
+//   point s of M has s·d < −m |d|: the bodies are apart by more than m along d, so M lies beyond one of its own
+//   face planes (one of the candidate axes) and the search would find a separating axis. Either way the
+//   verdict is the search's to the bit. GJK's own bookkeeping (which sub-simplex is kept, the next direction)
+//   only steers the search for a proof: a degenerate simplex, no progress or PD_GJK_ITERATIONS_MAX iterations
+//   hand the pair to the search, which then skips every axis that cannot separate: whose culling bound is above
+//   0, or (a face axis u) along which a support point p that GJK found gives −u·p above the margin (gjkTrail).
+//   GJK's support points come from vertex scans (support_vertex).
 #include "interference.h"
 
 #include <math.h>
@@ -250,9 +250,23 @@ static edgeData edge_of_B(const pdPolyhedron* B, int i, const relPose* f) {
   return d;
 }
 
-// min over the vertices of P of u·p (finite input: a plain comparison rather than a call to fmin). With
-// P's search structures, a steepest-descent walk over the vertex graph from *start (the previous axis's
-// support, usually a few edges away), which ends at the minimum; *start receives the support.
+// The first vertex of P minimising u·p, by a scan (finite input: a plain comparison rather than fmin). GJK
+// uses it for every polyhedron: its directions jump between iterations, and on the oracle's pairs a scan was
+// faster than min_projection's downhill walk even over the 642 vertices of a geodesic sphere (1.25 against
+// 1.40 times libccd's GJK over all pairs).
+static int support_vertex(const pdPolyhedron* P, pdVec3 u) {
+  int best = 0;
+  double lo = pd_v3_dot(u, P->vertices[0]);
+  for (int v = 1; v < P->vertexCount; ++v) {
+    double d = pd_v3_dot(u, P->vertices[v]);
+    if (d < lo) lo = d, best = v;
+  }
+  return best;
+}
+
+// min over the vertices of P of u·p: a scan (support_vertex), or with P's search structures a steepest-descent
+// walk over the vertex graph from *start (the previous axis's support, usually a few edges away), which ends at
+// the minimum; *start receives the support.
 static double min_projection(const pdPolyhedron* P, pdVec3 u, int* start) {
   const struct pdSatIndex* x = P->satIndex;
   if (x && x->neighbourFirst) {
@@ -270,25 +284,7 @@ static double min_projection(const pdPolyhedron* P, pdVec3 u, int* start) {
     *start = v;
     return lo;
   }
-  double lo = INFINITY;
-  for (int v = 0; v < P->vertexCount; ++v) {
-    double d = pd_v3_dot(u, P->vertices[v]);
-    lo = d < lo ? d : lo;
-  }
-  return lo;
-}
-
-// The vertex of P minimising u·p, by a scan: GJK's directions jump between iterations, and on the oracle's
-// pairs a scan was faster than min_projection's downhill walk even over the 642 vertices of a geodesic sphere
-// (1.25 against 1.40 times libccd's GJK over all pairs).
-static int support_vertex(const pdPolyhedron* P, pdVec3 u) {
-  int best = 0;
-  double lo = pd_v3_dot(u, P->vertices[0]);
-  for (int v = 1; v < P->vertexCount; ++v) {
-    double d = pd_v3_dot(u, P->vertices[v]);
-    if (d < lo) lo = d, best = v;
-  }
-  return best;
+  return pd_v3_dot(u, P->vertices[support_vertex(P, u)]);
 }
 
 // Overlap along u = n_A (face i of A). *support: see min_projection.
@@ -463,7 +459,7 @@ static void alive_edges(const pdPolyhedron* P, const edgeCull* c, double depth, 
 // GJK's iterations before the pair is handed to the search. Pairs GJK settles take a handful (a few more for
 // the geodesic spheres); past this many it is circling a boundary within rounding of the origin.
 #define PD_GJK_ITERATIONS_MAX 40
-// The certificates' margin, relative to the pair's coordinate size (cull_bounds): 100 times the largest error
+// The certificates' margin, relative to the pair's coordinate size (cull_bounds): 10 times the largest error
 // of a candidate axis's overlap as computed (~1e-8 of the size: the sliver edge pairs, PD_SAT_PARALLEL_TOL);
 // the oracle's pairs lie within a few % of touching, and a larger margin (the culling's 1e-5) left 18 % of them
 // within it, to the search.
@@ -621,7 +617,10 @@ static int gjk_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const r
     }
     // no progress past the simplex along d: the origin lies within ~margin of M's boundary
     double reached = -INFINITY;
-    for (int k = 0; k < n; ++k) reached = fmax(reached, pd_v3_dot(s[k], d) / dn);
+    for (int k = 0; k < n; ++k) {
+      double r = pd_v3_dot(s[k], d) / dn;
+      reached = r > reached ? r : reached;
+    }
     if (n > 0 && along <= reached + 1e-3 * margin) return -1;
     s[n++] = p;
     switch (n) {
@@ -712,10 +711,9 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   bool verdictOnly = mode == PD_SAT_VERDICT;
   bool cullFacesA = cull.on && (verdictOnly || !B->satIndex->neighbourFirst);
   bool cullFacesB = cull.on && (verdictOnly || !A->satIndex->neighbourFirst);
-  double cullAbove = INFINITY;  // in verdict mode: 0, else the best depth so far (b.depth)
   int supportB = 0, supportA = 0;
   for (int i = 0; i < A->faceCount; ++i) {
-    cullAbove = verdictOnly ? 0.0 : b.depth;
+    double cullAbove = verdictOnly ? 0.0 : b.depth;  // in verdict mode 0, else the best depth so far
     if (cullFacesA && A->faces[i].offset - pd_v3_dot(A->faces[i].normal, cull.cB) + cull.rB - cull.margin > cullAbove)
       continue;
     if (verdictOnly && trail_keeps_overlapping(&trail, A->faces[i].normal, cull.margin)) continue;
@@ -726,8 +724,9 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
     }
   }
   for (int i = 0; i < B->faceCount; ++i) {
-    cullAbove = verdictOnly ? 0.0 : b.depth;
-    if (cullFacesB && B->faces[i].offset - pd_v3_dot(B->faces[i].normal, cull.cAinB) + cull.rA - cull.margin > cullAbove)
+    double cullAbove = verdictOnly ? 0.0 : b.depth;
+    if (cullFacesB &&
+        B->faces[i].offset - pd_v3_dot(B->faces[i].normal, cull.cAinB) + cull.rA - cull.margin > cullAbove)
       continue;
     if (verdictOnly && trail_keeps_overlapping(&trail, pd_v3_scale(pd_mat3_mulv(&f.R, B->faces[i].normal), -1.0),
                                                cull.margin))
@@ -749,7 +748,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   uint64_t aliveA[PD_SAT_BITSET_WORDS], aliveB[PD_SAT_BITSET_WORDS];
   bool masks = cull.on && A->edgeCount <= 64 * PD_SAT_BITSET_WORDS && B->edgeCount <= 64 * PD_SAT_BITSET_WORDS;
   if (masks) {
-    cullAbove = verdictOnly ? 0.0 : b.depth;
+    double cullAbove = verdictOnly ? 0.0 : b.depth;
     alive_edges(A, &cull.edgesA, cullAbove, aliveA);
     alive_edges(B, &cull.edgesB, cullAbove, aliveB);
   }
@@ -818,6 +817,9 @@ done:
   out->a = b.a;
   out->b = b.b;
   out->minkowskiEdgePairs = minkowski;
-  if (cache) *cache = (pdSatCache){apart ? PD_SAT_APART : b.kind, b.a, b.b, apart ? pd_v3_scale(b.axis, -1.0) : (pdVec3){0, 0, 0}};
+  if (cache) {
+    pdVec3 direction = apart ? pd_v3_scale(b.axis, -1.0) : (pdVec3){0, 0, 0};  // GJK's d (PD_SAT_APART)
+    *cache = (pdSatCache){apart ? PD_SAT_APART : b.kind, b.a, b.b, direction};
+  }
   return !out->separated;
 }

@@ -76,9 +76,9 @@ typedef enum pdSatMode {
   PD_SAT_MIN_DEPTH = 1,
   // The verdict alone, the same as PD_SAT_FIRST_SEPARATING's for every pair (what the contact search asks:
   // touching or not). After the cached feature, a GJK search over the Minkowski difference looks for one of
-  // two certificates (interference.c, "Certificates"): a tetrahedron of difference points holding a ball of
-  // radius PD_SAT_CULL_MARGIN × the pair's size about the origin (overlap), or a direction along which the
-  // bodies are apart by more than that (separation). Where GJK finds neither, the PD_SAT_FIRST_SEPARATING search
+  // two certificates (interference.c, "Certificates"): a hull of difference points holding a ball of radius
+  // PD_GJK_MARGIN_REL × the pair's size about the origin (overlap), or a direction along which the bodies are
+  // apart by more than that (separation). Where GJK finds neither, the PD_SAT_FIRST_SEPARATING search
   // runs. A certified result has kind PD_SAT_NONE and a = b = -1; its depth is a lower bound on the penetration
   // (overlap) or the gap along its axis, negated (separation), and its axis is zero when overlapping. The cache
   // is left as it was after a certified overlap and holds the separating direction (PD_SAT_APART) after a
