@@ -39,6 +39,7 @@
 
 #include "broad_phase.h"
 #include "clock.h"
+#include "help_desk.h"
 #include "interference.h"
 #include "material.h"
 #include "model_contact.h"
@@ -120,6 +121,20 @@ typedef struct contactEval {
   pdContactForce force;
 } contactEval;
 
+// One contact's share of a derivative evaluation (pd_contact_forces), kept until the per-body sums.
+typedef struct contactPush {
+  pdVec3 point;  // where the force acts, world
+  pdVec3 force;  // on body 1, N
+  bool pulls;    // its normal springs would pull: no force
+} contactPush;
+
+// One part of the contact search (search_range): the contacts found for its pairs, pair after pair.
+typedef struct searchPart {
+  pdContactGeom* found;
+  int foundCount, foundCapacity;
+  pdContactId* previous;  // (capacity) scratch: the ids of one pair's contacts of C0
+} searchPart;
+
 // A contact of C1 that is not in C0.
 typedef struct candidate {
   pdContactGeom geom;
@@ -138,6 +153,7 @@ typedef struct stabilityTerms {
   pdMat3 k;             // K_i^½
   pdMat3 left[2], right[2];  // K^½ [r]ₓᵀ and W [r]ₓ K^½ per body (body1, body2)
   double overdamp;      // ζ + √(ζ² − 1) for the most over-damped direction (1 when ζ ≤ 1)
+  double rowsMax;       // stable_step_exact's largest Gershgorin row sum of this contact's rows
 } stabilityTerms;
 
 struct pdContactSet {
@@ -147,9 +163,8 @@ struct pdContactSet {
   contactSlot* next;       // (capacity) scratch for rebuilding the list
   int candidateCount, candidateCapacity;
   candidate* candidates;
-  pdContactId* previous;   // (capacity) the ids of one pair's contacts, for the contact search
-  pdContactGeom* found;
-  int foundCapacity;
+  searchPart search[2];  // the contact search's two halves of the pairs (help_desk.h's parts)
+  int searchSplit;       // the first pair of part 1 (the pair count when the search was not split)
   int bodyCount;
   pdPose* poses;           // (bodyCount) of the last derivative evaluation
   pdPose* poses0;          // (bodyCount) at the start of the analysed step
@@ -160,6 +175,8 @@ struct pdContactSet {
   int pairCapacity;
   pdPairSatCache *cache, *cacheNext;
   bool* touching;  // (cacheCapacity) did pair p of the contact search interfere
+  int *pairPrevious, *pairPreviousCount;  // (cacheCapacity) pair p's contacts of C0: items[first .. first + count)
+  int *pairFound, *pairFoundCount;        // (cacheCapacity) its contacts found: its part's found[first .. + count)
   int cacheCount, cacheCapacity;
   pdVec3 *force, *torque;  // (movingCount) contact force and moment on each moving body, world
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
@@ -175,6 +192,8 @@ struct pdContactSet {
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
+  contactPush* push;       // (capacity) per contact, of the last derivative evaluation
+  pdHelpDesk* help;        // where the per-contact and per-pair loops post half their work, or NULL (help_desk.h)
 };
 
 static void* grow(void* p, int count, size_t size) {
@@ -191,11 +210,21 @@ static void reserve_list(pdContactSet* set, int capacity) {
   while (c < capacity) c *= 2;
   set->items = grow(set->items, c, sizeof *set->items);
   set->eval = grow(set->eval, c, sizeof *set->eval);
+  set->push = grow(set->push, c, sizeof *set->push);
   set->next = grow(set->next, c, sizeof *set->next);
-  set->previous = grow(set->previous, c, sizeof *set->previous);
+  for (int part = 0; part < 2; ++part)
+    set->search[part].previous = grow(set->search[part].previous, c, sizeof *set->search[part].previous);
   set->stability = grow(set->stability, c, sizeof *set->stability);
   set->bodyList = grow(set->bodyList, 2 * c, sizeof *set->bodyList);
   set->capacity = c;
+}
+
+// The contact search's per-pair lists, to cacheCapacity.
+static void grow_pair_lists(pdContactSet* set) {
+  set->pairPrevious = grow(set->pairPrevious, set->cacheCapacity, sizeof *set->pairPrevious);
+  set->pairPreviousCount = grow(set->pairPreviousCount, set->cacheCapacity, sizeof *set->pairPreviousCount);
+  set->pairFound = grow(set->pairFound, set->cacheCapacity, sizeof *set->pairFound);
+  set->pairFoundCount = grow(set->pairFoundCount, set->cacheCapacity, sizeof *set->pairFoundCount);
 }
 
 pdContactSet* pd_contact_set_create(const pdModel* model) {
@@ -231,14 +260,17 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   reserve_list(set, 4 * model->movingCount + 16);
   set->candidateCapacity = 64;
   set->candidates = grow(NULL, set->candidateCapacity, sizeof *set->candidates);
-  set->foundCapacity = 64;
-  set->found = grow(NULL, set->foundCapacity, sizeof *set->found);
+  for (int part = 0; part < 2; ++part) {
+    set->search[part].foundCapacity = 64;
+    set->search[part].found = grow(NULL, set->search[part].foundCapacity, sizeof *set->search[part].found);
+  }
   set->pairCapacity = 2 * n + 16;
   set->pairs = grow(NULL, set->pairCapacity, sizeof *set->pairs);
   set->cacheCapacity = set->pairCapacity;
   set->cache = grow(NULL, set->cacheCapacity, sizeof *set->cache);
   set->cacheNext = grow(NULL, set->cacheCapacity, sizeof *set->cacheNext);
   set->touching = grow(NULL, set->cacheCapacity, sizeof *set->touching);
+  grow_pair_lists(set);
   return set;
 }
 
@@ -246,10 +278,13 @@ void pd_contact_set_free(pdContactSet* set) {
   if (!set) return;
   free(set->items);
   free(set->eval);
+  free(set->push);
   free(set->next);
   free(set->candidates);
-  free(set->previous);
-  free(set->found);
+  for (int part = 0; part < 2; ++part) {
+    free(set->search[part].previous);
+    free(set->search[part].found);
+  }
   free(set->force);
   free(set->stability);
   free(set->bodyFirst);
@@ -268,6 +303,10 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->cache);
   free(set->cacheNext);
   free(set->touching);
+  free(set->pairPrevious);
+  free(set->pairPreviousCount);
+  free(set->pairFound);
+  free(set->pairFoundCount);
   free(set);
 }
 
@@ -331,31 +370,59 @@ static void evaluate(const pdModel* model, const contactSlot* c, const double* y
   pd_contact_force(&c->params, springs, geom->normal, *du, f);
 }
 
+void pd_contact_set_help(pdContactSet* set, pdHelpDesk* desk) { set->help = desk; }
+
+// Contacts (or pairs) below which a loop is not split (help_desk.h): a handover costs about a microsecond, one
+// contact's force ~0.1 us, one pair's interference test ~1 us.
+#define PD_HELP_MIN_CONTACTS 128
+#define PD_HELP_MIN_PAIRS 32
+
+typedef struct forcesJob {
+  const pdModel* model;
+  pdContactSet* set;
+  const double* y;
+  double* dydt;
+} forcesJob;
+
+// Contacts [begin, end) of a derivative evaluation: their spring rates into dydt, their pushes into set->push.
+static void forces_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const forcesJob* job = ctx;
+  pdContactSet* set = job->set;
+  int base = spring_base(job->model);
+  for (int i = begin; i < end; ++i) {
+    pdSprings s = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
+    pdContactGeom g;
+    pdVec3 du;
+    pdContactForce f;
+    evaluate(job->model, &set->items[i], job->y, set->poses, &s, &g, NULL, &du, &f);
+    springs_store(job->dydt + base + PD_CONTACT_STATE_SIZE * i, &f.rate);
+    set->push[i] = (contactPush){g.point, f.force, pd_contact_force_pulls(&f)};
+  }
+}
+
 void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y, double* dydt) {
   poses_from(model, y, set->poses);
   pdVec3 *force = set->force, *torque = set->torque;
   for (int k = 0; k < model->movingCount; ++k) force[k] = torque[k] = (pdVec3){0, 0, 0};
-  int base = spring_base(model);
+  forcesJob job = {model, set, y, dydt};
+  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, forces_range, &job);
+  // the sums in contact order, whoever computed each contact
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
-    pdSprings s = springs_load(y + base + PD_CONTACT_STATE_SIZE * i);
-    pdContactGeom g;
-    pdVec3 du;
-    pdContactForce f;
-    evaluate(model, c, y, set->poses, &s, &g, NULL, &du, &f);
-    springs_store(dydt + base + PD_CONTACT_STATE_SIZE * i, &f.rate);
-    if (pd_contact_force_pulls(&f)) continue;  // normal springs are never in tension: no force
+    const contactPush* p = &set->push[i];
+    if (p->pulls) continue;  // normal springs are never in tension: no force
     const pdBody* b1 = &model->bodies[c->id.body1];
     const pdBody* b2 = &model->bodies[c->id.body2];
     if (!b1->fixed) {
       int k = b1->stateIndex;
-      force[k] = pd_v3_add(force[k], f.force);
-      torque[k] = pd_v3_add(torque[k], pd_v3_cross(pd_v3_sub(g.point, set->poses[c->id.body1].x), f.force));
+      force[k] = pd_v3_add(force[k], p->force);
+      torque[k] = pd_v3_add(torque[k], pd_v3_cross(pd_v3_sub(p->point, set->poses[c->id.body1].x), p->force));
     }
     if (!b2->fixed) {
       int k = b2->stateIndex;
-      force[k] = pd_v3_sub(force[k], f.force);
-      torque[k] = pd_v3_sub(torque[k], pd_v3_cross(pd_v3_sub(g.point, set->poses[c->id.body2].x), f.force));
+      force[k] = pd_v3_sub(force[k], p->force);
+      torque[k] = pd_v3_sub(torque[k], pd_v3_cross(pd_v3_sub(p->point, set->poses[c->id.body2].x), p->force));
     }
   }
 }
@@ -621,11 +688,20 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
 // of damped modes whose fast root exceeds ω. A Gershgorin sum is never below the true eigenvalue, and for a
 // cube resting on a face it is within 15 % of it (8 k/m against the rocking mode's 6 k/m). Needs the terms
 // of stability_prepare for the current list.
-static double stable_step_exact(const pdModel* model, pdContactSet* set) {
-  double omega2 = 0.0;
-  for (int i = 0; i < set->count; ++i) {
+typedef struct stabilityJob {
+  const pdModel* model;
+  pdContactSet* set;
+} stabilityJob;
+
+// The Gershgorin rows of contacts [begin, end) (stabilityTerms.rowsMax).
+static void gershgorin_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const stabilityJob* job = ctx;
+  const pdModel* model = job->model;
+  pdContactSet* set = job->set;
+  for (int i = begin; i < end; ++i) {
     const contactSlot* c = &set->items[i];
-    const stabilityTerms* ti = &set->stability[i];
+    stabilityTerms* ti = &set->stability[i];
     double rows[3] = {0, 0, 0};
     int ends[2] = {c->id.body1, c->id.body2};
     int lo = ends[0] < ends[1] ? ends[0] : ends[1], hi = ends[0] < ends[1] ? ends[1] : ends[0];
@@ -655,8 +731,15 @@ static double stable_step_exact(const pdModel* model, pdContactSet* set) {
         for (int r = 0; r < 3; ++r) rows[r] += row_abs_sum(&m, r);
       }
     }
-    omega2 = fmax(omega2, fmax(rows[0], fmax(rows[1], rows[2])));
+    ti->rowsMax = fmax(rows[0], fmax(rows[1], rows[2]));
   }
+}
+
+static double stable_step_exact(const pdModel* model, pdContactSet* set) {
+  stabilityJob job = {model, set};
+  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, gershgorin_range, &job);
+  double omega2 = 0.0;
+  for (int i = 0; i < set->count; ++i) omega2 = fmax(omega2, set->stability[i].rowsMax);
   return step_of(omega2, set->overdamp);
 }
 
@@ -671,18 +754,32 @@ double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double
 
 // Records geometry and force of every listed contact at state y for output, realignment and refinement.
 // poses must be those of y.
-static void record(const pdModel* model, pdContactSet* set, const double* y, const pdPose* poses) {
-  int base = spring_base(model);
-  for (int i = 0; i < set->count; ++i) {
-    contactSlot* c = &set->items[i];
-    pdSprings sp = springs_load(y + base + PD_CONTACT_STATE_SIZE * i);
+typedef struct recordJob {
+  const pdModel* model;
+  pdContactSet* set;
+  const double* y;
+  const pdPose* poses;
+} recordJob;
+
+static void record_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const recordJob* job = ctx;
+  int base = spring_base(job->model);
+  for (int i = begin; i < end; ++i) {
+    contactSlot* c = &job->set->items[i];
+    pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
     pdContactGeom g;
     pdVec3 du;  // unused here
-    evaluate(model, c, y, poses, &sp, &g, NULL, &du, &c->force);
+    evaluate(job->model, c, job->y, job->poses, &sp, &g, NULL, &du, &c->force);
     c->normal = g.normal;
     c->point = g.point;
     c->depth = g.depth;
   }
+}
+
+static void record(const pdModel* model, pdContactSet* set, const double* y, const pdPose* poses) {
+  recordJob job = {model, set, y, poses};
+  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, record_range, &job);
 }
 
 // The normal motion of one contact over the τ since its onset, alone at the effective mass m, undamped
@@ -843,6 +940,7 @@ static int broad_phase(const pdModel* model, pdState* s, const pdPose* poses0, c
     set->cache = grow(set->cache, set->cacheCapacity, sizeof *set->cache);
     set->cacheNext = grow(set->cacheNext, set->cacheCapacity, sizeof *set->cacheNext);
     set->touching = grow(set->touching, set->cacheCapacity, sizeof *set->touching);
+    grow_pair_lists(set);
   }
   return pairCount;
 }
@@ -881,6 +979,65 @@ static int compare_to_pair(const pdContactId* id, int a, int b) {
   return hi < b ? -1 : hi > b;
 }
 
+typedef struct interferenceJob {
+  const pdModel* model;
+  pdContactSet* set;
+  const pdPose* poses1;
+} interferenceJob;
+
+// Pairs [begin, end) of the contact search: touching[p] and the pair's new cache entry.
+static void interference_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const interferenceJob* job = ctx;
+  pdContactSet* set = job->set;
+  const pdPose* poses1 = job->poses1;
+  int cached = 0;  // the cache's cursor (sorted like the pairs); from its start in every range
+  for (int p = begin; p < end; ++p) {
+    int a = set->pairs[p].a, b = set->pairs[p].b;
+    pdPairSatCache entry = {a, b, pd_pair_sat_cache_find(set->cache, set->cacheCount, &cached, a, b)};
+    pdSatResult sat;
+    const pdBody *A = &job->model->bodies[a], *B = &job->model->bodies[b];
+    set->touching[p] = pd_interference(&A->shape, poses1[a].x, &poses1[a].R, &B->shape, poses1[b].x, &poses1[b].R,
+                                       PD_SAT_VERDICT, &entry.sat, &sat);
+    set->cacheNext[p] = entry;
+  }
+}
+
+typedef struct findJob {
+  const pdModel* model;
+  pdContactSet* set;
+  const pdPose *poses0, *poses1;
+} findJob;
+
+// The contacts of the touching pairs [begin, end) into the part's found[], pair after pair (pairFound,
+// pairFoundCount). A part's buffer grows here, on whichever thread runs it (between steps, not in the derivative).
+static void find_range(void* ctx, int part, int begin, int end) {
+  const findJob* job = ctx;
+  pdContactSet* set = job->set;
+  const pdPose *poses0 = job->poses0, *poses1 = job->poses1;
+  searchPart* sp = &set->search[part];
+  if (part == 1) set->searchSplit = begin;
+  sp->foundCount = 0;
+  for (int p = begin; p < end; ++p) {
+    set->pairFound[p] = sp->foundCount;
+    set->pairFoundCount[p] = 0;
+    if (!set->touching[p]) continue;
+    int a = set->pairs[p].a, b = set->pairs[p].b, first = set->pairPrevious[p], count = set->pairPreviousCount[p];
+    for (int k = 0; k < count; ++k) sp->previous[k] = set->items[first + k].id;
+    int room = sp->foundCapacity - sp->foundCount;
+    int n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous, count,
+                             sp->found + sp->foundCount, room);
+    if (n > room) {
+      sp->foundCapacity = 2 * (sp->foundCount + n);
+      sp->found = grow(sp->found, sp->foundCapacity, sizeof *sp->found);
+      n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous, count,
+                           sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount);
+    }
+    set->pairFoundCount[p] = n;
+    sp->foundCount += n;
+  }
+}
+
 // Interference of the pairs at poses1 (the verdict only, PD_SAT_VERDICT: GJK's certificates, then the
 // separating-axis search; cache of the last separating feature per pair, merged by the sorted pair order), then
 // the contact search of the interfering ones. Fills candidates. Times the interference
@@ -889,39 +1046,30 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
                    const pdPose* poses1, pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
   // every pair's interference first, timed as a whole (two clock reads per pair were 2 % of a pile's run)
-  int cached = 0;
-  for (int p = 0; p < pairCount; ++p) {
-    int a = set->pairs[p].a, b = set->pairs[p].b;
-    pdPairSatCache entry = {a, b, pd_pair_sat_cache_find(set->cache, set->cacheCount, &cached, a, b)};
-    pdSatResult sat;
-    const pdBody *A = &model->bodies[a], *B = &model->bodies[b];
-    set->touching[p] = pd_interference(&A->shape, poses1[a].x, &poses1[a].R, &B->shape, poses1[b].x, &poses1[b].R,
-                                       PD_SAT_VERDICT, &entry.sat, &sat);
-    set->cacheNext[p] = entry;
-  }
+  interferenceJob job = {model, set, poses1};
+  pd_help_for(set->help, pairCount, PD_HELP_MIN_PAIRS, interference_range, &job);
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageInterference]);
   set->candidateCount = 0;
+  // each pair's contacts in C0 (the list is sorted by the unordered body pair first)
   int listed = 0;
   for (int p = 0; p < pairCount; ++p) {
     int a = set->pairs[p].a, b = set->pairs[p].b;
-    // this pair's contacts in C0 (the list is sorted by the unordered body pair first)
     while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) < 0) ++listed;
-    int first = listed, previousCount = 0;
-    while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) == 0)
-      set->previous[previousCount++] = set->items[listed++].id;
+    set->pairPrevious[p] = listed;
+    while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) == 0) ++listed;
+    set->pairPreviousCount[p] = listed - set->pairPrevious[p];
+  }
+  findJob find = {model, set, poses0, poses1};
+  set->searchSplit = pairCount;
+  pd_help_for(set->help, pairCount, PD_HELP_MIN_PAIRS, find_range, &find);
+  for (int p = 0; p < pairCount; ++p) {
     if (!set->touching[p]) continue;
-    int n = pd_contacts_find(model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], set->previous,
-                             previousCount, set->found, set->foundCapacity);
-    if (n > set->foundCapacity) {
-      set->foundCapacity = 2 * n;
-      set->found = grow(set->found, set->foundCapacity, sizeof *set->found);
-      n = pd_contacts_find(model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], set->previous,
-                           previousCount, set->found, set->foundCapacity);
-    }
+    int first = set->pairPrevious[p], previousCount = set->pairPreviousCount[p], n = set->pairFoundCount[p];
+    const pdContactGeom* found = set->search[p >= set->searchSplit].found + set->pairFound[p];
     // found[] and C0's contacts of this pair are both sorted by id: merge
     int j = first;
     for (int f = 0; f < n; ++f) {
-      const pdContactGeom* g = &set->found[f];
+      const pdContactGeom* g = &found[f];
       while (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) < 0) ++j;
       if (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) == 0) continue;
       candidate c = {*g, 1.0, false, 0.0, -1};
@@ -965,6 +1113,27 @@ static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double a
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
 
+typedef struct trackingJob {
+  const pdModel* model;
+  pdContactSet* set;
+  const double* y1;
+} trackingJob;
+
+// Contacts [begin, end) of C0 tracked to y1 and their forces there (set->eval).
+static void tracking_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const trackingJob* job = ctx;
+  pdContactSet* set = job->set;
+  int base = spring_base(job->model);
+  for (int i = begin; i < end; ++i) {
+    contactEval* e = &set->eval[i];
+    pdSprings sp = springs_load(job->y1 + base + PD_CONTACT_STATE_SIZE * i);
+    pdVec3 du;
+    evaluate(job->model, &set->items[i], job->y1, set->poses1, &sp, &e->geom, &e->tracked, &du, &e->force);
+    e->transferred = false;
+  }
+}
+
 pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, const double* y1, double* hRetry,
                                  pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
@@ -987,15 +1156,12 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   }
 
   // 1. C0 at y1: tracking, forces, reversals
+  trackingJob job = {model, set, y1};
+  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, tracking_range, &job);
   double refineStep = 0.0;  // the largest refinement bound among the contacts that changed mode (0: none)
   for (int i = 0; i < set->count; ++i) {
-    contactSlot* c = &set->items[i];
-    contactEval* e = &set->eval[i];
-    pdSprings sp = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
-    pdVec3 du;
-    evaluate(model, c, y1, set->poses1, &sp, &e->geom, &e->tracked, &du, &e->force);
-    e->transferred = false;
-    if (changes_mode(c, &e->force)) refineStep = fmax(refineStep, refine_step(model, &c->params));
+    const contactSlot* c = &set->items[i];
+    if (changes_mode(c, &set->eval[i].force)) refineStep = fmax(refineStep, refine_step(model, &c->params));
   }
   pd_stopwatch_lap(watch, analysisSeconds);
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)

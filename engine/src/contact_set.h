@@ -21,6 +21,10 @@ pdContactSet* pd_contact_set_create(const pdModel* model);
 void pd_contact_set_free(pdContactSet* set);
 // Empties the list and clears the contact search's caches (state reset).
 void pd_contact_set_clear(pdContactSet* set);
+// The help desk the set's per-contact and per-pair loops post half their work at (help_desk.h), or NULL: the
+// islands' pool gives every island's set its own pool's desk. Results do not depend on it.
+struct pdHelpDesk;
+void pd_contact_set_help(pdContactSet* set, struct pdHelpDesk* desk);
 int pd_contact_set_count(const pdContactSet* set);
 
 // Inside the derivative: poses of every body from y (fixed bodies keep theirs), then for every contact

@@ -61,6 +61,11 @@
 //   jobOk entries and its bodies' entries of travel/ctravel; everything else (partition, rebuild,
 //   activations, the redo decision, the gather, the counters in island order) stays on the calling thread. An
 //   island computes the same numbers on any thread, so every thread count gives the same results bit for bit.
+// - Help inside an island (help_desk.h): a thread left without an island while others still run serves the pool's
+//   help desk; an island whose loops over contacts or pairs are long enough (contact_set.c, PD_HELP_MIN_CONTACTS)
+//   posts their second half there. A batch of one island wakes the workers only from PD_ISLAND_HELP_WEIGHT on.
+//   Each index is computed alike on either thread and combined in index order by the island's own, so this too
+//   leaves every result the same bit for bit.
 //
 // Memory: islands are set up, grown and freed only at sync times; a step allocates nothing. The pool's
 // threads are created with the set (or when pdState.threads changes) and joined when it is freed.
@@ -75,6 +80,7 @@
 #include "broad_phase.h"
 #include "clock.h"
 #include "contact_set.h"
+#include "help_desk.h"
 #include "interference.h"
 #include "model_contact.h"
 #include "state_layout.h"
@@ -106,6 +112,9 @@
 // contact counted as this many bodies (a contact's force and events cost about what a body's motion costs: a
 // rough guess; the heaviest go first, so that the last ones taken are small).
 #define PD_ISLAND_CONTACT_WEIGHT 1
+// A batch of one island wakes the other threads to serve its help desk (help_desk.h) from this weight on (bodies +
+// contacts): below it the per-contact loops are too short to split (PD_HELP_MIN_CONTACTS in contact_set.c).
+#define PD_ISLAND_HELP_WEIGHT 128
 
 typedef struct island {
   int bodyCount;   // moving bodies
@@ -187,6 +196,8 @@ struct pdIslandSet {
   bool* jobOk;             // (islandCapacity) written by the job's thread
   struct jobOrder* order;  // (islandCapacity) the jobs by weight, heaviest first: the order they are taken in
   atomic_int nextJob;      // the next entry of `order` to take
+  atomic_int jobsLeft;     // jobs of the batch not finished yet
+  pdHelpDesk desk;         // where a running island posts half loops for a thread without an island (help_desk.h)
 };
 
 static void* grow(void* p, size_t count, size_t size) {
@@ -209,7 +220,7 @@ static void island_free(island* is) {
 }
 
 // The model of members[0 .. count) (moving-body indices, ascending) and every fixed body, scene order.
-static island* island_create(const pdModel* model, const struct pdIslandSet* set, const int* members, int count) {
+static island* island_create(const pdModel* model, struct pdIslandSet* set, const int* members, int count) {
   island* is = calloc(1, sizeof *is);
   PD_ASSERT(is != NULL);
   is->bodyCount = count;
@@ -243,6 +254,7 @@ static island* island_create(const pdModel* model, const struct pdIslandSet* set
   }
   sub->materials = pd_material_table_view(model->materials, is->toScene, n);
   is->state = pd_state_create(sub);
+  pd_contact_set_help(is->state->contacts, &set->desk);
   return is;
 }
 
@@ -322,12 +334,15 @@ static int compare_jobs(const void* a, const void* b) {
   return (x->job > y->job) - (x->job < y->job);
 }
 
-// Takes the batch's jobs in `order`, one at a time, until none is left.
+// Takes the batch's jobs in `order`, one at a time, until none is left; then, with other threads, serves the
+// help desk until every job is finished (the islands still running post half their loops there).
 static void run_jobs(struct pdIslandSet* set) {
   for (int n; (n = atomic_fetch_add(&set->nextJob, 1)) < set->jobCount;) {
     int i = set->order[n].job;
     set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobCoarse[i]);
+    atomic_fetch_sub(&set->jobsLeft, 1);
   }
+  if (set->threadCount > 1) pd_help_serve(&set->desk, &set->jobsLeft);
 }
 
 static void* worker_main(void* user) {
@@ -397,7 +412,10 @@ static bool run_batch(struct pdIslandSet* set, double tNext) {
   }
   if (set->threadCount > 1) qsort(set->order, (size_t)set->jobCount, sizeof *set->order, compare_jobs);
   atomic_store(&set->nextJob, 0);
-  bool parallel = set->threadCount > 1 && set->jobCount > 1;
+  atomic_store(&set->jobsLeft, set->jobCount);
+  // one island alone gets the other threads' help when it has contacts enough to split
+  bool parallel = set->threadCount > 1 &&
+                  (set->jobCount > 1 || (set->jobCount == 1 && set->order[0].weight >= PD_ISLAND_HELP_WEIGHT));
   if (parallel) {
     pthread_mutex_lock(&set->lock);
     set->pending = set->threadCount - 1;
@@ -466,6 +484,8 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
 // ---------------------------------------------------------------- the set
 
 int pd_island_count(const pdState* s) { return s->islandSet ? s->islandSet->islandCount : 0; }
+
+long pd_island_help_served(const pdState* s) { return s->islandSet ? atomic_load(&s->islandSet->desk.served) : 0; }
 
 void pd_island_set_free(struct pdIslandSet* set) {
   if (!set) return;
@@ -583,6 +603,7 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->jobCoarse = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobCoarse);
   set->jobOk = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobOk);
   set->order = grow(NULL, (size_t)set->islandCapacity, sizeof *set->order);
+  pd_help_desk_init(&set->desk);
   pool_start(set, s->threads);
   return set;
 }

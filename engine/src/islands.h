@@ -21,5 +21,9 @@ bool pd_islands_advance(const pdModel* model, pdState* state, double tEnd, pdObs
 // The number of islands of the state's last interval (0 before the first, or with islands off).
 int pd_island_count(const pdState* state);
 
+// Half loops of an island run by another thread of the pool so far (help_desk.h; 0 with islands off or one
+// thread): how much help the islands got. Depends on timing; no result does.
+long pd_island_help_served(const pdState* state);
+
 // Frees the islands' states (state reset and free); NULL is allowed.
 void pd_island_set_free(struct pdIslandSet* set);

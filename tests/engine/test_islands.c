@@ -22,7 +22,8 @@
 //   gained beyond the integration error;
 // - threads (pdState.threads): a pile of 30 boxes in two layers gives, with 2 and 3 threads, every body's x, q,
 //   v, ω at every sample, the contact counts and every counter bit for bit as with 1 thread (each island's
-//   computation is its own: the split only decides which thread runs it);
+//   computation is its own: the split only decides which thread runs it); and a stack of twenty boxes, one
+//   island throughout, likewise, the other threads serving its help desk (some half loops run by them);
 // - stage timers (pdState.stageSeconds): on one thread, the stages timed whole (broad phase, interference,
 //   contact analysis, observe; laps of one stopwatch or intervals of their own, never overlapping) each ran and
 //   add up to no more than the time spent in pd_advance.
@@ -53,6 +54,8 @@
 #define GROUP_OFF_TOL_REL 1e-4
 
 enum { MAX_BODIES = 32, MAX_SAMPLES = 1001 };
+// contact_set.c's PD_HELP_MIN_CONTACTS: loops shorter than this are never split
+#define PD_TEST_HELP_MIN_CONTACTS 128
 
 typedef struct trace {
   int count, bodies;
@@ -385,20 +388,14 @@ static pdModel* pile_30(void) {
   return compile_text(text);
 }
 
-static void test_threads_give_the_same_bits(void** state) {
-  (void)state;
-  pdModel* m = pile_30();
-  assert_int_equal(m->movingCount, PILE_BOXES);
-  pdState* one = NULL;
-  trace* a = run_threads(m, pd_islandsOn, 1, &one);
-  print_message("pile_30, islands on: %ld islands formed (largest %ld), %ld intervals, %ld redos, %ld steps\n",
-                one->count.islandsFormed, one->count.islandsLargest, one->count.islandIntervals, one->count.islandRedos,
-                one->count.accepted);
-  assert_true(one->count.islandsFormed > PILE_BOXES);  // islands formed and changed: the threads had work
-  assert_true(one->count.islandsLargest > 1);
+// Runs m on 2 and 3 threads and checks every sample, counter, warning and the final state (contact springs
+// included) against the one-thread run (a, one); returns the half loops the islands got help with on 2 threads.
+static long same_bits_on_more_threads(const pdModel* m, const trace* a, const pdState* one) {
+  long helped = 0;
   for (int threads = 2; threads <= 3; ++threads) {
     pdState* s = NULL;
     trace* b = run_threads(m, pd_islandsOn, threads, &s);
+    if (threads == 2) helped = pd_island_help_served(s);
     assert_int_equal(a->count, b->count);
     assert_true(memcmp(a->t, b->t, sizeof a->t) == 0);
     assert_true(memcmp(a->body, b->body, sizeof a->body) == 0);
@@ -411,6 +408,57 @@ static void test_threads_give_the_same_bits(void** state) {
     pd_state_free(s);
     free(b);
   }
+  return helped;
+}
+
+static void test_threads_give_the_same_bits(void** state) {
+  (void)state;
+  pdModel* m = pile_30();
+  assert_int_equal(m->movingCount, PILE_BOXES);
+  pdState* one = NULL;
+  trace* a = run_threads(m, pd_islandsOn, 1, &one);
+  print_message("pile_30, islands on: %ld islands formed (largest %ld), %ld intervals, %ld redos, %ld steps\n",
+                one->count.islandsFormed, one->count.islandsLargest, one->count.islandIntervals, one->count.islandRedos,
+                one->count.accepted);
+  assert_true(one->count.islandsFormed > PILE_BOXES);  // islands formed and changed: the threads had work
+  assert_true(one->count.islandsLargest > 1);
+  same_bits_on_more_threads(m, a, one);
+  pd_state_free(one);
+  free(a);
+  pd_model_free(m);
+}
+
+enum { STACK_BOXES = 20 };
+
+// Twenty boxes stacked, each turned its own way, settling: one island from start to end, with over a hundred
+// contacts.
+static pdModel* stack_20(void) {
+  char text[PILE_TEXT];
+  int used = snprintf(text, sizeof text, "tend 0.1\nsample 200\n" FLOOR);
+  for (int k = 0; k < STACK_BOXES; ++k) {
+    used += snprintf(text + used, sizeof text - (size_t)used,
+                     "cube s%d tan 0.2 0.2 0.1\nloc 0 0 %.4f %d 0 0 1\nmu 0.5\nrestitution 0.5\n", k,
+                     0.0505 + 0.1005 * k, 17 * k % 90);
+    assert_true(used < PILE_TEXT);
+  }
+  return compile_text(text);
+}
+
+// One island alone in every interval: the other threads, with no island of their own, serve its help desk (half
+// its loops over contacts and pairs: help_desk.h), and the results stay the same bit for bit.
+static void test_one_island_helped_by_other_threads_gives_the_same_bits(void** state) {
+  (void)state;
+  pdModel* m = stack_20();
+  pdState* one = NULL;
+  trace* a = run_threads(m, pd_islandsOn, 1, &one);
+  print_message("stack_20: largest island %ld, %d contacts at the end, %ld derivative evaluations\n",
+                one->count.islandsLargest, a->contacts[a->count - 1], one->count.derivatives);
+  assert_int_equal(one->count.islandsLargest, STACK_BOXES);
+  assert_true(a->contacts[a->count - 1] >= PD_TEST_HELP_MIN_CONTACTS);  // loops long enough to be split
+  assert_int_equal(pd_island_help_served(one), 0);
+  long helped = same_bits_on_more_threads(m, a, one);
+  print_message("stack_20 on 2 threads: %ld half loops run by the other thread\n", helped);
+  assert_true(helped > 0);
   pd_state_free(one);
   free(a);
   pd_model_free(m);
@@ -458,6 +506,7 @@ int main(void) {
       cmocka_unit_test(test_an_island_splits_when_its_bodies_part),
       cmocka_unit_test(test_turned_bodies_apart_whose_boxes_overlap_are_two_islands),
       cmocka_unit_test(test_threads_give_the_same_bits),
+      cmocka_unit_test(test_one_island_helped_by_other_threads_gives_the_same_bits),
       cmocka_unit_test(test_whole_stages_add_up_to_at_most_the_run),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

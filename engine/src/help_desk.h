@@ -1,0 +1,36 @@
+// polydyn (internal) — a second thread's hands inside one island (issue 16 item 3; README, "Threads").
+//
+// With pdState.threads > 1 the islands of a sync interval are taken in turn by the pool's threads
+// (islands.c). A thread left without an island while another still runs serves the help desk instead of
+// sleeping: the running island's loops over its contacts (forces in every derivative evaluation, the
+// tracking and the interference tests between steps) post their second half there, and the server runs it
+// while the island's own thread runs the first. Every index is computed by the same function from the same
+// inputs whichever thread runs it, each writes only its own index's outputs, and whatever combines them
+// (sums of forces, the earliest onset, …) runs afterwards on the island's thread in index order: results
+// are the same bit for bit with or without help, on any number of threads.
+#pragma once
+
+#include <stdatomic.h>
+#include <stdbool.h>
+
+// f(ctx, part, begin, end) runs the indices [begin, end) of a loop: part 0 the first half (or the whole loop),
+// part 1 the second half. A loop that collects outputs of varying size keeps them per part.
+typedef void pdRangeFcn(void* ctx, int part, int begin, int end);
+
+typedef struct pdHelpTask pdHelpTask;
+
+typedef struct pdHelpDesk {
+  _Atomic(pdHelpTask*) posted;  // a half loop waiting for a server, or NULL
+  atomic_int servers;           // threads serving now
+  atomic_long served;           // half loops a server ran (how much help was given; no result depends on it)
+} pdHelpDesk;
+
+void pd_help_desk_init(pdHelpDesk* desk);
+
+// Runs f over [0, n): f(ctx, 0, 0, n), or f(ctx, 0, 0, n/2) and f(ctx, 1, n/2, n). With a desk, at least minSplit
+// indices and a server waiting, the second half is posted and the first run here; the second half is taken back and run
+// here too when no server took it by then.
+void pd_help_for(pdHelpDesk* desk, int n, int minSplit, pdRangeFcn* f, void* ctx);
+
+// Serves the desk (runs what is posted) while *pending is nonzero. Spins: a server has nothing else to do.
+void pd_help_serve(pdHelpDesk* desk, const atomic_int* pending);
