@@ -10,6 +10,7 @@
 // are the same bit for bit with or without help, on any number of threads.
 #pragma once
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdbool.h>
 
@@ -22,10 +23,19 @@ typedef struct pdHelpTask pdHelpTask;
 typedef struct pdHelpDesk {
   _Atomic(pdHelpTask*) posted;  // a half loop waiting for a server, or NULL
   atomic_int servers;           // threads serving now
+  atomic_int sleepers;          // of them, asleep on `wake` (nothing posted for a while)
+  atomic_int holdOff;           // loops to run without posting (help_desk.c)
+  atomic_int votes, against;    // helped loops in the current window, and those whose help cost time
   atomic_long served;           // half loops a server ran (how much help was given; no result depends on it)
+  pthread_mutex_t lock;         // guards the sleep on `wake`
+  pthread_cond_t wake;          // a post, or the end of the servers' batch
 } pdHelpDesk;
 
 void pd_help_desk_init(pdHelpDesk* desk);
+void pd_help_desk_destroy(pdHelpDesk* desk);
+
+// Wakes every sleeping server: call it when *pending (pd_help_serve's) drops to 0.
+void pd_help_wake_all(pdHelpDesk* desk);
 
 // Runs f over [0, n): f(ctx, 0, 0, n), or f(ctx, 0, 0, n/2) and f(ctx, 1, n/2, n). With a desk, at least minSplit
 // indices and a server waiting, the second half is posted and the first run here; the second half is taken back and run

@@ -340,7 +340,7 @@ static void run_jobs(struct pdIslandSet* set) {
   for (int n; (n = atomic_fetch_add(&set->nextJob, 1)) < set->jobCount;) {
     int i = set->order[n].job;
     set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobCoarse[i]);
-    atomic_fetch_sub(&set->jobsLeft, 1);
+    if (atomic_fetch_sub(&set->jobsLeft, 1) == 1 && set->threadCount > 1) pd_help_wake_all(&set->desk);
   }
   if (set->threadCount > 1) pd_help_serve(&set->desk, &set->jobsLeft);
 }
@@ -490,6 +490,7 @@ long pd_island_help_served(const pdState* s) { return s->islandSet ? atomic_load
 void pd_island_set_free(struct pdIslandSet* set) {
   if (!set) return;
   pool_stop(set);
+  pd_help_desk_destroy(&set->desk);
   free(set->jobs);
   free(set->jobCoarse);
   free(set->jobOk);
