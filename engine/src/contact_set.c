@@ -377,17 +377,19 @@ void pd_contact_set_help(pdContactSet* set, pdHelpDesk* desk) { set->help = desk
 #define PD_HELP_MIN_CONTACTS 128
 #define PD_HELP_MIN_PAIRS 32
 
-typedef struct forcesJob {
+// What a loop over contacts or pairs reads (pd_help_for's ctx); each loop uses the fields it names.
+typedef struct contactLoop {
   const pdModel* model;
   pdContactSet* set;
-  const double* y;
-  double* dydt;
-} forcesJob;
+  const double* y;                // the state the loop evaluates
+  double* dydt;                   // forces: where the spring rates go
+  const pdPose *poses0, *poses1;  // the contact search: the poses at the step's start and end
+} contactLoop;
 
 // Contacts [begin, end) of a derivative evaluation: their spring rates into dydt, their pushes into set->push.
 static void forces_range(void* ctx, int part, int begin, int end) {
   (void)part;
-  const forcesJob* job = ctx;
+  const contactLoop* job = ctx;
   pdContactSet* set = job->set;
   int base = spring_base(job->model);
   for (int i = begin; i < end; ++i) {
@@ -405,7 +407,7 @@ void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y,
   poses_from(model, y, set->poses);
   pdVec3 *force = set->force, *torque = set->torque;
   for (int k = 0; k < model->movingCount; ++k) force[k] = torque[k] = (pdVec3){0, 0, 0};
-  forcesJob job = {model, set, y, dydt};
+  contactLoop job = {.model = model, .set = set, .y = y, .dydt = dydt};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, forces_range, &job);
   // the sums in contact order, whoever computed each contact
   for (int i = 0; i < set->count; ++i) {
@@ -688,15 +690,10 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
 // of damped modes whose fast root exceeds ω. A Gershgorin sum is never below the true eigenvalue, and for a
 // cube resting on a face it is within 15 % of it (8 k/m against the rocking mode's 6 k/m). Needs the terms
 // of stability_prepare for the current list.
-typedef struct stabilityJob {
-  const pdModel* model;
-  pdContactSet* set;
-} stabilityJob;
-
 // The Gershgorin rows of contacts [begin, end) (stabilityTerms.rowsMax).
 static void gershgorin_range(void* ctx, int part, int begin, int end) {
   (void)part;
-  const stabilityJob* job = ctx;
+  const contactLoop* job = ctx;
   const pdModel* model = job->model;
   pdContactSet* set = job->set;
   for (int i = begin; i < end; ++i) {
@@ -736,7 +733,7 @@ static void gershgorin_range(void* ctx, int part, int begin, int end) {
 }
 
 static double stable_step_exact(const pdModel* model, pdContactSet* set) {
-  stabilityJob job = {model, set};
+  contactLoop job = {.model = model, .set = set};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, gershgorin_range, &job);
   double omega2 = 0.0;
   for (int i = 0; i < set->count; ++i) omega2 = fmax(omega2, set->stability[i].rowsMax);
@@ -754,23 +751,16 @@ double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double
 
 // Records geometry and force of every listed contact at state y for output, realignment and refinement.
 // poses must be those of y.
-typedef struct recordJob {
-  const pdModel* model;
-  pdContactSet* set;
-  const double* y;
-  const pdPose* poses;
-} recordJob;
-
 static void record_range(void* ctx, int part, int begin, int end) {
   (void)part;
-  const recordJob* job = ctx;
+  const contactLoop* job = ctx;
   int base = spring_base(job->model);
   for (int i = begin; i < end; ++i) {
     contactSlot* c = &job->set->items[i];
     pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
     pdContactGeom g;
     pdVec3 du;  // unused here
-    evaluate(job->model, c, job->y, job->poses, &sp, &g, NULL, &du, &c->force);
+    evaluate(job->model, c, job->y, job->poses1, &sp, &g, NULL, &du, &c->force);
     c->normal = g.normal;
     c->point = g.point;
     c->depth = g.depth;
@@ -778,7 +768,7 @@ static void record_range(void* ctx, int part, int begin, int end) {
 }
 
 static void record(const pdModel* model, pdContactSet* set, const double* y, const pdPose* poses) {
-  recordJob job = {model, set, y, poses};
+  contactLoop job = {.model = model, .set = set, .y = y, .poses1 = poses};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, record_range, &job);
 }
 
@@ -979,16 +969,10 @@ static int compare_to_pair(const pdContactId* id, int a, int b) {
   return hi < b ? -1 : hi > b;
 }
 
-typedef struct interferenceJob {
-  const pdModel* model;
-  pdContactSet* set;
-  const pdPose* poses1;
-} interferenceJob;
-
 // Pairs [begin, end) of the contact search: touching[p] and the pair's new cache entry.
 static void interference_range(void* ctx, int part, int begin, int end) {
   (void)part;
-  const interferenceJob* job = ctx;
+  const contactLoop* job = ctx;
   pdContactSet* set = job->set;
   const pdPose* poses1 = job->poses1;
   int cached = 0;  // the cache's cursor (sorted like the pairs); from its start in every range
@@ -1003,16 +987,10 @@ static void interference_range(void* ctx, int part, int begin, int end) {
   }
 }
 
-typedef struct findJob {
-  const pdModel* model;
-  pdContactSet* set;
-  const pdPose *poses0, *poses1;
-} findJob;
-
 // The contacts of the touching pairs [begin, end) into the part's found[], pair after pair (pairFound,
 // pairFoundCount). A part's buffer grows here, on whichever thread runs it (between steps, not in the derivative).
 static void find_range(void* ctx, int part, int begin, int end) {
-  const findJob* job = ctx;
+  const contactLoop* job = ctx;
   pdContactSet* set = job->set;
   const pdPose *poses0 = job->poses0, *poses1 = job->poses1;
   searchPart* sp = &set->search[part];
@@ -1046,7 +1024,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
                    const pdPose* poses1, pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
   // every pair's interference first, timed as a whole (two clock reads per pair were 2 % of a pile's run)
-  interferenceJob job = {model, set, poses1};
+  contactLoop job = {.model = model, .set = set, .poses1 = poses1};
   pd_help_for(set->help, pairCount, PD_HELP_MIN_PAIRS, interference_range, &job);
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageInterference]);
   set->candidateCount = 0;
@@ -1059,7 +1037,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
     while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) == 0) ++listed;
     set->pairPreviousCount[p] = listed - set->pairPrevious[p];
   }
-  findJob find = {model, set, poses0, poses1};
+  contactLoop find = {.model = model, .set = set, .poses0 = poses0, .poses1 = poses1};
   set->searchSplit = pairCount;
   pd_help_for(set->help, pairCount, PD_HELP_MIN_PAIRS, find_range, &find);
   for (int p = 0; p < pairCount; ++p) {
@@ -1113,23 +1091,17 @@ static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double a
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
 
-typedef struct trackingJob {
-  const pdModel* model;
-  pdContactSet* set;
-  const double* y1;
-} trackingJob;
-
 // Contacts [begin, end) of C0 tracked to y1 and their forces there (set->eval).
 static void tracking_range(void* ctx, int part, int begin, int end) {
   (void)part;
-  const trackingJob* job = ctx;
+  const contactLoop* job = ctx;
   pdContactSet* set = job->set;
   int base = spring_base(job->model);
   for (int i = begin; i < end; ++i) {
     contactEval* e = &set->eval[i];
-    pdSprings sp = springs_load(job->y1 + base + PD_CONTACT_STATE_SIZE * i);
+    pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
     pdVec3 du;
-    evaluate(job->model, &set->items[i], job->y1, set->poses1, &sp, &e->geom, &e->tracked, &du, &e->force);
+    evaluate(job->model, &set->items[i], job->y, set->poses1, &sp, &e->geom, &e->tracked, &du, &e->force);
     e->transferred = false;
   }
 }
@@ -1156,7 +1128,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   }
 
   // 1. C0 at y1: tracking, forces, reversals
-  trackingJob job = {model, set, y1};
+  contactLoop job = {.model = model, .set = set, .y = y1};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, tracking_range, &job);
   double refineStep = 0.0;  // the largest refinement bound among the contacts that changed mode (0: none)
   for (int i = 0; i < set->count; ++i) {
