@@ -100,8 +100,8 @@ typedef enum pdIslands {
                   // steps, error norm and contact events. Output at the common sample times.
 } pdIslands;
 
-// The most threads pdState.threads may ask for (a sanity bound: the islands of an interval are the only work
-// split, and more threads than cores only adds switching).
+// The most threads pdState.threads may ask for (a sanity bound: the islands of an interval, and an island's long
+// loops over contacts, are the only work split, and more threads than cores only adds switching).
 #define PD_THREADS_MAX 64
 
 // The island mode of a new state (pd_state_reset) and of the commands' --islands.
@@ -141,7 +141,8 @@ typedef struct pdState {
   pdIslands islands;  // one system or islands (PD_ISLANDS_DEFAULT unless the caller sets it)
   int threads;        // 1 .. PD_THREADS_MAX, 1 unless the caller sets it. With pd_islandsOn, the islands of each
                       // interval run on this many threads (the caller's and threads - 1 of the state's own, created
-                      // at the first pd_advance and joined by pd_state_free/reset); the results are bit-identical
+                      // at the first pd_advance and joined by pd_state_free/reset), a thread without an island
+                      // helping a running one with its long loops over contacts; the results are bit-identical
                       // for every count. Ignored with pd_islandsOff (one system: one thread).
   int n;             // length of y: 13 per moving body + 8 per active contact
   int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)
