@@ -185,6 +185,7 @@ struct pdContactSet {
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])
   int* bodyList;           // (2 capacity)
+  bool bodyListValid;      // bodyFirst/bodyList list the current contacts (stability_prepare; install clears it)
   double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
   double stableCheap;      // s: a step never above stableStep, from the cheap bound (stability_prepare)
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
@@ -312,6 +313,7 @@ void pd_contact_set_free(pdContactSet* set) {
 
 void pd_contact_set_clear(pdContactSet* set) {
   set->count = 0;
+  set->bodyListValid = false;
   set->stableStep = set->stableCheap = INFINITY;
   set->stableKnown = true;
   set->candidateCount = 0;
@@ -371,6 +373,7 @@ static void evaluate(const pdModel* model, const contactSlot* c, const double* y
 }
 
 void pd_contact_set_help(pdContactSet* set, pdHelpDesk* desk) { set->help = desk; }
+pdHelpDesk* pd_contact_set_help_desk(const pdContactSet* set) { return set->help; }
 
 // Contacts (or pairs) below which a loop is not split (help_desk.h): a handover costs about a microsecond, one
 // contact's force ~0.1 us, one pair's interference test ~1 us.
@@ -403,13 +406,53 @@ static void forces_range(void* ctx, int part, int begin, int end) {
   }
 }
 
+// Moving bodies [begin, end): their poses at job->y (set->poses).
+static void poses_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const contactLoop* job = ctx;
+  for (int k = begin; k < end; ++k) {
+    const double* yb = job->y + PD_BODY_STATE_SIZE * k;
+    job->set->poses[job->model->movingBodies[k]] = pose_of(pd_layout_x(yb), pd_layout_q(yb));
+  }
+}
+
+// Moving bodies [begin, end): the sums of their contacts' pushes, body by body over its contacts in contact order
+// (bodyList), so each body's force and torque are the very sums of the loop over all contacts.
+static void sums_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const contactLoop* job = ctx;
+  const pdContactSet* set = job->set;
+  for (int k = begin; k < end; ++k) {
+    int body = job->model->movingBodies[k];
+    pdVec3 force = {0, 0, 0}, torque = {0, 0, 0}, x = set->poses[body].x;
+    for (int l = set->bodyFirst[body]; l < set->bodyFirst[body + 1]; ++l) {
+      const contactPush* p = &set->push[set->bodyList[l] / 2];
+      if (p->pulls) continue;
+      pdVec3 moment = pd_v3_cross(pd_v3_sub(p->point, x), p->force);
+      if (set->bodyList[l] % 2 == 0) {
+        force = pd_v3_add(force, p->force);
+        torque = pd_v3_add(torque, moment);
+      } else {
+        force = pd_v3_sub(force, p->force);
+        torque = pd_v3_sub(torque, moment);
+      }
+    }
+    set->force[k] = force;
+    set->torque[k] = torque;
+  }
+}
+
 void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y, double* dydt) {
-  poses_from(model, y, set->poses);
+  contactLoop job = {.model = model, .set = set, .y = y, .dydt = dydt};
+  pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, poses_range, &job);
+  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, forces_range, &job);
+  if (set->bodyListValid) {
+    pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, sums_range, &job);
+    return;
+  }
+  // the same sums in contact order, whoever computed each contact (a list installed without stability_prepare)
   pdVec3 *force = set->force, *torque = set->torque;
   for (int k = 0; k < model->movingCount; ++k) force[k] = torque[k] = (pdVec3){0, 0, 0};
-  contactLoop job = {.model = model, .set = set, .y = y, .dydt = dydt};
-  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, forces_range, &job);
-  // the sums in contact order, whoever computed each contact
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     const contactPush* p = &set->push[i];
@@ -478,6 +521,7 @@ static void install(const pdModel* model, pdState* s, int count) {
   set->items = set->next;
   set->next = old;
   set->count = count;
+  set->bodyListValid = false;
   s->n = base + PD_CONTACT_STATE_SIZE * count;
 }
 
@@ -659,6 +703,7 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
   }
   for (int k = bodies; k > 0; --k) set->bodyFirst[k] = set->bodyFirst[k - 1];
   set->bodyFirst[0] = 0;
+  set->bodyListValid = true;
   // the cheap bound; its margin covers the rounding of both sums (~1e-15 relative), so that it stays above
   // the exact one as computed
   double cheap2 = 0.0;

@@ -25,6 +25,7 @@ void pd_contact_set_clear(pdContactSet* set);
 // islands' pool gives every island's set its own pool's desk. Results do not depend on it.
 struct pdHelpDesk;
 void pd_contact_set_help(pdContactSet* set, struct pdHelpDesk* desk);
+struct pdHelpDesk* pd_contact_set_help_desk(const pdContactSet* set);
 int pd_contact_set_count(const pdContactSet* set);
 
 // Inside the derivative: poses of every body from y (fixed bodies keep theirs), then for every contact

@@ -37,6 +37,10 @@ void pd_help_desk_destroy(pdHelpDesk* desk);
 // Wakes every sleeping server: call it when *pending (pd_help_serve's) drops to 0.
 void pd_help_wake_all(pdHelpDesk* desk);
 
+// Moving bodies below which a per-body loop is not split (forces' sums, poses and the dynamics of a derivative
+// evaluation: ~50 ns per body against a handover of about a microsecond).
+#define PD_HELP_MIN_BODIES 128
+
 // Runs f over [0, n): f(ctx, 0, 0, n), or f(ctx, 0, 0, n/2) and f(ctx, 1, n/2, n). With a desk, at least minSplit
 // indices and a server waiting, the second half is posted and the first run here; the second half is taken back and run
 // here too when no server took it by then.
