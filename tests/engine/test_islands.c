@@ -23,7 +23,8 @@
 // - threads (pdState.threads): a pile of 30 boxes in two layers gives, with 2 and 3 threads, every body's x, q,
 //   v, ω at every sample, the contact counts and every counter bit for bit as with 1 thread (each island's
 //   computation is its own: the split only decides which thread runs it); and a stack of twenty boxes, one
-//   island throughout, likewise, the other threads serving its help desk (some half loops run by them);
+//   island throughout, likewise, the other threads serving its help desk (some half loops run by them); and a
+//   layer of 132 bricks, one island of more bodies than PD_HELP_MIN_BODIES (its per-body loops split too);
 // - stage timers (pdState.stageSeconds): on one thread, the stages timed whole (broad phase, interference,
 //   contact analysis, observe; laps of one stopwatch or intervals of their own, never overlapping) each ran and
 //   add up to no more than the time spent in pd_advance.
@@ -39,6 +40,7 @@
 
 #include <cmocka.h>
 
+#include "help_desk.h"
 #include "islands.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
@@ -464,6 +466,40 @@ static void test_one_island_helped_by_other_threads_gives_the_same_bits(void** s
   pd_model_free(m);
 }
 
+enum { LAYER_ROWS = 11, LAYER_COLUMNS = 12, LAYER_BRICKS = LAYER_ROWS * LAYER_COLUMNS, LAYER_TEXT = 32768 };
+
+// A layer of 132 bricks lying flush side by side on the floor, touching it: one island of more moving bodies than
+// PD_HELP_MIN_BODIES, whose per-body loops (poses, force sums, Newton–Euler) are split too.
+static pdModel* layer_132(void) {
+  static char text[LAYER_TEXT];
+  int used = snprintf(text, sizeof text, "tend 0.003\nsample 1000\n" FLOOR);
+  for (int k = 0; k < LAYER_BRICKS; ++k) {
+    int row = k / LAYER_COLUMNS, col = k % LAYER_COLUMNS;
+    used += snprintf(text + used, sizeof text - (size_t)used,
+                     "cube k%d brown 0.2 0.1 0.1\nloc %.2f %.2f 0.05\nmu 0.6\nrestitution 0.5\n", k, -1.1 + 0.2 * col,
+                     -0.5 + 0.1 * row);
+    assert_true(used < LAYER_TEXT);
+  }
+  return compile_text(text);
+}
+
+static void test_a_wide_island_helped_body_by_body_gives_the_same_bits(void** state) {
+  (void)state;
+  pdModel* m = layer_132();
+  assert_true(m->movingCount >= PD_HELP_MIN_BODIES);
+  pdState* one = NULL;
+  trace* a = run_threads(m, pd_islandsOn, 1, &one);
+  print_message("layer_132: largest island %ld, %d contacts at the end\n", one->count.islandsLargest,
+                a->contacts[a->count - 1]);
+  assert_int_equal(one->count.islandsLargest, LAYER_BRICKS);
+  long helped = same_bits_on_more_threads(m, a, one);
+  print_message("layer_132 on 2 threads: %ld half loops run by the other thread\n", helped);
+  assert_true(helped > 0);
+  pd_state_free(one);
+  free(a);
+  pd_model_free(m);
+}
+
 // The stages timed whole are disjoint parts of pd_advance's interval: on one thread their sum cannot exceed it
 // (forces, derivative and integrate are left out: they are scaled-up samples and the remainders of them).
 static double wall_seconds(void) {
@@ -507,6 +543,7 @@ int main(void) {
       cmocka_unit_test(test_turned_bodies_apart_whose_boxes_overlap_are_two_islands),
       cmocka_unit_test(test_threads_give_the_same_bits),
       cmocka_unit_test(test_one_island_helped_by_other_threads_gives_the_same_bits),
+      cmocka_unit_test(test_a_wide_island_helped_body_by_body_gives_the_same_bits),
       cmocka_unit_test(test_whole_stages_add_up_to_at_most_the_run),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
