@@ -62,10 +62,11 @@
 //   activations, the redo decision, the gather, the counters in island order) stays on the calling thread. An
 //   island computes the same numbers on any thread, so every thread count gives the same results bit for bit.
 // - Help inside an island (help_desk.h): a thread left without an island while others still run serves the pool's
-//   help desk; an island whose loops over contacts or pairs are long enough (contact_set.c, PD_HELP_MIN_CONTACTS)
-//   posts their second half there. A batch of one island wakes the workers only from PD_ISLAND_HELP_WEIGHT on.
-//   Each index is computed alike on either thread and combined in index order by the island's own, so this too
-//   leaves every result the same bit for bit.
+//   help desk; an island whose loops over contacts, pairs, bodies or state components are long enough
+//   (PD_HELP_MIN_CONTACTS, PD_HELP_MIN_PAIRS, PD_HELP_MIN_BODIES, PD_HELP_MIN_COMPONENTS) posts their second
+//   half there. A batch of one island wakes the workers only from PD_ISLAND_HELP_WEIGHT on. Each index is
+//   computed alike on either thread and combined in index order by the island's own, so this too leaves every
+//   result the same bit for bit.
 //
 // Memory: islands are set up, grown and freed only at sync times; a step allocates nothing. The pool's
 // threads are created with the set (or when pdState.threads changes) and joined when it is freed.
