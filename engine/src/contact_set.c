@@ -347,11 +347,16 @@ static pdVec3 point_velocity(const pdModel* model, const double* y, const pdPose
   return pd_v3_add(pd_layout_v(yb), pd_v3_cross(pd_layout_w(yb), pd_v3_sub(p, poses[i].x)));
 }
 
-static void poses_from(const pdModel* model, const double* y, pdPose* poses) {
-  for (int k = 0; k < model->movingCount; ++k) {
+// The poses of moving bodies [begin, end) at y.
+static void poses_of_range(const pdModel* model, const double* y, pdPose* poses, int begin, int end) {
+  for (int k = begin; k < end; ++k) {
     const double* yb = y + PD_BODY_STATE_SIZE * k;
     poses[model->movingBodies[k]] = pose_of(pd_layout_x(yb), pd_layout_q(yb));
   }
+}
+
+static void poses_from(const pdModel* model, const double* y, pdPose* poses) {
+  poses_of_range(model, y, poses, 0, model->movingCount);
 }
 
 // Geometry, relative velocity and force of one contact at state y (poses of y given).
@@ -410,10 +415,30 @@ static void forces_range(void* ctx, int part, int begin, int end) {
 static void poses_range(void* ctx, int part, int begin, int end) {
   (void)part;
   const contactLoop* job = ctx;
-  for (int k = begin; k < end; ++k) {
-    const double* yb = job->y + PD_BODY_STATE_SIZE * k;
-    job->set->poses[job->model->movingBodies[k]] = pose_of(pd_layout_x(yb), pd_layout_q(yb));
+  poses_of_range(job->model, job->y, job->set->poses, begin, end);
+}
+
+// Each moving body's contacts in contact order, as 2 i + (0 on body1, 1 on body2): bodyFirst/bodyList. Read by the
+// exact stability bound and by the force sums (sums_range), built by stability_prepare or, for a list installed
+// without it, by the first derivative evaluation (the arrays are sized with the list: nothing is allocated).
+static void list_bodies(const pdModel* model, pdContactSet* set) {
+  int bodies = model->bodyCount;
+  for (int k = 0; k <= bodies; ++k) set->bodyFirst[k] = 0;
+  for (int i = 0; i < set->count; ++i) {
+    const contactSlot* c = &set->items[i];
+    if (!model->bodies[c->id.body1].fixed) ++set->bodyFirst[c->id.body1 + 1];
+    if (!model->bodies[c->id.body2].fixed) ++set->bodyFirst[c->id.body2 + 1];
   }
+  for (int k = 0; k < bodies; ++k) set->bodyFirst[k + 1] += set->bodyFirst[k];
+  // fill (bodyFirst[k] advances to bodyFirst[k + 1] and is shifted back after)
+  for (int i = 0; i < set->count; ++i) {
+    const contactSlot* c = &set->items[i];
+    if (!model->bodies[c->id.body1].fixed) set->bodyList[set->bodyFirst[c->id.body1]++] = 2 * i;
+    if (!model->bodies[c->id.body2].fixed) set->bodyList[set->bodyFirst[c->id.body2]++] = 2 * i + 1;
+  }
+  for (int k = bodies; k > 0; --k) set->bodyFirst[k] = set->bodyFirst[k - 1];
+  set->bodyFirst[0] = 0;
+  set->bodyListValid = true;
 }
 
 // Moving bodies [begin, end): the sums of their contacts' pushes, body by body over its contacts in contact order
@@ -446,30 +471,8 @@ void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y,
   contactLoop job = {.model = model, .set = set, .y = y, .dydt = dydt};
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, poses_range, &job);
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, forces_range, &job);
-  if (set->bodyListValid) {
-    pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, sums_range, &job);
-    return;
-  }
-  // the same sums in contact order, whoever computed each contact (a list installed without stability_prepare)
-  pdVec3 *force = set->force, *torque = set->torque;
-  for (int k = 0; k < model->movingCount; ++k) force[k] = torque[k] = (pdVec3){0, 0, 0};
-  for (int i = 0; i < set->count; ++i) {
-    const contactSlot* c = &set->items[i];
-    const contactPush* p = &set->push[i];
-    if (p->pulls) continue;  // normal springs are never in tension: no force
-    const pdBody* b1 = &model->bodies[c->id.body1];
-    const pdBody* b2 = &model->bodies[c->id.body2];
-    if (!b1->fixed) {
-      int k = b1->stateIndex;
-      force[k] = pd_v3_add(force[k], p->force);
-      torque[k] = pd_v3_add(torque[k], pd_v3_cross(pd_v3_sub(p->point, set->poses[c->id.body1].x), p->force));
-    }
-    if (!b2->fixed) {
-      int k = b2->stateIndex;
-      force[k] = pd_v3_sub(force[k], p->force);
-      torque[k] = pd_v3_sub(torque[k], pd_v3_cross(pd_v3_sub(p->point, set->poses[c->id.body2].x), p->force));
-    }
-  }
+  if (!set->bodyListValid) list_bodies(model, set);  // a list installed without stability_prepare (a gather)
+  pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, sums_range, &job);
 }
 
 double pd_contact_spring_energy(const pdContactSet* set, const double* y, int springBase) {
@@ -664,8 +667,8 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
     set->stableKnown = true;
     return;
   }
+  list_bodies(model, set);
   int bodies = model->bodyCount;
-  for (int k = 0; k <= bodies; ++k) set->bodyFirst[k] = 0;
   for (int k = 0; k < bodies; ++k) set->bodyRowsK[k] = set->bodyRowsRight[k] = (pdVec3){0, 0, 0};
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
@@ -684,7 +687,6 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
     for (int e = 0; e < 2; ++e) {
       const pdBody* b = &model->bodies[ends[e]];
       if (b->fixed) continue;
-      ++set->bodyFirst[ends[e] + 1];
       pdMat3 rx = cross_matrix(pd_v3_sub(c->point, poses[ends[e]].x));
       pdMat3 rxT = pd_mat3_transpose(&rx);
       t->left[e] = pd_mat3_mul(&t->k, &rxT);
@@ -694,16 +696,6 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
       set->bodyRowsRight[ends[e]] = pd_v3_add(set->bodyRowsRight[ends[e]], row_abs_sums(&t->right[e]));
     }
   }
-  for (int k = 0; k < bodies; ++k) set->bodyFirst[k + 1] += set->bodyFirst[k];
-  // fill (bodyFirst[k] advances to bodyFirst[k + 1] and is shifted back after)
-  for (int i = 0; i < set->count; ++i) {
-    const contactSlot* c = &set->items[i];
-    if (!model->bodies[c->id.body1].fixed) set->bodyList[set->bodyFirst[c->id.body1]++] = 2 * i;
-    if (!model->bodies[c->id.body2].fixed) set->bodyList[set->bodyFirst[c->id.body2]++] = 2 * i + 1;
-  }
-  for (int k = bodies; k > 0; --k) set->bodyFirst[k] = set->bodyFirst[k - 1];
-  set->bodyFirst[0] = 0;
-  set->bodyListValid = true;
   // the cheap bound; its margin covers the rounding of both sums (~1e-15 relative), so that it stays above
   // the exact one as computed
   double cheap2 = 0.0;
@@ -1047,14 +1039,12 @@ static void find_range(void* ctx, int part, int begin, int end) {
     if (!set->touching[p]) continue;
     int a = set->pairs[p].a, b = set->pairs[p].b, first = set->pairPrevious[p], count = set->pairPreviousCount[p];
     for (int k = 0; k < count; ++k) sp->previous[k] = set->items[first + k].id;
-    int room = sp->foundCapacity - sp->foundCount;
-    int n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous, count,
-                             sp->found + sp->foundCount, room);
-    if (n > room) {
+    int n;
+    while ((n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous, count,
+                                 sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount)) >
+           sp->foundCapacity - sp->foundCount) {
       sp->foundCapacity = 2 * (sp->foundCount + n);
       sp->found = grow(sp->found, sp->foundCapacity, sizeof *sp->found);
-      n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous, count,
-                           sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount);
     }
     set->pairFoundCount[p] = n;
     sp->foundCount += n;
