@@ -90,11 +90,8 @@ static void write_number(FILE* out, double x) {
   }
 }
 
-// ",x,y,…": a row's numbers as write_number writes them, in one fwrite.
-static void write_number_list(FILE* out, const double* x, int count) {
-  char text[16 * (PD_G17_MAX + 1)];
-  PD_ASSERT(count <= 16);
-  size_t n = 0;
+// Appends ",x,y,…" (a row's numbers as write_number writes them) to text at n; returns the new length.
+static size_t append_numbers(char* text, size_t n, const double* x, int count) {
   for (int k = 0; k < count; ++k) {
     text[n++] = ',';
     if (isfinite(x[k])) {
@@ -104,7 +101,30 @@ static void write_number_list(FILE* out, const double* x, int count) {
       n += 4;
     }
   }
-  fwrite(text, 1, n, out);
+  return n;
+}
+
+// Appends ",k" for a non-negative k (a feature index) to text at n; returns the new length.
+static size_t append_index(char* text, size_t n, int k) {
+  char digits[12];
+  int d = 0;
+  do digits[d++] = (char)('0' + k % 10);
+  while ((k /= 10) > 0);
+  text[n++] = ',';
+  while (d > 0) text[n++] = digits[--d];
+  return n;
+}
+
+// A sample time's text, formatted once for all of the sample's rows.
+typedef struct timeText {
+  char text[PD_G17_MAX];
+  size_t length;
+} timeText;
+
+static timeText time_text(double t) {
+  timeText r;
+  r.length = (size_t)pd_format_g17(t, r.text);
+  return r;
 }
 
 // CSV field: quoted (RFC 4180) only when it holds a comma, a quote or a line break.
@@ -142,23 +162,32 @@ static contactRecord contact_record(const pdContactReport* c) {
   return r;
 }
 
-static void write_contact_row(FILE* out, const pdModel* model, double t, const contactRecord* c) {
-  write_number(out, t);
+static void write_contact_row(FILE* out, const pdModel* model, const timeText* t, const contactRecord* c) {
+  fwrite(t->text, 1, t->length, out);
   fputc(',', out);
   write_csv_text(out, model->bodies[c->bodyA].name);
   fputc(',', out);
   write_csv_text(out, model->bodies[c->bodyB].name);
-  fprintf(out, ",%s,%d,%d", c->edgeEdge ? "EE" : "VF", (int)c->featureA, (int)c->featureB);
-  write_number_list(out, c->row, 10);
-  fputs(c->slip ? ",slip\n" : ",stick\n", out);
+  // the rest of the row in one fwrite: ",EE,3,7" (kind, features), 10 numbers, ",slip\n"
+  char text[32 + 10 * (PD_G17_MAX + 1)];
+  PD_ASSERT(c->featureA >= 0 && c->featureB >= 0);
+  memcpy(text, c->edgeEdge ? ",EE" : ",VF", 3);
+  size_t n = append_index(text, 3, (int)c->featureA);
+  n = append_index(text, n, (int)c->featureB);
+  n = append_numbers(text, n, c->row, 10);
+  const char* mode = c->slip ? ",slip\n" : ",stick\n";
+  size_t modeLength = strlen(mode);
+  memcpy(text + n, mode, modeLength);
+  fwrite(text, 1, n + modeLength, out);
 }
 
 void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state) {
   int count = pd_state_contact_count(state);
+  timeText t = time_text(state->t);
   for (int i = 0; i < count; ++i) {
     pdContactReport c = pd_state_contact(state, i);
     contactRecord r = contact_record(&c);
-    write_contact_row(out, model, state->t, &r);
+    write_contact_row(out, model, &t, &r);
   }
 }
 
@@ -171,20 +200,23 @@ static void body_row(const pdModel* model, const pdState* state, int i, double r
   memcpy(row, r, sizeof r);
 }
 
-static void write_trajectory_row(FILE* out, const pdModel* model, double t, int i, const double row[13]) {
-  write_number(out, t);
+static void write_trajectory_row(FILE* out, const pdModel* model, const timeText* t, int i, const double row[13]) {
+  fwrite(t->text, 1, t->length, out);
   fputc(',', out);
   write_csv_text(out, model->bodies[i].name);
-  write_number_list(out, row, 13);
-  fputc('\n', out);
+  char text[13 * (PD_G17_MAX + 1) + 1];
+  size_t n = append_numbers(text, 0, row, 13);
+  text[n++] = '\n';
+  fwrite(text, 1, n, out);
 }
 
 void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state) {
+  timeText t = time_text(state->t);
   for (int k = 0; k < model->movingCount; ++k) {
     int i = model->movingBodies[k];
     double row[13];
     body_row(model, state, i, row);
-    write_trajectory_row(out, model, state->t, i, row);
+    write_trajectory_row(out, model, &t, i, row);
   }
 }
 
@@ -210,17 +242,18 @@ static bool print_block(pdRunWriter* run, const outputBlock* b) {
     sampleHead h;
     memcpy(&h, b->data + at, sizeof h);
     at += sizeof h;
+    timeText t = time_text(h.t);
     for (int k = 0; k < model->movingCount; ++k) {
       double row[13];
       memcpy(row, b->data + at, sizeof row);
       at += sizeof row;
-      write_trajectory_row(run->trajectory, model, h.t, model->movingBodies[k], row);
+      write_trajectory_row(run->trajectory, model, &t, model->movingBodies[k], row);
     }
     for (int i = 0; i < h.contacts; ++i) {
       contactRecord c;
       memcpy(&c, b->data + at, sizeof c);
       at += sizeof c;
-      write_contact_row(run->contacts, model, h.t, &c);
+      write_contact_row(run->contacts, model, &t, &c);
     }
   }
   return !ferror(run->trajectory) && !ferror(run->contacts);
