@@ -189,6 +189,7 @@ struct pdContactSet {
   double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
   double stableCheap;      // s: a step never above stableStep, from the cheap bound (stability_prepare)
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
+  long exactFormed;        // stable_step_exact calls (pd_contact_set_exact_formed)
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
@@ -772,6 +773,7 @@ static void gershgorin_range(void* ctx, int part, int begin, int end) {
 }
 
 static double stable_step_exact(const pdModel* model, pdContactSet* set) {
+  ++set->exactFormed;
   contactLoop job = {.model = model, .set = set};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, gershgorin_range, &job);
   double omega2 = 0.0;
@@ -779,8 +781,12 @@ static double stable_step_exact(const pdModel* model, pdContactSet* set) {
   return step_of(omega2, set->overdamp);
 }
 
-double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction) {
-  if (fraction * set->stableCheap >= h) return h;  // the exact bound, never below the cheap one, cannot bind
+long pd_contact_set_exact_formed(const pdContactSet* set) { return set->exactFormed; }
+
+double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction,
+                                 bool* exactNeeded) {
+  *exactNeeded = fraction * set->stableCheap < h;
+  if (!*exactNeeded) return h;  // the exact bound, never below the cheap one, cannot bind
   if (!set->stableKnown) {
     set->stableStep = stable_step_exact(model, set);
     set->stableKnown = true;
