@@ -33,6 +33,10 @@
 // along it broke a flush stack's bitwise symmetry (README, "Contact onsets").
 #include "contact_set.h"
 
+#ifdef PD_SELF_CHECKS
+#include <gsl/gsl_eigen.h>
+#endif
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -76,15 +80,16 @@
 // the period (the stability bound), and every halving throws away a whole trial step.
 #define PD_REFINE_PERIOD_FRACTION 0.05
 // Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can
-// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (stable_step_exact). Classic
+// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (stability_prepare). Classic
 // RK4 is stable to |hλ| ≈ 2.8 along both the negative real and the imaginary axis; 2.5 leaves a margin
 // for what the bound does not see (contacts coupled through a fixed body's neighbours count none). Without
 // the bound the error control walks the step up to the stability edge, where round-off grows until a
 // step is rejected: a block at rest then jitters at the tolerance (µm/s) instead of round-off.
 #define PD_STABLE_STEP_OMEGA 2.5
-// Relative margin on the cheap stability bound (stability_prepare) against the rounding of the sums it
-// bounds, which are exact to ~1e-15: the cheap step must never exceed the exact one as computed.
-#define PD_STABLE_CHEAP_MARGIN 1e-9
+// Relative margin on the stability bounds (stability_prepare, stability_tight) against the rounding of their
+// sums (~1e-15 relative): where a Gershgorin bound is exact (a single contact), rounding must not take it below
+// ω_max².
+#define PD_STABLE_MARGIN 1e-9
 // Tunnelling guard: over one step, two bodies whose swept boxes overlap may move relative to each other by
 // at most this fraction of the thinner one's width. A quarter keeps a vertex that crossed a face within
 // the first half of the body, so the face it crossed is still the nearest one and the contact is found
@@ -144,17 +149,28 @@ typedef struct candidate {
   int inherit;        // index in C0 of the contact whose springs it carries (face continuity), or -1
 } candidate;
 
-// Contact i's share in the coupling of the contacts' spring displacements through the bodies: with
-// K_i^½ = √k_t I + (√k_n − √k_t) n nᵀ (series constants; k_t = 0 without friction) and, for each moving
-// body B of the contact, r = p_i − x_B, the symmetric matrix M = K^½ A K^½ has blocks
-//   M_ij = Σ_B σ_i σ_j (K_i^½ K_j^½ / m_B + (K_i^½ [r_i]ₓᵀ)(W_B [r_j]ₓ K_j^½)),   W_B = R I⁻¹ Rᵀ,
-// σ = +1 on body1, −1 on body2; its largest eigenvalue is ω_max² of the undamped contact modes.
+// Contact i's share in the stiffness of the undamped contact modes. With K_i^½ = √k_t I + (√k_n − √k_t) n nᵀ
+// (series constants; k_t = 0 without friction or while sliding) and, for each moving body B of the contact,
+// r = p_i − x_B, the contacts' relative velocities are J q̇ (J_iB = σ [I, −[r]ₓ], σ = +1 on body1, −1 on body2)
+// and ω_max² is the largest eigenvalue both of M = K^½ J 𝕄⁻¹ Jᵀ K^½ (contact space, blocks
+//   M_ij = Σ_B σ_i σ_j (K_i^½ K_j^½ / m_B + (K_i^½ [r_i]ₓᵀ)(W_B [r_j]ₓ K_j^½)),   W_B = R I⁻¹ Rᵀ)
+// and of S = 𝕄^-½ Jᵀ K J 𝕄^-½ (body space: 6 × 6 blocks per body and per touching pair), which share their
+// nonzero eigenvalues.
 typedef struct stabilityTerms {
   pdMat3 k;             // K_i^½
   pdMat3 left[2], right[2];  // K^½ [r]ₓᵀ and W [r]ₓ K^½ per body (body1, body2)
-  double overdamp;      // ζ + √(ζ² − 1) for the most over-damped direction (1 when ζ ≤ 1)
-  double rowsMax;       // stable_step_exact's largest Gershgorin row sum of this contact's rows
+  pdVec3 arm[2];             // r = p_i − x_B per body (body1, body2)
+  double overdamp;           // ζ + √(ζ² − 1) for the most over-damped direction (1 when ζ ≤ 1)
 } stabilityTerms;
+
+// A moving body's block of the body-space bound (stability_tight): 𝕄^-½ (1/√m and W^½ = R P diag(I_k^-½) (R P)ᵀ
+// at the list's poses, P the principal axes), the diagonal block S_BB being summed, and the absolute row sums.
+typedef struct bodySpaceBlock {
+  double invSqrtMass;
+  pdMat3 invSqrtInertia;
+  double diagonal[6][6];
+  double rows[6];
+} bodySpaceBlock;
 
 struct pdContactSet {
   int count, capacity;
@@ -181,15 +197,17 @@ struct pdContactSet {
   pdVec3 *force, *torque;  // (movingCount) contact force and moment on each moving body, world
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
   int onsetRetries;        // onset retries of the step under way
-  // stability bound (stability_prepare, stable_step_exact), sized with the list
+  // stability bound (stability_prepare, stability_tight), sized with the list
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])
   int* bodyList;           // (2 capacity)
   bool bodyListValid;      // bodyFirst/bodyList list the current contacts (stability_prepare; install clears it)
   double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
-  double stableCheap;      // s: a step never above stableStep, from the cheap bound (stability_prepare)
+  double stableCheap;      // s: the step of the cheap bound alone, never above stableStep (stability_prepare)
+  double cheapOmega2;      // the cheap bound's ω_max², its rounding margin included
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
-  long exactFormed;        // stable_step_exact calls (pd_contact_set_exact_formed)
+  long tightFormed;        // stability_tight calls (pd_contact_set_tight_formed)
+  bodySpaceBlock* bodyBlocks;  // (bodyCount) stability_tight's
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
@@ -241,6 +259,7 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   set->stableStep = set->stableCheap = INFINITY;
   set->stableKnown = true;
   set->bodyRowsK = grow(NULL, n, sizeof *set->bodyRowsK);
+  set->bodyBlocks = grow(NULL, n, sizeof *set->bodyBlocks);
   set->bodyRowsRight = grow(NULL, n, sizeof *set->bodyRowsRight);
   set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
   PD_ASSERT(set->travel != NULL);
@@ -292,6 +311,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->bodyFirst);
   free(set->bodyList);
   free(set->bodyRowsK);
+  free(set->bodyBlocks);
   free(set->bodyRowsRight);
   free(set->invInertiaWorld);
   free(set->travel);
@@ -650,25 +670,172 @@ static double step_of(double omega2, double overdamp) {
   return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
 }
 
-// The stability bound in two parts. stability_prepare (after every new list, O(contacts)) forms each
-// contact's terms, the per-body contact lists, and a cheap bound: by |Σ_j (A B_j)_rq| ≤ Σ_p |A_rp| |(B_j)_pq|,
-// row r of contact i's Gershgorin sum in stable_step_exact is at most Σ over its moving ends B of
-// Σ_p |(K_i^½)_rp| w_p / m_B + Σ_p |(K_i^½ [r_i]ₓᵀ)_rp| u_p, where w_p and u_p are the row-p absolute sums of
-// K_j^½ and of W_B [r_j]ₓ K_j^½ summed over B's contacts j; so its step (stableCheap) never exceeds the
-// exact one. The exact bound, O(contacts × contacts per body), is computed
-// only when the step the stepper wants exceeds the cheap one (pd_contact_set_limit_step): a resting stack
-// whose error control keeps the step below the bound then never pays for it, and the step taken is the
-// same bit for bit as with the exact bound computed every time.
-static double stable_step_exact(const pdModel* model, pdContactSet* set);
+// The stability bound in two parts, both Gershgorin bounds on ω_max² (never below it; README, Integration).
+// stability_prepare (after every new list, O(contacts)) forms each contact's terms and a cheap bound of the
+// contact-space matrix M above: by |Σ_j (A B_j)_rq| ≤ Σ_p |A_rp| |(B_j)_pq|, row r of contact i's Gershgorin sum
+// is at most Σ over its moving ends B of Σ_p |(K_i^½)_rp| w_p / m_B + Σ_p |(K_i^½ [r_i]ₓᵀ)_rp| u_p, where w_p
+// and u_p are the row-p absolute sums of K_j^½ and of W_B [r_j]ₓ K_j^½ summed over B's contacts j. Only when the
+// step the stepper wants exceeds the cheap bound's (pd_contact_set_limit_step) is the tight one formed
+// (stability_tight): the Gershgorin bound of the body-space matrix S, also O(contacts), and the bound is the
+// smaller of the two. On a stack of boxes S's rows are far tighter than M's (a box's 16 contacts couple with each
+// other in M, its 6 coordinates in S): on cases/bench/stack_20.scene ω_max² came out at 0.55–0.71 of M's exact
+// Gershgorin bound (which was O(contacts × contacts per body); the true ω_max² 0.46–0.62 of it), so its steps
+// are 1.2–1.35× longer. S's bound alone can be looser than M's (a box on an edge or a corner, its rows summing
+// translation and rotation: up to 1.75× M's exact bound on cases/sweep/pile_10.scene), hence the minimum.
+
+// Accumulates Gᵀ H into out (6 × 6) for G, H = [T | R] (3 × 6 each, given as their two 3 × 3 halves).
+static void add_gram(const pdMat3* gT, const pdMat3* gR, const pdMat3* hT, const pdMat3* hR, double out[6][6]) {
+  const pdMat3* g[2] = {gT, gR};
+  const pdMat3* h[2] = {hT, hR};
+  for (int a = 0; a < 6; ++a)
+    for (int b = 0; b < 6; ++b) {
+      const pdMat3 *ga = g[a / 3], *hb = h[b / 3];
+      int ca = a % 3, cb = b % 3;
+      out[a][b] += ga->m[0][ca] * hb->m[0][cb] + ga->m[1][ca] * hb->m[1][cb] + ga->m[2][ca] * hb->m[2][cb];
+    }
+}
+
+// Contact i's G = K^½ J_iB 𝕄_B^-½ on its end e (body B): T = σ K^½ / √m_B, R = −σ K^½ [r]ₓ W_B^½.
+static void contact_gram_factor(const stabilityTerms* t, int e, const bodySpaceBlock* b, pdMat3* T, pdMat3* R) {
+  double sigma = e == 0 ? 1.0 : -1.0;
+  pdMat3 rx = cross_matrix(t->arm[e]);
+  pdMat3 krx = pd_mat3_mul(&t->k, &rx);
+  pdMat3 krxw = pd_mat3_mul(&krx, &b->invSqrtInertia);
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) {
+      T->m[r][q] = sigma * b->invSqrtMass * t->k.m[r][q];
+      R->m[r][q] = -sigma * krxw.m[r][q];
+    }
+}
+
+// The tight bound: the largest absolute row sum of S, over the blocks of every moving body with contacts and of
+// every touching pair (the list is sorted by pair, so a pair's contacts are one run). ω_max², no margin.
+static double stability_tight(const pdModel* model, pdContactSet* set) {
+  ++set->tightFormed;
+  for (int k = 0; k < model->bodyCount; ++k) {
+    if (model->bodies[k].fixed || set->bodyFirst[k] == set->bodyFirst[k + 1]) continue;
+    bodySpaceBlock* b = &set->bodyBlocks[k];
+    memset(b->diagonal, 0, sizeof b->diagonal);
+    memset(b->rows, 0, sizeof b->rows);
+  }
+  for (int first = 0, last; first < set->count; first = last) {
+    const pdContactId* id0 = &set->items[first].id;
+    int lo = id0->body1 < id0->body2 ? id0->body1 : id0->body2, hi = id0->body1 < id0->body2 ? id0->body2 : id0->body1;
+    last = first + 1;
+    while (last < set->count && compare_to_pair(&set->items[last].id, lo, hi) == 0) ++last;
+    bool both = !model->bodies[lo].fixed && !model->bodies[hi].fixed;
+    double pair[6][6] = {{0}};  // S_lo,hi
+    for (int i = first; i < last; ++i) {
+      const stabilityTerms* t = &set->stability[i];
+      const pdContactId* id = &set->items[i].id;
+      pdMat3 T[2], R[2];
+      int ends[2] = {id->body1, id->body2};
+      for (int e = 0; e < 2; ++e) {
+        if (model->bodies[ends[e]].fixed) continue;
+        bodySpaceBlock* b = &set->bodyBlocks[ends[e]];
+        contact_gram_factor(t, e, b, &T[e], &R[e]);
+        add_gram(&T[e], &R[e], &T[e], &R[e], b->diagonal);
+      }
+      if (both) {
+        int eLo = id->body1 == lo ? 0 : 1;
+        add_gram(&T[eLo], &R[eLo], &T[1 - eLo], &R[1 - eLo], pair);
+      }
+    }
+    if (!both) continue;
+    // S_hi,lo = S_lo,hiᵀ: lo's rows take the pair block's row sums, hi's its column sums
+    bodySpaceBlock *bLo = &set->bodyBlocks[lo], *bHi = &set->bodyBlocks[hi];
+    for (int a = 0; a < 6; ++a)
+      for (int q = 0; q < 6; ++q) {
+        bLo->rows[a] += fabs(pair[a][q]);
+        bHi->rows[q] += fabs(pair[a][q]);
+      }
+  }
+  double omega2 = 0.0;
+  for (int k = 0; k < model->bodyCount; ++k) {
+    if (model->bodies[k].fixed || set->bodyFirst[k] == set->bodyFirst[k + 1]) continue;
+    bodySpaceBlock* b = &set->bodyBlocks[k];
+    for (int a = 0; a < 6; ++a) {
+      double row = b->rows[a];
+      for (int q = 0; q < 6; ++q) row += fabs(b->diagonal[a][q]);
+      omega2 = fmax(omega2, row);
+    }
+  }
+  return omega2;
+}
+
+// 𝕄^-½ of every moving body with contacts at `poses` (stability_tight reads it).
+static void body_space_scales(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+  for (int k = 0; k < model->bodyCount; ++k) {
+    const pdBody* body = &model->bodies[k];
+    if (body->fixed || set->bodyFirst[k] == set->bodyFirst[k + 1]) continue;
+    bodySpaceBlock* b = &set->bodyBlocks[k];
+    b->invSqrtMass = sqrt(body->invMass);
+    pdMat3 q = pd_mat3_mul(&poses[k].R, &body->principalAxes);  // principal axes in the world
+    pdMat3 qd = q;
+    for (int c = 0; c < 3; ++c) {
+      double s = 1.0 / sqrt(body->principal[c]);
+      for (int r = 0; r < 3; ++r) qd.m[r][c] *= s;
+    }
+    pdMat3 qt = pd_mat3_transpose(&q);
+    b->invSqrtInertia = pd_mat3_mul(&qd, &qt);
+  }
+}
+
+#ifdef PD_SELF_CHECKS
+// Lists of at most this many contacts are checked (a dense eigenproblem of 3 × this size per list).
+#define PD_STABILITY_CHECK_CONTACTS_MAX 32
+// The self-check of the sanitizer and Debug builds: both bounds against ω_max², the largest eigenvalue (GSL) of
+// the contact-space matrix M assembled from its own formula (the terms left and right), not from S.
+static void stability_self_check(const pdModel* model, pdContactSet* set) {
+  int c = set->count, n = 3 * c;
+  if (c > PD_STABILITY_CHECK_CONTACTS_MAX) return;
+  gsl_matrix* m = gsl_matrix_calloc((size_t)n, (size_t)n);
+  PD_ASSERT(m != NULL);
+  for (int i = 0; i < c; ++i)
+    for (int j = 0; j < c; ++j) {
+      const pdContactId *a = &set->items[i].id, *b = &set->items[j].id;
+      const stabilityTerms *ti = &set->stability[i], *tj = &set->stability[j];
+      int endsA[2] = {a->body1, a->body2}, endsB[2] = {b->body1, b->body2};
+      for (int ea = 0; ea < 2; ++ea)
+        for (int eb = 0; eb < 2; ++eb) {
+          const pdBody* body = &model->bodies[endsA[ea]];
+          if (endsA[ea] != endsB[eb] || body->fixed) continue;
+          double sign = (ea == eb) ? 1.0 : -1.0;
+          pdMat3 kk = pd_mat3_mul(&ti->k, &tj->k), rot = pd_mat3_mul(&ti->left[ea], &tj->right[eb]);
+          for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q) {
+              double v = sign * (kk.m[r][q] * body->invMass + rot.m[r][q]);
+              *gsl_matrix_ptr(m, (size_t)(3 * i + r), (size_t)(3 * j + q)) += 0.5 * v;
+              *gsl_matrix_ptr(m, (size_t)(3 * j + q), (size_t)(3 * i + r)) += 0.5 * v;
+            }
+        }
+    }
+  gsl_vector* eigenvalues = gsl_vector_alloc((size_t)n);
+  gsl_eigen_symm_workspace* w = gsl_eigen_symm_alloc((size_t)n);
+  PD_ASSERT(eigenvalues != NULL && w != NULL);
+  gsl_eigen_symm(m, eigenvalues, w);
+  double omega2 = gsl_vector_max(eigenvalues);
+  gsl_eigen_symm_free(w);
+  gsl_vector_free(eigenvalues);
+  gsl_matrix_free(m);
+  // the eigenvalue is exact to ~1e-15 of the largest entry; the bounds carry PD_STABLE_MARGIN
+  double tight2 = stability_tight(model, set) * (1.0 + PD_STABLE_MARGIN);
+  --set->tightFormed;  // a check, not the step's work
+  PD_ASSERT(set->cheapOmega2 >= omega2 * (1.0 - 1e-12));
+  PD_ASSERT(tight2 >= omega2 * (1.0 - 1e-12));
+}
+#endif
 
 static void stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses) {
   set->stableKnown = false;
   if (set->count == 0) {
     set->stableStep = set->stableCheap = INFINITY;
+    set->cheapOmega2 = 0.0;
     set->stableKnown = true;
     return;
   }
   list_bodies(model, set);
+  body_space_scales(model, set, poses);
   int bodies = model->bodyCount;
   for (int k = 0; k < bodies; ++k) set->bodyRowsK[k] = set->bodyRowsRight[k] = (pdVec3){0, 0, 0};
   for (int i = 0; i < set->count; ++i) {
@@ -688,7 +855,8 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
     for (int e = 0; e < 2; ++e) {
       const pdBody* b = &model->bodies[ends[e]];
       if (b->fixed) continue;
-      pdMat3 rx = cross_matrix(pd_v3_sub(c->point, poses[ends[e]].x));
+      t->arm[e] = pd_v3_sub(c->point, poses[ends[e]].x);
+      pdMat3 rx = cross_matrix(t->arm[e]);
       pdMat3 rxT = pd_mat3_transpose(&rx);
       t->left[e] = pd_mat3_mul(&t->k, &rxT);
       pdMat3 wrx = pd_mat3_mul(&set->invInertiaWorld[ends[e]], &rx);
@@ -697,8 +865,7 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
       set->bodyRowsRight[ends[e]] = pd_v3_add(set->bodyRowsRight[ends[e]], row_abs_sums(&t->right[e]));
     }
   }
-  // the cheap bound; its margin covers the rounding of both sums (~1e-15 relative), so that it stays above
-  // the exact one as computed
+  // the cheap bound
   double cheap2 = 0.0;
   set->overdamp = 1.0;
   for (int i = 0; i < set->count; ++i) {
@@ -714,81 +881,22 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
     }
     cheap2 = fmax(cheap2, fmax(rows[0], fmax(rows[1], rows[2])));
   }
-  set->stableCheap = step_of(cheap2 * (1.0 + PD_STABLE_CHEAP_MARGIN), set->overdamp);
+  set->cheapOmega2 = cheap2 * (1.0 + PD_STABLE_MARGIN);
+  set->stableCheap = step_of(set->cheapOmega2, set->overdamp);
 #ifdef PD_SELF_CHECKS
-  // The sanitizer build (every test) and Debug builds check the inequality the laziness rests on, every list.
-  // Not NDEBUG: asserts stay on in every build (CMakeLists.txt), and so did this check in Release until
-  // PD_SELF_CHECKS, which formed the exact bound for every list and left the laziness without effect.
-  set->stableStep = stable_step_exact(model, set);
-  set->stableKnown = true;
-  PD_ASSERT(set->stableCheap <= set->stableStep);
+  stability_self_check(model, set);
 #endif
 }
 
-// The exact Gershgorin bound: the largest step h with h ω_max ≤ PD_STABLE_STEP_OMEGA, ω_max bounded by the
-// Gershgorin row sums of M (above) over every contact sharing a moving body, times the over-damping factor
-// of damped modes whose fast root exceeds ω. A Gershgorin sum is never below the true eigenvalue, and for a
-// cube resting on a face it is within 15 % of it (8 k/m against the rocking mode's 6 k/m). Needs the terms
-// of stability_prepare for the current list.
-// The Gershgorin rows of contacts [begin, end) (stabilityTerms.rowsMax).
-static void gershgorin_range(void* ctx, int part, int begin, int end) {
-  (void)part;
-  const contactLoop* job = ctx;
-  const pdModel* model = job->model;
-  pdContactSet* set = job->set;
-  for (int i = begin; i < end; ++i) {
-    const contactSlot* c = &set->items[i];
-    stabilityTerms* ti = &set->stability[i];
-    double rows[3] = {0, 0, 0};
-    int ends[2] = {c->id.body1, c->id.body2};
-    int lo = ends[0] < ends[1] ? ends[0] : ends[1], hi = ends[0] < ends[1] ? ends[1] : ends[0];
-    int firstMoving = model->bodies[ends[0]].fixed ? 1 : 0;
-    for (int e = 0; e < 2; ++e) {
-      if (model->bodies[ends[e]].fixed) continue;
-      for (int l = set->bodyFirst[ends[e]]; l < set->bodyFirst[ends[e] + 1]; ++l) {
-        int j = set->bodyList[l] / 2, ej = set->bodyList[l] % 2;
-        const contactSlot* cj = &set->items[j];
-        const stabilityTerms* tj = &set->stability[j];
-        // a contact of the same pair couples through both bodies: its block is summed over them before
-        // the absolute value, once (from the first moving end); any other through body ends[e] alone
-        bool samePair = compare_to_pair(&cj->id, lo, hi) == 0;
-        if (samePair && e != firstMoving) continue;
-        pdMat3 kk = pd_mat3_mul(&ti->k, &tj->k);
-        pdMat3 m = {{{0}}};
-        for (int endI = 0; endI < 2; ++endI) {
-          if (!samePair && endI != e) continue;
-          const pdBody* body = &model->bodies[ends[endI]];
-          if (body->fixed) continue;
-          int endJ = samePair ? (cj->id.body1 == ends[endI] ? 0 : 1) : ej;
-          double sign = (endI == endJ) ? 1.0 : -1.0;
-          pdMat3 rot = pd_mat3_mul(&ti->left[endI], &tj->right[endJ]);
-          for (int r = 0; r < 3; ++r)
-            for (int q = 0; q < 3; ++q) m.m[r][q] += sign * (kk.m[r][q] * body->invMass + rot.m[r][q]);
-        }
-        for (int r = 0; r < 3; ++r) rows[r] += row_abs_sum(&m, r);
-      }
-    }
-    ti->rowsMax = fmax(rows[0], fmax(rows[1], rows[2]));
-  }
-}
-
-static double stable_step_exact(const pdModel* model, pdContactSet* set) {
-  ++set->exactFormed;
-  contactLoop job = {.model = model, .set = set};
-  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, gershgorin_range, &job);
-  double omega2 = 0.0;
-  for (int i = 0; i < set->count; ++i) omega2 = fmax(omega2, set->stability[i].rowsMax);
-  return step_of(omega2, set->overdamp);
-}
-
-long pd_contact_set_exact_formed(const pdContactSet* set) { return set->exactFormed; }
+long pd_contact_set_tight_formed(const pdContactSet* set) { return set->tightFormed; }
 
 double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction,
-                                 bool* exactNeeded) {
-  *exactNeeded = fraction * set->stableCheap < h;
-  if (!*exactNeeded) return h;  // the exact bound, never below the cheap one, cannot bind
+                                 bool* tightNeeded) {
+  *tightNeeded = fraction * set->stableCheap < h;
+  if (!*tightNeeded) return h;  // the bound, never below the cheap one's step, cannot bind
   if (!set->stableKnown) {
-    set->stableStep = stable_step_exact(model, set);
+    double tight2 = stability_tight(model, set) * (1.0 + PD_STABLE_MARGIN);
+    set->stableStep = step_of(fmin(set->cheapOmega2, tight2), set->overdamp);
     set->stableKnown = true;
   }
   return fmin(h, fraction * set->stableStep);

@@ -2,13 +2,12 @@
 //
 // With pdState.threads > 1 the islands of a sync interval are taken in turn by the pool's threads
 // (islands.c). A thread left without an island while another still runs serves the help desk instead of
-// sleeping: the running island's long loops (over its contacts: forces, tracking, recording, the stability
-// rows; over its pairs: interference and contact search; over its bodies: poses, force sums, Newton–Euler; over
-// its state: RK4's updates) post their second half there, and the server runs it while the island's own thread
-// runs the first. Every index is computed by the same function from the same inputs whichever thread runs it,
-// each writes only its own index's outputs, and whatever combines them (merges, maxima) runs afterwards on the
-// island's thread in index order: results are the same bit for bit with or without help, on any number of
-// threads.
+// sleeping: the running island's long loops (over its contacts: forces, tracking, recording; over its pairs:
+// interference and contact search; over its bodies: poses, force sums, Newton–Euler; over its state: RK4's updates)
+// post their second half there, and the server runs it while the island's own thread runs the first. Every index is
+// computed by the same function from the same inputs whichever thread runs it, each writes only its own index's
+// outputs, and whatever combines them (merges, maxima) runs afterwards on the island's thread in index order: results
+// are the same bit for bit with or without help, on any number of threads.
 #pragma once
 
 #include <pthread.h>

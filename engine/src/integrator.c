@@ -264,9 +264,9 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       s->h = fmin(set->dtmax, fmax(set->dtmin, grow * h));
     }
     // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge
-    bool exactNeeded;
-    s->h = fmax(set->dtmin, pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction, &exactNeeded));
-    s->count.stabilityExact += exactNeeded;
+    bool tightNeeded;
+    s->h = fmax(set->dtmin, pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction, &tightNeeded));
+    s->count.stabilityTight += tightNeeded;
     return h;
   }
 }

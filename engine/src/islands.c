@@ -446,7 +446,7 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->onsetsInterpolated += c->onsetsInterpolated;
   to->travelRetries += c->travelRetries;
   to->refinements += c->refinements;
-  to->stabilityExact += c->stabilityExact;
+  to->stabilityTight += c->stabilityTight;
   to->contactsMade += c->contactsMade;
   to->contactsVirtual += c->contactsVirtual;
   to->contactsTransferred += c->contactsTransferred;

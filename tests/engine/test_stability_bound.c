@@ -1,14 +1,15 @@
-// The contacts' stability bound (README, Integration; engine/src/contact_set.c): the exact Gershgorin bound,
-// O(contacts × contacts per body), is formed only for a step that the cheap O(contacts) bound does not settle
-// (the step the error control wants is longer than the cheap bound allows), and summary.json's `stability_exact`
-// counts those steps. Two scenes with a 0.1 m cube on a fixed floor, islands off (one contact set for the run,
-// whose work counter the tests read):
-// - resting: the error control wants long steps and the bound sets them, so most steps need the exact bound;
+// The contacts' stability bound (README, Integration; engine/src/contact_set.c): the smaller of a cheap Gershgorin
+// bound of the contact-space matrix and a tight one of the body-space matrix. The tight bound is formed only for
+// a step that the cheap one does not settle (the step the error control wants is longer than the cheap bound
+// allows), and summary.json's `stability_tight` counts those steps. Two scenes with a 0.1 m cube on a fixed floor,
+// islands off (one contact set for the run, whose work counter the tests read):
+// - resting: the error control wants long steps and the bound sets them, so most steps need the tight bound;
 // - dropped tilted with restitution 0.8: in flight there is no contact and during the bounces the error control
 //   keeps the steps short, so few steps need it.
-// In both the exact bound is formed at most once per step that needs it, and under PD_SELF_CHECKS (the sanitizer
-// build) for every contact list. Until ced591b it was formed for every contact list in every build (the check
-// was under #ifndef NDEBUG, which no build defines): these tests would have failed.
+// In both the tight bound is formed at most once per step that needs it. (Until ced591b the bound the cheap one
+// stood for was formed for every contact list in every build, by a check under #ifndef NDEBUG, which no build
+// defines: these tests would have failed.) The sanitizer build's self-check (PD_SELF_CHECKS) compares both bounds
+// with the largest eigenvalue of the contact-space matrix on every list of up to 32 contacts, in every test.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -34,37 +35,28 @@ static pdModel* cube_on_floor(const char* placement) {
   return compile_text(text);
 }
 
-// Runs m with islands off; returns the final state and the exact bounds formed in *formed.
+// Runs m with islands off; returns the final state and the tight bounds formed in *formed.
 static pdState* run_counting(const pdModel* m, long* formed) {
   pdState* s = NULL;
   free(run_onsets_islands(m, pd_onsetsExact, pd_islandsOff, &s));
-  *formed = pd_contact_set_exact_formed(s->contacts);
-  print_message("%ld accepted steps, %ld needed the exact bound, formed %ld times\n", s->count.accepted,
-                s->count.stabilityExact, *formed);
-  assert_true(s->count.stabilityExact <= s->count.accepted);
+  *formed = pd_contact_set_tight_formed(s->contacts);
+  print_message("%ld accepted steps, %ld needed the tight bound, formed %ld times\n", s->count.accepted,
+                s->count.stabilityTight, *formed);
+  assert_true(s->count.stabilityTight <= s->count.accepted);
   return s;
 }
 
-// At most once per step that needs it; under the self-checks, for every contact list (every step here).
-static void check_formed(const pdState* s, long formed) {
-#ifdef PD_SELF_CHECKS
-  (void)s;
-  assert_true(formed > 0);
-#else
-  assert_true(formed <= s->count.stabilityExact);
-#endif
-}
+// At most once per step that needs it (once per contact list at most).
+static void check_formed(const pdState* s, long formed) { assert_true(formed <= s->count.stabilityTight); }
 
-static void test_a_resting_cube_needs_the_exact_bound_on_most_steps(void** state) {
+static void test_a_resting_cube_needs_the_tight_bound_on_most_steps(void** state) {
   (void)state;
   pdModel* m = cube_on_floor("loc 0 0 0.05");
   long formed;
   pdState* s = run_counting(m, &formed);
   assert_true(pd_state_contact_count(s) == 4);
-  assert_true(s->count.stabilityExact > s->count.accepted / 2);
-#ifdef PD_SELF_CHECKS
-  assert_true(formed >= s->count.accepted);
-#endif
+  assert_true(s->count.stabilityTight > s->count.accepted / 2);
+  assert_true(formed > 0);
   check_formed(s, formed);
   pd_state_free(s);
   pd_model_free(m);
@@ -76,7 +68,7 @@ static void test_a_bouncing_cube_needs_it_on_few_steps(void** state) {
   long formed;
   pdState* s = run_counting(m, &formed);
   assert_true(s->count.contactsMade > 0);
-  assert_true(s->count.stabilityExact < s->count.accepted / 2);
+  assert_true(s->count.stabilityTight < s->count.accepted / 2);
   check_formed(s, formed);
   pd_state_free(s);
   pd_model_free(m);
@@ -84,7 +76,7 @@ static void test_a_bouncing_cube_needs_it_on_few_steps(void** state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_a_resting_cube_needs_the_exact_bound_on_most_steps),
+      cmocka_unit_test(test_a_resting_cube_needs_the_tight_bound_on_most_steps),
       cmocka_unit_test(test_a_bouncing_cube_needs_it_on_few_steps),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -119,7 +119,7 @@ typedef struct pdCounters {
   long onsetsInterpolated;  // contacts that joined at a step's end from an onset inside it (pd_onsetsPair)
   long travelRetries;     // trial steps cut short because two bodies that may meet moved too far (tunnelling)
   long refinements;       // trial steps halved around a reversal or a stick/slip change (§3.4)
-  long stabilityExact;    // accepted steps whose limit needed the exact stability bound: the cheap bound allowed
+  long stabilityTight;    // accepted steps whose limit needed the tight stability bound: the cheap bound allowed
                           // less than the step the error control wanted (README, Integration)
   long contactsMade;      // contacts added at the end of a step (found, approaching)
   long contactsVirtual;   // contacts added at the start of a step (onset within the first dt_min)
