@@ -208,6 +208,7 @@ struct pdContactSet {
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
   long tightFormed;        // stability_tight calls (pd_contact_set_tight_formed)
   bodySpaceBlock* bodyBlocks;  // (bodyCount) stability_tight's
+  const pdPose* stablePoses;   // the poses of the list's stability_prepare (unchanged until the step's limit)
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
@@ -710,8 +711,11 @@ static void contact_gram_factor(const stabilityTerms* t, int e, const bodySpaceB
 
 // The tight bound: the largest absolute row sum of S, over the blocks of every moving body with contacts and of
 // every touching pair (the list is sorted by pair, so a pair's contacts are one run). ω_max², no margin.
+static void body_space_scales(const pdModel* model, pdContactSet* set, const pdPose* poses);
+
 static double stability_tight(const pdModel* model, pdContactSet* set) {
   ++set->tightFormed;
+  body_space_scales(model, set, set->stablePoses);
   for (int k = 0; k < model->bodyCount; ++k) {
     if (model->bodies[k].fixed || set->bodyFirst[k] == set->bodyFirst[k + 1]) continue;
     bodySpaceBlock* b = &set->bodyBlocks[k];
@@ -835,7 +839,7 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
     return;
   }
   list_bodies(model, set);
-  body_space_scales(model, set, poses);
+  set->stablePoses = poses;
   int bodies = model->bodyCount;
   for (int k = 0; k < bodies; ++k) set->bodyRowsK[k] = set->bodyRowsRight[k] = (pdVec3){0, 0, 0};
   for (int i = 0; i < set->count; ++i) {
