@@ -10,6 +10,7 @@
 // stood for was formed for every contact list in every build, by a check under #ifndef NDEBUG, which no build
 // defines: these tests would have failed.) The sanitizer build's self-check (PD_SELF_CHECKS) compares both bounds
 // with the largest eigenvalue of the contact-space matrix on every list of up to 32 contacts, in every test.
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -20,6 +21,8 @@
 #include <cmocka.h>
 
 #include "contact_set.h"
+#include "material.h"
+#include "model_contact.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
@@ -74,10 +77,42 @@ static void test_a_bouncing_cube_needs_it_on_few_steps(void** state) {
   pd_model_free(m);
 }
 
+// A frictionless 0.1 m cube (1 kg) resting on a face: its four corner contacts have stiffness only along the
+// vertical, so its modes are the bounce, ω² = 4 k/m, and the rocking about either horizontal axis,
+// ω² = 4 k (a/2)² / I = 6 k/m with I = m a²/6; k the pair's series normal stiffness. The body-space bound is exact
+// here (its off-diagonal terms cancel by symmetry), where the contact-space Gershgorin bound gave 8 k/m
+// (README, Integration): the step it allows is 2 × 2.5 / ω_max for the rocking mode, to the bound's margin.
+#define CUBE_ROCKING_REL_TOL 1e-6  // the corners' lever arms are a/2 to the static deflection (~1e-5 of a)
+
+static void test_the_tight_bound_of_a_cube_resting_on_a_face_is_its_rocking_mode(void** state) {
+  (void)state;
+  pdModel* m = compile_text(
+      "tend 0.05\nsample 100\n"
+      "cube floor grey 1 1 0.2\nfixed\nloc 0 0 -0.1\nmu 0\n"
+      "cube block red 0.1 0.1 0.1\nloc 0 0 0.05\nmu 0\n");
+  pdState* s = NULL;
+  free(run_onsets_islands(m, pd_onsetsExact, pd_islandsOff, &s));
+  assert_int_equal(pd_state_contact_count(s), 4);
+  int block = body_index(m, "block"), floor = body_index(m, "floor");
+  pdContactParams p = pd_model_contact_params(m, block, floor);
+  double k = pd_series(p.k1n, p.k2n), mass = m->bodies[block].mass;
+  bool needed;
+  double step = pd_contact_set_limit_step(m, s->contacts, INFINITY, 1.0, &needed);
+  double omega2 = pow(2.0 * 2.5 / step, 2.0), rocking2 = 6.0 * k / mass;
+  print_message("k %.6g N/m, m %.6g kg: bound omega^2 %.9g, rocking 6 k/m %.9g (ratio %.9f)\n", k, mass, omega2,
+                rocking2, omega2 / rocking2);
+  assert_true(needed);
+  assert_true(omega2 >= rocking2 * (1.0 - CUBE_ROCKING_REL_TOL));
+  assert_true(omega2 <= rocking2 * (1.0 + CUBE_ROCKING_REL_TOL));
+  pd_state_free(s);
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_resting_cube_needs_the_tight_bound_on_most_steps),
       cmocka_unit_test(test_a_bouncing_cube_needs_it_on_few_steps),
+      cmocka_unit_test(test_the_tight_bound_of_a_cube_resting_on_a_face_is_its_rocking_mode),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
