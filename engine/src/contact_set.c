@@ -206,7 +206,7 @@ struct pdContactSet {
   double stableCheap;      // s: the step of the cheap bound alone, never above stableStep (stability_prepare)
   double cheapOmega2;      // the cheap bound's ω_max², its rounding margin included
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
-  long tightFormed;        // stability_tight calls (pd_contact_set_tight_formed)
+  long tightFormed;        // tight bounds formed for a step's limit (pd_contact_set_tight_formed)
   bodySpaceBlock* bodyBlocks;  // (bodyCount) stability_tight's
   const pdPose* stablePoses;   // the poses of the list's stability_prepare (unchanged until the step's limit)
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
@@ -711,17 +711,33 @@ static void contact_gram_factor(const stabilityTerms* t, int e, const bodySpaceB
 
 // The tight bound: the largest absolute row sum of S, over the blocks of every moving body with contacts and of
 // every touching pair (the list is sorted by pair, so a pair's contacts are one run). ω_max², no margin.
-static void body_space_scales(const pdModel* model, pdContactSet* set, const pdPose* poses);
+// Does moving body k have contacts in the list (a block of S)?
+static bool has_block(const pdModel* model, const pdContactSet* set, int k) {
+  return !model->bodies[k].fixed && set->bodyFirst[k] < set->bodyFirst[k + 1];
+}
 
-static double stability_tight(const pdModel* model, pdContactSet* set) {
-  ++set->tightFormed;
-  body_space_scales(model, set, set->stablePoses);
+// Each block's 𝕄^-½ at `poses`, its sums cleared.
+static void body_space_scales(const pdModel* model, pdContactSet* set, const pdPose* poses) {
   for (int k = 0; k < model->bodyCount; ++k) {
-    if (model->bodies[k].fixed || set->bodyFirst[k] == set->bodyFirst[k + 1]) continue;
+    if (!has_block(model, set, k)) continue;
+    const pdBody* body = &model->bodies[k];
     bodySpaceBlock* b = &set->bodyBlocks[k];
+    b->invSqrtMass = sqrt(body->invMass);
+    pdMat3 q = pd_mat3_mul(&poses[k].R, &body->principalAxes);  // principal axes in the world
+    pdMat3 qd = q;
+    for (int c = 0; c < 3; ++c) {
+      double s = 1.0 / sqrt(body->principal[c]);
+      for (int r = 0; r < 3; ++r) qd.m[r][c] *= s;
+    }
+    pdMat3 qt = pd_mat3_transpose(&q);
+    b->invSqrtInertia = pd_mat3_mul(&qd, &qt);
     memset(b->diagonal, 0, sizeof b->diagonal);
     memset(b->rows, 0, sizeof b->rows);
   }
+}
+
+static double stability_tight(const pdModel* model, pdContactSet* set) {
+  body_space_scales(model, set, set->stablePoses);
   for (int first = 0, last; first < set->count; first = last) {
     const pdContactId* id0 = &set->items[first].id;
     int lo = id0->body1 < id0->body2 ? id0->body1 : id0->body2, hi = id0->body1 < id0->body2 ? id0->body2 : id0->body1;
@@ -756,8 +772,8 @@ static double stability_tight(const pdModel* model, pdContactSet* set) {
   }
   double omega2 = 0.0;
   for (int k = 0; k < model->bodyCount; ++k) {
-    if (model->bodies[k].fixed || set->bodyFirst[k] == set->bodyFirst[k + 1]) continue;
-    bodySpaceBlock* b = &set->bodyBlocks[k];
+    if (!has_block(model, set, k)) continue;
+    const bodySpaceBlock* b = &set->bodyBlocks[k];
     for (int a = 0; a < 6; ++a) {
       double row = b->rows[a];
       for (int q = 0; q < 6; ++q) row += fabs(b->diagonal[a][q]);
@@ -765,24 +781,6 @@ static double stability_tight(const pdModel* model, pdContactSet* set) {
     }
   }
   return omega2;
-}
-
-// 𝕄^-½ of every moving body with contacts at `poses` (stability_tight reads it).
-static void body_space_scales(const pdModel* model, pdContactSet* set, const pdPose* poses) {
-  for (int k = 0; k < model->bodyCount; ++k) {
-    const pdBody* body = &model->bodies[k];
-    if (body->fixed || set->bodyFirst[k] == set->bodyFirst[k + 1]) continue;
-    bodySpaceBlock* b = &set->bodyBlocks[k];
-    b->invSqrtMass = sqrt(body->invMass);
-    pdMat3 q = pd_mat3_mul(&poses[k].R, &body->principalAxes);  // principal axes in the world
-    pdMat3 qd = q;
-    for (int c = 0; c < 3; ++c) {
-      double s = 1.0 / sqrt(body->principal[c]);
-      for (int r = 0; r < 3; ++r) qd.m[r][c] *= s;
-    }
-    pdMat3 qt = pd_mat3_transpose(&q);
-    b->invSqrtInertia = pd_mat3_mul(&qd, &qt);
-  }
 }
 
 #ifdef PD_SELF_CHECKS
@@ -824,7 +822,6 @@ static void stability_self_check(const pdModel* model, pdContactSet* set) {
   gsl_matrix_free(m);
   // the eigenvalue is exact to ~1e-15 of the largest entry; the bounds carry PD_STABLE_MARGIN
   double tight2 = stability_tight(model, set) * (1.0 + PD_STABLE_MARGIN);
-  --set->tightFormed;  // a check, not the step's work
   PD_ASSERT(set->cheapOmega2 >= omega2 * (1.0 - 1e-12));
   PD_ASSERT(tight2 >= omega2 * (1.0 - 1e-12));
 }
@@ -899,6 +896,7 @@ double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double
   *tightNeeded = fraction * set->stableCheap < h;
   if (!*tightNeeded) return h;  // the bound, never below the cheap one's step, cannot bind
   if (!set->stableKnown) {
+    ++set->tightFormed;
     double tight2 = stability_tight(model, set) * (1.0 + PD_STABLE_MARGIN);
     set->stableStep = step_of(fmin(set->cheapOmega2, tight2), set->overdamp);
     set->stableKnown = true;
