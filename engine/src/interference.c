@@ -55,14 +55,20 @@
 //   size (the size of the culling bounds): (1) difference points whose hull (GJK's tetrahedron, fattened as
 //   EPA does when it is thin) holds the ball of radius m about the origin: then M holds it, the overlap along
 //   every axis is at least m, and every candidate axis as computed (off by at most ~1e-8 of the size, for the
-//   sliver edge pairs) overlaps, so the search would find no separating axis; (2) a direction d whose support
-//   point s of M has s·d < −m |d|: the bodies are apart by more than m along d, so M lies beyond one of its own
-//   face planes (one of the candidate axes) and the search would find a separating axis. Either way the
-//   verdict is the search's to the bit. GJK's own bookkeeping (which sub-simplex is kept, the next direction)
-//   only steers the search for a proof: a degenerate simplex, no progress or PD_GJK_ITERATIONS_MAX iterations
-//   hand the pair to the search, which then skips every axis that cannot separate: whose culling bound is above
-//   0, or (a face axis u) along which a support point p that GJK found gives −u·p above the margin (gjkTrail).
-//   GJK's support points come from vertex scans (support_vertex).
+//   sliver edge pairs) overlaps; (2) a direction d whose support point s of M has s·d < −m |d|: the bodies are
+//   apart by more than m along d, so M lies beyond one of its own face planes (one of the candidate axes) and
+//   the separating-axis search would find a separating axis. GJK's own bookkeeping (which sub-simplex is kept,
+//   the next direction) only steers the search for a proof. Where it finds none (no progress past its simplex,
+//   a degenerate simplex, PD_GJK_ITERATIONS_MAX iterations) the pair is called touching: GJK stops making
+//   progress only within ~m of M's boundary (at a gap of more than 1.001 m its support point already certifies
+//   the separation), so such a pair touches or is apart by about m at most. "Separated" is thus always the
+//   separating-axis search's verdict too (a proof, or the cached axis evaluated by the search's own helper),
+//   and "touching" may include pairs apart by up to ~m (1e-7 of the size): the contact search then runs the
+//   contact analysis on them, whose own depth tests (1e-12 of the size) find no contact where nothing
+//   penetrates. Until issue 16's last round the separating-axis search decided those pairs, exactly; they are
+//   about a fifth of the oracle's random pairs (drawn log-uniformly near touching) and took three quarters of
+//   the mode's time there, and in a simulation they are the rare steps that end within 1e-7 of the size of an
+//   onset. GJK's support points come from vertex scans (support_vertex).
 #include "interference.h"
 
 #include <math.h>
@@ -456,14 +462,9 @@ static void alive_edges(const pdPolyhedron* P, const edgeCull* c, double depth, 
   }
 }
 
-// GJK's iterations before the pair is handed to the search. Pairs GJK settles take a handful (a few more for
-// the geodesic spheres); past this many it is circling a boundary within rounding of the origin.
+// GJK's iterations before the pair is called touching. Pairs GJK settles take a handful (a few more for the
+// geodesic spheres); past this many it is circling a boundary within rounding of the origin.
 #define PD_GJK_ITERATIONS_MAX 40
-// The certificates' margin, relative to the pair's coordinate size (cull_bounds): 10 times the largest error
-// of a candidate axis's overlap as computed (~1e-8 of the size: the sliver edge pairs, PD_SAT_PARALLEL_TOL);
-// the oracle's pairs lie within a few % of touching, and a larger margin (the culling's 1e-5) left 18 % of them
-// within it, to the search.
-#define PD_GJK_MARGIN_REL 1e-7
 
 // The support point of M = B − A (A's frame) along d: B's vertex farthest along d less A's farthest along −d.
 static pdVec3 difference_support(const pdPolyhedron* A, const pdPolyhedron* B, const relPose* f, pdVec3 d) {
@@ -511,23 +512,11 @@ static int simplex_triangle(pdVec3* s, pdVec3 C, pdVec3 B, pdVec3 A, pdVec3* d) 
   return 3;
 }
 
+// What GJK's search for a certificate found (gjk_certificate).
+enum { gjkApart, gjkOverlap, gjkWithinMargin, gjkUndecided };
+
 // The points GJK may hold: the tetrahedron and the points added to fatten it (enclosed_certificate).
 #define PD_GJK_POINTS_MAX 8
-
-// Every support point of M that GJK found (design note): where GJK leaves the verdict to the search, an axis u
-// along which one of them gives −u·p above the margin overlaps by at least that (M holds p), so it cannot
-// separate and is skipped.
-#define PD_GJK_TRAIL_MAX (PD_GJK_ITERATIONS_MAX + PD_GJK_POINTS_MAX)
-typedef struct gjkTrail {
-  pdVec3 p[PD_GJK_TRAIL_MAX];
-  int n;
-} gjkTrail;
-
-static bool trail_keeps_overlapping(const gjkTrail* trail, pdVec3 u, double margin) {
-  for (int k = 0; k < trail->n; ++k)
-    if (-pd_v3_dot(u, trail->p[k]) > margin) return true;
-  return false;
-}
 
 // The depth of the origin inside the hull of p[0..n) (the origin inside it), m, and the outward unit normal and
 // offset of the face plane nearest to it. Every plane through three of the points with every point on its inner
@@ -560,21 +549,21 @@ static double hull_depth(const pdVec3* p, int n, double slack, pdVec3* normal, d
 // The origin lies inside GJK's tetrahedron s[0..4) (as computed). The certificate needs it deeper than the
 // margin: while it is not, the nearest face of the hull is pushed out to M's support point along its normal
 // (as EPA does), up to PD_GJK_POINTS_MAX points; when that face is M's own (the support does not pass it), the
-// origin is within the margin of M's boundary and the search decides. +1 (certified, b->depth the depth) or −1.
+// origin is within the margin of M's boundary (gjkWithinMargin).
 static int enclosed_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const relPose* f, double margin,
-                                pdVec3* s, best* b, gjkTrail* trail) {
+                                pdVec3* s, best* b) {
   double slack = 1e-6 * margin;
   for (int n = 4;; ++n) {
     pdVec3 normal = {0, 0, 0};
     double offset = 0.0, depth = hull_depth(s, n, slack, &normal, &offset);
     if (depth > margin) {
       *b = (best){depth, {0, 0, 0}, PD_SAT_NONE, -1, -1};
-      return 1;
+      return gjkOverlap;
     }
-    if (n == PD_GJK_POINTS_MAX || !(depth > -margin)) return -1;
+    if (!(depth > -margin)) return gjkUndecided;  // GJK's bookkeeping and the hull disagree: leave it to the search
+    if (n == PD_GJK_POINTS_MAX) return gjkWithinMargin;
     pdVec3 w = difference_support(A, B, f, normal);
-    trail->p[trail->n++] = w;
-    if (!(pd_v3_dot(w, normal) > offset + 1e-3 * margin)) return -1;  // that face is on M's boundary
+    if (!(pd_v3_dot(w, normal) > offset + 1e-3 * margin)) return gjkWithinMargin;  // that face is on M's boundary
     s[n] = w;
   }
 }
@@ -594,11 +583,12 @@ static int simplex_tetrahedron(pdVec3* s, pdVec3 D, pdVec3 C, pdVec3 B, pdVec3 A
   return 4;
 }
 
-// GJK's search for a certificate (design note, "Certificates"): +1 overlap (b->depth a lower bound on the
-// depth), 0 separation (b->depth the gap along b->axis, negated), −1 neither (the search decides).
+// GJK's search for a certificate (design note, "Certificates"): gjkOverlap (b->depth a lower bound on the
+// depth), gjkApart (b->depth the gap along b->axis, negated), gjkWithinMargin (neither: the origin within ~the
+// margin of M's boundary), gjkUndecided (GJK went wrong: the search decides).
 // `start`: the first direction (a cached one, PD_SAT_APART), or zero for the one from B's centre to A's.
 static int gjk_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const relPose* f, const cullBounds* cull,
-                           pdVec3 start, best* b, gjkTrail* trail) {
+                           pdVec3 start, best* b) {
   double margin = PD_GJK_MARGIN_REL * cull->margin / PD_SAT_CULL_MARGIN;
   pdVec3 d = start;
   if (!(pd_v3_dot(d, d) > 0.0)) d = pd_v3_sub(A->satIndex->centre, cull->cB);  // from inside M to the origin
@@ -607,13 +597,13 @@ static int gjk_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const r
   int n = 0;
   for (int iteration = 0; iteration < PD_GJK_ITERATIONS_MAX; ++iteration) {
     double dn = pd_v3_norm(d);
-    if (!(dn > 0.0) || !isfinite(dn)) return -1;  // the origin on the simplex: within rounding of M's boundary
+    if (!isfinite(dn)) return gjkUndecided;
+    if (!(dn > 0.0)) return gjkWithinMargin;  // the origin on the simplex: in M, within rounding of its boundary
     pdVec3 p = difference_support(A, B, f, d);
-    trail->p[trail->n++] = p;
     double along = pd_v3_dot(p, d) / dn;  // M's extent along d: the overlap along −d
     if (along < -margin) {
       *b = (best){along, pd_v3_scale(d, -1.0 / dn), PD_SAT_NONE, -1, -1};
-      return 0;
+      return gjkApart;
     }
     // no progress past the simplex along d: the origin lies within ~margin of M's boundary
     double reached = -INFINITY;
@@ -621,7 +611,7 @@ static int gjk_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const r
       double r = pd_v3_dot(s[k], d) / dn;
       reached = r > reached ? r : reached;
     }
-    if (n > 0 && along <= reached + 1e-3 * margin) return -1;
+    if (n > 0 && along <= reached + 1e-3 * margin) return gjkWithinMargin;
     s[n++] = p;
     switch (n) {
       case 1:
@@ -635,10 +625,10 @@ static int gjk_certificate(const pdPolyhedron* A, const pdPolyhedron* B, const r
         break;
       default:
         n = simplex_tetrahedron(s, s[0], s[1], s[2], s[3], &d);
-        if (n == 4) return enclosed_certificate(A, B, f, margin, s, b, trail);
+        if (n == 4) return enclosed_certificate(A, B, f, margin, s, b);
     }
   }
-  return -1;
+  return gjkUndecided;
 }
 
 // The cached feature's overlap, when it is still a candidate axis.
@@ -691,32 +681,27 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
 
   cullBounds cull;
   cull_bounds(A, B, &f, &cull);
-  gjkTrail trail;
-  trail.n = 0;
   if (mode == PD_SAT_VERDICT && cull.on) {
     pdVec3 start = cache && cache->kind == PD_SAT_APART ? cache->apart : (pdVec3){0, 0, 0};
-    int verdict = gjk_certificate(A, B, &f, &cull, start, &b, &trail);
-    if (verdict == 1) {  // overlap: the cache keeps what it holds
-      *out = (pdSatResult){false, b.depth, {0, 0, 0}, PD_SAT_NONE, -1, -1, 0};
+    int verdict = gjk_certificate(A, B, &f, &cull, start, &b);
+    apart = verdict == gjkApart;
+    if (apart) goto done;
+    if (verdict != gjkUndecided) {
+      // touching: a certified overlap (b.depth its lower bound), or within the margin of touching (depth 0);
+      // the cache keeps what it holds
+      double depth = verdict == gjkOverlap ? b.depth : 0.0;
+      *out = (pdSatResult){false, depth, {0, 0, 0}, PD_SAT_NONE, -1, -1, 0};
       return true;
     }
-    apart = verdict == 0;
-    if (apart) goto done;
     b = (best){INFINITY, {0, 0, 0}, PD_SAT_NONE, -1, -1};
   }
   // a polyhedron searched by a downhill walk keeps every face axis (the walk starts where the last ended)
-  // In verdict mode only an axis that may separate matters: every axis whose bound exceeds 0 by the margin is
-  // skipped (its overlap as computed is positive), faces of a walked body included (where a walk stops among
-  // supports tied to rounding moves a value by rounding only, far inside the margin).
-  bool verdictOnly = mode == PD_SAT_VERDICT;
-  bool cullFacesA = cull.on && (verdictOnly || !B->satIndex->neighbourFirst);
-  bool cullFacesB = cull.on && (verdictOnly || !A->satIndex->neighbourFirst);
+  bool cullFacesA = cull.on && !B->satIndex->neighbourFirst;
+  bool cullFacesB = cull.on && !A->satIndex->neighbourFirst;
   int supportB = 0, supportA = 0;
   for (int i = 0; i < A->faceCount; ++i) {
-    double cullAbove = verdictOnly ? 0.0 : b.depth;  // in verdict mode 0, else the best depth so far
-    if (cullFacesA && A->faces[i].offset - pd_v3_dot(A->faces[i].normal, cull.cB) + cull.rB - cull.margin > cullAbove)
+    if (cullFacesA && A->faces[i].offset - pd_v3_dot(A->faces[i].normal, cull.cB) + cull.rB - cull.margin > b.depth)
       continue;
-    if (verdictOnly && trail_keeps_overlapping(&trail, A->faces[i].normal, cull.margin)) continue;
     double d = face_A_overlap(A, i, B, &f, &supportB);
     if (d < b.depth) {
       b = (best){d, A->faces[i].normal, PD_SAT_FACE_A, i, -1};
@@ -724,12 +709,7 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
     }
   }
   for (int i = 0; i < B->faceCount; ++i) {
-    double cullAbove = verdictOnly ? 0.0 : b.depth;
-    if (cullFacesB &&
-        B->faces[i].offset - pd_v3_dot(B->faces[i].normal, cull.cAinB) + cull.rA - cull.margin > cullAbove)
-      continue;
-    if (verdictOnly && trail_keeps_overlapping(&trail, pd_v3_scale(pd_mat3_mulv(&f.R, B->faces[i].normal), -1.0),
-                                               cull.margin))
+    if (cullFacesB && B->faces[i].offset - pd_v3_dot(B->faces[i].normal, cull.cAinB) + cull.rA - cull.margin > b.depth)
       continue;
     pdVec3 axis;
     double d = face_B_overlap(A, B, i, &f, &axis, &supportA);
@@ -748,9 +728,8 @@ bool pd_interference(const pdPolyhedron* A, pdVec3 xA, const pdMat3* RA, const p
   uint64_t aliveA[PD_SAT_BITSET_WORDS], aliveB[PD_SAT_BITSET_WORDS];
   bool masks = cull.on && A->edgeCount <= 64 * PD_SAT_BITSET_WORDS && B->edgeCount <= 64 * PD_SAT_BITSET_WORDS;
   if (masks) {
-    double cullAbove = verdictOnly ? 0.0 : b.depth;
-    alive_edges(A, &cull.edgesA, cullAbove, aliveA);
-    alive_edges(B, &cull.edgesB, cullAbove, aliveB);
+    alive_edges(A, &cull.edgesA, b.depth, aliveA);
+    alive_edges(B, &cull.edgesB, b.depth, aliveB);
   }
   if (ia && ia->byZ && A->edgeCount <= 64 * PD_SAT_BITSET_WORDS) {
     uint64_t candidates[PD_SAT_BITSET_WORDS];

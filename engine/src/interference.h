@@ -74,17 +74,27 @@ typedef enum pdSatMode {
   // Evaluate every candidate axis: depth is the minimum whether separated or not. The cache is not used
   // to shorten the search (it is still updated), so the result does not depend on it.
   PD_SAT_MIN_DEPTH = 1,
-  // The verdict alone, the same as PD_SAT_FIRST_SEPARATING's for every pair (what the contact search asks:
-  // touching or not). After the cached feature, a GJK search over the Minkowski difference looks for one of
-  // two certificates (interference.c, "Certificates"): a hull of difference points holding a ball of radius
-  // PD_GJK_MARGIN_REL × the pair's size about the origin (overlap), or a direction along which the bodies are
-  // apart by more than that (separation). Where GJK finds neither, the PD_SAT_FIRST_SEPARATING search
-  // runs. A certified result has kind PD_SAT_NONE and a = b = -1; its depth is a lower bound on the penetration
-  // (overlap) or the gap along its axis, negated (separation), and its axis is zero when overlapping. The cache
-  // is left as it was after a certified overlap and holds the separating direction (PD_SAT_APART) after a
-  // certified separation, tried first next time (as a cached feature is).
+  // The verdict alone, what the contact search asks: touching or not. After the cached feature, a GJK search
+  // over the Minkowski difference looks for one of two certificates (interference.c, "Certificates"): a hull of
+  // difference points holding a ball of radius m = PD_GJK_MARGIN_REL × the pair's size about the origin
+  // (overlap), or a direction along which the bodies are apart by more than m (separation). Where GJK finds
+  // neither, the pair is within about m of touching and is called touching, with depth 0. So "separated" is
+  // always PD_SAT_FIRST_SEPARATING's verdict too, and so is "touching" except for pairs apart by about m at
+  // most. The result has kind PD_SAT_NONE and a = b = -1 (unless the cached feature separates: then it is that
+  // feature, as in PD_SAT_FIRST_SEPARATING); its depth is a lower bound on the penetration (certified overlap),
+  // 0 (within the margin), or the gap along its axis, negated (separation); its axis is zero when touching.
+  // The cache is left as it was when touching and holds the separating direction (PD_SAT_APART) after a
+  // certified separation, tried first next time (as a cached feature is). Polyhedra without a pdSatIndex (filled
+  // in by hand) get the PD_SAT_FIRST_SEPARATING search instead.
   PD_SAT_VERDICT = 2,
 } pdSatMode;
+
+// The verdict mode's margin, relative to the pair's coordinate size (interference.c, cull_bounds: the body
+// centres' distances from their origins, their circumradii and the distance between the origins, summed): 10
+// times the largest error of a candidate axis's overlap as computed (~1e-8 of the size: the sliver edge pairs,
+// PD_SAT_PARALLEL_TOL), so that a certified overlap is the separating-axis search's too; and about the widest
+// gap that may be called touching, far below any deflection of the contact model (δ_max ~1e-3 of the size).
+#define PD_GJK_MARGIN_REL 1e-7
 
 typedef struct pdSatResult {
   bool separated;          // depth < 0

@@ -189,12 +189,20 @@ typedef struct pdOracleTimingGroup {
   double usMin[pd_oracleTimingModeCount], usMax[pd_oracleTimingModeCount];
 } pdOracleTimingGroup;
 
+// The widest gap, in PD_GJK_MARGIN_REL × the pair's scale (the bodies' radii about their origins and the
+// origins' distances from the world's), that PD_SAT_VERDICT may call touching: its margin is relative to a size
+// of at most 3 such scales, and GJK certifies every gap above 1.001 margins.
+#define PD_ORACLE_VERDICT_BAND_MAX 3.01
+
 typedef struct pdOracleTiming {
   long pairCount;
   int repeats;
   long oursOverlap, gjkOverlap, ccdStalled;
-  bool oursAgree;       // our four modes give the same verdicts (and the three searches the same depths where
-                        // overlapping)
+  bool oursAgree;            // our three searches give the same verdicts (and the same depths where overlapping), and
+                             // the verdict mode separates only what they separate, and calls touching only pairs
+                             // they call apart by at most PD_ORACLE_VERDICT_BAND_MAX margins
+  long verdictWithinMargin;  // pairs the verdict mode calls touching and the searches apart
+  double verdictBandMax;     // the widest of their gaps, in PD_GJK_MARGIN_REL × the pair's scale
   uint64_t resultHash;  // FNV-1a over every field of our three modes' results but the work counter
   double checksum;      // a sum of all timed answers (keeps them from being optimised away)
   pdOracleTimingGroup groups[pd_oracleTimingGroupCount];
