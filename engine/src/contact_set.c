@@ -1169,9 +1169,10 @@ static void find_range(void* ctx, int part, int begin, int end) {
   }
 }
 
-// Interference of the pairs at poses1 (the verdict only, PD_SAT_VERDICT: GJK's certificates, then the
-// separating-axis search; cache of the last separating feature per pair, merged by the sorted pair order), then
-// the contact search of the interfering ones. Fills candidates. Times the interference
+// Interference of the pairs at poses1 (the verdict only, PD_SAT_VERDICT: GJK's certificates, and touching where
+// they prove neither, within 1e-7 of the size; cache of the last separating feature or direction per pair, merged
+// by the sorted pair order), then the contact search of the touching ones, whose own depth tests find no contact
+// where nothing penetrates. Fills candidates. Times the interference
 // (a lap of `watch`), not the search after it.
 static void search(const pdModel* model, pdState* s, const double* y1, int pairCount, const pdPose* poses0,
                    const pdPose* poses1, pdStopwatch* watch) {
