@@ -58,10 +58,12 @@
 //   sliver edge pairs) overlaps; (2) a direction d whose support point s of M has s·d < −m |d|: the bodies are
 //   apart by more than m along d, so M lies beyond one of its own face planes (one of the candidate axes) and
 //   the separating-axis search would find a separating axis. GJK's own bookkeeping (which sub-simplex is kept,
-//   the next direction) only steers the search for a proof. Where it finds none (no progress past its simplex,
-//   a degenerate simplex, PD_GJK_ITERATIONS_MAX iterations) the pair is called touching: GJK stops making
-//   progress only within ~m of M's boundary (at a gap of more than 1.001 m its support point already certifies
-//   the separation), so such a pair touches or is apart by about m at most. "Separated" is thus always the
+//   the next direction) only steers the search for a proof. Where it stops without one — no progress past its
+//   simplex, the origin on the simplex, or the fattened hull's nearest face on M's boundary — the pair is called
+//   touching: GJK stops making progress only within ~m of M's boundary (at a gap of more than 1.001 m its
+//   support point already certifies the separation), so such a pair touches or is apart by about m at most.
+//   Where its bookkeeping goes wrong (the tetrahedron holds the origin but the hull puts it more than m outside,
+//   a non-finite direction, PD_GJK_ITERATIONS_MAX iterations) the PD_SAT_FIRST_SEPARATING search decides. "Separated" is thus always the
 //   separating-axis search's verdict too (a proof, or the cached axis evaluated by the search's own helper),
 //   and "touching" may include pairs apart by up to ~m (1e-7 of the size): the contact search then runs the
 //   contact analysis on them, whose own depth tests (1e-12 of the size) find no contact where nothing
@@ -462,8 +464,8 @@ static void alive_edges(const pdPolyhedron* P, const edgeCull* c, double depth, 
   }
 }
 
-// GJK's iterations before the pair is called touching. Pairs GJK settles take a handful (a few more for the
-// geodesic spheres); past this many it is circling a boundary within rounding of the origin.
+// GJK's iterations before the separating-axis search decides. Pairs GJK settles take a handful (a few more for
+// the geodesic spheres); past this many it is circling a boundary within rounding of the origin.
 #define PD_GJK_ITERATIONS_MAX 40
 
 // The support point of M = B − A (A's frame) along d: B's vertex farthest along d less A's farthest along −d.
