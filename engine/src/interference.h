@@ -78,7 +78,8 @@ typedef enum pdSatMode {
   // over the Minkowski difference looks for one of two certificates (interference.c, "Certificates"): a hull of
   // difference points holding a ball of radius m = PD_GJK_MARGIN_REL × the pair's size about the origin
   // (overlap), or a direction along which the bodies are apart by more than m (separation). Where GJK finds
-  // neither, the pair is within about m of touching and is called touching, with depth 0. So "separated" is
+  // neither, the pair is within about m of touching and is called touching, with depth 0 (where GJK's own
+  // bookkeeping goes wrong, rarely, the PD_SAT_FIRST_SEPARATING search decides instead). So "separated" is
   // always PD_SAT_FIRST_SEPARATING's verdict too, and so is "touching" except for pairs apart by about m at
   // most. The result has kind PD_SAT_NONE and a = b = -1 (unless the cached feature separates: then it is that
   // feature, as in PD_SAT_FIRST_SEPARATING); its depth is a lower bound on the penetration (certified overlap),
