@@ -81,9 +81,10 @@ typedef enum pdSatMode {
   // neither, the pair is within about m of touching and is called touching, with depth 0 (where GJK's own
   // bookkeeping goes wrong, rarely, the PD_SAT_FIRST_SEPARATING search decides instead). So "separated" is
   // always PD_SAT_FIRST_SEPARATING's verdict too, and so is "touching" except for pairs apart by about m at
-  // most. The result has kind PD_SAT_NONE and a = b = -1 (unless the cached feature separates: then it is that
-  // feature, as in PD_SAT_FIRST_SEPARATING); its depth is a lower bound on the penetration (certified overlap),
-  // 0 (within the margin), or the gap along its axis, negated (separation); its axis is zero when touching.
+  // most. The result has kind PD_SAT_NONE and a = b = -1 (unless the cached feature separates or the search
+  // decides: then it is PD_SAT_FIRST_SEPARATING's result); its depth is a lower bound on the penetration
+  // (certified overlap), 0 (within the margin), or the gap along its axis, negated (separation); its axis is
+  // zero when touching.
   // The cache is left as it was when touching and holds the separating direction (PD_SAT_APART) after a
   // certified separation, tried first next time (as a cached feature is). Polyhedra without a pdSatIndex (filled
   // in by hand) get the PD_SAT_FIRST_SEPARATING search instead.
