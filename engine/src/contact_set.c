@@ -441,8 +441,9 @@ static void poses_range(void* ctx, int part, int begin, int end) {
 }
 
 // Each moving body's contacts in contact order, as 2 i + (0 on body1, 1 on body2): bodyFirst/bodyList. Read by the
-// exact stability bound and by the force sums (sums_range), built by stability_prepare or, for a list installed
-// without it, by the first derivative evaluation (the arrays are sized with the list: nothing is allocated).
+// tight stability bound (has_block) and by the force sums (sums_range), built by stability_prepare or, for a list
+// installed without it, by the first derivative evaluation (the arrays are sized with the list: nothing is
+// allocated).
 static void list_bodies(const pdModel* model, pdContactSet* set) {
   int bodies = model->bodyCount;
   for (int k = 0; k <= bodies; ++k) set->bodyFirst[k] = 0;
@@ -709,8 +710,6 @@ static void contact_gram_factor(const stabilityTerms* t, int e, const bodySpaceB
     }
 }
 
-// The tight bound: the largest absolute row sum of S, over the blocks of every moving body with contacts and of
-// every touching pair (the list is sorted by pair, so a pair's contacts are one run). ω_max², no margin.
 // Does moving body k have contacts in the list (a block of S)?
 static bool has_block(const pdModel* model, const pdContactSet* set, int k) {
   return !model->bodies[k].fixed && set->bodyFirst[k] < set->bodyFirst[k + 1];
@@ -736,6 +735,8 @@ static void body_space_scales(const pdModel* model, pdContactSet* set, const pdP
   }
 }
 
+// The tight bound: the largest absolute row sum of S, over the blocks of every moving body with contacts and of
+// every touching pair (the list is sorted by pair, so a pair's contacts are one run). ω_max², no margin.
 static double stability_tight(const pdModel* model, pdContactSet* set) {
   body_space_scales(model, set, set->stablePoses);
   for (int first = 0, last; first < set->count; first = last) {

@@ -80,26 +80,24 @@ static int remove_entry(const char* path, const struct stat* sb, int flag, struc
 
 static void remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
 
+// Appends x to text at n (at most PD_G17_MAX − 1 characters); returns the new length. The engine never lets a
+// non-finite number reach an output; should one get here, it is written "null", so JSON stays valid.
+static size_t append_number(char* text, size_t n, double x) {
+  if (isfinite(x)) return n + (size_t)pd_format_g17(x, text + n);
+  memcpy(text + n, "null", 4);
+  return n + 4;
+}
+
 static void write_number(FILE* out, double x) {
-  // the engine never lets a non-finite number reach an output; should one get here, JSON stays valid
-  if (isfinite(x)) {
-    char text[PD_G17_MAX];
-    fwrite(text, 1, (size_t)pd_format_g17(x, text), out);
-  } else {
-    fputs("null", out);
-  }
+  char text[PD_G17_MAX];
+  fwrite(text, 1, append_number(text, 0, x), out);
 }
 
 // Appends ",x,y,…" (a row's numbers as write_number writes them) to text at n; returns the new length.
 static size_t append_numbers(char* text, size_t n, const double* x, int count) {
   for (int k = 0; k < count; ++k) {
     text[n++] = ',';
-    if (isfinite(x[k])) {
-      n += (size_t)pd_format_g17(x[k], text + n);
-    } else {
-      memcpy(text + n, "null", 4);
-      n += 4;
-    }
+    n = append_number(text, n, x[k]);
   }
   return n;
 }
