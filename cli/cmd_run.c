@@ -14,7 +14,7 @@
 
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
-    "                         [--stepper adaptive|fixed|embedded] [--variant native|matched]\n"
+    "                         [--stepper adaptive|fixed|embedded|implicit] [--variant native|matched]\n"
     "                         [--onsets pair|exact|auto] [--islands on|off] [--threads N] [--step H]\n"
     "                         [--ode-friction pyramid|aligned]\n"
     "\n"
@@ -28,7 +28,9 @@ static const char* const help =
     "  --sample HZ      output samples per second, overrides the scene's sample\n"
     "  --stepper NAME   adaptive: RK4 with step-doubling error control (default);\n"
     "                   fixed: RK4 with the scene's dt, no error control;\n"
-    "                   embedded: RK4 with its embedded third-order error estimate (soft engine)\n"
+    "                   embedded: RK4 with its embedded third-order error estimate;\n"
+    "                   implicit: a linearly implicit method (ROS34PW2) with no stability bound, in\n"
+    "                   islands of up to 16 bodies, for resting contact (soft engine; README \"Integration\")\n"
     "  --onsets MODE    soft engine, a contact that began inside a step: exact cuts the whole step back\n"
     "                   to its onset; pair joins it at the step's end, run for that pair alone since its\n"
     "                   onset, when it began within 1/omega and is shallow; auto (default) pair in an island\n"
@@ -156,8 +158,11 @@ int pd_cmd_run(int argc, char** argv) {
       } else if (strcmp(v, "embedded") == 0) {
         softOptionGiven = true;
         stepper = pd_stepperRK43Embedded;
+      } else if (strcmp(v, "implicit") == 0) {
+        softOptionGiven = true;
+        stepper = pd_stepperImplicit;
       } else {
-        return pd_cli_usage_error("run", "--stepper must be adaptive, fixed or embedded");
+        return pd_cli_usage_error("run", "--stepper must be adaptive, fixed, embedded or implicit");
       }
     } else if (a[0] == '-' && a[1] != '\0') {
       return pd_cli_usage_error("run", "unknown option '%s'", a);

@@ -498,6 +498,63 @@ void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y,
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, sums_range, &job);
 }
 
+// Forward-difference steps of the linearisation: this fraction of a spring's deflection or δ_max, and of a relative
+// velocity component or vmax, whichever is larger (~√ε: the truncation and rounding errors balance). The matrix need
+// not be exact (a W-method keeps its order with any), only close enough to keep the stiff modes stable.
+#define PD_LINEARISE_STEP_REL 1.5e-8
+
+// F and ṡ of a contact as one vector: F (3), then the rates (8); F is 0 when it pulls (sums_range applies none).
+static void force_and_rates(const pdContactParams* p, const double s[PD_CONTACT_STATE_SIZE], pdVec3 n, pdVec3 du,
+                            double out[3 + PD_CONTACT_STATE_SIZE]) {
+  pdSprings sp = springs_load(s);
+  pdContactForce f;
+  pd_contact_force(p, &sp, n, du, &f);
+  pdVec3 force = pd_contact_force_pulls(&f) ? (pdVec3){0, 0, 0} : f.force;
+  out[0] = force.x, out[1] = force.y, out[2] = force.z;
+  springs_store(out + 3, &f.rate);
+}
+
+void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const double* y, pdContactLinear* out) {
+  poses_from(model, y, set->poses);
+  int base = spring_base(model);
+  double vmax = model->settings.vmax;
+  for (int i = 0; i < set->count; ++i) {
+    const contactSlot* c = &set->items[i];
+    int b1 = c->id.body1, b2 = c->id.body2;
+    pdContactGeom g;
+    pd_contact_geometry(model, &c->id, &set->poses[b1], &set->poses[b2], &g);
+    if (g.normal.x == 0.0 && g.normal.y == 0.0 && g.normal.z == 0.0) g.normal = c->normal, g.point = c->point;
+    pdVec3 du =
+        pd_v3_sub(point_velocity(model, y, set->poses, b1, g.point), point_velocity(model, y, set->poses, b2, g.point));
+    double s[PD_CONTACT_STATE_SIZE], f0[3 + PD_CONTACT_STATE_SIZE], f1[3 + PD_CONTACT_STATE_SIZE];
+    for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) s[j] = y[base + PD_CONTACT_STATE_SIZE * i + j];
+    force_and_rates(&c->params, s, g.normal, du, f0);
+    pdContactLinear* l = &out[i];
+    l->body1 = b1, l->body2 = b2;
+    l->r1 = pd_v3_sub(g.point, set->poses[b1].x);
+    l->r2 = pd_v3_sub(g.point, set->poses[b2].x);
+    for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) {
+      double keep = s[j];
+      s[j] += PD_LINEARISE_STEP_REL * fmax(fabs(keep), c->deltaMax);
+      double step = s[j] - keep;
+      force_and_rates(&c->params, s, g.normal, du, f1);
+      s[j] = keep;
+      for (int r = 0; r < 3; ++r) l->Ds[r][j] = (f1[r] - f0[r]) / step;
+      for (int r = 0; r < PD_CONTACT_STATE_SIZE; ++r) l->Gs[r][j] = (f1[3 + r] - f0[3 + r]) / step;
+    }
+    double u[3] = {du.x, du.y, du.z};
+    for (int j = 0; j < 3; ++j) {
+      double keep = u[j];
+      u[j] += PD_LINEARISE_STEP_REL * fmax(fabs(keep), vmax);
+      double step = u[j] - keep;
+      force_and_rates(&c->params, s, g.normal, (pdVec3){u[0], u[1], u[2]}, f1);
+      u[j] = keep;
+      for (int r = 0; r < 3; ++r) l->Du[r][j] = (f1[r] - f0[r]) / step;
+      for (int r = 0; r < PD_CONTACT_STATE_SIZE; ++r) l->Gu[r][j] = (f1[3 + r] - f0[3 + r]) / step;
+    }
+  }
+}
+
 double pd_contact_spring_energy(const pdContactSet* set, const double* y, int springBase) {
   double e = 0.0;
   for (int i = 0; i < set->count; ++i) {

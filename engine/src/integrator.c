@@ -17,6 +17,10 @@
 // analysed once per accepted step — so it wins on impacts and free flight and loses on resting and sliding
 // contacts (README, "Integration"); step doubling stays the default. Both run through adaptive_step,
 // which takes the trial, the order of its estimate (the controller's exponents) and the bound's share.
+// The implicit stepper (pd_stepperImplicit, switching_step) runs step doubling until the contacts' stability bound
+// holds it well below what its error control wants (resting contact), then ROS34PW2, a linearly implicit method
+// with no stability bound (trial_implicit; its matrices in implicit.c), until step doubling could take about its
+// steps again: one system (island) at a time, decided from its own numbers.
 //
 // Output samples fall exactly on t = k / sampleRate: a step that would pass the next sample is cut
 // to end on it (the time is then set to the sample time itself, so stamps never drift), and the
@@ -35,6 +39,7 @@
 #include "contact_set.h"
 #include "dynamics.h"
 #include "help_desk.h"
+#include "implicit.h"
 #include "islands.h"
 #include "polydyn/state.h"
 #include "state_layout.h"
@@ -70,13 +75,14 @@ static void integrate_lap(pdState* s, pdStopwatch* watch, double tDerivative) {
 typedef struct stepperWork {
   double *k1, *ktmp, *ytmp, *acc, *full, *half, *k1half, *trial;
   double halfStep;  // s: `half` is the RK4 step of this size from the step's start (k1 and y as now); 0: none
+  bool linearised;  // the implicit stepper's W is formed at the step's start (trials from there share it)
 } stepperWork;
 
 // The scratch of a step from the state as it is now (nothing in it yet).
 static stepperWork work_of(pdState* s) {
   double* w = s->work;
   size_t n = (size_t)s->capacity;
-  return (stepperWork){w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n, 0.0};
+  return (stepperWork){w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n, 0.0, false};
 }
 
 // RK4's vector updates, elementwise (so a split loop computes the same numbers: help_desk.h): stage 0 starts the
@@ -203,15 +209,83 @@ static double trial_embedded(const pdModel* model, pdState* s, stepperWork* w, d
   return norm;
 }
 
+// ROS34PW2 (Rang & Angermann, BIT 45 (2005) 761–787): a Rosenbrock-W method of 4 stages, order 3 for any
+// matrix W, with an embedded order-2 solution, L-stable and stiffly accurate. In the transformed form (Hairer &
+// Wanner II, IV.7), with M = I/(hγ) − W:
+//   M u_i = f(t + α_i h, y + Σ_{j<i} a_ij u_j) + Σ_{j<i} (c_ij/h) u_j,   y1 = y + Σ m_i u_i,   error Σ e_i u_i.
+// The coefficients are those of the method's tableau (γ, α_ij, γ_ij, b, b̂) transformed (a = αΓ⁻¹,
+// c = diag(1/γ) − Γ⁻¹, m = bΓ⁻¹, e = (b − b̂)Γ⁻¹); checked on y' = λy: local error O((hλ)⁴), estimate O((hλ)³),
+// R(∞) = 0 (reports/bench/implicit/README.md). α_i are the stage times (the time as a state component whose
+// row of W is 0, so no ∂f/∂t term is needed).
+static const double ROSW_GAMMA = 0.4358665215084590;
+static const double ROSW_ALPHA[4] = {0.0, 0.87173304301691801, 0.73157995778885238, 1.0};
+static const double ROSW_A[4][3] = {{0, 0, 0},
+                                    {2.0, 0, 0},
+                                    {1.4192173174557647, -0.25923221167296973, 0},
+                                    {4.1847604823191604, -0.28519201735549593, 2.2942803602790418}};
+static const double ROSW_C[4][3] = {{0, 0, 0},
+                                    {-4.5885607205580836, 0, 0},
+                                    {-4.1847604823191604, 0.28519201735549593, 0},
+                                    {-6.3681792001283579, -6.7956209444668367, 2.8700986043310559}};
+static const double ROSW_M[4] = {4.1847604823191595, -0.2851920173554956, 2.2942803602790414, 1.0};
+static const double ROSW_E[4] = {0.27774994764796723, -1.4032398951759988, 1.7726301276675507, 0.5};
+
+// The implicit stepper's trial (pd_stepperImplicit): one ROS34PW2 step of h, W linearised at the step's start
+// (implicit.c) and M factorised for this h. 3 derivative evaluations besides k1, which a retry keeps, with W. A
+// singular or non-finite M gives a non-finite norm: the step is retried smaller.
+static double trial_implicit(const pdModel* model, pdState* s, stepperWork* w, double h) {
+  if (!s->implicit) s->implicit = pd_implicit_create();
+  w->halfStep = 0.0;
+  int n = s->n;
+  if (!w->linearised) pd_implicit_linearise(model, s, s->implicit, s->y);
+  w->linearised = true;
+  if (!pd_implicit_factor(model, s, s->implicit, ROSW_GAMMA * h)) return NAN;
+  double* u[4] = {w->acc, w->full, w->half, w->k1half};
+  for (int i = 0; i < 4; ++i) {
+    const double* f = w->k1;
+    if (i > 0) {
+      for (int c = 0; c < n; ++c) {
+        double acc = s->y[c];
+        for (int j = 0; j < i; ++j) acc += ROSW_A[i][j] * u[j][c];
+        w->ytmp[c] = acc;
+      }
+      derivative(model, s, s->t + ROSW_ALPHA[i] * h, w->ytmp, w->ktmp);
+      f = w->ktmp;
+    }
+    for (int c = 0; c < n; ++c) {
+      double acc = f[c];
+      for (int j = 0; j < i; ++j) acc += (ROSW_C[i][j] / h) * u[j][c];
+      w->trial[c] = acc;  // the right-hand side, until the result goes there
+    }
+    pd_implicit_solve(model, s, s->implicit, w->trial, u[i]);
+  }
+  double norm = 0.0;
+  for (int c = 0; c < n; ++c) {
+    double y1 = s->y[c], e = 0.0;
+    for (int j = 0; j < 4; ++j) y1 += ROSW_M[j] * u[j][c], e += ROSW_E[j] * u[j][c];
+    w->trial[c] = y1;
+    norm = max_skipping_nan(norm, fabs(e) / s->weight[c]);
+  }
+  return norm;
+}
+
 // Takes one accepted step of at most `hMax` from state->t with error control. Returns the step taken (0 on
 // failure). `order` is the order of the error estimate's leading term in h (5 for step doubling, 4 for the
 // embedded pair); `stableFraction` the part of the contacts' stability bound (a bound for half steps) the
 // whole trial step may use.
+// What an accepted step's caller may want to know (switching_step): the step the error control wants next, before
+// the stability bound, and whether a contact event (tunnelling guard, onset, stick–slip refinement) cut the step.
+typedef struct stepOutcome {
+  double wanted;
+  bool eventCut;
+} stepOutcome;
+
 static double adaptive_step(const pdModel* model, pdState* s, double hMax, trialFcn* trial, double order,
-                            double stableFraction) {
+                            double stableFraction, stepOutcome* outcome) {
   const pdSettings* set = &model->settings;
   stepperWork w = work_of(s);
   derivative(model, s, s->t, s->y, w.k1);
+  bool eventCut = false;
   for (;;) {
     // a step cut short to meet a sample says nothing about a longer one: s->h keeps the wanted size
     bool cut = hMax < s->h;
@@ -247,6 +321,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry, &watch);
     if (verdict == pd_eventRetry) {
       hMax = hRetry;
+      eventCut = true;
       continue;
     }
     if (verdict == pd_eventRestart) {
@@ -263,12 +338,51 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       grow = fmin(STEP_GROW_MAX, fmax(STEP_SHRINK_MIN, grow));
       s->h = fmin(set->dtmax, fmax(set->dtmin, grow * h));
     }
-    // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge
-    bool tightNeeded;
-    s->h = fmax(set->dtmin, pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction, &tightNeeded));
-    s->count.stabilityTight += tightNeeded;
+    if (outcome) *outcome = (stepOutcome){s->h, eventCut};
+    // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge (an implicit
+    // trial has none: stableFraction INFINITY)
+    if (stableFraction < INFINITY) {
+      bool tightNeeded;
+      s->h = fmax(set->dtmin, pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction, &tightNeeded));
+      s->count.stabilityTight += tightNeeded;
+    }
     return h;
   }
+}
+
+// The implicit stepper (pd_stepperImplicit): step doubling while its step is set by the error control, ROS34PW2 while
+// the contacts' stability bound would hold step doubling far below what its error control wants — resting contact,
+// where the implicit method's steps are limited by its own error estimate alone (reports/bench/implicit: 3× fewer
+// steps on a resting pile). The switch (implicit.h, PD_IMPLICIT_SWITCH_STEPS) looks only at the state's own
+// numbers, so it is the same on every run. Systems of more than PD_IMPLICIT_BODIES_MAX moving bodies stay explicit.
+static double switching_step(const pdModel* model, pdState* s, double hMax) {
+  if (model->movingCount > PD_IMPLICIT_BODIES_MAX) return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL);
+  if (!s->implicit) s->implicit = pd_implicit_create();
+  pdImplicit* im = s->implicit;
+  stepOutcome out = {0.0, false};
+  if (!pd_implicit_active(im)) {
+    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, &out);
+    // s->h is now the bound's step: on a switch the implicit method starts from the step the error control wanted
+    bool held = !out.eventCut && out.wanted >= PD_IMPLICIT_HELD_RATIO * s->h;
+    if (taken > 0.0 && pd_implicit_note_explicit(im, held)) s->h = out.wanted;
+    return taken;
+  }
+  double taken = adaptive_step(model, s, hMax, trial_implicit, 3.0, INFINITY, &out);
+  if (taken > 0.0) {
+    s->count.implicitSteps += 1;
+    // a step an event cut (a body sliding fast at its tunnelling guard) is the step the next one will meet too:
+    // the implicit trial is dear, so it grows from there rather than from what its error control wants
+    if (out.eventCut) s->h = fmin(s->h, PD_IMPLICIT_GROWTH_AFTER_CUT * taken);
+    // back to step doubling when its bound would allow 1/PD_IMPLICIT_HELD_RATIO of the implicit step: an implicit
+    // trial costs about two explicit ones on a small system
+    double worth = (out.eventCut ? fmin(out.wanted, taken) : out.wanted) / PD_IMPLICIT_HELD_RATIO;
+    bool tightNeeded;
+    if (pd_contact_set_limit_step(model, s->contacts, worth, 1.0, &tightNeeded) >= worth) {
+      pd_implicit_deactivate(im);
+      s->count.stabilityTight += tightNeeded;
+    }
+  }
+  return taken;
 }
 
 static double fixed_step(const pdModel* model, pdState* s, double hMax) {
@@ -339,11 +453,14 @@ bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, pdObserver
           taken = fixed_step(model, s, hMax);
           break;
         case pd_stepperRK43Embedded:
-          taken = adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5);
+          taken = adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, NULL);
+          break;
+        case pd_stepperImplicit:
+          taken = switching_step(model, s, hMax);
           break;
         case pd_stepperRK4Adaptive:
         default:
-          taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0);
+          taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL);
           break;
       }
     }

@@ -447,6 +447,7 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->travelRetries += c->travelRetries;
   to->refinements += c->refinements;
   to->stabilityTight += c->stabilityTight;
+  to->implicitSteps += c->implicitSteps;
   to->contactsMade += c->contactsMade;
   to->contactsVirtual += c->contactsVirtual;
   to->contactsTransferred += c->contactsTransferred;

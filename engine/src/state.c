@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "contact_set.h"
+#include "implicit.h"
 #include "islands.h"
 #include "state_layout.h"
 
@@ -63,6 +64,7 @@ void pd_state_free(pdState* s) {
   free(s->work);
   pd_contact_set_free(s->contacts);
   pd_island_set_free(s->islandSet);
+  pd_implicit_free(s->implicit);
   free(s);
 }
 
@@ -91,6 +93,8 @@ const char* pd_stepper_name(pdStepper stepper) {
       return "rk4-fixed";
     case pd_stepperRK43Embedded:
       return "rk43-embedded";
+    case pd_stepperImplicit:
+      return "ros34pw2";
     case pd_stepperRK4Adaptive:
       break;
   }

@@ -43,8 +43,9 @@
 // 2e-6 m/s, the error control's level: steps at the stability bound grew the twist's error until rejected).
 #define TWIST_STILL_SPEED 1e-9  // m/s
 
-// Every test runs twice: with the default stepper (step-doubled RK4) and with the embedded RK4(3) pair
-// (group setups below), which must reach the same closed forms at the same default tolerance.
+// Every test runs three times: with the default stepper (step-doubled RK4), with the embedded RK4(3) pair and with
+// the implicit stepper (ROS34PW2 where contacts rest; group setups below), which must reach the same closed forms
+// at the same default tolerance.
 static pdStepper stepper = pd_stepperRK4Adaptive;
 
 // ---------------------------------------------------------------------------------------------
@@ -307,5 +308,7 @@ int main(void) {
   int failed = cmocka_run_group_tests_name("default stepper (rk4-adaptive)", tests, NULL, NULL);
   stepper = pd_stepperRK43Embedded;
   failed += cmocka_run_group_tests_name("embedded stepper (rk43-embedded)", tests, NULL, NULL);
+  stepper = pd_stepperImplicit;
+  failed += cmocka_run_group_tests_name("implicit stepper (ros34pw2 where contacts rest)", tests, NULL, NULL);
   return failed;
 }

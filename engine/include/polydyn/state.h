@@ -60,9 +60,12 @@ typedef enum pdStepper {
   pd_stepperRK4Adaptive,   // classic RK4 with step doubling: error = |two half steps − one full step|/15
   pd_stepperRK4Fixed,      // classic RK4 with the step fixed at settings.dt (no error control)
   pd_stepperRK43Embedded,  // classic RK4 with its embedded third-order partner: error = h |k4 − f(t+h, y1)|/6
+  pd_stepperImplicit,      // ROS34PW2, a linearly implicit (Rosenbrock-W) method of order 3 with an order-2 estimate,
+                           // with no stability bound, in systems of at most PD_IMPLICIT_BODIES_MAX (16) moving
+                           // bodies; larger ones take step doubling. For resting contact (README, Integration)
 } pdStepper;
 
-// The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed" or "rk43-embedded".
+// The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed", "rk43-embedded" or "ros34pw2".
 PD_API const char* pd_stepper_name(pdStepper stepper);
 
 // How a contact that began inside a step joins the list (paper App. C; README, "Contact onsets").
@@ -121,6 +124,7 @@ typedef struct pdCounters {
   long refinements;       // trial steps halved around a reversal or a stick/slip change (§3.4)
   long stabilityTight;    // accepted steps whose limit needed the tight stability bound: the cheap bound allowed
                           // less than the step the error control wanted (README, Integration)
+  long implicitSteps;     // accepted steps taken by the implicit method (pd_stepperImplicit; 0 with other steppers)
   long contactsMade;      // contacts added at the end of a step (found, approaching)
   long contactsVirtual;   // contacts added at the start of a step (onset within the first dt_min)
   long contactsTransferred;  // VF contacts whose sliding vertex moved on to an adjacent face (§4.4.3)
@@ -153,6 +157,7 @@ typedef struct pdState {
   double* work;      // scratch for the stepper (owned)
   struct pdContactSet* contacts;  // the contact list and the contact search's scratch (internal)
   struct pdIslandSet* islandSet;  // the islands' own states between samples (internal; NULL when off)
+  struct pdImplicit* implicit;    // the implicit stepper's matrices (internal; NULL until it first steps)
   long nextSample;   // index k of the next output sample, at t = k / sampleRate
   bool failed;       // the run could not continue (see warnings); pd_advance returns false
   bool stopped;      // the observer asked to stop; pd_advance returns false

@@ -1,0 +1,58 @@
+// polydyn (internal) — the linear systems of the implicit stepper (pd_stepperImplicit, integrator.c).
+//
+// The stepper needs M = I/(hγ) − W solved for several right-hand sides per step, W an approximation of the
+// Jacobian ∂f/∂y of the state derivative. W holds only the stiff part: how the contacts' springs and the moving
+// bodies' velocities drive one another (each contact linearised by pd_contact_set_linearise). The rows and
+// columns of positions and orientations, gravity, applied forces and the gyroscopic term are left out (0): a
+// W-method keeps its order with any W, and those couplings are slow beside the springs'.
+#pragma once
+
+#include <stdbool.h>
+
+#include "polydyn/model.h"
+#include "polydyn/state.h"
+
+// Moving bodies above which a system (an island, or the scene with islands off) is not stepped implicitly:
+// M's body part is a dense 6N × 6N matrix, factorised in O(N³) (~0.3 ms at 16 bodies), more than the steps it
+// saves on a larger system. Larger systems take step doubling (README, Integration).
+#define PD_IMPLICIT_BODIES_MAX 16
+
+// The implicit stepper switches between step doubling and the implicit method system by system (integrator.c,
+// switching_step): to the implicit method after this many accepted steps in a row whose step the stability bound
+// held to at most 1/PD_IMPLICIT_HELD_RATIO of what the error control wanted (resting contact), back to step
+// doubling as soon as the bound would allow 1/PD_IMPLICIT_HELD_RATIO of the implicit method's step (an implicit
+// trial costs about two explicit ones on a small system).
+#define PD_IMPLICIT_SWITCH_STEPS 3
+#define PD_IMPLICIT_HELD_RATIO 2.0
+// After an implicit step that a contact event cut, the next may be at most this many times as long (the event,
+// typically the tunnelling guard of a sliding body, would cut a longer one again, each retry a wasted trial).
+#define PD_IMPLICIT_GROWTH_AFTER_CUT 1.0
+
+typedef struct pdImplicit pdImplicit;
+
+// An empty workspace; it grows at pd_implicit_factor to the largest system it has seen (then allocates nothing).
+pdImplicit* pd_implicit_create(void);
+void pd_implicit_free(pdImplicit* im);
+
+// Whether the system steps implicitly now, and the switch's bookkeeping (PD_IMPLICIT_SWITCH_STEPS).
+bool pd_implicit_active(const pdImplicit* im);
+// After an accepted explicit step: `held` says whether the stability bound held it (see above). Returns true
+// when the system switches to the implicit method.
+bool pd_implicit_note_explicit(pdImplicit* im, bool held);
+// Back to step doubling.
+void pd_implicit_deactivate(pdImplicit* im);
+
+// Linearises the contacts of `state` at state y (W's blocks; the set's poses are left at y): once per step start,
+// whatever the trials from there.
+void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im, const double* y);
+
+// Forms M = I/hg − W from the last linearisation and factorises it. Returns false when M is singular or not finite
+// (the caller rejects the step and retries a smaller one).
+bool pd_implicit_factor(const pdModel* model, const pdState* state, pdImplicit* im, double hg);
+
+// u = M⁻¹ r over the state's n components, M as last factorised (r and u must not overlap).
+void pd_implicit_solve(const pdModel* model, const pdState* state, pdImplicit* im, const double* r, double* u);
+
+// w = W x over the state's n components, W as last factorised (the tests compare it with finite differences of
+// the derivative).
+void pd_implicit_apply_w(const pdModel* model, const pdState* state, const pdImplicit* im, const double* x, double* w);
