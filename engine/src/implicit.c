@@ -175,8 +175,9 @@ void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im,
   }
 }
 
-// Whether a contact's springs drive their own rates (Gs ≠ 0: a slipping contact, whose friction limit depends on
-// the normal springs); in stick and in the proportional branches they do not, and B_c⁻¹ is hg I.
+// Whether a contact's springs drive their own rates (Gs ≠ 0, as in slip, where the friction limit follows the
+// normal springs). Where none does (Gs = 0 exactly, as in stick with the default proportional dampers) B_c⁻¹ is
+// hg I and needs no inversion.
 static bool springs_self_coupled(const pdContactLinear* l) {
   for (int i = 0; i < SPRINGS; ++i)
     for (int j = 0; j < SPRINGS; ++j)

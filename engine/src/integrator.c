@@ -234,7 +234,7 @@ static const double ROSW_E[4] = {0.27774994764796723, -1.4032398951759988, 1.772
 // (implicit.c) and M factorised for this h. 3 derivative evaluations besides k1, which a retry keeps, with W. A
 // singular or non-finite M gives a non-finite norm: the step is retried smaller.
 static double trial_implicit(const pdModel* model, pdState* s, stepperWork* w, double h) {
-  if (!s->implicit) s->implicit = pd_implicit_create();
+  PD_ASSERT(s->implicit != NULL);  // created by switching_step
   w->halfStep = 0.0;
   int n = s->n;
   if (!w->linearised) pd_implicit_linearise(model, s, s->implicit, s->y);

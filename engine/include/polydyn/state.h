@@ -60,9 +60,10 @@ typedef enum pdStepper {
   pd_stepperRK4Adaptive,   // classic RK4 with step doubling: error = |two half steps − one full step|/15
   pd_stepperRK4Fixed,      // classic RK4 with the step fixed at settings.dt (no error control)
   pd_stepperRK43Embedded,  // classic RK4 with its embedded third-order partner: error = h |k4 − f(t+h, y1)|/6
-  pd_stepperImplicit,      // ROS34PW2, a linearly implicit (Rosenbrock-W) method of order 3 with an order-2 estimate,
-                           // with no stability bound, in systems of at most PD_IMPLICIT_BODIES_MAX (16) moving
-                           // bodies; larger ones take step doubling. For resting contact (README, Integration)
+  pd_stepperImplicit,      // step doubling, switching system by system to ROS34PW2 (a linearly implicit method of
+                           // order 3 with an order-2 estimate and no stability bound) where the contacts' stability
+                           // bound holds step doubling: resting contact. Systems of more than 16 moving bodies
+                           // (PD_IMPLICIT_BODIES_MAX) keep step doubling (README, Integration)
 } pdStepper;
 
 // The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed", "rk43-embedded" or "ros34pw2".
