@@ -269,16 +269,17 @@ static double trial_implicit(const pdModel* model, pdState* s, stepperWork* w, d
   return norm;
 }
 
-// Takes one accepted step of at most `hMax` from state->t with error control. Returns the step taken (0 on
-// failure). `order` is the order of the error estimate's leading term in h (5 for step doubling, 4 for the
-// embedded pair); `stableFraction` the part of the contacts' stability bound (a bound for half steps) the
-// whole trial step may use.
 // What an accepted step's caller may want to know (switching_step): the step the error control wants next, before
 // the stability bound, and whether a contact event (tunnelling guard, onset, stick–slip refinement) cut the step.
 typedef struct stepOutcome {
   double wanted;
   bool eventCut;
 } stepOutcome;
+
+// Takes one accepted step of at most `hMax` from state->t with error control. Returns the step taken (0 on
+// failure). `order` is the order of the error estimate's leading term in h (5 for step doubling, 4 for the
+// embedded pair, 3 for ROS34PW2); `stableFraction` the part of the contacts' stability bound (a bound for half
+// steps) the whole trial step may use (INFINITY: none); `outcome` (nullable) receives the accepted step's outcome.
 
 static double adaptive_step(const pdModel* model, pdState* s, double hMax, trialFcn* trial, double order,
                             double stableFraction, stepOutcome* outcome) {
