@@ -361,12 +361,18 @@ static void springs_store(double* y, const pdSprings* s) {
   y[5] = s->s2t.x, y[6] = s->s2t.y, y[7] = s->s2t.z;
 }
 
+// Body b's point velocity at lever arm r from its centre, at state y (0 for a fixed body).
+static pdVec3 velocity_at(const pdModel* model, const double* y, int b, pdVec3 r) {
+  const pdBody* body = &model->bodies[b];
+  if (body->fixed) return (pdVec3){0, 0, 0};
+  const double* yb = y + PD_BODY_STATE_SIZE * body->stateIndex;
+  return pd_v3_add(pd_layout_v(yb), pd_v3_cross(pd_layout_w(yb), r));
+}
+
 // Velocity of body i's material point at world point p.
 static pdVec3 point_velocity(const pdModel* model, const double* y, const pdPose* poses, int i, pdVec3 p) {
-  const pdBody* b = &model->bodies[i];
-  if (b->fixed) return (pdVec3){0, 0, 0};
-  const double* yb = y + PD_BODY_STATE_SIZE * b->stateIndex;
-  return pd_v3_add(pd_layout_v(yb), pd_v3_cross(pd_layout_w(yb), pd_v3_sub(p, poses[i].x)));
+  if (model->bodies[i].fixed) return (pdVec3){0, 0, 0};
+  return velocity_at(model, y, i, pd_v3_sub(p, poses[i].x));
 }
 
 // The poses of moving bodies [begin, end) at y.
@@ -514,30 +520,34 @@ static void force_and_rates(const pdContactParams* p, const double s[PD_CONTACT_
   springs_store(out + 3, &f.rate);
 }
 
+// Body b's centre at state y (a fixed body's where it stands).
+static pdVec3 centre_at(const pdModel* model, const double* y, int b) {
+  const pdBody* body = &model->bodies[b];
+  return body->fixed ? body->x0 : pd_layout_x(y + PD_BODY_STATE_SIZE * body->stateIndex);
+}
+
 void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const double* y, pdContactLinear* out) {
-  poses_from(model, y, set->poses);
   int base = spring_base(model);
   double vmax = model->settings.vmax;
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     int b1 = c->id.body1, b2 = c->id.body2;
-    pdContactGeom g;
-    pd_contact_geometry(model, &c->id, &set->poses[b1], &set->poses[b2], &g);
-    if (g.normal.x == 0.0 && g.normal.y == 0.0 && g.normal.z == 0.0) g.normal = c->normal, g.point = c->point;
-    pdVec3 du =
-        pd_v3_sub(point_velocity(model, y, set->poses, b1, g.point), point_velocity(model, y, set->poses, b2, g.point));
-    double s[PD_CONTACT_STATE_SIZE], f0[3 + PD_CONTACT_STATE_SIZE], f1[3 + PD_CONTACT_STATE_SIZE];
-    for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) s[j] = y[base + PD_CONTACT_STATE_SIZE * i + j];
-    force_and_rates(&c->params, s, g.normal, du, f0);
     pdContactLinear* l = &out[i];
     l->body1 = b1, l->body2 = b2;
-    l->r1 = pd_v3_sub(g.point, set->poses[b1].x);
-    l->r2 = pd_v3_sub(g.point, set->poses[b2].x);
+    // the contact's point and normal as record() left them at the list's preparation, at y
+    l->r1 = pd_v3_sub(c->point, centre_at(model, y, b1));
+    l->r2 = pd_v3_sub(c->point, centre_at(model, y, b2));
+    l->invInertia1 = set->invInertiaWorld[b1];
+    l->invInertia2 = set->invInertiaWorld[b2];
+    pdVec3 du = pd_v3_sub(velocity_at(model, y, b1, l->r1), velocity_at(model, y, b2, l->r2));
+    double s[PD_CONTACT_STATE_SIZE], f0[3 + PD_CONTACT_STATE_SIZE], f1[3 + PD_CONTACT_STATE_SIZE];
+    for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) s[j] = y[base + PD_CONTACT_STATE_SIZE * i + j];
+    force_and_rates(&c->params, s, c->normal, du, f0);
     for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) {
       double keep = s[j];
       s[j] += PD_LINEARISE_STEP_REL * fmax(fabs(keep), c->deltaMax);
       double step = s[j] - keep;
-      force_and_rates(&c->params, s, g.normal, du, f1);
+      force_and_rates(&c->params, s, c->normal, du, f1);
       s[j] = keep;
       for (int r = 0; r < 3; ++r) l->Ds[r][j] = (f1[r] - f0[r]) / step;
       for (int r = 0; r < PD_CONTACT_STATE_SIZE; ++r) l->Gs[r][j] = (f1[3 + r] - f0[3 + r]) / step;
@@ -547,7 +557,7 @@ void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const dou
       double keep = u[j];
       u[j] += PD_LINEARISE_STEP_REL * fmax(fabs(keep), vmax);
       double step = u[j] - keep;
-      force_and_rates(&c->params, s, g.normal, (pdVec3){u[0], u[1], u[2]}, f1);
+      force_and_rates(&c->params, s, c->normal, (pdVec3){u[0], u[1], u[2]}, f1);
       u[j] = keep;
       for (int r = 0; r < 3; ++r) l->Du[r][j] = (f1[r] - f0[r]) / step;
       for (int r = 0; r < PD_CONTACT_STATE_SIZE; ++r) l->Gu[r][j] = (f1[3 + r] - f0[3 + r]) / step;

@@ -98,16 +98,19 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
 // One contact linearised at a state (the implicit stepper's matrix W): with Δu its relative velocity and s its 8
 // springs (pdSprings' order: s1n, s2n, s1t, s2t), the force F on body 1 (−F on body 2) and the spring rates ṡ
 // change as δF = Du δΔu + Ds δs and δṡ = Gu δΔu + Gs δs; r1, r2 are the lever arms p − x of the contact point
-// from the bodies' centres (world). A contact whose force pulls applies none: its Du and Ds are 0.
+// from the bodies' centres (world), invInertia1, 2 the bodies' world inverse inertias (0 for a fixed body). A
+// contact whose force pulls applies none: its Du and Ds are 0.
 typedef struct pdContactLinear {
   int body1, body2;  // model body indices
   pdVec3 r1, r2;     // m
+  pdMat3 invInertia1, invInertia2;  // R I⁻¹ Rᵀ, 1/(kg m²)
   double Du[3][3], Ds[3][PD_CONTACT_STATE_SIZE];
   double Gu[PD_CONTACT_STATE_SIZE][3], Gs[PD_CONTACT_STATE_SIZE][PD_CONTACT_STATE_SIZE];
 } pdContactLinear;
 
-// Every listed contact linearised at state y (out[i] for contact i, out sized for the list), by forward
-// differences of pd_contact_force (11 calls a contact) at the geometry of y. Leaves the set's poses at y.
+// Every listed contact linearised at state y, the state the list was last prepared at (a step's start: its
+// geometry, force and the bodies' inertias are the list's own), into out[i] for contact i (out sized for the
+// list), by forward differences of pd_contact_force (11 calls a contact).
 void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const double* y, pdContactLinear* out);
 
 // Spring energy ½ Σ k s² of the contacts whose springs are in y (J).

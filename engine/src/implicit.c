@@ -44,7 +44,6 @@ struct pdImplicit {
   gsl_permutation* perm;  // of `rows` elements
   int rows;
   double hg;
-  pdMat3* invInertia;  // world inverse inertia per moving body (rowCapacity / 6)
 };
 
 pdImplicit* pd_implicit_create(void) {
@@ -59,7 +58,6 @@ void pd_implicit_free(pdImplicit* im) {
   free(im->blocks);
   free(im->S);
   free(im->rb);
-  free(im->invInertia);
   if (im->perm) gsl_permutation_free(im->perm);
   free(im);
 }
@@ -84,8 +82,7 @@ static void reserve(pdImplicit* im, int contacts, int rows) {
   if (rows > im->rowCapacity) {
     im->S = realloc(im->S, (size_t)rows * (size_t)rows * sizeof *im->S);
     im->rb = realloc(im->rb, (size_t)rows * sizeof *im->rb);
-    im->invInertia = realloc(im->invInertia, (size_t)(rows / BODY_ROWS) * sizeof *im->invInertia);
-    PD_ASSERT(im->S != NULL && im->rb != NULL && im->invInertia != NULL);
+    PD_ASSERT(im->S != NULL && im->rb != NULL);
     im->rowCapacity = rows;
   }
   if (!im->perm || im->perm->size != (size_t)rows) {  // an island's rows change only when its bodies do
@@ -142,13 +139,11 @@ static pdVec3 relative_velocity(const double* x, int row1, int row2, pdVec3 r1, 
   return du;
 }
 
-// out[row ..] += sign L F for moving body b (moving index k): F/m to the velocity rows, I⁻¹ (r × F) to the
-// angular ones.
-static void add_push(const pdModel* model, const pdImplicit* im, int b, int row, pdVec3 r, pdVec3 F, double sign,
-                     double* out, int k) {
-  const pdBody* body = &model->bodies[b];
-  pdVec3 a = pd_v3_scale(F, body->invMass * sign);
-  pdVec3 alpha = pd_v3_scale(pd_mat3_mulv(&im->invInertia[k], pd_v3_cross(r, F)), sign);
+// out[row ..] += sign L F for a moving body of inverse mass invMass and world inverse inertia invInertia: F/m to the
+// velocity rows, I⁻¹ (r × F) to the angular ones.
+static void add_push(double invMass, const pdMat3* invInertia, int row, pdVec3 r, pdVec3 F, double sign, double* out) {
+  pdVec3 a = pd_v3_scale(F, invMass * sign);
+  pdVec3 alpha = pd_v3_scale(pd_mat3_mulv(invInertia, pd_v3_cross(r, F)), sign);
   out[row] += a.x, out[row + 1] += a.y, out[row + 2] += a.z;
   out[row + 3] += alpha.x, out[row + 4] += alpha.y, out[row + 5] += alpha.z;
 }
@@ -165,14 +160,14 @@ void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im,
   reserve(im, contacts > 0 ? contacts : 1, rows);
   im->rows = rows;
   pd_contact_set_linearise(model, state->contacts, y, im->linear);
-  const pdPose* poses = pd_contact_set_poses(state->contacts);
-  for (int k = 0; k < model->movingCount; ++k) {
-    int b = model->movingBodies[k];
-    const pdMat3* R = &poses[b].R;
-    pdMat3 t = pd_mat3_mul(R, &model->bodies[b].invInertia);
-    pdMat3 Rt = pd_mat3_transpose(R);
-    im->invInertia[k] = pd_mat3_mul(&t, &Rt);
-  }
+}
+
+// Contact l's push σ_k L_k F on its end k (0: body 1, 1: body 2) into out.
+static void push_end(const pdModel* model, const pdContactLinear* l, int k, int row, pdVec3 F, double* out) {
+  if (k == 0)
+    add_push(model->bodies[l->body1].invMass, &l->invInertia1, row, l->r1, F, 1.0, out);
+  else
+    add_push(model->bodies[l->body2].invMass, &l->invInertia2, row, l->r2, F, -1.0, out);
 }
 
 // Whether a contact's springs drive their own rates (Gs ≠ 0, as in slip, where the friction limit follows the
@@ -229,7 +224,6 @@ bool pd_implicit_factor(const pdModel* model, const pdState* state, pdImplicit* 
     // S −= σ_k σ_l L_k E K_l, column by column of K_l (a unit velocity or spin of body l): its point velocity
     // through E is a force, pushed on body k
     const int rowOf[2] = {blk->row1, blk->row2};
-    const int bodyOf[2] = {l->body1, l->body2};
     const pdVec3 leverOf[2] = {l->r1, l->r2};
     const double sign[2] = {1.0, -1.0};
     for (int ll = 0; ll < 2; ++ll) {
@@ -240,9 +234,9 @@ bool pd_implicit_factor(const pdModel* model, const pdState* state, pdImplicit* 
         pdVec3 F = mul3((const double(*)[3])E, point_velocity_of(unit, leverOf[ll]));
         for (int kk = 0; kk < 2; ++kk) {
           if (rowOf[kk] < 0) continue;
-          double col[BODY_ROWS] = {0};
-          add_push(model, im, bodyOf[kk], 0, leverOf[kk], F, 1.0, col, rowOf[kk] / BODY_ROWS);
-          double s = -sign[kk] * sign[ll];
+          double col[BODY_ROWS] = {0};  // σ_k L_k F
+          push_end(model, l, kk, 0, F, col);
+          double s = -sign[ll];
           for (int i = 0; i < BODY_ROWS; ++i) S[(rowOf[kk] + i) * rows + rowOf[ll] + j] += s * col[i];
         }
       }
@@ -281,8 +275,8 @@ void pd_implicit_solve(const pdModel* model, const pdState* state, pdImplicit* i
       f[i] = acc;
     }
     pdVec3 F = {f[0], f[1], f[2]};
-    if (blk->row1 >= 0) add_push(model, im, l->body1, blk->row1, l->r1, F, 1.0, im->rb, blk->row1 / BODY_ROWS);
-    if (blk->row2 >= 0) add_push(model, im, l->body2, blk->row2, l->r2, F, -1.0, im->rb, blk->row2 / BODY_ROWS);
+    if (blk->row1 >= 0) push_end(model, l, 0, blk->row1, F, im->rb);
+    if (blk->row2 >= 0) push_end(model, l, 1, blk->row2, F, im->rb);
   }
   if (im->rows > 0) {
     gsl_matrix_view mv = gsl_matrix_view_array(im->S, (size_t)im->rows, (size_t)im->rows);
@@ -323,8 +317,8 @@ void pd_implicit_apply_w(const pdModel* model, const pdState* state, const pdImp
     for (int i = 0; i < 3; ++i)
       for (int m = 0; m < SPRINGS; ++m) f[i] += l->Ds[i][m] * xc[m];
     F = (pdVec3){f[0], f[1], f[2]};
-    if (blk->row1 >= 0) add_push(model, im, l->body1, blk->row1, l->r1, F, 1.0, body, blk->row1 / BODY_ROWS);
-    if (blk->row2 >= 0) add_push(model, im, l->body2, blk->row2, l->r2, F, -1.0, body, blk->row2 / BODY_ROWS);
+    if (blk->row1 >= 0) push_end(model, l, 0, blk->row1, F, body);
+    if (blk->row2 >= 0) push_end(model, l, 1, blk->row2, F, body);
     for (int i = 0; i < SPRINGS; ++i) {
       double acc = l->Gu[i][0] * du.x + l->Gu[i][1] * du.y + l->Gu[i][2] * du.z;
       for (int m = 0; m < SPRINGS; ++m) acc += l->Gs[i][m] * xc[m];

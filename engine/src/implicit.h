@@ -42,8 +42,8 @@ bool pd_implicit_note_explicit(pdImplicit* im, bool held);
 // Back to step doubling.
 void pd_implicit_deactivate(pdImplicit* im);
 
-// Linearises the contacts of `state` at state y (W's blocks; the set's poses are left at y): once per step start,
-// whatever the trials from there.
+// Linearises the contacts of `state` at state y, the state its contact list was last prepared at (a step's start;
+// pd_contact_set_linearise), into W's blocks: once per step, whatever the trials from there.
 void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im, const double* y);
 
 // Forms M = I/hg − W from the last linearisation and factorises it. Returns false when M is singular or not finite
