@@ -14,7 +14,7 @@
 
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
-    "                         [--stepper adaptive|fixed|embedded|implicit] [--variant native|matched]\n"
+    "                         [--stepper implicit|adaptive|fixed|embedded] [--variant native|matched]\n"
     "                         [--onsets pair|exact|auto] [--islands on|off] [--threads N] [--step H]\n"
     "                         [--ode-friction pyramid|aligned]\n"
     "\n"
@@ -26,11 +26,13 @@ static const char* const help =
     "                   a reference engine (README \"Reference engines\")\n"
     "  --tend T         simulated seconds, overrides the scene's tend\n"
     "  --sample HZ      output samples per second, overrides the scene's sample\n"
-    "  --stepper NAME   adaptive: RK4 with step-doubling error control (default);\n"
+    "  --stepper NAME   implicit (default): RK4 with step-doubling error control, switching island by\n"
+    "                   island to a linearly implicit method (ROS34PW2) where the contacts' stability\n"
+    "                   bound holds RK4 to a fraction of the steps its error allows: resting and\n"
+    "                   sliding contact, islands of up to 16 bodies (README \"Integration\");\n"
+    "                   adaptive: RK4 with step-doubling error control alone (the paper's);\n"
     "                   fixed: RK4 with the scene's dt, no error control;\n"
-    "                   embedded: RK4 with its embedded third-order error estimate;\n"
-    "                   implicit: a linearly implicit method (ROS34PW2) with no stability bound, in\n"
-    "                   islands of up to 16 bodies, for resting contact (soft engine; README \"Integration\")\n"
+    "                   embedded: RK4 with its embedded third-order error estimate\n"
     "  --onsets MODE    soft engine, a contact that began inside a step: exact cuts the whole step back\n"
     "                   to its onset; pair joins it at the step's end, run for that pair alone since its\n"
     "                   onset, when it began within 1/omega and is shallow; auto (default) pair in an island\n"
@@ -90,7 +92,7 @@ int pd_cmd_run(int argc, char** argv) {
   const char* out = NULL;
   const char* engine = "soft";
   pdCliOverrides overrides = {0};
-  pdStepper stepper = pd_stepperRK4Adaptive;
+  pdStepper stepper = PD_STEPPER_DEFAULT;
   pdRefOptions ref = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
   pdOnsets onsets = PD_ONSETS_DEFAULT;
   pdIslands islands = PD_ISLANDS_DEFAULT;

@@ -41,8 +41,10 @@
 static const char* const help =
     "usage: polydyn sweep SCENE --out DIR [--repeats R] [--engines soft,ode,bullet] [--tend T] [--jobs N]\n"
     "\n"
-    "Work-precision sweep of SCENE: polydyn's adaptive RK4 (step doubling) and its embedded RK4(3) pair at\n"
-    "tol 1e-2 ... 1e-10 (decades), its fixed-step RK4 at dt 1e-3 ... 1e-5, ODE and Bullet (native and matched)\n"
+    "Work-precision sweep of SCENE: polydyn's default stepper (implicit: step doubling switching to ROS34PW2\n"
+    "where the contacts' stability bound holds it), adaptive RK4 (step doubling alone) and its embedded RK4(3)\n"
+    "pair at tol 1e-2 ... 1e-10 (decades), its fixed-step RK4 at dt 1e-3 ... 1e-5, ODE and Bullet (native and\n"
+    "matched)\n"
     "at steps 1/60 ... 1/16000 s. Errors are the RMS over samples and moving bodies of\n"
     "max(|x - x_ref| / body size, rotation angle in rad):\n"
     "  error        against the soft engine at tol 1e-12 (whose own error, against tol 1e-13, is reported as\n"
@@ -151,6 +153,7 @@ static void measure_soft(const char* scene, const pdCliOverrides* base, int repe
   pdTrajectory* tr = pd_trajectory_create(model);
   pdStepper stepper = fixed                                 ? pd_stepperRK4Fixed
                       : strcmp(p->variant, "embedded") == 0 ? pd_stepperRK43Embedded
+                      : strcmp(p->variant, "implicit") == 0 ? pd_stepperImplicit
                                                             : pd_stepperRK4Adaptive;
   for (int r = 0; r < repeats; ++r) {
     p->completed = soft_run(model, stepper, r == 0 ? tr : NULL, &walls[r], &p->steps, &p->derivatives);
@@ -398,6 +401,8 @@ int pd_cmd_sweep(int argc, char** argv) {
       points[count++] = (point){.engine = "soft", .variant = "fixed", .setting = "step", .value = fixedSteps[i]};
     for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i)
       points[count++] = (point){.engine = "soft", .variant = "embedded", .setting = "tol", .value = tols[i]};
+    for (size_t i = 0; i < sizeof tols / sizeof tols[0]; ++i)
+      points[count++] = (point){.engine = "soft", .variant = "implicit", .setting = "tol", .value = tols[i]};
   }
   // the kept runs: the soft reference, its check, and each ODE and Bullet variant's finest step (its own
   // reference: the variant's coarser points are measured against it in the second batch)

@@ -47,7 +47,7 @@ static const char* const pointStatusNames[] = {"ok", "failed", "no_measure", "re
 typedef struct gkPoint {
   const gkCase* c;
   pdGkEngine engine;
-  const char* variant;  // "adaptive", "fixed", "embedded", "native", "matched"
+  const char* variant;  // "adaptive", "fixed", "embedded", "implicit", "native", "matched"
   const char* setting;  // "tol", "step", "iterations"; "" for a not_built row
   double value;
   // measured (travels between processes as gkPointResult)
@@ -145,6 +145,7 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
       pdState* state = pd_state_create(model);
       state->stepper = strcmp(p->variant, "fixed") == 0      ? pd_stepperRK4Fixed
                        : strcmp(p->variant, "embedded") == 0 ? pd_stepperRK43Embedded
+                       : strcmp(p->variant, "implicit") == 0 ? pd_stepperImplicit
                                                              : pd_stepperRK4Adaptive;
       double t0 = gk_wall_seconds();
       completed = pd_advance(model, state, model->settings.tend, observe, &observer);
@@ -249,6 +250,7 @@ static void add_case_points(gkPrecision* s, const gkCase* c) {
     for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "adaptive", "tol", softTolerances[k]);
     for (int k = 0; k < SOFT_FIXED_COUNT; ++k) add(s, c, pd_gkSoft, "fixed", "step", softFixedSteps[k]);
     for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "embedded", "tol", softTolerances[k]);
+    for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "implicit", "tol", softTolerances[k]);
   }
   for (int engine = pd_gkOde; engine < pd_gkEngineCount; ++engine) {
     if (!o->engines[engine]) continue;

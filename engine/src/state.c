@@ -28,7 +28,7 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   s->h = set->dt;
   s->n = PD_BODY_STATE_SIZE * model->movingCount;
   pd_contact_set_clear(s->contacts);
-  s->stepper = pd_stepperRK4Adaptive;
+  s->stepper = PD_STEPPER_DEFAULT;
   s->onsets = PD_ONSETS_DEFAULT;
   s->islands = PD_ISLANDS_DEFAULT;
   s->threads = 1;

@@ -6,7 +6,7 @@
 # runs with MALLOC_PERTURB_ set (glibc then fills fresh and freed heap memory with a pattern), so an output
 # that depends on where it is written or on uninitialised memory shows up. Covered here:
 #   run       demo.scene, a hard case (the 10-box stack), the brick wall (short), the pile of ten boxes (also
-#             with --islands on); the pile in ODE and Bullet; demo with the fixed stepper and with the embedded pair;
+#             with --islands on); the pile in ODE and Bullet; demo with the fixed stepper, with the embedded pair and with step doubling alone;
 #             the pile of 100 boxes (short) with --islands on, --threads 1 against --threads 2
 #   check     the pile
 #   oracle    --random, a SCENE, --replay (its CSV and its summary)
@@ -69,7 +69,8 @@ twice run_pile_ode run "$SRC/cases/sweep/pile_10.scene" --tend $TEND_PILE --engi
 twice run_pile_bullet run "$SRC/cases/sweep/pile_10.scene" --tend $TEND_PILE --engine bullet
 twice run_demo_fixed run "$SRC/cases/examples/demo.scene" --stepper fixed --tend 1
 twice run_demo_embedded run "$SRC/cases/examples/demo.scene" --stepper embedded --tend 1
-for R in run_demo run_stack run_bricks run_pile run_pile_islands run_pile_ode run_pile_bullet run_demo_fixed run_demo_embedded; do
+twice run_demo_adaptive run "$SRC/cases/examples/demo.scene" --stepper adaptive --tend 1
+for R in run_demo run_stack run_bricks run_pile run_pile_islands run_pile_ode run_pile_bullet run_demo_fixed run_demo_embedded run_demo_adaptive; do
   [ -d "$SCRATCH/$R" ] || continue
   check "$R: trajectory.csv byte for byte" 'cmp -s "$SCRATCH/$R/first/trajectory.csv" "$SCRATCH/$R/second-run/trajectory.csv"'
   same_dirs $R

@@ -32,7 +32,7 @@ check "9 tolerances, 5 fixed steps, 9 tolerances of the embedded pair" \
 awk -F, 'NR > 1 && $2 == "soft" && $16 !~ /^[1-9][0-9]*$/ { bad = 1 } END { exit bad }' "$OUT/sweep.csv"; rc=$?
 check "every soft row counts its derivative evaluations" '[ $rc -eq 0 ]'
 check "reference.json states the reference's own error" 'grep -q "error_against_check" "$OUT/reference.json"'
-for v in adaptive embedded; do
+for v in implicit adaptive embedded; do
   awk -F, -v v=$v '$3 == v && $5 == "1e-05" { a = $6 } $3 == v && $5 == "1e-09" { b = $6 } END { exit !(a > 0 && b >= 0 && b * 100 < a) }' "$OUT/sweep.csv"; rc=$?
   check "$v: error at tol 1e-9 is at least 100x below that at tol 1e-5" '[ $rc -eq 0 ]'
 done
@@ -64,7 +64,7 @@ for r in rows:
         if not (math.isfinite(e) and e >= 0): bad.append(f"{name}: self_error {r['self_error']!r} is not a finite number")
         if r["engine"] == "soft" and r["self_error"] != r["error"]: bad.append(f"{name}: soft self_error differs from error")
     if r["horizon_seconds"] and not 0 <= float(r["horizon_seconds"]) <= tend: bad.append(f"{name}: horizon {r['horizon_seconds']} outside [0, tend]")
-if len(rows) != 33: bad.append(f"{len(rows)} rows, expected 33 (23 soft, 10 ode)")
+if len(rows) != 42: bad.append(f"{len(rows)} rows, expected 42 (32 soft, 10 ode)")
 bad += [f"{r['engine']} {r['variant']} {r['value']}: derivatives {r['derivatives']!r}" for r in rows
         if r["error"] and (r["derivatives"] == "") != (r["engine"] != "soft")]
 if not any(r["horizon_seconds"] for r in rows): bad.append("no point has a horizon on the tumbling cube")

@@ -55,7 +55,8 @@ typedef enum pdWarning {
 // Names of the warnings (e.g. "step_at_minimum"), as summary.json writes them.
 PD_API extern const char* const pdWarningNames[pd_warnCount];
 
-// Which stepper advances the state. Adaptive RK4 is the paper's; the fixed one is for sweeps.
+// Which stepper advances the state. Adaptive RK4 is the paper's; the implicit one (step doubling that switches to
+// ROS34PW2 where the contacts' stability bound holds it) is the default; the fixed one is for sweeps.
 typedef enum pdStepper {
   pd_stepperRK4Adaptive,   // classic RK4 with step doubling: error = |two half steps − one full step|/15
   pd_stepperRK4Fixed,      // classic RK4 with the step fixed at settings.dt (no error control)
@@ -65,6 +66,11 @@ typedef enum pdStepper {
                            // bound holds step doubling: resting contact. Systems of more than 16 moving bodies
                            // (PD_IMPLICIT_BODIES_MAX) keep step doubling (README, Integration)
 } pdStepper;
+
+// The stepper a new or reset state takes (pd_state_reset) and `polydyn run` uses unless told: it takes step doubling's
+// steps wherever the error control sets them, and longer ones where resting and sliding contacts' stability bound
+// would hold step doubling to a fraction of them (README, Integration).
+#define PD_STEPPER_DEFAULT pd_stepperImplicit
 
 // The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed", "rk43-embedded" or "ros34pw2".
 PD_API const char* pd_stepper_name(pdStepper stepper);
@@ -180,7 +186,7 @@ typedef struct pdBodyState {
 // and be the model passed with it to every other call.
 PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to the adaptive one, onsets to PD_ONSETS_DEFAULT, islands to PD_ISLANDS_DEFAULT and threads to 1 (set
+// to PD_STEPPER_DEFAULT, onsets to PD_ONSETS_DEFAULT, islands to PD_ISLANDS_DEFAULT and threads to 1 (set
 // state->stepper, state->onsets, state->islands, state->threads after this call).
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.

@@ -5,7 +5,7 @@
 export const TARGET_ERROR = 1e-3;
 
 const ENGINE_ORDER = ['soft', 'ode', 'bullet'];
-const VARIANT_ORDER = ['adaptive', 'fixed', 'embedded', 'native', 'matched'];
+const VARIANT_ORDER = ['implicit', 'adaptive', 'fixed', 'embedded', 'native', 'matched'];
 const STATUS_RANK = { PASS: 0, NOT_APPLICABLE: 1, NOT_BUILT: 2, REFUSED: 3, FAIL: 4, ERROR: 5 };
 
 function rank(list, x) {
@@ -14,7 +14,7 @@ function rank(list, x) {
 }
 
 // Engine-variant labels ("soft adaptive", "ode native", ...) in a fixed order: soft, ode, bullet,
-// then others alphabetically; within an engine adaptive, fixed, embedded, native, matched, then others.
+// then others alphabetically; within an engine implicit (the soft default), adaptive, fixed, embedded, native, matched, then others.
 export function orderEngineVariants(items) {
   const seen = new Map();
   for (const it of items) if (!seen.has(it.ev)) seen.set(it.ev, { ev: it.ev, engine: it.engine, variant: it.variant });

@@ -62,7 +62,7 @@ export default {
     if (!pr) return null;
     const labels = pr.curves;
     let html = '<p>Each Gedanken experiment with a closed form, run at every setting of each engine’s accuracy knob (soft: ' +
-      'tolerance of the adaptive RK4 (step doubling) and of the embedded RK4(3) pair, the step of fixed-step RK4; ODE and Bullet: the time step, native and matched). The error is the ' +
+      'tolerance of the default implicit stepper (step doubling switching to ROS34PW2 where contacts rest), of the adaptive RK4 (step doubling alone) and of the embedded RK4(3) pair, the step of fixed-step RK4; ODE and Bullet: the time step, native and matched). The error is the ' +
       'experiment’s own measure against its closed form — the same number the PASS/FAIL matrix judges — and the cost the wall time per ' +
       'simulated second (median of the repeats). Read a diagram from the right: a curve that falls below the dashed tolerance line reaches ' +
       'the answer, and how far left it does so is what it costs; a curve that flattens above the line has an error floor that a finer ' +

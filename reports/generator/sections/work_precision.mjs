@@ -21,7 +21,7 @@ export default {
     if (anySelf)
       html += '<p>Self-convergence: each point is one setting (tolerance or step size; hover for its value), its error the RMS over samples and ' +
         'moving bodies of max(|x − x_ref|/size, rotation angle in rad) against the <em>same engine-variant\'s finest run</em> (polydyn soft, ' +
-        'adaptive, fixed-step and embedded: its adaptive run at tol 1e-12; ODE and Bullet: their own run at the finest step, 1/16000 s, which is their ' +
+        'implicit, adaptive, fixed-step and embedded: its adaptive run at tol 1e-12; ODE and Bullet: their own run at the finest step, 1/16000 s, which is their ' +
         'reference and has no point of its own). It measures how far each engine is from what it would compute with an ever finer ' +
         'setting — not from physics, not from the other engines. Cost: the median wall time of the repeats per simulated second. Lower ' +
         `and further left is better. The dashed line is the error the cost table reads (${num(wp[0].target)}). Below each, the same points ` +
