@@ -34,8 +34,11 @@ typedef struct contactBlock {
 } contactBlock;
 
 struct pdImplicit {
-  bool active;  // stepping implicitly (integrator.c, switching_step)
-  int held;     // explicit steps in a row held by the stability bound
+  bool active;       // stepping implicitly (integrator.c, switching_step)
+  int held;          // explicit steps in a row held by the stability bound
+  double probation;  // s: PD_IMPLICIT_HELD_RATIO × the bound's step at the switch, until an implicit step is accepted
+  double backoff;    // bound steps to wait after the next failed probation (0: none failed since the last that paid)
+  double retryAt;    // s: no switch before this time
   int contactCapacity, rowCapacity;
   pdContactLinear* linear;
   contactBlock* blocks;
@@ -49,6 +52,7 @@ struct pdImplicit {
 pdImplicit* pd_implicit_create(void) {
   pdImplicit* im = calloc(1, sizeof *im);
   PD_ASSERT(im != NULL);
+  im->retryAt = -INFINITY;
   return im;
 }
 
@@ -64,13 +68,25 @@ void pd_implicit_free(pdImplicit* im) {
 
 bool pd_implicit_active(const pdImplicit* im) { return im->active; }
 
-bool pd_implicit_note_explicit(pdImplicit* im, bool held) {
+bool pd_implicit_note_explicit(pdImplicit* im, bool held, double boundStep, double t) {
   im->held = held ? im->held + 1 : 0;
-  if (im->held >= PD_IMPLICIT_SWITCH_STEPS) im->active = true, im->held = 0;
+  if (im->held >= PD_IMPLICIT_SWITCH_STEPS && t >= im->retryAt) {
+    im->active = true, im->held = 0, im->probation = PD_IMPLICIT_HELD_RATIO * boundStep;
+  }
   return im->active;
 }
 
-void pd_implicit_deactivate(pdImplicit* im) { im->active = false, im->held = 0; }
+double pd_implicit_probation_floor(const pdImplicit* im) { return im->probation; }
+
+void pd_implicit_paid(pdImplicit* im) { im->probation = 0.0, im->backoff = 0.0; }
+
+void pd_implicit_deactivate(pdImplicit* im, bool gaveUp, double t) {
+  if (gaveUp) {
+    im->backoff = im->backoff > 0.0 ? fmin(2.0 * im->backoff, PD_IMPLICIT_BACKOFF_MAX) : PD_IMPLICIT_BACKOFF_FIRST;
+    im->retryAt = t + im->backoff * im->probation / PD_IMPLICIT_HELD_RATIO;
+  }
+  im->active = false, im->held = 0, im->probation = 0.0;
+}
 
 static void reserve(pdImplicit* im, int contacts, int rows) {
   if (contacts > im->contactCapacity) {

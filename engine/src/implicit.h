@@ -24,6 +24,16 @@
 // trial costs about two explicit ones on a small system).
 #define PD_IMPLICIT_SWITCH_STEPS 3
 #define PD_IMPLICIT_HELD_RATIO 2.0
+// A switch is on probation until its first implicit step is accepted. Its error control may reject the first trial
+// down to the probation floor, PD_IMPLICIT_HELD_RATIO times the step the bound held step doubling to, and no
+// further: a trial at the floor rejected means that the implicit method's order-2 estimate, not the bound, limits
+// its step (a stack still ringing after its landing). The system then gives up, takes the step by step doubling,
+// and tries again no earlier than a back-off later: PD_IMPLICIT_BACKOFF_FIRST bound steps after the first failure,
+// doubling after each failure in a row up to PD_IMPLICIT_BACKOFF_MAX bound steps (at most one wasted pair of trials
+// in so many steps), and none after a switch that paid. Without it a ringing stack of 5-9 boxes switched every
+// fourth step and had its implicit trials rejected: up to 2× step doubling's steps (soak seeds 28 and 29).
+#define PD_IMPLICIT_BACKOFF_FIRST 8.0
+#define PD_IMPLICIT_BACKOFF_MAX 256.0
 // After an implicit step that a contact event cut, the next may be at most this many times as long (the event,
 // typically the tunnelling guard of a sliding body, would cut a longer one again, each retry a wasted trial).
 #define PD_IMPLICIT_GROWTH_AFTER_CUT 1.0
@@ -36,11 +46,16 @@ void pd_implicit_free(pdImplicit* im);
 
 // Whether the system steps implicitly now, and the switch's bookkeeping (PD_IMPLICIT_SWITCH_STEPS).
 bool pd_implicit_active(const pdImplicit* im);
-// After an accepted explicit step: `held` says whether the stability bound held it (see above). Returns true
-// when the system switches to the implicit method.
-bool pd_implicit_note_explicit(pdImplicit* im, bool held);
-// Back to step doubling.
-void pd_implicit_deactivate(pdImplicit* im);
+// After an explicit step accepted at time t: `held` says whether the stability bound held it (see above), `boundStep`
+// (s) the step it held it to. Returns true when the system switches to the implicit method, on probation.
+bool pd_implicit_note_explicit(pdImplicit* im, bool held, double boundStep, double t);
+// On probation, the step below which the implicit method does not pay (PD_IMPLICIT_HELD_RATIO × the bound's step);
+// 0 once an implicit step was accepted.
+double pd_implicit_probation_floor(const pdImplicit* im);
+// The first implicit step after a switch was accepted: no back-off before the next switch.
+void pd_implicit_paid(pdImplicit* im);
+// Back to step doubling at time t; `gaveUp` after a probation that failed (the back-off above).
+void pd_implicit_deactivate(pdImplicit* im, bool gaveUp, double t);
 
 // Linearises the contacts of `state` at state y, the state its contact list was last prepared at (a step's start;
 // pd_contact_set_linearise), into W's blocks: once per step, whatever the trials from there.

@@ -274,6 +274,7 @@ static double trial_implicit(const pdModel* model, pdState* s, stepperWork* w, d
 typedef struct stepOutcome {
   double wanted;
   bool eventCut;
+  bool gaveUp;  // the error control rejected the trial below `giveUpBelow` (nothing taken, s->h unchanged)
 } stepOutcome;
 
 // Takes one accepted step of at most `hMax` from state->t with error control. Returns the step taken (0 on
@@ -282,7 +283,7 @@ typedef struct stepOutcome {
 // steps) the whole trial step may use (INFINITY: none); `outcome` (nullable) receives the accepted step's outcome.
 
 static double adaptive_step(const pdModel* model, pdState* s, double hMax, trialFcn* trial, double order,
-                            double stableFraction, stepOutcome* outcome) {
+                            double stableFraction, double giveUpBelow, stepOutcome* outcome) {
   const pdSettings* set = &model->settings;
   stepperWork w = work_of(s);
   derivative(model, s, s->t, s->y, w.k1);
@@ -313,6 +314,14 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     if (norm > set->tol && !atMinimum) {
       ++s->count.rejected;
       double shrink = fmax(STEP_REJECT_SHRINK_MIN, STEP_SAFETY * pow(set->tol / norm, 1.0 / (order - 1.0)));
+      if (shrink * h < giveUpBelow) {
+        // a trial at the floor itself was rejected: give up; else the next trial is the floor
+        if (h <= giveUpBelow) {
+          if (outcome) *outcome = (stepOutcome){s->h, eventCut, true};
+          return 0.0;
+        }
+        shrink = giveUpBelow / h;
+      }
       s->h = fmax(set->dtmin, shrink * h);
       continue;
     }
@@ -339,7 +348,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       grow = fmin(STEP_GROW_MAX, fmax(STEP_SHRINK_MIN, grow));
       s->h = fmin(set->dtmax, fmax(set->dtmin, grow * h));
     }
-    if (outcome) *outcome = (stepOutcome){s->h, eventCut};
+    if (outcome) *outcome = (stepOutcome){s->h, eventCut, false};
     // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge (an implicit
     // trial has none: stableFraction INFINITY)
     if (stableFraction < INFINITY) {
@@ -357,19 +366,37 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
 // steps on a resting pile). The switch (implicit.h, PD_IMPLICIT_SWITCH_STEPS) looks only at the state's own
 // numbers, so it is the same on every run. Systems of more than PD_IMPLICIT_BODIES_MAX moving bodies stay explicit.
 static double switching_step(const pdModel* model, pdState* s, double hMax) {
-  if (model->movingCount > PD_IMPLICIT_BODIES_MAX) return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL);
+  if (model->movingCount > PD_IMPLICIT_BODIES_MAX)
+    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, NULL);
   if (!s->implicit) s->implicit = pd_implicit_create();
   pdImplicit* im = s->implicit;
-  stepOutcome out = {0.0, false};
+  stepOutcome out = {0.0, false, false};
   if (!pd_implicit_active(im)) {
-    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, &out);
+    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, &out);
     // s->h is now the bound's step: on a switch the implicit method starts from the step the error control wanted
     bool held = !out.eventCut && out.wanted >= PD_IMPLICIT_HELD_RATIO * s->h;
-    if (taken > 0.0 && pd_implicit_note_explicit(im, held)) s->h = out.wanted;
+    if (taken > 0.0 && pd_implicit_note_explicit(im, held, s->h, s->t)) s->h = out.wanted;
     return taken;
   }
-  double taken = adaptive_step(model, s, hMax, trial_implicit, 3.0, INFINITY, &out);
+  double floor = pd_implicit_probation_floor(im);
+  // on probation, a step a sample cuts below the floor would prove nothing: step doubling takes it, from the bound's
+  // step, and the probation waits for the next
+  if (hMax < floor) {
+    double wanted = s->h;
+    s->h = floor / PD_IMPLICIT_HELD_RATIO;
+    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, NULL);
+    if (taken > 0.0) s->h = fmax(s->h, wanted);
+    return taken;
+  }
+  double taken = adaptive_step(model, s, hMax, trial_implicit, 3.0, INFINITY, floor, &out);
+  if (out.gaveUp) {
+    // on probation and not paying: step doubling takes this step, from the bound's step it was held to
+    s->h = floor / PD_IMPLICIT_HELD_RATIO;
+    pd_implicit_deactivate(im, true, s->t);
+    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, NULL);
+  }
   if (taken > 0.0) {
+    if (floor > 0.0) pd_implicit_paid(im);
     s->count.implicitSteps += 1;
     // a step an event cut (a body sliding fast at its tunnelling guard) is the step the next one will meet too:
     // the implicit trial is dear, so it grows from there rather than from what its error control wants
@@ -379,7 +406,7 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     double worth = (out.eventCut ? fmin(out.wanted, taken) : out.wanted) / PD_IMPLICIT_HELD_RATIO;
     bool tightNeeded;
     if (pd_contact_set_limit_step(model, s->contacts, worth, 1.0, &tightNeeded) >= worth) {
-      pd_implicit_deactivate(im);
+      pd_implicit_deactivate(im, false, s->t);
       s->count.stabilityTight += tightNeeded;
     }
   }
@@ -454,14 +481,14 @@ bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, pdObserver
           taken = fixed_step(model, s, hMax);
           break;
         case pd_stepperRK43Embedded:
-          taken = adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, NULL);
+          taken = adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, 0.0, NULL);
           break;
         case pd_stepperImplicit:
           taken = switching_step(model, s, hMax);
           break;
         case pd_stepperRK4Adaptive:
         default:
-          taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL);
+          taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, NULL);
           break;
       }
     }

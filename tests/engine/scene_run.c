@@ -41,7 +41,7 @@ static bool record_sample(const pdModel* model, const pdState* state, void* user
   return true;
 }
 
-record* run(const pdModel* model, pdState** stateOut) { return run_with(model, pd_stepperRK4Adaptive, stateOut); }
+record* run(const pdModel* model, pdState** stateOut) { return run_with(model, PD_STEPPER_DEFAULT, stateOut); }
 
 record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut) {
   return run_onsets(model, stepper, pd_onsetsExact, stateOut);

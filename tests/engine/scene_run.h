@@ -23,7 +23,7 @@ pdModel* compile_text(const char* text);
 // Runs the model to its tend; asserts that it got there with finite numbers only. The record is the
 // caller's (free); the final state too when stateOut is not NULL (pd_state_free).
 record* run(const pdModel* model, pdState** stateOut);
-// The same with the given stepper (run: the default, adaptive RK4 with step doubling).
+// The same with the given stepper (run: the default, PD_STEPPER_DEFAULT).
 record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut);
 // The same with the given onset mode too (run_with: pd_onsetsExact, which the default pd_onsetsAuto is in
 // systems of at most PD_ONSETS_CROWD_BODIES moving bodies).
