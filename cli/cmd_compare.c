@@ -287,8 +287,8 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
   snprintf(runs[count].name, sizeof runs[count].name, "soft-reference");
   ++count;
   if (pd_cli_list_has(c->engines, "soft")) {
-    runs[count] = (compareRun){.engine = "soft", .variant = "adaptive", .status = "failed"};
-    snprintf(runs[count].name, sizeof runs[count].name, "soft-adaptive");
+    runs[count] = (compareRun){.engine = "soft", .variant = "implicit", .status = "failed"};
+    snprintf(runs[count].name, sizeof runs[count].name, "soft-implicit");
     ++count;
   }
   static const char* const refEngines[] = {"ode", "bullet"};

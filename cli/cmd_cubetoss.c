@@ -77,7 +77,7 @@ static void on_signal(int sig) {
 typedef struct engineSpec {
   const char* name;     // soft, ode, bullet
   char label[24];       // soft, ode-native, ...: run directories, messages
-  const char* variant;  // adaptive, native, matched
+  const char* variant;  // implicit (the soft engine's default stepper), native, matched
   pdTossEngine engine;
   pdTossParams params;
   const char* paramsFile;  // nullable
@@ -240,7 +240,7 @@ static int make_engines(const options* o, engineSpec* specs, char* why, size_t w
     memset(s, 0, sizeof *s);
     s->name = order[e];
     bool soft = e == 0;
-    s->variant = soft ? "adaptive" : o->variant == pd_refMatched ? "matched" : "native";
+    s->variant = soft ? "implicit" : o->variant == pd_refMatched ? "matched" : "native";
     snprintf(s->label, sizeof s->label, soft ? "%s" : "%s-%s", s->name, s->variant);
     s->engine = (pdTossEngine){.name = s->name,
                                .ref = {.variant = o->variant, .step = o->step, .odeFriction = pd_odeFrictionPyramid}};

@@ -100,7 +100,7 @@ typedef struct gkJob {
 } gkJob;
 
 static const char* variant_of(pdGkEngine engine, bool matched) {
-  if (engine == pd_gkSoft) return "adaptive";
+  if (engine == pd_gkSoft) return "implicit";  // the soft runs take the default stepper (PD_STEPPER_DEFAULT)
   return matched ? "matched" : "native";
 }
 

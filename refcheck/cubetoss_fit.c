@@ -96,8 +96,9 @@ static void trace_row(const fitContext* c, double j, double penalty) {
   FILE* out = c->o->trace;
   if (!out) return;
   const pdTossParams* p = &c->params;
-  const char* variant = strcmp(c->o->engine.name, "soft") == 0 ? "adaptive"
-                        : c->o->engine.ref.variant == pd_refMatched ? "matched" : "native";
+  const char* variant = strcmp(c->o->engine.name, "soft") == 0      ? "implicit"
+                        : c->o->engine.ref.variant == pd_refMatched ? "matched"
+                                                                    : "native";
   fprintf(out, "%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%.6g\n", c->o->engine.name, variant, c->evaluations,
           p->mu, p->restitution, p->kn, j, c->posMean, c->rotMean, c->failed, penalty);
   fflush(out);

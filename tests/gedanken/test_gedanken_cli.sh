@@ -45,8 +45,8 @@ check "fast subset, soft engine: exit 0" '[ $rc -eq 0 ]'
 check "results.csv has the fixed header" '[ "$(head -n 1 "$FAST/results.csv")" = "$HEADER" ]'
 check "every soft row of the fast subset PASSes" \
   '[ "$(csv_query "$FAST/results.csv" "len(rows) > 0 and all(r[\"status\"] == \"PASS\" for r in rows)")" = True ]'
-check "rows are soft/adaptive only" \
-  '[ "$(csv_query "$FAST/results.csv" "{(r[\"engine\"], r[\"variant\"]) for r in rows}")" = "{('"'"'soft'"'"', '"'"'adaptive'"'"')}" ]'
+check "rows are soft/implicit only" \
+  '[ "$(csv_query "$FAST/results.csv" "{(r[\"engine\"], r[\"variant\"]) for r in rows}")" = "{('"'"'soft'"'"', '"'"'implicit'"'"')}" ]'
 check "every row has 16 fields and no NaN" \
   '[ "$(csv_query "$FAST/results.csv" "all(len(r) == 16 and None not in r and \"nan\" not in \",\".join(r.values()).lower() for r in rows)")" = True ]'
 check "quantitative rows carry measured, expected, error and tolerance as numbers" \
@@ -62,8 +62,8 @@ check "experiments.json lists the experiments run, with the schema's fields" \
 check "one series file per experiment, with its header and at most 500 rows per run" \
   '[ "$(python3 -c "import csv, glob, collections; fs = glob.glob(\"$FAST/series/*.csv\"); n = [collections.Counter((r[\"engine\"], r[\"variant\"], r[\"input\"]) for r in csv.DictReader(open(f))) for f in fs]; print(len(fs), all(open(f).readline().strip() == \"t,engine,variant,input,value,analytic\" for f in fs), max(max(c.values()) for c in n) <= 500)")" = "$(csv_query "$FAST/results.csv" "len({r[\"experiment\"] for r in rows})") True True" ]'
 check "a run directory replays: its scene.scene gives the same trajectory" \
-  '"$PD" run "$FAST/runs/c2_momentum/soft-adaptive/scene.scene" --out "$SCRATCH/replay" >/dev/null 2>&1 &&
-   cmp -s "$SCRATCH/replay/trajectory.csv" "$FAST/runs/c2_momentum/soft-adaptive/trajectory.csv"'
+  '"$PD" run "$FAST/runs/c2_momentum/soft-implicit/scene.scene" --out "$SCRATCH/replay" >/dev/null 2>&1 &&
+   cmp -s "$SCRATCH/replay/trajectory.csv" "$FAST/runs/c2_momentum/soft-implicit/trajectory.csv"'
 
 # --- the applied-force experiments (catalogue B3, B5) on the soft engine --------------------------------
 FORCE=$SCRATCH/force
@@ -74,15 +74,15 @@ check "B3: the onset at two ramp rates, each within 0.5 % of mu m g/beta" \
 check "B5: slides (0) 2 % below mu = w/(2H), tips (1) 2 % above" \
   '[ "$(csv_query "$FORCE/results.csv" "[(r[\"input\"], r[\"measured\"], r[\"status\"]) for r in rows if r[\"experiment\"] == \"b5_tip_or_slide\"]")" = "[('"'"'mu_ratio=0.98'"'"', '"'"'0'"'"', '"'"'PASS'"'"'), ('"'"'mu_ratio=1.02'"'"', '"'"'1'"'"', '"'"'PASS'"'"')]" ]'
 check "B3: the run directory records the applied force" \
-  'grep -q "\"applied_force\": {\"force\": \[0,0,0\], \"rate\": \[4,0,0\]" "$FORCE/runs/b3_ramp_onset/soft-adaptive-beta=4/summary.json" &&
-   grep -q "\"excludes_applied_work\": true" "$FORCE/runs/b3_ramp_onset/soft-adaptive-beta=4/summary.json"'
+  'grep -q "\"applied_force\": {\"force\": \[0,0,0\], \"rate\": \[4,0,0\]" "$FORCE/runs/b3_ramp_onset/soft-implicit-beta=4/summary.json" &&
+   grep -q "\"excludes_applied_work\": true" "$FORCE/runs/b3_ramp_onset/soft-implicit-beta=4/summary.json"'
 
 # --- reference engines: rows for every variant, never a failure of the exit status ---------------------
 REF=$SCRATCH/ref
 run_pd gedanken --only a3_sinkage --out "$REF"
 check "all engines: exit 0 when the soft engine passes" '[ $rc -eq 0 ]'
 check "all engines: one soft row and ode/bullet native and matched rows" \
-  '[ "$(csv_query "$REF/results.csv" "[(r[\"engine\"], r[\"variant\"]) for r in rows]")" = "[('"'"'soft'"'"', '"'"'adaptive'"'"'), ('"'"'ode'"'"', '"'"'native'"'"'), ('"'"'ode'"'"', '"'"'matched'"'"'), ('"'"'bullet'"'"', '"'"'native'"'"'), ('"'"'bullet'"'"', '"'"'matched'"'"')]" ]'
+  '[ "$(csv_query "$REF/results.csv" "[(r[\"engine\"], r[\"variant\"]) for r in rows]")" = "[('"'"'soft'"'"', '"'"'implicit'"'"'), ('"'"'ode'"'"', '"'"'native'"'"'), ('"'"'ode'"'"', '"'"'matched'"'"'), ('"'"'bullet'"'"', '"'"'native'"'"'), ('"'"'bullet'"'"', '"'"'matched'"'"')]" ]'
 check "all engines: statuses from the schema; a run directory exactly for PASS, FAIL, NOT_APPLICABLE (and some ERRORs)" \
   '[ "$(csv_query "$REF/results.csv" "all(r[\"status\"] in (\"PASS\", \"FAIL\", \"REFUSED\", \"NOT_BUILT\", \"ERROR\", \"NOT_APPLICABLE\") and (r[\"status\"] == \"ERROR\" or (r[\"run_dir\"] != \"\") == (r[\"status\"] in (\"PASS\", \"FAIL\", \"NOT_APPLICABLE\"))) for r in rows)")" = True ]'
 # a3_sinkage is a prediction of the soft model (issue 17 item 4): judged on soft and the matched variants; the
@@ -90,7 +90,7 @@ check "all engines: statuses from the schema; a run directory exactly for PASS, 
 check "model prediction: native rows NOT_APPLICABLE (or NOT_BUILT) with the reason, matched and soft judged" \
   '[ "$(csv_query "$REF/results.csv" "all((r[\"status\"] == \"NOT_APPLICABLE\" and r[\"measured\"] != \"\" and r[\"note\"].startswith(\"not applicable: \") and \"rigid contact does not sink\" in r[\"note\"]) or r[\"status\"] == \"NOT_BUILT\" if r[\"variant\"] == \"native\" else r[\"status\"] in (\"PASS\", \"FAIL\", \"NOT_BUILT\") for r in rows)")" = True ]'
 check "model prediction: experiments.json names the kind, the judged variants and the reason" \
-  '[ "$(python3 -c "import json; e = json.load(open(\"$REF/experiments.json\"))[0]; print(e[\"kind\"], e[\"applies_to\"], e[\"not_applicable_reason\"])")" = "model_prediction ['"'"'soft-adaptive'"'"', '"'"'ode-matched'"'"', '"'"'bullet-matched'"'"'] ODE and Bullet native: a rigid contact does not sink" ]'
+  '[ "$(python3 -c "import json; e = json.load(open(\"$REF/experiments.json\"))[0]; print(e[\"kind\"], e[\"applies_to\"], e[\"not_applicable_reason\"])")" = "model_prediction ['"'"'soft-implicit'"'"', '"'"'ode-matched'"'"', '"'"'bullet-matched'"'"'] ODE and Bullet native: a rigid contact does not sink" ]'
 check "a law: every variant judged, no reason" \
   '[ "$(python3 -c "import json; e = [x for x in json.load(open(\"$FAST/experiments.json\")) if x[\"name\"] == \"c2_momentum\"][0]; print(e[\"kind\"], len(e[\"applies_to\"]), e[\"not_applicable_reason\"])")" = "law 5 None" ]'
 

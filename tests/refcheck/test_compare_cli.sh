@@ -47,8 +47,8 @@ check "compare soft: exit 0" '[ $rc -eq 0 ]'
 check "metrics.csv header is the documented schema" \
   '[ "$(head -n 1 "$OUT/metrics.csv")" = "scene,engine,variant,reference,pos_err_final,pos_err_rms,rot_err_final_rad,rot_err_rms_rad,energy_drift_rel,momentum_drift_rel,max_penetration_over_size,wall_per_sim_second,steps,restitution_impacts" ]'
 check "two rows: the reference and the soft run" '[ "$(tail -n +2 "$OUT/metrics.csv" | wc -l)" -eq 2 ]'
-check "run directories kept for replay" '[ -f "$OUT/runs/soft-adaptive/trajectory.csv" ] && [ -f "$OUT/runs/soft-reference/summary.json" ]'
-check "compare.json lists the runs" 'grep -q "\"soft-adaptive\"\|runs/soft-adaptive" "$OUT/compare.json"'
+check "run directories kept for replay" '[ -f "$OUT/runs/soft-implicit/trajectory.csv" ] && [ -f "$OUT/runs/soft-reference/summary.json" ]'
+check "compare.json lists the runs" 'grep -q "\"soft-implicit\"\|runs/soft-implicit" "$OUT/compare.json"'
 check "no partial directory left" '[ -z "$(ls -d "$SCRATCH"/cmp.partial-* 2>/dev/null)" ]'
 # the soft run against the reference: final position error below 1e-4 of the block's size (smooth scene,
 # the default tolerance vs 100× tighter), energy lost (sliding friction), the reference's row says "self"
@@ -67,7 +67,7 @@ cp "$SCENE" "$SCENES/b_slide.scene"
 sed 's/^vel 2 0 0/vel 1 0 0/' "$SCENE" >"$SCENES/a_slow.scene"
 "$PD" compare "$SCENES" --out "$SCRATCH/many" --engines soft --tend 0.2 >"$SCRATCH/stdout" 2>"$SCRATCH/err"; rc=$?
 check "a directory of scenes: exit 0, one sub-directory per scene" \
-  '[ $rc -eq 0 ] && [ -f "$SCRATCH/many/a_slow/compare.json" ] && [ -f "$SCRATCH/many/b_slide/runs/soft-adaptive/trajectory.csv" ]'
+  '[ $rc -eq 0 ] && [ -f "$SCRATCH/many/a_slow/compare.json" ] && [ -f "$SCRATCH/many/b_slide/runs/soft-implicit/trajectory.csv" ]'
 check "a directory of scenes: metrics.csv is the header, then a_slow's rows, then b_slide's" \
   '[ "$(cat "$SCRATCH/many/metrics.csv")" = "$(head -n 1 "$SCRATCH/many/a_slow/metrics.csv"; tail -n +2 "$SCRATCH/many/a_slow/metrics.csv"; tail -n +2 "$SCRATCH/many/b_slide/metrics.csv")" ] && [ "$(wc -l <"$SCRATCH/many/metrics.csv")" -eq 5 ]'
 printf 'cube c red 1 1 1\nloc 0 0 zero\n' >"$SCENES/c_bad.scene"

@@ -43,8 +43,8 @@ OVERLAP=$SCRATCH/overlap.csv
 printf 'toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n1,0.000000,0,0,0.01,1,0,0,0,0,0,0,0,0,0\n1,0.006757,0,0,0.01,1,0,0,0,0,0,0,0,0,0\n' >"$OVERLAP"
 "$PD" cubetoss --data "$OVERLAP" --out "$SCRATCH/ov" --engines soft >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "a refused toss: exit 1, a row saying refused and why, no run directory named" \
-  '[ $rc -eq 1 ] && grep -q "^1,train,soft,adaptive,default,refused,2,[0-9.]*,,,,,,,,,toss 1:[0-9]*:1: bodies .board. and .cube. overlap" "$SCRATCH/ov/per_toss.csv" && [ ! -e "$SCRATCH/ov/runs/1/soft" ]'
-check "a refused toss: summary says failed, with no numbers" 'grep -q "^soft,adaptive,default,all,failed,1,0,pos_err_end,cube_widths,,,$" "$SCRATCH/ov/summary.csv"'
+  '[ $rc -eq 1 ] && grep -q "^1,train,soft,implicit,default,refused,2,[0-9.]*,,,,,,,,,toss 1:[0-9]*:1: bodies .board. and .cube. overlap" "$SCRATCH/ov/per_toss.csv" && [ ! -e "$SCRATCH/ov/runs/1/soft" ]'
+check "a refused toss: summary says failed, with no numbers" 'grep -q "^soft,implicit,default,all,failed,1,0,pos_err_end,cube_widths,,,$" "$SCRATCH/ov/summary.csv"'
 "$PD" cubetoss --help | grep -q "per_toss.csv"; rc=$?; check "--help documents per_toss.csv" '[ $rc -eq 0 ]'
 "$PD" help | grep -q "cubetoss"; rc=$?; check "polydyn help lists cubetoss" '[ $rc -eq 0 ]'
 
@@ -77,7 +77,7 @@ check "soft rows ok with finite errors" \
 check "split: positions 0, 2 train, 1 test" '[ "$(awk -F, '"'"'$3 == "soft" {printf "%s ", $2}'"'"' "$OUT/per_toss.csv")" = "train test train " ]'
 check "no NaN anywhere" '! grep -qi "nan" "$OUT/per_toss.csv" "$OUT/summary.csv"'
 check "summary: soft over all 3 tosses, 6 quantities, and the train and test splits" \
-  '[ "$(grep -c "^soft,adaptive,default,all,ok,3,3," "$OUT/summary.csv")" -eq 6 ] && grep -q "^soft,adaptive,default,test,ok,1,1,pos_err_end,cube_widths," "$OUT/summary.csv"'
+  '[ "$(grep -c "^soft,implicit,default,all,ok,3,3," "$OUT/summary.csv")" -eq 6 ] && grep -q "^soft,implicit,default,test,ok,1,1,pos_err_end,cube_widths," "$OUT/summary.csv"'
 if "$PD" cubetoss --data "$DATA" --out "$SCRATCH/probe" --tosses 1 --engines ode --no-runs 2>&1 | grep -q "not built"; then
   check "an engine without adapter: reported as not built" 'grep -q "^1,train,ode,native,default,not built," "$OUT/per_toss.csv" && grep -q "^ode,native,default,all,not built," "$OUT/summary.csv"'
 fi
@@ -106,11 +106,11 @@ printf '# the defaults, written out\nmu 0.18\nrestitution 0.125\nkn 2.1e6\n' >"$
 "$PD" cubetoss --data "$DATA" --out "$SCRATCH/same" --tosses 1-3 --engines soft --params "$SCRATCH/same.scene" --no-runs >/dev/null 2>&1
 check "--params with the default values: the same errors" \
   '[ "$(cut -d, -f1-4,6-12 "$SCRATCH/same/per_toss.csv")" = "$(grep -v "^[0-9]*,[a-z]*,\(ode\|bullet\)," "$OUT/per_toss.csv" | cut -d, -f1-4,6-12)" ]'
-check "--params labels the rows params" 'grep -q "^1,train,soft,adaptive,params,ok," "$SCRATCH/same/per_toss.csv"'
+check "--params labels the rows params" 'grep -q "^1,train,soft,implicit,params,ok," "$SCRATCH/same/per_toss.csv"'
 printf 'mu 0.5\n' >"$SCRATCH/mu.scene"
 "$PD" cubetoss --data "$DATA" --out "$SCRATCH/mu" --tosses 1 --engines soft --params soft="$SCRATCH/mu.scene" --label mu05 --no-runs >/dev/null 2>&1
 check "--params soft=FILE changes the result and the label" \
-  'grep -q "^1,train,soft,adaptive,mu05,ok," "$SCRATCH/mu/per_toss.csv" && [ "$(sed -n 2p "$SCRATCH/mu/per_toss.csv" | cut -d, -f9)" != "$(sed -n 2p "$OUT/per_toss.csv" | cut -d, -f9)" ]'
+  'grep -q "^1,train,soft,implicit,mu05,ok," "$SCRATCH/mu/per_toss.csv" && [ "$(sed -n 2p "$SCRATCH/mu/per_toss.csv" | cut -d, -f9)" != "$(sed -n 2p "$OUT/per_toss.csv" | cut -d, -f9)" ]'
 printf 'mu 0.5\nspgrav 2\n' >"$SCRATCH/bad.scene"
 "$PD" cubetoss --data "$DATA" --out "$SCRATCH/x" --engines soft --params "$SCRATCH/bad.scene" >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "a bad fragment: exit 2 at its line and column" '[ $rc -eq 2 ] && grep -q "bad.scene:2:1: .spgrav." "$SCRATCH/err" && [ ! -e "$SCRATCH/x" ]'
@@ -120,13 +120,13 @@ FIT=$SCRATCH/fit
 "$PD" cubetoss fit --data "$DATA" --out "$FIT" --engines soft --max-evals 3 >"$SCRATCH/stdout" 2>"$SCRATCH/err"; rc=$?
 check "fit: exit 0" '[ $rc -eq 0 ]'
 check "fit.csv: one row for soft, 2 training and 2 test tosses" \
-  '[ "$(tail -n +2 "$FIT/fit.csv" | wc -l)" -eq 1 ] && [ "$(tail -n +2 "$FIT/fit.csv" | cut -d, -f1-4,14-16)" = "soft,adaptive,ok,mu;restitution;kn,2,1,2" ]'
+  '[ "$(tail -n +2 "$FIT/fit.csv" | wc -l)" -eq 1 ] && [ "$(tail -n +2 "$FIT/fit.csv" | cut -d, -f1-4,14-16)" = "soft,implicit,ok,mu;restitution;kn,2,1,2" ]'
 check "fit_trace.csv: the start first, then at least one simplex vertex and the final point" \
-  '[ "$(tail -n +2 "$FIT/fit_trace.csv" | wc -l)" -ge 5 ] && [ "$(sed -n 2p "$FIT/fit_trace.csv" | cut -d, -f1-6)" = "soft,adaptive,1,0.18,0.125,2100000" ]'
+  '[ "$(tail -n +2 "$FIT/fit_trace.csv" | wc -l)" -ge 5 ] && [ "$(sed -n 2p "$FIT/fit_trace.csv" | cut -d, -f1-6)" = "soft,implicit,1,0.18,0.125,2100000" ]'
 check "fit: test tosses only, with the default and the fitted parameters" \
   '[ "$(tail -n +2 "$FIT/per_toss.csv" | cut -d, -f1,2,5 | tr "\n" " ")" = "2,test,default 4,test,default 2,test,fitted 4,test,fitted " ]'
 check "fit: the default rows equal cubetoss's own" \
-  '[ "$(grep "^2,test,soft,adaptive,default" "$FIT/per_toss.csv" | cut -d, -f1-12)" = "$(grep "^2,test,soft" "$SCRATCH/one/per_toss.csv" | cut -d, -f1-12)" ]'
+  '[ "$(grep "^2,test,soft,implicit,default" "$FIT/per_toss.csv" | cut -d, -f1-12)" = "$(grep "^2,test,soft" "$SCRATCH/one/per_toss.csv" | cut -d, -f1-12)" ]'
 "$PD" cubetoss --data "$DATA" --out "$SCRATCH/fitted" --tosses test --engines soft --params soft="$FIT/fitted-soft.scene" \
   --label fitted --no-runs >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "--params reads the fitted fragment, and reproduces fit's test rows" \

@@ -13,7 +13,7 @@ function rank(list, x) {
   return k < 0 ? list.length : k;
 }
 
-// Engine-variant labels ("soft adaptive", "ode native", ...) in a fixed order: soft, ode, bullet,
+// Engine-variant labels ("soft implicit", "ode native", ...) in a fixed order: soft, ode, bullet,
 // then others alphabetically; within an engine implicit (the soft default), adaptive, fixed, embedded, native, matched, then others.
 export function orderEngineVariants(items) {
   const seen = new Map();

@@ -32,7 +32,7 @@ export function exact(x) {
 
 // Fixed colours per engine-variant, the same in every chart of the report.
 const KNOWN = {
-  'soft implicit': '#7b3fbf', 'soft adaptive': '#1f5fbf', 'soft fixed': '#6a9de0', 'soft embedded': '#0b2f6b',
+  'soft implicit': '#1f5fbf', 'soft adaptive': '#7b3fbf', 'soft fixed': '#6a9de0', 'soft embedded': '#0b2f6b',
   'ode native': '#c0392b', 'ode matched': '#e8877c',
   'bullet native': '#1e8449', 'bullet matched': '#7dcea0',
 };
