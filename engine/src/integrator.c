@@ -280,8 +280,10 @@ typedef struct stepOutcome {
 // Takes one accepted step of at most `hMax` from state->t with error control. Returns the step taken (0 on
 // failure). `order` is the order of the error estimate's leading term in h (5 for step doubling, 4 for the
 // embedded pair, 3 for ROS34PW2); `stableFraction` the part of the contacts' stability bound (a bound for half
-// steps) the whole trial step may use (INFINITY: none); `outcome` (nullable) receives the accepted step's outcome.
-
+// steps) the whole trial step may use (INFINITY: none); `giveUpBelow` (s; 0: never) the step below which the error
+// control does not retry (an implicit switch on probation, implicit.h): a rejection there retries at it once, and a
+// trial at it rejected returns 0 with outcome->gaveUp set and nothing taken; `outcome` (nullable) receives the
+// accepted step's outcome.
 static double adaptive_step(const pdModel* model, pdState* s, double hMax, trialFcn* trial, double order,
                             double stableFraction, double giveUpBelow, stepOutcome* outcome) {
   const pdSettings* set = &model->settings;
