@@ -32,6 +32,14 @@
 // doubling after each failure in a row up to PD_IMPLICIT_BACKOFF_MAX bound steps (at most one wasted pair of trials
 // in so many steps), and none after a switch that paid. Without it a ringing stack of 5-9 boxes switched every
 // fourth step and had its implicit trials rejected: up to 2× step doubling's steps (soak seeds 28 and 29).
+// A probation's trial passes only when its error norm is at most this fraction of tol, where the error control's next
+// step, 0.9 (tol/norm)^(1/3) times this one, is at least 1.34 times it. A trial that only just meets tol leaves the
+// implicit method about at the floor, no cheaper than step doubling, and spends the whole tolerance in one step: a
+// stack that spent it so (soak seed 30, scene 1797, 0.84 tol) had its modes stirred to tol where step doubling's
+// steps at the bound had left them at ~1e-3 of it, and step doubling then took 1.5× its steps and 1.8× its
+// evaluations to resolve them. 0.09 (a next step of twice this one) cost up to 8 % more evaluations on the cost
+// scenes (tests/engine/test_implicit.c; README, Integration).
+#define PD_IMPLICIT_PROBATION_ERROR 0.3
 #define PD_IMPLICIT_BACKOFF_FIRST 8.0
 #define PD_IMPLICIT_BACKOFF_MAX 256.0
 // After an implicit step that a contact event cut, the next may be at most this many times as long (the event,

@@ -282,8 +282,8 @@ typedef struct stepOutcome {
 // embedded pair, 3 for ROS34PW2); `stableFraction` the part of the contacts' stability bound (a bound for half
 // steps) the whole trial step may use (INFINITY: none); `giveUpBelow` (s; 0: never) the step below which the error
 // control does not retry (an implicit switch on probation, implicit.h): a rejection there retries at it once, and a
-// trial at it rejected returns 0 with outcome->gaveUp set and nothing taken; `outcome` (nullable) receives the
-// accepted step's outcome.
+// trial at it rejected returns 0 with outcome->gaveUp set and nothing taken; on probation a trial also needs its norm
+// within PD_IMPLICIT_PROBATION_ERROR × tol; `outcome` (nullable) receives the accepted step's outcome.
 static double adaptive_step(const pdModel* model, pdState* s, double hMax, trialFcn* trial, double order,
                             double stableFraction, double giveUpBelow, stepOutcome* outcome) {
   const pdSettings* set = &model->settings;
@@ -313,9 +313,11 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       s->h = fmax(set->dtmin, NONFINITE_SHRINK * h);
       continue;
     }
-    if (norm > set->tol && !atMinimum) {
+    // on probation a trial passes only with room to grow (implicit.h, PD_IMPLICIT_PROBATION_ERROR)
+    double tolTrial = giveUpBelow > 0.0 ? PD_IMPLICIT_PROBATION_ERROR * set->tol : set->tol;
+    if (norm > tolTrial && !atMinimum) {
       ++s->count.rejected;
-      double shrink = fmax(STEP_REJECT_SHRINK_MIN, STEP_SAFETY * pow(set->tol / norm, 1.0 / (order - 1.0)));
+      double shrink = fmax(STEP_REJECT_SHRINK_MIN, STEP_SAFETY * pow(tolTrial / norm, 1.0 / (order - 1.0)));
       if (shrink * h < giveUpBelow) {
         // a trial at the floor itself was rejected: give up; else the next trial is the floor
         if (h <= giveUpBelow) {
