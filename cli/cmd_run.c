@@ -29,7 +29,7 @@ static const char* const help =
     "  --stepper NAME   implicit (default): RK4 with step-doubling error control, switching island by\n"
     "                   island to a linearly implicit method (ROS34PW2) where the contacts' stability\n"
     "                   bound holds RK4 to a fraction of the steps its error allows: resting and\n"
-    "                   sliding contact, islands of up to 16 bodies (README \"Integration\");\n"
+    "                   sliding contact, islands of up to 32 bodies (README \"Integration\");\n"
     "                   adaptive: RK4 with step-doubling error control alone (the paper's);\n"
     "                   fixed: RK4 with the scene's dt, no error control;\n"
     "                   embedded: RK4 with its embedded third-order error estimate\n"

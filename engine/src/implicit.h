@@ -13,9 +13,11 @@
 #include "polydyn/state.h"
 
 // Moving bodies above which a system (an island, or the scene with islands off) is not stepped implicitly:
-// M's body part is a dense 6N × 6N matrix, factorised in O(N³) (~0.3 ms at 16 bodies), more than the steps it
-// saves on a larger system. Larger systems take step doubling (README, Integration).
-#define PD_IMPLICIT_BODIES_MAX 16
+// M's body part is a dense 6N × 6N matrix, factorised in O(N³) (~0.3 ms at 16 bodies, 8× that at 32), more than
+// the steps it saves on a larger system. Larger systems take step doubling (README, Integration). 16 until 3da7396:
+// at 32, with the switch's probation, stacks of 20-30 boxes took 0.72-0.83× the wall time (farm-bench), every soak
+// scene of campaigns 30 and 31 the same steps (their islands are smaller), the piles the same.
+#define PD_IMPLICIT_BODIES_MAX 32
 
 // The implicit stepper switches between step doubling and the implicit method system by system (integrator.c,
 // switching_step): to the implicit method after this many accepted steps in a row whose step the stability bound

@@ -63,7 +63,7 @@ typedef enum pdStepper {
   pd_stepperRK43Embedded,  // classic RK4 with its embedded third-order partner: error = h |k4 − f(t+h, y1)|/6
   pd_stepperImplicit,      // step doubling, switching system by system to ROS34PW2 (a linearly implicit method of
                            // order 3 with an order-2 estimate and no stability bound) where the contacts' stability
-                           // bound holds step doubling: resting contact. Systems of more than 16 moving bodies
+                           // bound holds step doubling: resting contact. Systems of more than 32 moving bodies
                            // (PD_IMPLICIT_BODIES_MAX) keep step doubling (README, Integration)
 } pdStepper;
 
