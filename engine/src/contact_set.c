@@ -371,7 +371,6 @@ static pdVec3 velocity_at(const pdModel* model, const double* y, int b, pdVec3 r
 
 // Velocity of body i's material point at world point p.
 static pdVec3 point_velocity(const pdModel* model, const double* y, const pdPose* poses, int i, pdVec3 p) {
-  if (model->bodies[i].fixed) return (pdVec3){0, 0, 0};
   return velocity_at(model, y, i, pd_v3_sub(p, poses[i].x));
 }
 

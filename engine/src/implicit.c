@@ -36,7 +36,7 @@ typedef struct contactBlock {
 struct pdImplicit {
   bool active;       // stepping implicitly (integrator.c, switching_step)
   int held;          // explicit steps in a row held by the stability bound
-  double probation;  // s: PD_IMPLICIT_HELD_RATIO × the bound's step at the switch, until an implicit step is accepted
+  double boundStep;  // s: the bound's step at the switch, until an implicit step is accepted (0: not on probation)
   double backoff;    // bound steps to wait after the next failed probation (0: none failed since the last that paid)
   double retryAt;    // s: no switch before this time
   int contactCapacity, rowCapacity;
@@ -71,21 +71,21 @@ bool pd_implicit_active(const pdImplicit* im) { return im->active; }
 bool pd_implicit_note_explicit(pdImplicit* im, bool held, double boundStep, double t) {
   im->held = held ? im->held + 1 : 0;
   if (im->held >= PD_IMPLICIT_SWITCH_STEPS && t >= im->retryAt) {
-    im->active = true, im->held = 0, im->probation = PD_IMPLICIT_HELD_RATIO * boundStep;
+    im->active = true, im->held = 0, im->boundStep = boundStep;
   }
   return im->active;
 }
 
-double pd_implicit_probation_floor(const pdImplicit* im) { return im->probation; }
+double pd_implicit_probation_bound_step(const pdImplicit* im) { return im->boundStep; }
 
-void pd_implicit_paid(pdImplicit* im) { im->probation = 0.0, im->backoff = 0.0; }
+void pd_implicit_paid(pdImplicit* im) { im->boundStep = 0.0, im->backoff = 0.0; }
 
 void pd_implicit_deactivate(pdImplicit* im, bool gaveUp, double t) {
   if (gaveUp) {
     im->backoff = im->backoff > 0.0 ? fmin(2.0 * im->backoff, PD_IMPLICIT_BACKOFF_MAX) : PD_IMPLICIT_BACKOFF_FIRST;
-    im->retryAt = t + im->backoff * im->probation / PD_IMPLICIT_HELD_RATIO;
+    im->retryAt = t + im->backoff * im->boundStep;
   }
-  im->active = false, im->held = 0, im->probation = 0.0;
+  im->active = false, im->held = 0, im->boundStep = 0.0;
 }
 
 static void reserve(pdImplicit* im, int contacts, int rows) {

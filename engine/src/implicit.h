@@ -59,9 +59,8 @@ bool pd_implicit_active(const pdImplicit* im);
 // After an explicit step accepted at time t: `held` says whether the stability bound held it (see above), `boundStep`
 // (s) the step it held it to. Returns true when the system switches to the implicit method, on probation.
 bool pd_implicit_note_explicit(pdImplicit* im, bool held, double boundStep, double t);
-// On probation, the step below which the implicit method does not pay (PD_IMPLICIT_HELD_RATIO × the bound's step);
-// 0 once an implicit step was accepted.
-double pd_implicit_probation_floor(const pdImplicit* im);
+// On probation, the step (s) the bound held step doubling to at the switch; 0 once an implicit step was accepted.
+double pd_implicit_probation_bound_step(const pdImplicit* im);
 // The first implicit step after a switch was accepted: no back-off before the next switch.
 void pd_implicit_paid(pdImplicit* im);
 // Back to step doubling at time t; `gaveUp` after a probation that failed (the back-off above).

@@ -15,8 +15,8 @@
 // third-order partner, h (k4 − f(t + h, y1))/6: 5 evaluations per step instead of 11, but twice the
 // steps for the same stability bound (a single RK4 step must now be stable), and the contact events are
 // analysed once per accepted step — so it wins on impacts and free flight and loses on resting and sliding
-// contacts (README, "Integration"); step doubling stays the default. Both run through adaptive_step,
-// which takes the trial, the order of its estimate (the controller's exponents) and the bound's share.
+// contacts (README, "Integration"); step doubling, not this pair, is the default's explicit part. Both run through
+// adaptive_step, which takes the trial, the order of its estimate (the controller's exponents) and the bound's share.
 // The implicit stepper (pd_stepperImplicit, switching_step) runs step doubling until the contacts' stability bound
 // holds it well below what its error control wants (resting contact), then ROS34PW2, a linearly implicit method
 // with no stability bound (trial_implicit; its matrices in implicit.c), until step doubling could take about its
@@ -274,18 +274,24 @@ static double trial_implicit(const pdModel* model, pdState* s, stepperWork* w, d
 typedef struct stepOutcome {
   double wanted;
   bool eventCut;
-  bool gaveUp;  // the error control rejected the trial below `giveUpBelow` (nothing taken, s->h unchanged)
+  bool gaveUp;  // a probation's trial at its floor was rejected (nothing taken, s->h unchanged)
 } stepOutcome;
+
+// The limits of a trial on probation (an implicit switch, implicit.h): the step below which the error control does not
+// retry, and the error norm a trial must meet instead of tol.
+typedef struct probationLimits {
+  double floor;  // s
+  double tol;
+} probationLimits;
 
 // Takes one accepted step of at most `hMax` from state->t with error control. Returns the step taken (0 on
 // failure). `order` is the order of the error estimate's leading term in h (5 for step doubling, 4 for the
 // embedded pair, 3 for ROS34PW2); `stableFraction` the part of the contacts' stability bound (a bound for half
-// steps) the whole trial step may use (INFINITY: none); `giveUpBelow` (s; 0: never) the step below which the error
-// control does not retry (an implicit switch on probation, implicit.h): a rejection there retries at it once, and a
-// trial at it rejected returns 0 with outcome->gaveUp set and nothing taken; on probation a trial also needs its norm
-// within PD_IMPLICIT_PROBATION_ERROR × tol; `outcome` (nullable) receives the accepted step's outcome.
+// steps) the whole trial step may use (INFINITY: none); `probation` (nullable): a trial must meet its tol, a rejection
+// below its floor retries at the floor once, and a trial at the floor rejected returns 0 with outcome->gaveUp set and
+// nothing taken; `outcome` (nullable) receives the accepted step's outcome.
 static double adaptive_step(const pdModel* model, pdState* s, double hMax, trialFcn* trial, double order,
-                            double stableFraction, double giveUpBelow, stepOutcome* outcome) {
+                            double stableFraction, const probationLimits* probation, stepOutcome* outcome) {
   const pdSettings* set = &model->settings;
   stepperWork w = work_of(s);
   derivative(model, s, s->t, s->y, w.k1);
@@ -313,18 +319,17 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       s->h = fmax(set->dtmin, NONFINITE_SHRINK * h);
       continue;
     }
-    // on probation a trial passes only with room to grow (implicit.h, PD_IMPLICIT_PROBATION_ERROR)
-    double tolTrial = giveUpBelow > 0.0 ? PD_IMPLICIT_PROBATION_ERROR * set->tol : set->tol;
+    double tolTrial = probation ? probation->tol : set->tol;
     if (norm > tolTrial && !atMinimum) {
       ++s->count.rejected;
       double shrink = fmax(STEP_REJECT_SHRINK_MIN, STEP_SAFETY * pow(tolTrial / norm, 1.0 / (order - 1.0)));
-      if (shrink * h < giveUpBelow) {
+      if (probation && shrink * h < probation->floor) {
         // a trial at the floor itself was rejected: give up; else the next trial is the floor
-        if (h <= giveUpBelow) {
+        if (h <= probation->floor) {
           if (outcome) *outcome = (stepOutcome){s->h, eventCut, true};
           return 0.0;
         }
-        shrink = giveUpBelow / h;
+        shrink = probation->floor / h;
       }
       s->h = fmax(set->dtmin, shrink * h);
       continue;
@@ -371,36 +376,40 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
 // numbers, so it is the same on every run. Systems of more than PD_IMPLICIT_BODIES_MAX moving bodies stay explicit.
 static double switching_step(const pdModel* model, pdState* s, double hMax) {
   if (model->movingCount > PD_IMPLICIT_BODIES_MAX)
-    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, NULL);
+    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
   if (!s->implicit) s->implicit = pd_implicit_create();
   pdImplicit* im = s->implicit;
   stepOutcome out = {0.0, false, false};
   if (!pd_implicit_active(im)) {
-    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, &out);
+    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, &out);
     // s->h is now the bound's step: on a switch the implicit method starts from the step the error control wanted
     bool held = !out.eventCut && out.wanted >= PD_IMPLICIT_HELD_RATIO * s->h;
     if (taken > 0.0 && pd_implicit_note_explicit(im, held, s->h, s->t)) s->h = out.wanted;
     return taken;
   }
-  double floor = pd_implicit_probation_floor(im);
-  // on probation, a step a sample cuts below the floor would prove nothing: step doubling takes it, from the bound's
-  // step, and the probation waits for the next
-  if (hMax < floor) {
+  // on probation (implicit.h): the implicit step must reach PD_IMPLICIT_HELD_RATIO × the step the bound held step
+  // doubling to, with room to grow (PD_IMPLICIT_PROBATION_ERROR)
+  double boundStep = pd_implicit_probation_bound_step(im);
+  probationLimits limits = {PD_IMPLICIT_HELD_RATIO * boundStep, PD_IMPLICIT_PROBATION_ERROR * model->settings.tol};
+  bool onProbation = boundStep > 0.0;
+  // a step a sample cuts below the floor would prove nothing: step doubling takes it, from the bound's step, and the
+  // probation waits for the next
+  if (onProbation && hMax < limits.floor) {
     double wanted = s->h;
-    s->h = floor / PD_IMPLICIT_HELD_RATIO;
-    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, NULL);
+    s->h = boundStep;
+    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
     if (taken > 0.0) s->h = fmax(s->h, wanted);
     return taken;
   }
-  double taken = adaptive_step(model, s, hMax, trial_implicit, 3.0, INFINITY, floor, &out);
+  double taken = adaptive_step(model, s, hMax, trial_implicit, 3.0, INFINITY, onProbation ? &limits : NULL, &out);
   if (out.gaveUp) {
     // on probation and not paying: step doubling takes this step, from the bound's step it was held to
-    s->h = floor / PD_IMPLICIT_HELD_RATIO;
+    s->h = boundStep;
     pd_implicit_deactivate(im, true, s->t);
-    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, NULL);
+    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
   }
   if (taken > 0.0) {
-    if (floor > 0.0) pd_implicit_paid(im);
+    if (onProbation) pd_implicit_paid(im);
     s->count.implicitSteps += 1;
     // a step an event cut (a body sliding fast at its tunnelling guard) is the step the next one will meet too:
     // the implicit trial is dear, so it grows from there rather than from what its error control wants
@@ -485,14 +494,14 @@ bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, pdObserver
           taken = fixed_step(model, s, hMax);
           break;
         case pd_stepperRK43Embedded:
-          taken = adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, 0.0, NULL);
+          taken = adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, NULL, NULL);
           break;
         case pd_stepperImplicit:
           taken = switching_step(model, s, hMax);
           break;
         case pd_stepperRK4Adaptive:
         default:
-          taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, 0.0, NULL);
+          taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
           break;
       }
     }

@@ -14,15 +14,25 @@
 
 #include "polydyn/scene.h"
 
+// Compiles a parsed scene (NULL: the parse failed, err says why) and frees it; fails the test with err's position.
+static pdModel* compile_parsed(pdScene* scene, pdError* err) {
+  if (!scene) fail_msg("parse: %s:%d:%d: %s", err->file, err->line, err->col, err->message);
+  pdModel* model = pd_model_compile(scene, err);
+  pd_scene_free(scene);
+  if (!model) fail_msg("compile: %s:%d:%d: %s", err->file, err->line, err->col, err->message);
+  return model;
+}
+
 pdModel* compile_text(const char* text) {
   pdError err;
   memset(&err, 0, sizeof err);
-  pdScene* scene = pd_scene_parse_buffer("physics.scene", text, strlen(text), &err);
-  if (!scene) fail_msg("parse: %d:%d: %s", err.line, err.col, err.message);
-  pdModel* model = pd_model_compile(scene, &err);
-  pd_scene_free(scene);
-  if (!model) fail_msg("compile: %d:%d: %s", err.line, err.col, err.message);
-  return model;
+  return compile_parsed(pd_scene_parse_buffer("physics.scene", text, strlen(text), &err), &err);
+}
+
+pdModel* compile_file(const char* path) {
+  pdError err;
+  memset(&err, 0, sizeof err);
+  return compile_parsed(pd_scene_parse_file(path, &err), &err);
 }
 
 static bool record_sample(const pdModel* model, const pdState* state, void* user) {

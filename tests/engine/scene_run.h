@@ -20,6 +20,8 @@ typedef struct record {
 
 // Parses and compiles `text`; fails the test with the error's position otherwise.
 pdModel* compile_text(const char* text);
+// The same for a scene file.
+pdModel* compile_file(const char* path);
 // Runs the model to its tend; asserts that it got there with finite numbers only. The record is the
 // caller's (free); the final state too when stateOut is not NULL (pd_state_free).
 record* run(const pdModel* model, pdState** stateOut);

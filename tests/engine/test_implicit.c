@@ -187,24 +187,25 @@ static void test_resting_boxes_stick_in_a_fraction_of_the_steps(void** state) {
 #define NOT_PAYING_EVALUATIONS_RATIO_MAX 1.05
 #define NOT_PAYING_REJECTED_SHARE_MAX 0.05  // of the accepted steps
 
-static void a_switch_that_does_not_pay_costs_nothing(const char* path) {
-  pdError err = {0};
-  pdScene* scene = pd_scene_parse_file(path, &err);
-  pdModel* m = scene ? pd_model_compile(scene, &err) : NULL;
-  pd_scene_free(scene);
-  if (!m) fail_msg("%s:%d:%d: %s", err.file, err.line, err.col, err.message);
-  long evaluations[2];
+// The model's run with step doubling alone (counts[0]) and with the implicit stepper (counts[1]).
+static void run_both(const pdModel* m, pdCounters counts[2]) {
   for (int k = 0; k < 2; ++k) {
     pdState* s = NULL;
     free(run_with(m, k == 0 ? pd_stepperRK4Adaptive : pd_stepperImplicit, &s));
-    evaluations[k] = s->count.derivatives;
+    counts[k] = s->count;
     print_message("%s: %ld accepted, %ld rejected, %ld implicit steps, %ld derivative evaluations\n",
                   pd_stepper_name(s->stepper), s->count.accepted, s->count.rejected, s->count.implicitSteps,
                   s->count.derivatives);
-    if (k == 1) assert_true((double)s->count.rejected <= NOT_PAYING_REJECTED_SHARE_MAX * (double)s->count.accepted);
     pd_state_free(s);
   }
-  assert_true((double)evaluations[1] <= NOT_PAYING_EVALUATIONS_RATIO_MAX * (double)evaluations[0]);
+}
+
+static void a_switch_that_does_not_pay_costs_nothing(const char* path) {
+  pdModel* m = compile_file(path);
+  pdCounters c[2];
+  run_both(m, c);
+  assert_true((double)c[1].rejected <= NOT_PAYING_REJECTED_SHARE_MAX * (double)c[1].accepted);
+  assert_true((double)c[1].derivatives <= NOT_PAYING_EVALUATIONS_RATIO_MAX * (double)c[0].derivatives);
   pd_model_free(m);
 }
 
@@ -226,23 +227,12 @@ static void test_a_probation_step_must_leave_room_to_grow(void** state) {
 
 static void test_a_stack_of_20_steps_implicitly(void** state) {
   (void)state;
-  pdError err = {0};
-  pdScene* scene = pd_scene_parse_file(PD_SOURCE_DIR "/cases/bench/stack_20.scene", &err);
-  pdModel* m = scene ? pd_model_compile(scene, &err) : NULL;
-  pd_scene_free(scene);
-  if (!m) fail_msg("%s:%d:%d: %s", err.file, err.line, err.col, err.message);
+  pdModel* m = compile_file(PD_SOURCE_DIR "/cases/bench/stack_20.scene");
   assert_true(m->movingCount == 20 && m->movingCount <= PD_IMPLICIT_BODIES_MAX);
-  long accepted[2];
-  for (int k = 0; k < 2; ++k) {
-    pdState* s = NULL;
-    free(run_with(m, k == 0 ? pd_stepperRK4Adaptive : pd_stepperImplicit, &s));
-    accepted[k] = s->count.accepted;
-    print_message("%s: %ld accepted (%ld implicit), %ld derivative evaluations\n", pd_stepper_name(s->stepper),
-                  s->count.accepted, s->count.implicitSteps, s->count.derivatives);
-    if (k == 1) assert_true(s->count.implicitSteps > 0);
-    pd_state_free(s);
-  }
-  assert_true((double)accepted[1] <= STACK_20_STEP_SHARE_MAX * (double)accepted[0]);
+  pdCounters c[2];
+  run_both(m, c);
+  assert_true(c[1].implicitSteps > 0);
+  assert_true((double)c[1].accepted <= STACK_20_STEP_SHARE_MAX * (double)c[0].accepted);
   pd_model_free(m);
 }
 

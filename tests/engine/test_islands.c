@@ -198,16 +198,7 @@ static void test_one_island_is_islands_off_bit_for_bit(void** state) {
 
 // ---------------------------------------------------------------- run to run, and a pile's physics
 
-static pdModel* load_pile(void) {
-  pdError err;
-  memset(&err, 0, sizeof err);
-  pdScene* scene = pd_scene_parse_file(PD_SOURCE_DIR "/cases/bench/pile_10.scene", &err);
-  if (!scene) fail_msg("parse: %d:%d: %s", err.line, err.col, err.message);
-  pdModel* m = pd_model_compile(scene, &err);
-  pd_scene_free(scene);
-  if (!m) fail_msg("compile: %s", err.message);
-  return m;
-}
+static pdModel* load_pile(void) { return compile_file(PD_SOURCE_DIR "/cases/bench/pile_10.scene"); }
 
 static void test_the_same_bits_run_after_run(void** state) {
   (void)state;
