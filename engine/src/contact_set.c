@@ -214,6 +214,7 @@ struct pdContactSet {
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation
+  int capturedCount;       // a dense output's view (dense_output.h): the captured list's length, its slots in next
   pdHelpDesk* help;        // where the per-contact and per-pair loops post half their work, or NULL (help_desk.h)
 };
 
@@ -1475,6 +1476,38 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
   poses_from(model, s->y, set->poses1);
   s->count.onsetsInterpolated += prepare_list(model, set, s->y, set->poses1);
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageContactAnalysis]);
+}
+
+// ---------------------------------------------------------------- dense output (dense_output.c)
+
+void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
+  reserve_list(view, from->count);
+  memcpy(view->next, from->items, (size_t)from->count * sizeof *view->next);
+  view->capturedCount = from->count;
+}
+
+void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y) {
+  int count = view->capturedCount;
+  memcpy(view->items, view->next, (size_t)count * sizeof *view->items);
+  view->count = count;
+  view->bodyListValid = false;
+  poses_from(model, y, view->poses1);
+  world_inverse_inertias(model, view, view->poses1);  // read by the implicit stepper's linearisation
+  int base = spring_base(model);
+  // realigned as a commit realigns the contacts it keeps (one that pulls keeps its springs: a commit drops it)
+  for (int i = 0; i < count; ++i) {
+    const contactSlot* c = &view->items[i];
+    double* yc = y + base + PD_CONTACT_STATE_SIZE * i;
+    pdSprings sp = springs_load(yc);
+    pdContactGeom g;
+    pdVec3 du;
+    pdContactForce f;
+    evaluate(model, c, y, view->poses1, &sp, &g, NULL, &du, &f);
+    if (pd_contact_force_pulls(&f)) continue;
+    pd_springs_realign(&sp, c->normal, g.normal, c->params.mu, &c->params, f.fn);
+    springs_store(yc, &sp);
+  }
+  record(model, view, y, view->poses1);
 }
 
 // ---------------------------------------------------------------- read-out

@@ -80,6 +80,12 @@ void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contact
 // in scene order, so a contact's id orders the same in both); contacts move between the scene's state and
 // the islands' states at output samples only.
 
+// Dense output (dense_output.h): copies the list of `from` into `view` (another set of the same model), kept there
+// until the next capture.
+void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view);
+// Makes the captured list the list of `view` at state y (its layout): each contact's springs in y realigned to its
+// normal at y as a commit would (those that pull left as they are), then its geometry and force recorded for output.
+void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y);
 // The bodies of contact i of the list (model body indices).
 void pd_contact_set_bodies(const pdContactSet* set, int i, int* body1, int* body2);
 // Makes contacts[0 .. count) of `from` (a state of `model`, in list order) the contact list of `to` (a state

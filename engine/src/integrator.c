@@ -22,9 +22,11 @@
 // with no stability bound (trial_implicit; its matrices in implicit.c), until step doubling could take about its
 // steps again: one system (island) at a time, decided from its own numbers.
 //
-// Output samples fall exactly on t = k / sampleRate: a step that would pass the next sample is cut
-// to end on it (the time is then set to the sample time itself, so stamps never drift), and the
-// step size the controller wanted is kept for the step after.
+// Output samples fall exactly on t = k / sampleRate, but they do not cut the error-controlled steppers' steps, nor
+// does pd_advance's tEnd: the step that passes such a time keeps its interpolant (dense_output.h), the state is
+// presented there for the observer, and at tEnd it is left presented while the integration's own state waits at its
+// step's end for the next call. So the samples and the call's slices do not change the steps. The fixed stepper
+// (a reference for the work-precision sweeps) still cuts its step to end on each sample and on tEnd.
 //
 // Numerical trouble: a trial step that produces a non-finite number is rejected and retried four
 // times smaller (warning counted). At dtmin the run stops with state->failed set; the state keeps
@@ -37,6 +39,7 @@
 
 #include "clock.h"
 #include "contact_set.h"
+#include "dense_output.h"
 #include "dynamics.h"
 #include "help_desk.h"
 #include "implicit.h"
@@ -277,6 +280,22 @@ typedef struct stepOutcome {
   bool gaveUp;  // a probation's trial at its floor was rejected (nothing taken, s->h unchanged)
 } stepOutcome;
 
+// Dense output (dense_output.h): an accepted step that passes the time the state must next be presented at keeps
+// its interpolant, from the trial's own numbers (step doubling: the first half step and its slope; the embedded pair:
+// f(y1), its k5; the implicit method: f(y1), evaluated here). Before the commit, which may change the contact list.
+static void capture_step(const pdModel* model, pdState* s, stepperWork* w, trialFcn* trial, double h) {
+  if (!s->dense || !pd_dense_wanted(s->dense, s->t, h)) return;
+  if (trial == trial_doubling) {
+    pd_dense_capture(model, s, h, w->k1, w->half, w->k1half, w->trial, NULL);
+  } else if (trial == trial_embedded) {
+    pd_dense_capture(model, s, h, w->k1, NULL, NULL, w->trial, w->k1half);
+  } else {
+    double* f1 = pd_dense_slope_scratch(s->dense, s->n);
+    derivative(model, s, s->t + h, w->trial, f1);
+    pd_dense_capture(model, s, h, w->k1, NULL, NULL, w->trial, f1);
+  }
+}
+
 // The limits of a trial on probation (an implicit switch, implicit.h): the step below which the error control does not
 // retry, and the error norm a trial must meet instead of tol.
 typedef struct probationLimits {
@@ -349,6 +368,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       continue;
     }
     if (norm > set->tol) ++s->warnings[pd_warnStepAtMinimum];
+    capture_step(model, s, &w, trial, h);
     pd_contact_events_commit(model, s, w.trial, &watch);
     renormalise_quaternions(model, s->y);
     ++s->count.accepted;
@@ -470,49 +490,76 @@ static void observe(const pdModel* model, pdState* s, pdObserverFcn* observer, v
 bool pd_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
   if (s->islands == pd_islandsOn) return pd_islands_advance(model, s, tEnd, observer, user);
-  return pd_advance_hooked(model, s, tEnd, observer, user, NULL, NULL);
+  return pd_advance_hooked(model, s, tEnd, false, observer, user, NULL, NULL);
 }
 
-bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user,
-                       pdStepHookFcn* hook, void* hookUser) {
+// One step of the state's stepper from state->t; `target` the next time the state must be at or presented at. The
+// fixed stepper ends on it, and so does any stepper when `land`; else the error-controlled ones do not cut their
+// steps for it (dense output). Returns the step taken (0 on failure).
+static double one_step(const pdModel* model, pdState* s, double target, bool land) {
+  if (s->stepper == pd_stepperRK4Fixed) return fixed_step(model, s, target - s->t);
+  if (!s->dense) s->dense = pd_dense_create();
+  pd_dense_expect(s->dense, target);
+  double hMax = land ? target - s->t : INFINITY;
+  switch (s->stepper) {
+    case pd_stepperRK43Embedded:
+      return adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, NULL, NULL);
+    case pd_stepperImplicit:
+      return switching_step(model, s, hMax);
+    case pd_stepperRK4Adaptive:
+    default:
+      return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
+  }
+}
+
+bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, bool landOnEnd, pdObserverFcn* observer,
+                       void* user, pdStepHookFcn* hook, void* hookUser) {
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
   if (s->failed) return false;
   s->stopped = false;
   // skip samples already behind us (a state advanced without an observer, then with one)
   while (sample_time(model, s->nextSample) < s->t) ++s->nextSample;
   if (sample_time(model, s->nextSample) == s->t) observe(model, s, observer, user);
-  while (s->t < tEnd && !s->stopped) {
+  // a state presented at the last call's end goes on from the integration's own, later, state; that step's end was
+  // never shown to the hook (it lay beyond that call's end)
+  if (pd_dense_resume(s) && hook && s->t <= tEnd) hook(model, s, hookUser);
+  for (;;) {
+    // the samples up to the integration's time: the last step's end itself, or presented inside that step
+    while (!s->stopped) {
+      double tSample = sample_time(model, s->nextSample);
+      if (tSample > s->t || tSample > tEnd) break;
+      if (tSample < s->t && observer) pd_dense_present(model, s, tSample);
+      observe(model, s, observer, user);
+      pd_dense_resume(s);
+    }
+    if (s->stopped || s->t >= tEnd) break;
     double tSample = sample_time(model, s->nextSample);
     double target = fmin(tEnd, tSample);
     double taken = 0.0;
     if (s->n == 0) {
       taken = target - s->t;  // nothing moves: jump to the next sample
     } else {
-      double hMax = target - s->t;
-      switch (s->stepper) {
-        case pd_stepperRK4Fixed:
-          taken = fixed_step(model, s, hMax);
-          break;
-        case pd_stepperRK43Embedded:
-          taken = adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, NULL, NULL);
-          break;
-        case pd_stepperImplicit:
-          taken = switching_step(model, s, hMax);
-          break;
-        case pd_stepperRK4Adaptive:
-        default:
-          taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
-          break;
-      }
+      taken = one_step(model, s, target, landOnEnd && target == tEnd);
+      if (s->failed) return false;
     }
-    if (s->failed) return false;
-    // a step cut to the target lands exactly on it, so sample stamps never drift; so does a step that
-    // ends within rounding of it (a fixed dt equal to the sample interval), else a ~1e-19 s sliver follows
+    // a step cut to the target (the fixed stepper's, or nothing moving) lands exactly on it, so sample stamps never
+    // drift; so does a step that ends within rounding of it (a fixed dt equal to the sample interval), else a
+    // ~1e-19 s sliver follows
     double next = s->t + taken;
-    bool lands = taken >= target - s->t || target - next <= TIME_SNAP_ULPS * DBL_EPSILON * fabs(target);
+    bool lands =
+        next <= target && (taken >= target - s->t || target - next <= TIME_SNAP_ULPS * DBL_EPSILON * fabs(target));
     s->t = lands ? target : next;
-    if (hook && taken > 0.0) hook(model, s, hookUser);
-    if (s->t == tSample) observe(model, s, observer, user);
+    if (hook && taken > 0.0 && s->t <= tEnd) hook(model, s, hookUser);
   }
-  return !s->stopped;
+  if (s->stopped) {
+    // the state is that sample's (state->t is its time)
+    double tSample = sample_time(model, s->nextSample - 1);
+    if (tSample < s->t) pd_dense_present(model, s, tSample);
+    return false;
+  }
+  if (s->t > tEnd) {
+    pd_dense_present(model, s, tEnd);
+    if (hook) hook(model, s, hookUser);
+  }
+  return true;
 }

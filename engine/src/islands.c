@@ -81,6 +81,7 @@
 #include "broad_phase.h"
 #include "clock.h"
 #include "contact_set.h"
+#include "dense_output.h"
 #include "help_desk.h"
 #include "interference.h"
 #include "model_contact.h"
@@ -192,6 +193,7 @@ struct pdIslandSet {
   // the batch: jobCount islands, all to jobTime
   int jobCount;
   double jobTime;
+  bool jobLand;            // cut the islands' last steps to end on jobTime (a sync time inside a sample interval)
   island** jobs;           // (islandCapacity)
   bool* jobCoarse;         // (islandCapacity) a free body's island (island_advance's coarse)
   bool* jobOk;             // (islandCapacity) written by the job's thread
@@ -265,6 +267,7 @@ static island* island_create(const pdModel* model, struct pdIslandSet* set, cons
 static void island_load(const pdModel* model, const pdState* s, struct pdIslandSet* set, island* is,
                         const int* contacts, int count) {
   pdState* sub = is->state;
+  pd_dense_discard(sub);
   sub->stepper = s->stepper;
   sub->onsets = s->onsets;
   sub->t = s->t;
@@ -312,13 +315,13 @@ static void measure_travel(const pdModel* sub, const pdState* state, void* user)
 
 // Advances island `is` to tNext; false if it failed. A free body's island (coarse) measures against its path
 // over the whole sample interval, and keeps what it measured since T0.
-static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool coarse) {
+static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool land, bool coarse) {
   if (!coarse)
     for (int j = 0; j < is->bodyCount; ++j) set->travel[is->bodies[j]] = 0.0;
   travelProbe probe = coarse ? (travelProbe){is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel}
                              : (travelProbe){is, set->t0, set->x0, set->v0, set->q0, set->travel};
   is->advanced = true;
-  return pd_advance_hooked(&is->model, is->state, tNext, NULL, NULL, measure_travel, &probe);
+  return pd_advance_hooked(&is->model, is->state, tNext, land, NULL, NULL, measure_travel, &probe);
 }
 
 // ---------------------------------------------------------------- the pool
@@ -340,7 +343,7 @@ static int compare_jobs(const void* a, const void* b) {
 static void run_jobs(struct pdIslandSet* set) {
   for (int n; (n = atomic_fetch_add(&set->nextJob, 1)) < set->jobCount;) {
     int i = set->order[n].job;
-    set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobCoarse[i]);
+    set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobLand, set->jobCoarse[i]);
     if (atomic_fetch_sub(&set->jobsLeft, 1) == 1 && set->threadCount > 1) pd_help_wake_all(&set->desk);
   }
   if (set->threadCount > 1) pd_help_serve(&set->desk, &set->jobsLeft);
@@ -405,8 +408,9 @@ static void add_job(struct pdIslandSet* set, island* is, bool coarse) {
 // Runs the batch to tNext: the jobs ordered heaviest first, the workers woken, the caller taking jobs too,
 // then a wait for the rest. False if an island failed; every job runs either way, so the islands' states do
 // not depend on the thread count.
-static bool run_batch(struct pdIslandSet* set, double tNext) {
+static bool run_batch(struct pdIslandSet* set, double tNext, bool land) {
   set->jobTime = tNext;
+  set->jobLand = land;
   for (int i = 0; i < set->jobCount; ++i) {
     const island* is = set->jobs[i];
     set->order[i] = (jobOrder){is->bodyCount + PD_ISLAND_CONTACT_WEIGHT * (long)pd_state_contact_count(is->state), i};
@@ -857,12 +861,12 @@ static void mark_touching(const pdModel* model, const pdState* s, struct pdIslan
 
 // A free body's island goes on to tNext alone (coarse: against its path over the sample interval); its
 // numbers go to the scene's state. False if it failed.
-static bool free_advance(pdState* s, struct pdIslandSet* set, int k, double tNext) {
+static bool free_advance(pdState* s, struct pdIslandSet* set, int k, double tNext, bool land) {
   island* is = set->islands[set->islandOld[k]];
   PD_ASSERT(is->bodyCount == 1 && is->bodies[0] == k);
   if (is->state->t < tNext) {
     ++set->intervals;
-    if (!island_advance(set, is, tNext, true)) return false;
+    if (!island_advance(set, is, tNext, land, true)) return false;
   }
   if (set->ctravel[k] > set->cbound[k]) ++set->strays;
   memcpy(s->y + PD_BODY_STATE_SIZE * k, is->state->y, PD_BODY_STATE_SIZE * sizeof *s->y);
@@ -884,7 +888,7 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
     for (int activations; (activations = partition(model, s, set, dt, true)) > 0;)
       for (int i = 0; i < activations; ++i) {
         int k = set->activate[i];
-        if (s->t > set->ct0 && !free_advance(s, set, k, s->t)) return false;
+        if (s->t > set->ct0 && !free_advance(s, set, k, s->t, true)) return false;
         set->free[k] = false;
         set_start(model, s, set, k, dt);
       }
@@ -896,7 +900,7 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
       ++set->intervals;
       add_job(set, is, false);
     }
-    if (!run_batch(set, tNext)) return false;
+    if (!run_batch(set, tNext, !last)) return false;
     // a body that left its grown box could have met another island's body unseen: grow its bound and
     // form the partition again; islands that change are redone from T
     bool left = false;
@@ -916,9 +920,9 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
         add_job(set, is, true);
       }
     }
-    if (!run_batch(set, tNext)) return false;
+    if (!run_batch(set, tNext, false)) return false;
     for (int k = 0; k < set->movingCount; ++k)
-      if (set->free[k] && !free_advance(s, set, k, tNext)) return false;
+      if (set->free[k] && !free_advance(s, set, k, tNext, false)) return false;
   }
   // gather: bodies, then contacts (sorted by id), and each body's next step
   for (int j = 0; j < set->islandCount; ++j) {

@@ -10,10 +10,12 @@
 // state at its new time.
 typedef void pdStepHookFcn(const pdModel* model, const pdState* state, void* user);
 
-// pd_advance without the islands' dispatch, calling `hook` (nullable) with `hookUser` after each step
-// (integrator.c). pd_advance is pd_advance_hooked with no hook when islands are off.
-bool pd_advance_hooked(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user,
-                       pdStepHookFcn* hook, void* hookUser);
+// pd_advance without the islands' dispatch, calling `hook` (nullable) with `hookUser` after each step that ends by
+// tEnd, and once more with the state presented at tEnd when the last step passed it (integrator.c). With landOnEnd the
+// last step is cut to end on tEnd unless the state is already past it (dense output, dense_output.h). pd_advance is
+// pd_advance_hooked with no hook, landOnEnd false, when islands are off.
+bool pd_advance_hooked(const pdModel* model, pdState* state, double tEnd, bool landOnEnd, pdObserverFcn* observer,
+                       void* user, pdStepHookFcn* hook, void* hookUser);
 
 // pd_advance with state->islands == pd_islandsOn (contract of pd_advance, state.h).
 bool pd_islands_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "contact_set.h"
+#include "dense_output.h"
 #include "implicit.h"
 #include "islands.h"
 #include "state_layout.h"
@@ -24,6 +25,7 @@ pdState* pd_state_create(const pdModel* model) {
 
 void pd_state_reset(const pdModel* model, pdState* s) {
   const pdSettings* set = &model->settings;
+  pd_dense_discard(s);  // first: a presented state's y and contacts are the presentation's
   s->t = 0.0;
   s->h = set->dt;
   s->n = PD_BODY_STATE_SIZE * model->movingCount;
@@ -59,6 +61,8 @@ void pd_state_reset(const pdModel* model, pdState* s) {
 
 void pd_state_free(pdState* s) {
   if (!s) return;
+  pd_dense_resume(s);
+  pd_dense_free(s->dense);
   free(s->y);
   free(s->weight);
   free(s->work);

@@ -165,6 +165,9 @@ typedef struct pdState {
   struct pdContactSet* contacts;  // the contact list and the contact search's scratch (internal)
   struct pdIslandSet* islandSet;  // the islands' own states between samples (internal; NULL when off)
   struct pdImplicit* implicit;    // the implicit stepper's matrices (internal; NULL until it first steps)
+  struct pdDense* dense;          // dense output: the last step that passed a sample or tEnd, and the integration's
+                                  // own state while the state is presented between step ends (internal; NULL until
+                                  // an error-controlled stepper first steps)
   long nextSample;   // index k of the next output sample, at t = k / sampleRate
   bool failed;       // the run could not continue (see warnings); pd_advance returns false
   bool stopped;      // the observer asked to stop; pd_advance returns false

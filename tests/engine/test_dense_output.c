@@ -1,0 +1,152 @@
+// Dense output (engine/src/dense_output.h; README, "Integration"): the output samples and pd_advance's end do not cut
+// the error-controlled steppers' steps; the state is presented at each sample inside the step that passes it.
+// - The steps do not depend on the sample rate: a scene with contacts sampled at 50 Hz and at 1 kHz takes the same
+//   steps, and its states at the common samples are the same bit for bit (islands off and on; step doubling, the
+//   embedded pair and the implicit stepper).
+// - A presented state is the trajectory's: free flight under gravity is a parabola, which both interpolants (quartic
+//   and cubic) hold exactly, so a spinning cube's centre at every 1 ms sample inside its 10 ms steps is the closed
+//   form to rounding.
+// - A presented state's contacts carry their forces there: a box resting on a floor, sampled at 1 kHz inside the
+//   implicit stepper's 10 ms steps, has its normal forces summing to its weight at every sample.
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "polydyn/model.h"
+#include "polydyn/scene.h"
+#include "polydyn/state.h"
+#include "scene_run.h"
+
+// Free flight: the interpolants reproduce a quadratic exactly; what is left is the rounding of the step's numbers
+// (positions ~1 m, ~1e-16 relative, summed over a few hundred steps).
+#define PARABOLA_TOL 1e-12  // m, and m/s for the velocity
+// The resting box: its contacts' springs carry its weight to the integration's error (tol 1e-6 of δ_max scale) and
+// the residue of its landing's ringing, damped by 0.6 s.
+#define WEIGHT_REL_TOL 1e-6
+
+enum { MAX_SAMPLES = 1201 };
+
+typedef struct trace {
+  int count;
+  double t[MAX_SAMPLES];
+  pdBodyState b[MAX_SAMPLES];
+  double normalForce[MAX_SAMPLES];  // the sum of fn over the contacts
+} trace;
+
+static bool keep(const pdModel* model, const pdState* state, void* user) {
+  trace* tr = user;
+  if (tr->count == MAX_SAMPLES) return false;
+  int k = tr->count++;
+  tr->t[k] = state->t;
+  tr->b[k] = pd_state_body(model, state, model->movingBodies[0]);
+  double fn = 0.0;
+  for (int i = 0; i < pd_state_contact_count(state); ++i) fn += pd_state_contact(state, i).fn;
+  tr->normalForce[k] = fn;
+  return true;
+}
+
+static trace* run_sampled(const char* body, double sampleRate, pdStepper stepper, pdIslands islands, long* steps) {
+  char text[1024];
+  snprintf(text, sizeof text, "tend 0.6\nsample %g\n%s", sampleRate, body);
+  pdModel* m = compile_text(text);
+  pdState* s = pd_state_create(m);
+  s->stepper = stepper;
+  s->islands = islands;
+  trace* tr = calloc(1, sizeof *tr);
+  assert_non_null(tr);
+  assert_true(pd_advance(m, s, m->settings.tend, keep, tr));
+  *steps = s->count.accepted;
+  pd_state_free(s);
+  pd_model_free(m);
+  return tr;
+}
+
+static bool same_state(const pdBodyState* a, const pdBodyState* b) { return memcmp(a, b, sizeof *a) == 0; }
+
+static const char TUMBLE[] =
+    "cube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nmu 0.5\n"
+    "cube box red 0.2 0.15 0.1\nloc 0 0 0.12  30 1 1 0\nvel 0.4 0 0  5 0 1 0\nmu 0.5\nrestitution 0.5\n";
+
+static void test_the_samples_do_not_change_the_steps(void** state) {
+  (void)state;
+  const pdStepper steppers[] = {pd_stepperRK4Adaptive, pd_stepperRK43Embedded, pd_stepperImplicit};
+  const pdIslands islands[] = {pd_islandsOff, pd_islandsOn};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 2; ++j) {
+      long coarseSteps, fineSteps;
+      trace* coarse = run_sampled(TUMBLE, 50, steppers[i], islands[j], &coarseSteps);
+      trace* fine = run_sampled(TUMBLE, 1000, steppers[i], islands[j], &fineSteps);
+      assert_int_equal(coarse->count, 31);
+      assert_int_equal(fine->count, 601);
+      int differ = 0;
+      for (int k = 0; k < coarse->count; ++k) {
+        assert_true(coarse->t[k] == fine->t[20 * k]);
+        differ += !same_state(&coarse->b[k], &fine->b[20 * k]);
+      }
+      print_message("%s, islands %s: %ld steps at 50 Hz, %ld at 1 kHz; %d of the 31 common samples differ\n",
+                    pd_stepper_name(steppers[i]), islands[j] == pd_islandsOn ? "on" : "off", coarseSteps, fineSteps,
+                    differ);
+      assert_int_equal(coarseSteps, fineSteps);
+      assert_int_equal(differ, 0);
+      free(coarse);
+      free(fine);
+    }
+}
+
+static void test_a_presented_free_flight_is_the_parabola(void** state) {
+  (void)state;
+  const pdStepper steppers[] = {pd_stepperRK4Adaptive, pd_stepperRK43Embedded, pd_stepperImplicit};
+  const pdVec3 x0 = {0.1, -0.2, 1.0}, v0 = {0.5, 0.3, 2.0};
+  for (int i = 0; i < 3; ++i) {
+    long steps;
+    trace* tr = run_sampled("cube box red 0.2 0.15 0.1\nloc 0.1 -0.2 1  30 1 1 0\nvel 0.5 0.3 2  3 0 1 1\n", 1000,
+                            steppers[i], pd_islandsOn, &steps);
+    double worstX = 0.0, worstV = 0.0;
+    for (int k = 0; k < tr->count; ++k) {
+      double t = tr->t[k];
+      pdVec3 x = {x0.x + v0.x * t, x0.y + v0.y * t, x0.z + v0.z * t - 0.5 * 9.81 * t * t};
+      pdVec3 v = {v0.x, v0.y, v0.z - 9.81 * t};
+      worstX = fmax(worstX, pd_v3_norm(pd_v3_sub(tr->b[k].x, x)));
+      worstV = fmax(worstV, pd_v3_norm(pd_v3_sub(tr->b[k].v, v)));
+    }
+    print_message("%s: %ld steps for 600 samples; centre off the parabola by at most %.2e m, velocity %.2e m/s\n",
+                  pd_stepper_name(steppers[i]), steps, worstX, worstV);
+    assert_true(steps < tr->count / 2);  // the samples lie inside the steps, not at their ends
+    assert_true(worstX <= PARABOLA_TOL);
+    assert_true(worstV <= PARABOLA_TOL);
+    free(tr);
+  }
+}
+
+static void test_a_presented_resting_box_carries_its_weight(void** state) {
+  (void)state;
+  long steps;
+  trace* tr = run_sampled(
+      "cube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nmu 0.5\ncube box red 0.2 0.15 0.1\nloc 0 0 0.05\nmu 0.5\n", 1000,
+      pd_stepperImplicit, pd_islandsOn, &steps);
+  double weight = 1000.0 * 0.2 * 0.15 * 0.1 * 9.81, worst = 0.0;
+  for (int k = 300; k < tr->count; ++k) worst = fmax(worst, fabs(tr->normalForce[k] / weight - 1.0));
+  print_message(
+      "box at rest: %ld steps for 600 samples; sum of the normal forces off its weight %.4g N by at most "
+      "%.2e of it over [0.3, 0.6] s\n",
+      steps, weight, worst);
+  assert_true(steps < tr->count / 4);
+  assert_true(worst <= WEIGHT_REL_TOL);
+  free(tr);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_the_samples_do_not_change_the_steps),
+      cmocka_unit_test(test_a_presented_free_flight_is_the_parabola),
+      cmocka_unit_test(test_a_presented_resting_box_carries_its_weight),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
