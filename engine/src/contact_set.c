@@ -231,13 +231,15 @@ static void reserve_list(pdContactSet* set, int capacity) {
   int c = set->capacity > 0 ? set->capacity : 16;
   while (c < capacity) c *= 2;
   set->items = grow(set->items, c, sizeof *set->items);
-  set->eval = grow(set->eval, c, sizeof *set->eval);
   set->push = grow(set->push, c, sizeof *set->push);
   set->next = grow(set->next, c, sizeof *set->next);
-  for (int part = 0; part < 2; ++part)
-    set->search[part].previous = grow(set->search[part].previous, c, sizeof *set->search[part].previous);
-  set->stability = grow(set->stability, c, sizeof *set->stability);
   set->bodyList = grow(set->bodyList, 2 * c, sizeof *set->bodyList);
+  if (set->broad) {  // a view (pd_contact_set_create_view) has no contact events or stability bound
+    set->eval = grow(set->eval, c, sizeof *set->eval);
+    for (int part = 0; part < 2; ++part)
+      set->search[part].previous = grow(set->search[part].previous, c, sizeof *set->search[part].previous);
+    set->stability = grow(set->stability, c, sizeof *set->stability);
+  }
   set->capacity = c;
 }
 
@@ -249,7 +251,9 @@ static void grow_pair_lists(pdContactSet* set) {
   set->pairFoundCount = grow(set->pairFoundCount, set->cacheCapacity, sizeof *set->pairFoundCount);
 }
 
-pdContactSet* pd_contact_set_create(const pdModel* model) {
+// A set with its per-body arrays; with `search`, also the contact search's (broad phase, pairs, caches, candidates)
+// and room for the list a state starts with.
+static pdContactSet* create(const pdModel* model, bool search) {
   pdContactSet* set = calloc(1, sizeof *set);
   PD_ASSERT(set != NULL);
   int n = model->bodyCount;
@@ -277,6 +281,10 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
     set->poses[i] = set->poses0[i] = set->poses1[i] = pose_of(b->x0, b->q0);
     set->boxes[i] = pd_aabb_of(&b->shape, set->poses[i].x, &set->poses[i].R);
   }
+  if (!search) {
+    free(fixed);
+    return set;
+  }
   set->broad = pd_broad_phase_create(n, fixed, 0.0);
   PD_ASSERT(set->broad != NULL);
   free(fixed);
@@ -296,6 +304,10 @@ pdContactSet* pd_contact_set_create(const pdModel* model) {
   grow_pair_lists(set);
   return set;
 }
+
+pdContactSet* pd_contact_set_create(const pdModel* model) { return create(model, true); }
+
+pdContactSet* pd_contact_set_create_view(const pdModel* model) { return create(model, false); }
 
 void pd_contact_set_free(pdContactSet* set) {
   if (!set) return;
@@ -1481,7 +1493,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
 // ---------------------------------------------------------------- dense output (dense_output.c)
 
 void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
-  reserve_list(view, from->count);
+  reserve_list(view, from->count > 0 ? from->count : 1);  // never NULL: memcpy of nothing still wants a pointer
   memcpy(view->next, from->items, (size_t)from->count * sizeof *view->next);
   view->capturedCount = from->count;
 }

@@ -80,6 +80,10 @@ void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contact
 // in scene order, so a contact's id orders the same in both); contacts move between the scene's state and
 // the islands' states at output samples only.
 
+// A set for dense output's presented states (dense_output.h): the per-body arrays only, no contact search, its list
+// grown by the captures. Read-out, derivative evaluations and the implicit stepper's linearisation work on it; the
+// contact events and the stability bound do not.
+pdContactSet* pd_contact_set_create_view(const pdModel* model);
 // Dense output (dense_output.h): copies the list of `from` into `view` (another set of the same model), kept there
 // until the next capture.
 void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view);

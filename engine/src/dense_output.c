@@ -55,7 +55,7 @@ void pd_dense_free(pdDense* d) {
 
 static void reserve(pdDense* d, int n) {
   if (n <= d->capacity) return;
-  int c = d->capacity > 0 ? d->capacity : 64;
+  int c = d->capacity > 0 ? d->capacity : n;
   while (c < n) c *= 2;
   for (int k = 0; k < NODE_COUNT; ++k) d->node[k] = grow(d->node[k], (size_t)c, sizeof(double));
   d->slope = grow(d->slope, (size_t)c, sizeof(double));
@@ -93,7 +93,7 @@ void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* 
     d->node[NODE_F1] = d->slope;
     d->slope = t;
   }
-  if (!d->view) d->view = pd_contact_set_create(model);
+  if (!d->view) d->view = pd_contact_set_create_view(model);
   pd_contact_set_capture(s->contacts, d->view);
   d->t0 = s->t;
   d->h = h;
