@@ -231,10 +231,15 @@ typedef bool pdObserverFcn(const pdModel* model, const pdState* state, void* use
 
 // Advances the state to tEnd, s (tEnd >= state->t, asserted; clamping to settings.tend is the caller's
 // choice), calling `observer` (nullable) with `user` at every output sample t = k / sampleRate <= tEnd,
-// including t = 0 when the state is there. Call it again with a later tEnd to go on: the samples continue
-// where they stopped, and a run stopped on a sample time (tEnd = k / sampleRate, that very division) and
-// resumed computes the same numbers as one call (tests/engine/test_determinism.c); any other tEnd cuts a
-// step there. Returns true when state->t == tEnd; false if the run had to stop (state->failed,
+// including t = 0 when the state is there. Neither the samples nor tEnd cut the error-controlled steppers' steps
+// (dense output, README "Integration"): at a sample inside a step, and at tEnd when the last step passed it, the
+// state is presented there (its bodies and springs interpolated within that step, its contacts' forces evaluated
+// there), and the integration's own state waits at that step's end; writing to state->y between calls does not
+// reach it. The fixed stepper ends its steps on every sample and on tEnd. Call it again with a later tEnd to go
+// on: the samples continue where they stopped, and a run stopped on a sample time (tEnd = k / sampleRate, that very
+// division) and resumed computes the same numbers as one call (tests/engine/test_determinism.c); so does one
+// stopped at any other tEnd with islands off (with islands on, tEnd ends a sync interval there).
+// Returns true when state->t == tEnd; false if the run had to stop (state->failed,
 // with the reason counted in state->warnings; the state stays finite and later calls return false at once)
 // or the observer asked to stop (state->stopped; state->t is then that sample's time).
 PD_API bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
