@@ -6,6 +6,7 @@
 // - A presented state is the trajectory's: free flight under gravity is a parabola, which both interpolants (quartic
 //   and cubic) hold exactly, so a spinning cube's centre at every 1 ms sample inside its 10 ms steps is the closed
 //   form to rounding.
+// - Stopped between samples and resumed (islands off), a run is the run that did not stop, bit for bit.
 // - A presented state's contacts carry their forces there: a box resting on a floor, sampled at 1 kHz inside the
 //   implicit stepper's 10 ms steps, has its normal forces summing to its weight at every sample.
 #include <math.h>
@@ -142,11 +143,44 @@ static void test_a_presented_resting_box_carries_its_weight(void** state) {
   free(tr);
 }
 
+// Stopped at times between the samples and resumed: with islands off the same steps and numbers as one call, since no
+// tEnd cuts a step (with islands on a tEnd also ends a sync interval, so only sample times keep that: state.h).
+static void test_a_run_stopped_between_samples_is_the_run_that_did_not_stop(void** state) {
+  (void)state;
+  const pdStepper steppers[] = {pd_stepperRK4Adaptive, pd_stepperRK43Embedded, pd_stepperImplicit};
+  char text[1024];
+  snprintf(text, sizeof text, "tend 0.6\nsample 100\n%s", TUMBLE);
+  pdModel* m = compile_text(text);
+  for (int i = 0; i < 3; ++i) {
+    pdState *whole = pd_state_create(m), *sliced = pd_state_create(m);
+    whole->stepper = sliced->stepper = steppers[i];
+    whole->islands = sliced->islands = pd_islandsOff;
+    trace *a = calloc(1, sizeof *a), *b = calloc(1, sizeof *b);
+    assert_true(a != NULL && b != NULL);
+    assert_true(pd_advance(m, whole, m->settings.tend, keep, a));
+    for (double t = 0.0137; t < m->settings.tend; t += 0.0291) assert_true(pd_advance(m, sliced, t, keep, b));
+    assert_true(pd_advance(m, sliced, m->settings.tend, keep, b));
+    assert_int_equal(a->count, b->count);
+    int differ = 0;
+    for (int k = 0; k < a->count; ++k) differ += a->t[k] != b->t[k] || !same_state(&a->b[k], &b->b[k]);
+    print_message("%s, islands off, stopped 21 times between samples: %ld and %ld steps, %d of %d samples differ\n",
+                  pd_stepper_name(steppers[i]), whole->count.accepted, sliced->count.accepted, differ, a->count);
+    assert_int_equal(whole->count.accepted, sliced->count.accepted);
+    assert_int_equal(differ, 0);
+    free(a);
+    free(b);
+    pd_state_free(whole);
+    pd_state_free(sliced);
+  }
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_the_samples_do_not_change_the_steps),
       cmocka_unit_test(test_a_presented_free_flight_is_the_parabola),
       cmocka_unit_test(test_a_presented_resting_box_carries_its_weight),
+      cmocka_unit_test(test_a_run_stopped_between_samples_is_the_run_that_did_not_stop),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
