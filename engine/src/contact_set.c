@@ -43,6 +43,7 @@
 
 #include "broad_phase.h"
 #include "clock.h"
+#include "grow.h"
 #include "help_desk.h"
 #include "interference.h"
 #include "material.h"
@@ -218,37 +219,31 @@ struct pdContactSet {
   pdHelpDesk* help;        // where the per-contact and per-pair loops post half their work, or NULL (help_desk.h)
 };
 
-static void* grow(void* p, int count, size_t size) {
-  void* q = realloc(p, (size_t)(count > 0 ? count : 1) * size);
-  PD_ASSERT(q != NULL);
-  return q;
-}
-
 static pdPose pose_of(pdVec3 x, pdQuat q) { return (pdPose){x, pd_quat_to_mat3(pd_quat_normalize(q))}; }
 
 static void reserve_list(pdContactSet* set, int capacity) {
   if (capacity <= set->capacity) return;
   int c = set->capacity > 0 ? set->capacity : 16;
   while (c < capacity) c *= 2;
-  set->items = grow(set->items, c, sizeof *set->items);
-  set->push = grow(set->push, c, sizeof *set->push);
-  set->next = grow(set->next, c, sizeof *set->next);
-  set->bodyList = grow(set->bodyList, 2 * c, sizeof *set->bodyList);
+  set->items = pd_grow(set->items, c, sizeof *set->items);
+  set->push = pd_grow(set->push, c, sizeof *set->push);
+  set->next = pd_grow(set->next, c, sizeof *set->next);
+  set->bodyList = pd_grow(set->bodyList, 2 * c, sizeof *set->bodyList);
   if (set->broad) {  // a view (pd_contact_set_create_view) has no contact events or stability bound
-    set->eval = grow(set->eval, c, sizeof *set->eval);
+    set->eval = pd_grow(set->eval, c, sizeof *set->eval);
     for (int part = 0; part < 2; ++part)
-      set->search[part].previous = grow(set->search[part].previous, c, sizeof *set->search[part].previous);
-    set->stability = grow(set->stability, c, sizeof *set->stability);
+      set->search[part].previous = pd_grow(set->search[part].previous, c, sizeof *set->search[part].previous);
+    set->stability = pd_grow(set->stability, c, sizeof *set->stability);
   }
   set->capacity = c;
 }
 
 // The contact search's per-pair lists, to cacheCapacity.
 static void grow_pair_lists(pdContactSet* set) {
-  set->pairPrevious = grow(set->pairPrevious, set->cacheCapacity, sizeof *set->pairPrevious);
-  set->pairPreviousCount = grow(set->pairPreviousCount, set->cacheCapacity, sizeof *set->pairPreviousCount);
-  set->pairFound = grow(set->pairFound, set->cacheCapacity, sizeof *set->pairFound);
-  set->pairFoundCount = grow(set->pairFoundCount, set->cacheCapacity, sizeof *set->pairFoundCount);
+  set->pairPrevious = pd_grow(set->pairPrevious, set->cacheCapacity, sizeof *set->pairPrevious);
+  set->pairPreviousCount = pd_grow(set->pairPreviousCount, set->cacheCapacity, sizeof *set->pairPreviousCount);
+  set->pairFound = pd_grow(set->pairFound, set->cacheCapacity, sizeof *set->pairFound);
+  set->pairFoundCount = pd_grow(set->pairFoundCount, set->cacheCapacity, sizeof *set->pairFoundCount);
 }
 
 // A set with its per-body arrays; with `search`, also the contact search's (broad phase, pairs, caches, candidates)
@@ -258,23 +253,23 @@ static pdContactSet* create(const pdModel* model, bool search) {
   PD_ASSERT(set != NULL);
   int n = model->bodyCount;
   set->bodyCount = n;
-  set->force = grow(NULL, model->movingCount, sizeof *set->force);
-  set->bodyFirst = grow(NULL, n + 1, sizeof *set->bodyFirst);
-  set->invInertiaWorld = grow(NULL, n, sizeof *set->invInertiaWorld);
+  set->force = pd_grow(NULL, model->movingCount, sizeof *set->force);
+  set->bodyFirst = pd_grow(NULL, n + 1, sizeof *set->bodyFirst);
+  set->invInertiaWorld = pd_grow(NULL, n, sizeof *set->invInertiaWorld);
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
   set->stableStep = set->stableCheap = INFINITY;
   set->stableKnown = true;
-  set->bodyRowsK = grow(NULL, n, sizeof *set->bodyRowsK);
-  set->bodyBlocks = grow(NULL, n, sizeof *set->bodyBlocks);
-  set->bodyRowsRight = grow(NULL, n, sizeof *set->bodyRowsRight);
+  set->bodyRowsK = pd_grow(NULL, n, sizeof *set->bodyRowsK);
+  set->bodyBlocks = pd_grow(NULL, n, sizeof *set->bodyBlocks);
+  set->bodyRowsRight = pd_grow(NULL, n, sizeof *set->bodyRowsRight);
   set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
   PD_ASSERT(set->travel != NULL);
-  set->torque = grow(NULL, model->movingCount, sizeof *set->torque);
-  set->poses = grow(NULL, n, sizeof *set->poses);
-  set->poses0 = grow(NULL, n, sizeof *set->poses0);
-  set->poses1 = grow(NULL, n, sizeof *set->poses1);
-  set->boxes = grow(NULL, n, sizeof *set->boxes);
-  bool* fixed = grow(NULL, n, sizeof *fixed);
+  set->torque = pd_grow(NULL, model->movingCount, sizeof *set->torque);
+  set->poses = pd_grow(NULL, n, sizeof *set->poses);
+  set->poses0 = pd_grow(NULL, n, sizeof *set->poses0);
+  set->poses1 = pd_grow(NULL, n, sizeof *set->poses1);
+  set->boxes = pd_grow(NULL, n, sizeof *set->boxes);
+  bool* fixed = pd_grow(NULL, n, sizeof *fixed);
   for (int i = 0; i < n; ++i) {
     const pdBody* b = &model->bodies[i];
     fixed[i] = b->fixed;
@@ -290,17 +285,17 @@ static pdContactSet* create(const pdModel* model, bool search) {
   free(fixed);
   reserve_list(set, 4 * model->movingCount + 16);
   set->candidateCapacity = 64;
-  set->candidates = grow(NULL, set->candidateCapacity, sizeof *set->candidates);
+  set->candidates = pd_grow(NULL, set->candidateCapacity, sizeof *set->candidates);
   for (int part = 0; part < 2; ++part) {
     set->search[part].foundCapacity = 64;
-    set->search[part].found = grow(NULL, set->search[part].foundCapacity, sizeof *set->search[part].found);
+    set->search[part].found = pd_grow(NULL, set->search[part].foundCapacity, sizeof *set->search[part].found);
   }
   set->pairCapacity = 2 * n + 16;
-  set->pairs = grow(NULL, set->pairCapacity, sizeof *set->pairs);
+  set->pairs = pd_grow(NULL, set->pairCapacity, sizeof *set->pairs);
   set->cacheCapacity = set->pairCapacity;
-  set->cache = grow(NULL, set->cacheCapacity, sizeof *set->cache);
-  set->cacheNext = grow(NULL, set->cacheCapacity, sizeof *set->cacheNext);
-  set->touching = grow(NULL, set->cacheCapacity, sizeof *set->touching);
+  set->cache = pd_grow(NULL, set->cacheCapacity, sizeof *set->cache);
+  set->cacheNext = pd_grow(NULL, set->cacheCapacity, sizeof *set->cacheNext);
+  set->touching = pd_grow(NULL, set->cacheCapacity, sizeof *set->touching);
   grow_pair_lists(set);
   return set;
 }
@@ -596,8 +591,8 @@ void pd_state_reserve_contacts(const pdModel* model, pdState* s, int contacts) {
   if (needed <= s->capacity) return;
   int c = s->capacity > 0 ? s->capacity : 1;
   while (c < needed) c *= 2;
-  s->y = grow(s->y, c, sizeof *s->y);
-  s->weight = grow(s->weight, c, sizeof *s->weight);
+  s->y = pd_grow(s->y, c, sizeof *s->y);
+  s->weight = pd_grow(s->weight, c, sizeof *s->weight);
   // the stepper's vectors hold no data between steps: reallocate rather than copy
   free(s->work);
   s->work = calloc((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
@@ -1135,7 +1130,7 @@ static int prepare_list(const pdModel* model, pdContactSet* set, double* y, cons
 static void add_candidate(pdContactSet* set, const candidate* c) {
   if (set->candidateCount == set->candidateCapacity) {
     set->candidateCapacity *= 2;
-    set->candidates = grow(set->candidates, set->candidateCapacity, sizeof *set->candidates);
+    set->candidates = pd_grow(set->candidates, set->candidateCapacity, sizeof *set->candidates);
   }
   set->candidates[set->candidateCount++] = *c;
 }
@@ -1157,14 +1152,14 @@ static int broad_phase(const pdModel* model, pdState* s, const pdPose* poses0, c
   if (pairCount > set->pairCapacity) {
     // grown between steps: the analysis runs after a step, outside the derivative
     set->pairCapacity = 2 * pairCount;
-    set->pairs = grow(set->pairs, set->pairCapacity, sizeof *set->pairs);
+    set->pairs = pd_grow(set->pairs, set->pairCapacity, sizeof *set->pairs);
     pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
   }
   if (pairCount > set->cacheCapacity) {
     set->cacheCapacity = set->pairCapacity;
-    set->cache = grow(set->cache, set->cacheCapacity, sizeof *set->cache);
-    set->cacheNext = grow(set->cacheNext, set->cacheCapacity, sizeof *set->cacheNext);
-    set->touching = grow(set->touching, set->cacheCapacity, sizeof *set->touching);
+    set->cache = pd_grow(set->cache, set->cacheCapacity, sizeof *set->cache);
+    set->cacheNext = pd_grow(set->cacheNext, set->cacheCapacity, sizeof *set->cacheNext);
+    set->touching = pd_grow(set->touching, set->cacheCapacity, sizeof *set->touching);
     grow_pair_lists(set);
   }
   return pairCount;
@@ -1242,7 +1237,7 @@ static void find_range(void* ctx, int part, int begin, int end) {
                                  sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount)) >
            sp->foundCapacity - sp->foundCount) {
       sp->foundCapacity = 2 * (sp->foundCount + n);
-      sp->found = grow(sp->found, sp->foundCapacity, sizeof *sp->found);
+      sp->found = pd_grow(sp->found, sp->foundCapacity, sizeof *sp->found);
     }
     set->pairFoundCount[p] = n;
     sp->foundCount += n;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "contact_set.h"
+#include "grow.h"
 #include "polydyn/error.h"
 #include "state_layout.h"
 
@@ -19,7 +20,6 @@ struct pdDense {
   double t0, h;
   int n, capacity;
   double* node[NODE_COUNT];  // (capacity) each
-  double* slope;             // (capacity) the implicit method's f(y1), before it is captured
   // the presentation
   pdContactSet* view;  // the captured contact list, presented (NULL until the first capture)
   double* yView;       // (capacity)
@@ -29,12 +29,6 @@ struct pdDense {
   int nOwn;
   pdContactSet* contactsOwn;
 };
-
-static void* grow(void* p, size_t count, size_t size) {
-  void* q = realloc(p, (count > 0 ? count : 1) * size);
-  PD_ASSERT(q != NULL);
-  return q;
-}
 
 pdDense* pd_dense_create(void) {
   pdDense* d = calloc(1, sizeof *d);
@@ -47,7 +41,6 @@ void pd_dense_free(pdDense* d) {
   if (!d) return;
   PD_ASSERT(!d->presenting);
   for (int k = 0; k < NODE_COUNT; ++k) free(d->node[k]);
-  free(d->slope);
   free(d->yView);
   pd_contact_set_free(d->view);
   free(d);
@@ -57,9 +50,8 @@ static void reserve(pdDense* d, int n) {
   if (n <= d->capacity) return;
   int c = d->capacity > 0 ? d->capacity : n;
   while (c < n) c *= 2;
-  for (int k = 0; k < NODE_COUNT; ++k) d->node[k] = grow(d->node[k], (size_t)c, sizeof(double));
-  d->slope = grow(d->slope, (size_t)c, sizeof(double));
-  d->yView = grow(d->yView, (size_t)c, sizeof(double));
+  for (int k = 0; k < NODE_COUNT; ++k) d->node[k] = pd_grow(d->node[k], (size_t)c, sizeof(double));
+  d->yView = pd_grow(d->yView, (size_t)c, sizeof(double));
   d->capacity = c;
 }
 
@@ -69,7 +61,7 @@ bool pd_dense_wanted(const pdDense* d, double t0, double h) { return t0 + h > d-
 
 double* pd_dense_slope_scratch(pdDense* d, int n) {
   reserve(d, n);
-  return d->slope;
+  return d->node[NODE_F1];
 }
 
 void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* f0, const double* yHalf,
@@ -86,12 +78,8 @@ void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* 
   if (d->quartic) {
     memcpy(d->node[NODE_YHALF], yHalf, bytes);
     memcpy(d->node[NODE_FHALF], fHalf, bytes);
-  } else if (f1 != d->slope) {
+  } else if (f1 != d->node[NODE_F1]) {  // the implicit method's f(y1) is already there (pd_dense_slope_scratch)
     memcpy(d->node[NODE_F1], f1, bytes);
-  } else {
-    double* t = d->node[NODE_F1];  // the implicit method's f(y1) is already in the record: swap it in
-    d->node[NODE_F1] = d->slope;
-    d->slope = t;
   }
   if (!d->view) d->view = pd_contact_set_create_view(model);
   pd_contact_set_capture(s->contacts, d->view);

@@ -37,7 +37,7 @@ bool pd_dense_wanted(const pdDense* d, double t0, double h);
 // list. May grow the record (the first steps of a state, or a longer state vector).
 void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* f0, const double* yHalf,
                       const double* fHalf, const double* y1, const double* f1);
-// Scratch of state->n numbers for the implicit method's f(y1).
+// Where the implicit method evaluates f(y1) for its capture (state->n numbers; pd_dense_capture takes it as is).
 double* pd_dense_slope_scratch(pdDense* d, int n);
 
 // Presents the state at t, inside the last captured step (t0 < t < t0 + h, asserted). A state already presented

@@ -316,7 +316,8 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
   derivative(model, s, s->t, s->y, w.k1);
   bool eventCut = false;
   for (;;) {
-    // a step cut short to meet a sample says nothing about a longer one: s->h keeps the wanted size
+    // a step cut short to land on a time (one_step's `land`) says nothing about a longer one: s->h keeps the wanted
+    // size
     bool cut = hMax < s->h;
     double h = cut ? hMax : s->h;
     bool atMinimum = h <= set->dtmin;
@@ -412,8 +413,8 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
   double boundStep = pd_implicit_probation_bound_step(im);
   probationLimits limits = {PD_IMPLICIT_HELD_RATIO * boundStep, PD_IMPLICIT_PROBATION_ERROR * model->settings.tol};
   bool onProbation = boundStep > 0.0;
-  // a step a sample cuts below the floor would prove nothing: step doubling takes it, from the bound's step, and the
-  // probation waits for the next
+  // a step a landing cuts below the floor (a sync time inside a sample interval: islands.c) would prove nothing: step
+  // doubling takes it, from the bound's step, and the probation waits for the next
   if (onProbation && hMax < limits.floor) {
     double wanted = s->h;
     s->h = boundStep;
@@ -520,19 +521,20 @@ bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, bool landO
   // skip samples already behind us (a state advanced without an observer, then with one)
   while (sample_time(model, s->nextSample) < s->t) ++s->nextSample;
   if (sample_time(model, s->nextSample) == s->t) observe(model, s, observer, user);
+  if (s->stopped) return false;
   // a state presented at the last call's end goes on from the integration's own, later, state; that step's end was
   // never shown to the hook (it lay beyond that call's end)
   if (pd_dense_resume(s) && hook && s->t <= tEnd) hook(model, s, hookUser);
   for (;;) {
-    // the samples up to the integration's time: the last step's end itself, or presented inside that step
-    while (!s->stopped) {
-      double tSample = sample_time(model, s->nextSample);
-      if (tSample > s->t || tSample > tEnd) break;
+    // the samples up to the integration's time: the last step's end itself, or presented inside that step (a stop
+    // leaves the state at that sample, presented)
+    for (double tSample; (tSample = sample_time(model, s->nextSample)) <= s->t && tSample <= tEnd;) {
       if (tSample < s->t && observer) pd_dense_present(model, s, tSample);
       observe(model, s, observer, user);
+      if (s->stopped) return false;
       pd_dense_resume(s);
     }
-    if (s->stopped || s->t >= tEnd) break;
+    if (s->t >= tEnd) break;
     double tSample = sample_time(model, s->nextSample);
     double target = fmin(tEnd, tSample);
     double taken = 0.0;
@@ -542,20 +544,14 @@ bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, bool landO
       taken = one_step(model, s, target, landOnEnd && target == tEnd);
       if (s->failed) return false;
     }
-    // a step cut to the target (the fixed stepper's, or nothing moving) lands exactly on it, so sample stamps never
-    // drift; so does a step that ends within rounding of it (a fixed dt equal to the sample interval), else a
-    // ~1e-19 s sliver follows
+    // a step cut to the target (the fixed stepper's, a landing one's, or nothing moving) lands exactly on it, so sample
+    // stamps never drift; so does a step that ends within rounding short of it (a fixed dt equal to the sample
+    // interval), else a ~1e-19 s sliver follows; a step that passed it (dense output) keeps its own end
     double next = s->t + taken;
     bool lands =
         next <= target && (taken >= target - s->t || target - next <= TIME_SNAP_ULPS * DBL_EPSILON * fabs(target));
     s->t = lands ? target : next;
     if (hook && taken > 0.0 && s->t <= tEnd) hook(model, s, hookUser);
-  }
-  if (s->stopped) {
-    // the state is that sample's (state->t is its time)
-    double tSample = sample_time(model, s->nextSample - 1);
-    if (tSample < s->t) pd_dense_present(model, s, tSample);
-    return false;
   }
   if (s->t > tEnd) {
     pd_dense_present(model, s, tEnd);

@@ -81,7 +81,7 @@
 #include "broad_phase.h"
 #include "clock.h"
 #include "contact_set.h"
-#include "dense_output.h"
+#include "grow.h"
 #include "help_desk.h"
 #include "interference.h"
 #include "model_contact.h"
@@ -203,12 +203,6 @@ struct pdIslandSet {
   pdHelpDesk desk;         // where a running island posts half loops for a thread without an island (help_desk.h)
 };
 
-static void* grow(void* p, size_t count, size_t size) {
-  void* q = realloc(p, (count > 0 ? count : 1) * size);
-  PD_ASSERT(q != NULL);
-  return q;
-}
-
 // ---------------------------------------------------------------- one island
 
 static void island_free(island* is) {
@@ -227,10 +221,10 @@ static island* island_create(const pdModel* model, struct pdIslandSet* set, cons
   island* is = calloc(1, sizeof *is);
   PD_ASSERT(is != NULL);
   is->bodyCount = count;
-  is->bodies = grow(NULL, (size_t)count, sizeof *is->bodies);
+  is->bodies = pd_grow(NULL, (size_t)count, sizeof *is->bodies);
   memcpy(is->bodies, members, (size_t)count * sizeof *members);
   int n = count + set->fixedCount;
-  is->toScene = grow(NULL, (size_t)n, sizeof *is->toScene);
+  is->toScene = pd_grow(NULL, (size_t)n, sizeof *is->toScene);
   // merge the two ascending lists of scene indices
   for (int m = 0, f = 0, l = 0; l < n; ++l) {
     int moving = m < count ? model->movingBodies[members[m]] : model->bodyCount;
@@ -247,8 +241,8 @@ static island* island_create(const pdModel* model, struct pdIslandSet* set, cons
   *sub = *model;  // settings, scene path, length scale
   sub->bodyCount = n;
   sub->movingCount = count;
-  sub->bodies = grow(NULL, (size_t)n, sizeof *sub->bodies);
-  sub->movingBodies = grow(NULL, (size_t)count, sizeof *sub->movingBodies);
+  sub->bodies = pd_grow(NULL, (size_t)n, sizeof *sub->bodies);
+  sub->movingBodies = pd_grow(NULL, (size_t)count, sizeof *sub->movingBodies);
   for (int l = 0, k = 0; l < n; ++l) {
     sub->bodies[l] = model->bodies[is->toScene[l]];
     if (sub->bodies[l].fixed) continue;
@@ -267,7 +261,6 @@ static island* island_create(const pdModel* model, struct pdIslandSet* set, cons
 static void island_load(const pdModel* model, const pdState* s, struct pdIslandSet* set, island* is,
                         const int* contacts, int count) {
   pdState* sub = is->state;
-  pd_dense_discard(sub);
   sub->stepper = s->stepper;
   sub->onsets = s->onsets;
   sub->t = s->t;
@@ -389,7 +382,7 @@ static void pool_start(struct pdIslandSet* set, int threads) {
   set->generation = 0;
   set->pending = 0;
   if (threads == 1) return;
-  set->workers = grow(NULL, (size_t)threads - 1, sizeof *set->workers);
+  set->workers = pd_grow(NULL, (size_t)threads - 1, sizeof *set->workers);
   PD_ASSERT(pthread_mutex_init(&set->lock, NULL) == 0 && pthread_cond_init(&set->wake, NULL) == 0 &&
             pthread_cond_init(&set->done, NULL) == 0);
   for (int w = 0; w < threads - 1; ++w) {
@@ -549,10 +542,10 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   int m = model->movingCount, n = model->bodyCount;
   set->movingCount = m;
   set->bodyCount = n;
-  set->fixedBodies = grow(NULL, (size_t)n, sizeof *set->fixedBodies);
-  bool* fixed = grow(NULL, (size_t)n, sizeof *fixed);
-  set->boxes = grow(NULL, (size_t)n, sizeof *set->boxes);
-  set->toSub = grow(NULL, (size_t)n, sizeof *set->toSub);
+  set->fixedBodies = pd_grow(NULL, (size_t)n, sizeof *set->fixedBodies);
+  bool* fixed = pd_grow(NULL, (size_t)n, sizeof *fixed);
+  set->boxes = pd_grow(NULL, (size_t)n, sizeof *set->boxes);
+  set->toSub = pd_grow(NULL, (size_t)n, sizeof *set->toSub);
   for (int i = 0; i < n; ++i) {
     const pdBody* b = &model->bodies[i];
     fixed[i] = b->fixed;
@@ -565,36 +558,36 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   PD_ASSERT(set->broad != NULL);
   free(fixed);
   set->pairCapacity = 4 * m + 16;
-  set->pairs = grow(NULL, (size_t)set->pairCapacity, sizeof *set->pairs);
-  set->sat = grow(NULL, (size_t)set->pairCapacity, sizeof *set->sat);
-  set->satNext = grow(NULL, (size_t)set->pairCapacity, sizeof *set->satNext);
-  set->root = grow(NULL, (size_t)m, sizeof *set->root);
-  set->islandOf = grow(NULL, (size_t)m, sizeof *set->islandOf);
-  set->islandOld = grow(NULL, (size_t)m, sizeof *set->islandOld);
-  set->members = grow(NULL, (size_t)m, sizeof *set->members);
-  set->first = grow(NULL, (size_t)m + 1, sizeof *set->first);
-  set->contactFirst = grow(NULL, (size_t)m + 1, sizeof *set->contactFirst);
+  set->pairs = pd_grow(NULL, (size_t)set->pairCapacity, sizeof *set->pairs);
+  set->sat = pd_grow(NULL, (size_t)set->pairCapacity, sizeof *set->sat);
+  set->satNext = pd_grow(NULL, (size_t)set->pairCapacity, sizeof *set->satNext);
+  set->root = pd_grow(NULL, (size_t)m, sizeof *set->root);
+  set->islandOf = pd_grow(NULL, (size_t)m, sizeof *set->islandOf);
+  set->islandOld = pd_grow(NULL, (size_t)m, sizeof *set->islandOld);
+  set->members = pd_grow(NULL, (size_t)m, sizeof *set->members);
+  set->first = pd_grow(NULL, (size_t)m + 1, sizeof *set->first);
+  set->contactFirst = pd_grow(NULL, (size_t)m + 1, sizeof *set->contactFirst);
   set->contactCapacity = 4 * m + 16;  // grown in partition when the list outgrows it
-  set->contactOf = grow(NULL, (size_t)set->contactCapacity, sizeof *set->contactOf);
-  set->contacts = grow(NULL, (size_t)set->contactCapacity, sizeof *set->contacts);
-  set->bound = grow(NULL, (size_t)m, sizeof *set->bound);
-  set->travel = grow(NULL, (size_t)m, sizeof *set->travel);
-  set->h = grow(NULL, (size_t)m, sizeof *set->h);
-  set->x0 = grow(NULL, (size_t)m, sizeof *set->x0);
-  set->v0 = grow(NULL, (size_t)m, sizeof *set->v0);
-  set->box0 = grow(NULL, (size_t)m, sizeof *set->box0);
-  set->touching = grow(NULL, (size_t)m, sizeof *set->touching);
+  set->contactOf = pd_grow(NULL, (size_t)set->contactCapacity, sizeof *set->contactOf);
+  set->contacts = pd_grow(NULL, (size_t)set->contactCapacity, sizeof *set->contacts);
+  set->bound = pd_grow(NULL, (size_t)m, sizeof *set->bound);
+  set->travel = pd_grow(NULL, (size_t)m, sizeof *set->travel);
+  set->h = pd_grow(NULL, (size_t)m, sizeof *set->h);
+  set->x0 = pd_grow(NULL, (size_t)m, sizeof *set->x0);
+  set->v0 = pd_grow(NULL, (size_t)m, sizeof *set->v0);
+  set->box0 = pd_grow(NULL, (size_t)m, sizeof *set->box0);
+  set->touching = pd_grow(NULL, (size_t)m, sizeof *set->touching);
   set->free = calloc((size_t)(m > 0 ? m : 1), sizeof *set->free);
   PD_ASSERT(set->free != NULL);
-  set->cx0 = grow(NULL, (size_t)m, sizeof *set->cx0);
-  set->cv0 = grow(NULL, (size_t)m, sizeof *set->cv0);
-  set->cq0 = grow(NULL, (size_t)m, sizeof *set->cq0);
-  set->cbound = grow(NULL, (size_t)m, sizeof *set->cbound);
-  set->ctravel = grow(NULL, (size_t)m, sizeof *set->ctravel);
-  set->cbox = grow(NULL, (size_t)m, sizeof *set->cbox);
-  set->activate = grow(NULL, (size_t)m, sizeof *set->activate);
-  set->q0 = grow(NULL, (size_t)m, sizeof *set->q0);
-  set->r0 = grow(NULL, (size_t)m, sizeof *set->r0);
+  set->cx0 = pd_grow(NULL, (size_t)m, sizeof *set->cx0);
+  set->cv0 = pd_grow(NULL, (size_t)m, sizeof *set->cv0);
+  set->cq0 = pd_grow(NULL, (size_t)m, sizeof *set->cq0);
+  set->cbound = pd_grow(NULL, (size_t)m, sizeof *set->cbound);
+  set->ctravel = pd_grow(NULL, (size_t)m, sizeof *set->ctravel);
+  set->cbox = pd_grow(NULL, (size_t)m, sizeof *set->cbox);
+  set->activate = pd_grow(NULL, (size_t)m, sizeof *set->activate);
+  set->q0 = pd_grow(NULL, (size_t)m, sizeof *set->q0);
+  set->r0 = pd_grow(NULL, (size_t)m, sizeof *set->r0);
   set->sizeMin = INFINITY;
   for (int k = 0; k < m; ++k) {
     set->sizeMin = fmin(set->sizeMin, model->bodies[model->movingBodies[k]].size);
@@ -602,15 +595,15 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
     set->h[k] = s->h;
   }
   set->islandCapacity = m > 0 ? m : 1;
-  set->islands = grow(NULL, (size_t)set->islandCapacity, sizeof *set->islands);
-  set->next = grow(NULL, (size_t)set->islandCapacity, sizeof *set->next);
-  set->subModels = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subModels);
-  set->subStates = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subStates);
-  set->subMaps = grow(NULL, (size_t)set->islandCapacity, sizeof *set->subMaps);
-  set->jobs = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobs);
-  set->jobCoarse = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobCoarse);
-  set->jobOk = grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobOk);
-  set->order = grow(NULL, (size_t)set->islandCapacity, sizeof *set->order);
+  set->islands = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->islands);
+  set->next = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->next);
+  set->subModels = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->subModels);
+  set->subStates = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->subStates);
+  set->subMaps = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->subMaps);
+  set->jobs = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobs);
+  set->jobCoarse = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobCoarse);
+  set->jobOk = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobOk);
+  set->order = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->order);
   pd_help_desk_init(&set->desk);
   pool_start(set, s->threads);
   return set;
@@ -739,9 +732,9 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
   int pairCount = pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
   if (pairCount > set->pairCapacity) {
     set->pairCapacity = 2 * pairCount;
-    set->pairs = grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
-    set->sat = grow(set->sat, (size_t)set->pairCapacity, sizeof *set->sat);
-    set->satNext = grow(set->satNext, (size_t)set->pairCapacity, sizeof *set->satNext);
+    set->pairs = pd_grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
+    set->sat = pd_grow(set->sat, (size_t)set->pairCapacity, sizeof *set->sat);
+    set->satNext = pd_grow(set->satNext, (size_t)set->pairCapacity, sizeof *set->satNext);
     pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
   }
   // bodies in contact first: a pair already in one island needs no separation test
@@ -785,8 +778,8 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
   group_by(set->islandOf, m, set->partCount, set->first, set->members);
   if (contacts > set->contactCapacity) {
     set->contactCapacity = 2 * contacts;
-    set->contactOf = grow(set->contactOf, (size_t)set->contactCapacity, sizeof *set->contactOf);
-    set->contacts = grow(set->contacts, (size_t)set->contactCapacity, sizeof *set->contacts);
+    set->contactOf = pd_grow(set->contactOf, (size_t)set->contactCapacity, sizeof *set->contactOf);
+    set->contacts = pd_grow(set->contacts, (size_t)set->contactCapacity, sizeof *set->contacts);
   }
   for (int c = 0; c < contacts; ++c) {
     int b1, b2;
