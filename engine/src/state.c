@@ -36,6 +36,8 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   s->threads = 1;
   pd_island_set_free(s->islandSet);
   s->islandSet = NULL;
+  pd_implicit_free(s->implicit);  // its switch (active, on probation, backing off) is the last run's
+  s->implicit = NULL;
   s->nextSample = 0;
   s->failed = false;
   s->stopped = false;

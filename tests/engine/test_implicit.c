@@ -248,6 +248,29 @@ static void test_the_same_run_twice_gives_the_same_numbers(void** state) {
   pd_model_free(m);
 }
 
+// pd_state_reset takes a state back to a new one's: the second run of a reset state (islands off, so the scene's own
+// state steps, and its switch is active at the first run's end: the boxes rest) is the first run, bit for bit.
+static void test_a_reset_state_runs_as_a_new_one(void** state) {
+  (void)state;
+  pdModel* m = two_boxes_on_a_ramp(0.6);
+  pdState* s = pd_state_create(m);
+  long steps[2];
+  pdBodyState end[2];
+  for (int k = 0; k < 2; ++k) {
+    pd_state_reset(m, s);
+    s->islands = pd_islandsOff;
+    assert_true(pd_advance(m, s, m->settings.tend, NULL, NULL));
+    steps[k] = s->count.accepted;
+    end[k] = pd_state_body(m, s, m->movingBodies[0]);
+  }
+  print_message("two boxes on a ramp, islands off: %ld accepted steps, then %ld after pd_state_reset\n", steps[0],
+                steps[1]);
+  assert_int_equal(steps[0], steps[1]);
+  assert_memory_equal(&end[0], &end[1], sizeof end[0]);
+  pd_state_free(s);
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_w_matches_finite_differences_of_the_derivative),
@@ -257,6 +280,7 @@ int main(void) {
       cmocka_unit_test(test_a_probation_step_must_leave_room_to_grow),
       cmocka_unit_test(test_a_stack_of_20_steps_implicitly),
       cmocka_unit_test(test_the_same_run_twice_gives_the_same_numbers),
+      cmocka_unit_test(test_a_reset_state_runs_as_a_new_one),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
