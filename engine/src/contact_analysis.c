@@ -201,15 +201,24 @@ static bool same_side_beyond(double u, double v, double norm2, double slack) {
   return m > 0.0 && m * m > 4.0 * slack * slack * norm2;
 }
 typedef enum arcMeeting { arcsApart = 0, arcsCross, arcsTouch } arcMeeting;
-static arcMeeting arcs_meet(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d, double slack) {
-  pdVec3 bxa = pd_v3_cross(b, a), dxc = pd_v3_cross(d, c);
+// An arc (a, b) of the Gauss map with its great circle's normal b × a and that normal's squared length: the
+// search tests every edge of one body against every edge of the other, so each arc's are formed once.
+typedef struct gaussArc {
+  pdVec3 a, b, bxa;
+  double norm2;
+} gaussArc;
+static gaussArc gauss_arc(pdVec3 a, pdVec3 b) {
+  pdVec3 bxa = pd_v3_cross(b, a);
+  return (gaussArc){a, b, bxa, pd_v3_dot(bxa, bxa)};
+}
+static arcMeeting arcs_meet_formed(const gaussArc* ab, const gaussArc* cd, double slack) {
+  pdVec3 a = ab->a, b = ab->b, c = cd->a, d = cd->b, bxa = ab->bxa, dxc = cd->bxa;
   double cba = pd_v3_dot(c, bxa), dba = pd_v3_dot(d, bxa), adc = pd_v3_dot(a, dxc), bdc = pd_v3_dot(b, dxc);
   // Apart for certain, and cheaply (most edge pairs): both ends of one arc on the same side of the other's
   // great circle, each by a sine beyond twice the slack (plus a margin for the rounding of the triple
   // products: the sine is cba/|b × a|). The arc between them is then on that side too, and so is every point
   // within the slack of it, so the touch test below, whose point lies on that great circle, would find none.
-  if (same_side_beyond(cba, dba, pd_v3_dot(bxa, bxa), slack) || same_side_beyond(adc, bdc, pd_v3_dot(dxc, dxc), slack))
-    return arcsApart;
+  if (same_side_beyond(cba, dba, ab->norm2, slack) || same_side_beyond(adc, bdc, cd->norm2, slack)) return arcsApart;
   // a crossing by a roundoff (an end of one arc within ARC_TOUCH_TOL of the other's great circle, as
   // when two faces are parallel) is a touch: it gets the touch's depth check, whatever the roundoff's sign
   // (the least of the four at most the tolerance: any of them, which is the same test NaN included, without
@@ -230,6 +239,10 @@ static arcMeeting arcs_meet(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d, double slack
     if (on1 && on2) return arcsTouch;
   }
   return arcsApart;
+}
+static arcMeeting arcs_meet(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d, double slack) {
+  gaussArc ab = gauss_arc(a, b), cd = gauss_arc(c, d);
+  return arcs_meet_formed(&ab, &cd, slack);
 }
 
 // Overlap of A and B along unit u (A's frame, pointing from A to B), m; B's pose in A's frame (rel, off).
@@ -344,6 +357,10 @@ static bool end_in_vf_contact(const pdContactGeom* found, int count, int body, i
 // interpolated to 10⁻³ δ_max), so a deeper one was missed for several δ_max of travel or is not a contact.
 #define EE_NEW_DEPTH_MAX_DEFLECTIONS 3.0
 
+// find_ee's per-search caches, on the stack: A's Gauss arcs of its first this many edges, the overlaps along the
+// first this many faces of each body (a bit of a faceMask per entry).
+#define FIND_EE_CACHED 64
+
 static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
                    int capacity, int n) {
   const pdPolyhedron* sa = &model->bodies[ia].shape;
@@ -366,6 +383,13 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
                   maskA);
     outside_masks(sb, &rel, off, sa, deltaMax + PRUNE_OUTSIDE_TOLS * tolA, maskB);
   }
+  // A's arcs (its edges' face normals, fixed in A's frame), each formed once for all of B's edges when first
+  // needed (most pairs are pruned), and the overlap along a face normal by face (A's, then B's reversed): touching
+  // arcs (a 45° stack's flush faces) test the same four faces for most of their edge pairs. A bit per entry says
+  // it is formed (the first 64 edges and faces; the others are formed where used, as the same numbers).
+  gaussArc arcsA[FIND_EE_CACHED];
+  double overlapAlongFace[2][FIND_EE_CACHED];
+  faceMask arcFormed = 0, overlapFormed[2] = {0, 0};
   for (int j = 0; j < sb->edgeCount; ++j) {
     const pdEdge* eb = &sb->edges[j];
     if (prune && (maskB[eb->v[0]] & maskB[eb->v[1]])) continue;
@@ -373,18 +397,40 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
     pdVec3 b1 = pd_v3_add(off, pd_mat3_mulv(&rel, sb->vertices[eb->v[1]]));
     pdVec3 c = pd_v3_scale(pd_mat3_mulv(&rel, sb->faces[eb->f[0]].normal), -1.0);
     pdVec3 d = pd_v3_scale(pd_mat3_mulv(&rel, sb->faces[eb->f[1]].normal), -1.0);
+    gaussArc arcB;
+    bool arcBFormed = false;
     for (int i = 0; i < sa->edgeCount; ++i) {
       const pdEdge* ea = &sa->edges[i];
       if (prune && (maskA[ea->v[0]] & maskA[ea->v[1]])) continue;
-      arcMeeting meet = arcs_meet(sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal, c, d, ARC_TOUCH_TOL);
+      gaussArc arcA;
+      if (i < FIND_EE_CACHED && (arcFormed >> i & 1u)) {
+        arcA = arcsA[i];
+      } else {
+        arcA = gauss_arc(sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal);
+        if (i < FIND_EE_CACHED) arcsA[i] = arcA, arcFormed |= 1ull << i;
+      }
+      if (!arcBFormed) arcB = gauss_arc(c, d), arcBFormed = true;
+      arcMeeting meet = arcs_meet_formed(&arcA, &arcB, ARC_TOUCH_TOL);
       if (meet == arcsApart) continue;
       edgeGeom g;
       if (!edge_pair_geometry(sa, i, b0, b1, true, &g) || !(g.depth > 0.0)) continue;
       if (meet == arcsTouch) {
         // the faces around the two edges, as axes from A to B: A's normals, B's reversed (c, d)
         const pdVec3 axes[4] = {sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal, c, d};
+        const int faces[4] = {ea->f[0], ea->f[1], eb->f[0], eb->f[1]};
         double shallowest = INFINITY;
-        for (int k = 0; k < 4; ++k) shallowest = fmin(shallowest, overlap_along(sa, sb, &rel, off, axes[k]));
+        for (int k = 0; k < 4; ++k) {
+          int f = faces[k];
+          faceMask* formed = &overlapFormed[k / 2];
+          double overlap;
+          if (f < FIND_EE_CACHED && (*formed >> f & 1u)) {
+            overlap = overlapAlongFace[k / 2][f];
+          } else {
+            overlap = overlap_along(sa, sb, &rel, off, axes[k]);
+            if (f < FIND_EE_CACHED) overlapAlongFace[k / 2][f] = overlap, *formed |= 1ull << f;
+          }
+          shallowest = fmin(shallowest, overlap);
+        }
         if (g.depth > shallowest + tolA + tolB) continue;
       }
       // edges crossing inside a plane both bodies share (the flush sides of a brick on a brick of its
@@ -476,16 +522,24 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
 }
 
 // EE contact geometry of a known edge pair at the given poses, computed in body 1's frame.
+// frame (nullable): body 2's pose in body 1's frame, formed here unless it holds it for these poses already.
 static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
-                         bool interior, pdContactGeom* out) {
+                         pdPairFrame* frame, bool interior, pdContactGeom* out) {
   const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
   const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
-  pdMat3 R1T = pd_mat3_transpose(&p1->R);
-  pdMat3 rel = pd_mat3_mul(&R1T, &p2->R);
-  pdVec3 off = pd_mat3_mulv(&R1T, pd_v3_sub(p2->x, p1->x));
+  pdPairFrame own;
+  if (!frame) frame = &own, own.p1 = NULL;
+  if (frame->p1 != p1 || frame->p2 != p2) {
+    pdMat3 R1T = pd_mat3_transpose(&p1->R);
+    frame->rel = pd_mat3_mul(&R1T, &p2->R);
+    frame->off = pd_mat3_mulv(&R1T, pd_v3_sub(p2->x, p1->x));
+    frame->p1 = p1, frame->p2 = p2;
+  }
+  const pdMat3* rel = &frame->rel;
+  pdVec3 off = frame->off;
   const pdEdge* e2 = &s2->edges[id->feat2];
-  pdVec3 b0 = pd_v3_add(off, pd_mat3_mulv(&rel, s2->vertices[e2->v[0]]));
-  pdVec3 b1 = pd_v3_add(off, pd_mat3_mulv(&rel, s2->vertices[e2->v[1]]));
+  pdVec3 b0 = pd_v3_add(off, pd_mat3_mulv(rel, s2->vertices[e2->v[0]]));
+  pdVec3 b1 = pd_v3_add(off, pd_mat3_mulv(rel, s2->vertices[e2->v[1]]));
   edgeGeom g;
   if (!edge_pair_geometry(s1, id->feat1, b0, b1, interior, &g)) return false;
   out->id = *id;
@@ -533,6 +587,11 @@ static bool edge_arcs_meet(const pdModel* model, const pdContactId* id, const pd
 
 void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                          pdContactGeom* out) {
+  pd_contact_geometry_framed(model, id, p1, p2, NULL, out);
+}
+
+void pd_contact_geometry_framed(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                                pdPairFrame* frame, pdContactGeom* out) {
   out->id = *id;
   if (id->kind == pd_contactVF) {
     const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
@@ -545,7 +604,7 @@ void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPo
     return;
   }
   // where the edge lines are closest; parallel lines have no closest points: normal 0 says so
-  if (!edge_contact(model, id, p1, p2, false, out)) {
+  if (!edge_contact(model, id, p1, p2, frame, false, out)) {
     out->point = p1->x;
     out->normal = (pdVec3){0, 0, 0};
     out->depth = 0.0;
@@ -554,6 +613,11 @@ void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPo
 
 bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                       pdContactGeom* out) {
+  return pd_contact_track_framed(model, id, p1, p2, NULL, out);
+}
+
+bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                             pdPairFrame* frame, pdContactGeom* out) {
   if (id->kind == pd_contactVF) {
     pd_contact_geometry(model, id, p1, p2, out);
     const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
@@ -570,11 +634,11 @@ bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose*
   // an edge pair stays a contact while its closest points lie inside both edges and it spans a face of
   // the Minkowski difference (its Gauss-map arcs still meet): past that, other features carry the contact
   // and the lines' distance means nothing
-  if (edge_contact(model, id, p1, p2, true, out))
+  if (edge_contact(model, id, p1, p2, frame, true, out))
     return edge_arcs_meet(model, id, p1, p2) && edge_points_inside(model, id, p1, p2, out);
   // broken: still report where the edge lines are closest (the caller may integrate on to the end of the
   // step before it drops the contact)
-  pd_contact_geometry(model, id, p1, p2, out);
+  pd_contact_geometry_framed(model, id, p1, p2, frame, out);
   return false;
 }
 
@@ -622,8 +686,8 @@ double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPos
   // App. C (26): the signed distance between the two edge lines at the start and at the end of the
   // step, each measured in the bodies' relative pose (the same as holding body 2 fixed)
   pdContactGeom end, start;
-  if (!edge_contact(model, id, body1End, body2End, false, &end) ||
-      !edge_contact(model, id, body1Start, body2Start, false, &start))
+  if (!edge_contact(model, id, body1End, body2End, NULL, false, &end) ||
+      !edge_contact(model, id, body1Start, body2Start, NULL, false, &start))
     return 0.0;  // parallel at one end of the step: no interpolation possible, take the contact as it is
   double d1 = -start.depth, d2 = -end.depth;  // separations
   if (d1 <= 0.0) return 0.0;

@@ -68,6 +68,20 @@ bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose*
 void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                          pdContactGeom* out);
 
+// Body 2's pose in body 1's frame (rotation rel, offset off) at the poses p1, p2, which EE geometry is computed in.
+// A loop over a list of contacts sorted by id meets each pair's contacts one after another: one frame, with p1
+// NULL to start, passed to the _framed forms below for them all is formed once per pair, as the same numbers.
+// It is valid while the poses it was formed at (pointers it compares) keep their values: within one loop.
+typedef struct pdPairFrame {
+  const pdPose *p1, *p2;
+  pdMat3 rel;
+  pdVec3 off;
+} pdPairFrame;
+// pd_contact_track and pd_contact_geometry with a pair frame (nullable), bit for bit the same results.
+bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                             pdPairFrame* frame, pdContactGeom* out);
+void pd_contact_geometry_framed(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                                pdPairFrame* frame, pdContactGeom* out);
 // Onset of a contact found at the end of a step (App. C): the fraction δ ∈ [0, 1] of the step at
 // which the features first touched, given the poses of body 1 and body 2 at the start and the end
 // of the step. VF by the quadratic (24)–(25) with linearly interpolated vertex, face point and normal;

@@ -395,13 +395,15 @@ static void poses_from(const pdModel* model, const double* y, pdPose* poses) {
 }
 
 // Geometry, relative velocity and force of one contact at state y (poses of y given).
+// frame: the loop's pair frame (pdPairFrame), shared by a pair's contacts (consecutive in the sorted list).
 static void evaluate(const pdModel* model, const contactSlot* c, const double* y, const pdPose* poses,
-                     const pdSprings* springs, pdContactGeom* geom, bool* tracked, pdVec3* du, pdContactForce* f) {
+                     pdPairFrame* frame, const pdSprings* springs, pdContactGeom* geom, bool* tracked, pdVec3* du,
+                     pdContactForce* f) {
   int b1 = c->id.body1, b2 = c->id.body2;
   if (tracked)
-    *tracked = pd_contact_track(model, &c->id, &poses[b1], &poses[b2], geom);
+    *tracked = pd_contact_track_framed(model, &c->id, &poses[b1], &poses[b2], frame, geom);
   else
-    pd_contact_geometry(model, &c->id, &poses[b1], &poses[b2], geom);
+    pd_contact_geometry_framed(model, &c->id, &poses[b1], &poses[b2], frame, geom);
   if (geom->normal.x == 0.0 && geom->normal.y == 0.0 && geom->normal.z == 0.0) {
     // EE edges turned parallel inside a step: keep the last accepted geometry until the step's end drops it
     geom->normal = c->normal;
@@ -435,12 +437,14 @@ static void forces_range(void* ctx, int part, int begin, int end) {
   const contactLoop* job = ctx;
   pdContactSet* set = job->set;
   int base = spring_base(job->model);
+  pdPairFrame frame;
+  frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = begin; i < end; ++i) {
     pdSprings s = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
     pdContactGeom g;
     pdVec3 du;
     pdContactForce f;
-    evaluate(job->model, &set->items[i], job->y, set->poses, &s, &g, NULL, &du, &f);
+    evaluate(job->model, &set->items[i], job->y, set->poses, &frame, &s, &g, NULL, &du, &f);
     springs_store(job->dydt + base + PD_CONTACT_STATE_SIZE * i, &f.rate);
     set->push[i] = (contactPush){g.point, f.force, pd_contact_force_pulls(&f)};
   }
@@ -609,7 +613,11 @@ static int compare_slots(const void* a, const void* b) {
 // state's vectors: the stepper's scratch is dropped then, so nothing may still point into it.
 static void install(const pdModel* model, pdState* s, int count) {
   pdContactSet* set = s->contacts;
-  qsort(set->next, (size_t)count, sizeof *set->next, compare_slots);
+  // a list that changed in no contact comes in sorted (ids are unique, so any sort gives the one order): checked
+  // first, since qsort moves slots of ~0.5 kB through a scratch copy (7 % of cases/hard/stack_10.scene's work)
+  bool sorted = true;
+  for (int i = 1; i < count && sorted; ++i) sorted = compare_slots(&set->next[i - 1], &set->next[i]) < 0;
+  if (!sorted) qsort(set->next, (size_t)count, sizeof *set->next, compare_slots);
   pd_state_reserve_contacts(model, s, count);
   int base = spring_base(model);
   for (int i = 0; i < count; ++i) {
@@ -981,19 +989,25 @@ double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double
 
 // Records geometry and force of every listed contact at state y for output, realignment and refinement.
 // poses must be those of y.
+static void record_geometry(contactSlot* c, const pdContactGeom* g) {
+  c->normal = g->normal;
+  c->point = g->point;
+  c->depth = g->depth;
+}
+
 static void record_range(void* ctx, int part, int begin, int end) {
   (void)part;
   const contactLoop* job = ctx;
   int base = spring_base(job->model);
+  pdPairFrame frame;
+  frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = begin; i < end; ++i) {
     contactSlot* c = &job->set->items[i];
     pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
     pdContactGeom g;
     pdVec3 du;  // unused here
-    evaluate(job->model, c, job->y, job->poses1, &sp, &g, NULL, &du, &c->force);
-    c->normal = g.normal;
-    c->point = g.point;
-    c->depth = g.depth;
+    evaluate(job->model, c, job->y, job->poses1, &frame, &sp, &g, NULL, &du, &c->force);
+    record_geometry(c, &g);
   }
 }
 
@@ -1326,11 +1340,13 @@ static void tracking_range(void* ctx, int part, int begin, int end) {
   const contactLoop* job = ctx;
   pdContactSet* set = job->set;
   int base = spring_base(job->model);
+  pdPairFrame frame;
+  frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = begin; i < end; ++i) {
     contactEval* e = &set->eval[i];
     pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
     pdVec3 du;
-    evaluate(job->model, &set->items[i], job->y, set->poses1, &sp, &e->geom, &e->tracked, &du, &e->force);
+    evaluate(job->model, &set->items[i], job->y, set->poses1, &frame, &sp, &e->geom, &e->tracked, &du, &e->force);
     e->transferred = false;
   }
 }
@@ -1501,20 +1517,25 @@ void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y)
   poses_from(model, y, view->poses1);
   world_inverse_inertias(model, view, view->poses1);  // read by the implicit stepper's linearisation
   int base = spring_base(model);
-  // realigned as a commit realigns the contacts it keeps (one that pulls keeps its springs: a commit drops it)
+  // realigned as a commit realigns the contacts it keeps (one that pulls keeps its springs: a commit drops it),
+  // then recorded as record() records: the same geometry and relative velocity, the force of the springs as
+  // they are now
+  pdPairFrame frame;
+  frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = 0; i < count; ++i) {
-    const contactSlot* c = &view->items[i];
+    contactSlot* c = &view->items[i];
     double* yc = y + base + PD_CONTACT_STATE_SIZE * i;
     pdSprings sp = springs_load(yc);
     pdContactGeom g;
     pdVec3 du;
-    pdContactForce f;
-    evaluate(model, c, y, view->poses1, &sp, &g, NULL, &du, &f);
-    if (pd_contact_force_pulls(&f)) continue;
-    pd_springs_realign(&sp, c->normal, g.normal, c->params.mu, &c->params, f.fn);
-    springs_store(yc, &sp);
+    evaluate(model, c, y, view->poses1, &frame, &sp, &g, NULL, &du, &c->force);
+    if (!pd_contact_force_pulls(&c->force)) {
+      pd_springs_realign(&sp, c->normal, g.normal, c->params.mu, &c->params, c->force.fn);
+      springs_store(yc, &sp);
+      pd_contact_force(&c->params, &sp, g.normal, du, &c->force);
+    }
+    record_geometry(c, &g);
   }
-  record(model, view, y, view->poses1);
 }
 
 // ---------------------------------------------------------------- read-out
