@@ -82,6 +82,21 @@ bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const 
                              pdPairFrame* frame, pdContactGeom* out);
 void pd_contact_geometry_framed(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                                 pdPairFrame* frame, pdContactGeom* out);
+// A certificate of a pair's contact search (contact_analysis.c, "search certificates"): at any poses whose motion
+// from the ones it was issued at (pd_search_motion) is below `margin`, pd_contacts_find reports no contact of the
+// pair (ia < ib) outside the exempt list it was issued with. margin 0: none.
+typedef struct pdSearchCertificate {
+  double margin;  // m, of pd_search_motion
+  pdMat3 rel;     // B's rotation in A's frame when issued
+  pdVec3 off;     // B's origin in A's frame when issued, m
+  double reach;   // m: max(R_B, R_A + |off|), R a body's largest vertex distance from its origin
+} pdSearchCertificate;
+// The certificate of pair ia < ib at poses pa, pb with the contacts `exempt` (the pair's contacts of C0).
+pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
+                                        const pdContactId* exempt, int exemptCount);
+// The motion of the pair from the certificate's poses to pa, pb, m: |Δoff| + ‖Δrel‖_F reach, which bounds how far
+// any point of B moves in A's frame and any point of A in B's frame, and (over reach) how far B's directions turn.
+double pd_search_motion(const pdSearchCertificate* cert, const pdPose* pa, const pdPose* pb);
 // Onset of a contact found at the end of a step (App. C): the fraction δ ∈ [0, 1] of the step at
 // which the features first touched, given the poses of body 1 and body 2 at the start and the end
 // of the step. VF by the quadratic (24)–(25) with linearly interpolated vertex, face point and normal;

@@ -119,6 +119,18 @@ typedef struct contactSlot {
   int modalCount;       // contacts its pair had when set_modal_dampers last set its dampers (0: not yet)
 } contactSlot;
 
+// A pair's search certificate (contact_analysis.h, "search certificates") and when to issue its next, kept beside
+// its interference cache from one search to the next.
+typedef struct pairCertificate {
+  pdSearchCertificate cert;  // margin 0: none
+  int contacts;              // the pair's contacts of C0 it exempts
+  bool used;                 // a search was skipped on it
+  int wait;                  // quiet searches to let pass before the next is issued
+  int backoff;               // the wait after the next one that saves no search
+} pairCertificate;
+// The longest wait between certificates of a pair whose certificates save no search (it doubles each time from 1).
+#define CERT_BACKOFF_MAX 64
+
 // Analysis of one contact of C0 at the end of a trial step.
 typedef struct contactEval {
   bool tracked;       // still geometrically valid
@@ -191,7 +203,9 @@ struct pdContactSet {
   pdPair* pairs;
   int pairCapacity;
   pdPairSatCache *cache, *cacheNext;
+  pairCertificate *certs, *certsNext;  // (cacheCapacity) beside cache, cacheNext
   bool* touching;  // (cacheCapacity) did pair p of the contact search interfere
+  bool* certified;                        // (cacheCapacity) was pair p's search skipped on its certificate
   int *pairPrevious, *pairPreviousCount;  // (cacheCapacity) pair p's contacts of C0: items[first .. first + count)
   int *pairFound, *pairFoundCount;        // (cacheCapacity) its contacts found: its part's found[first .. + count)
   int cacheCount, cacheCapacity;
@@ -240,6 +254,8 @@ static void reserve_list(pdContactSet* set, int capacity) {
 
 // The contact search's per-pair lists, to cacheCapacity.
 static void grow_pair_lists(pdContactSet* set) {
+  set->certs = pd_grow(set->certs, set->cacheCapacity, sizeof *set->certs);
+  set->certsNext = pd_grow(set->certsNext, set->cacheCapacity, sizeof *set->certsNext);
   set->pairPrevious = pd_grow(set->pairPrevious, set->cacheCapacity, sizeof *set->pairPrevious);
   set->pairPreviousCount = pd_grow(set->pairPreviousCount, set->cacheCapacity, sizeof *set->pairPreviousCount);
   set->pairFound = pd_grow(set->pairFound, set->cacheCapacity, sizeof *set->pairFound);
@@ -296,6 +312,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   set->cache = pd_grow(NULL, set->cacheCapacity, sizeof *set->cache);
   set->cacheNext = pd_grow(NULL, set->cacheCapacity, sizeof *set->cacheNext);
   set->touching = pd_grow(NULL, set->cacheCapacity, sizeof *set->touching);
+  set->certified = pd_grow(NULL, set->cacheCapacity, sizeof *set->certified);
   grow_pair_lists(set);
   return set;
 }
@@ -338,6 +355,9 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->pairPreviousCount);
   free(set->pairFound);
   free(set->pairFoundCount);
+  free(set->certs);
+  free(set->certified);
+  free(set->certsNext);
   free(set);
 }
 
@@ -429,6 +449,7 @@ typedef struct contactLoop {
   const double* y;                // the state the loop evaluates
   double* dydt;                   // forces: where the spring rates go
   const pdPose *poses0, *poses1;  // the contact search: the poses at the step's start and end
+  bool certificates;              // the contact search: pdState.searchCertificates
 } contactLoop;
 
 // Contacts [begin, end) of a derivative evaluation: their spring rates into dydt, their pushes into set->push.
@@ -1174,6 +1195,7 @@ static int broad_phase(const pdModel* model, pdState* s, const pdPose* poses0, c
     set->cache = pd_grow(set->cache, set->cacheCapacity, sizeof *set->cache);
     set->cacheNext = pd_grow(set->cacheNext, set->cacheCapacity, sizeof *set->cacheNext);
     set->touching = pd_grow(set->touching, set->cacheCapacity, sizeof *set->touching);
+    set->certified = pd_grow(set->certified, set->cacheCapacity, sizeof *set->certified);
     grow_pair_lists(set);
   }
   return pairCount;
@@ -1213,7 +1235,26 @@ static int compare_to_pair(const pdContactId* id, int a, int b) {
   return hi < b ? -1 : hi > b;
 }
 
-// Pairs [begin, end) of the contact search: touching[p] and the pair's new cache entry.
+// A certificate that saved no search, or none issued: the pair waits longer before the next try (a pair in motion, or
+// one whose features no certificate covers, would pay for one after every step). The wait doubles from 1.
+static void back_off(pairCertificate* c) {
+  c->backoff = c->backoff < CERT_BACKOFF_MAX ? 2 * c->backoff + 1 : CERT_BACKOFF_MAX;
+  c->wait = c->backoff;
+}
+
+// Does pair p's certificate, issued with c->contacts of its contacts of C0, hold at the poses pa, pb: the same
+// contacts listed (the list only loses contacts between searches, at commits: the same count is the same list),
+// each still tracked, and the pair within the certificate's motion?
+static bool certificate_holds(const pdContactSet* set, int p, const pairCertificate* c, const pdPose* pa,
+                              const pdPose* pb) {
+  if (c->contacts != set->pairPreviousCount[p]) return false;
+  for (int k = set->pairPrevious[p]; k < set->pairPrevious[p] + c->contacts; ++k)
+    if (!set->eval[k].tracked) return false;
+  return pd_search_motion(&c->cert, pa, pb) < c->cert.margin;
+}
+
+// Pairs [begin, end) of the contact search: touching[p] and the pair's new cache entry, or certified[p] when its
+// certificate holds.
 static void interference_range(void* ctx, int part, int begin, int end) {
   (void)part;
   const contactLoop* job = ctx;
@@ -1223,12 +1264,47 @@ static void interference_range(void* ctx, int part, int begin, int end) {
   for (int p = begin; p < end; ++p) {
     int a = set->pairs[p].a, b = set->pairs[p].b;
     pdPairSatCache entry = {a, b, pd_pair_sat_cache_find(set->cache, set->cacheCount, &cached, a, b)};
+    bool listed = cached < set->cacheCount && set->cache[cached].a == a && set->cache[cached].b == b;
+    pairCertificate cert = listed ? set->certs[cached] : (pairCertificate){.cert.margin = 0.0};
+    set->certified[p] = false;
+    if (job->certificates && cert.cert.margin > 0.0) {
+      if (certificate_holds(set, p, &cert, &poses1[a], &poses1[b])) {
+        // nothing new to find (contact_analysis.h): the pair keeps its cache and certificate, and is not searched
+        cert.used = true;
+        set->certified[p] = true;
+        set->touching[p] = false;
+        set->cacheNext[p] = set->cache[cached];
+        set->certsNext[p] = cert;
+        continue;
+      }
+      if (cert.used)
+        cert.backoff = 0;
+      else
+        back_off(&cert);
+      cert.cert.margin = 0.0;
+      cert.used = false;
+    }
+    set->certsNext[p] = cert;
     pdSatResult sat;
     const pdBody *A = &job->model->bodies[a], *B = &job->model->bodies[b];
     set->touching[p] = pd_interference(&A->shape, poses1[a].x, &poses1[a].R, &B->shape, poses1[b].x, &poses1[b].R,
                                        PD_SAT_VERDICT, &entry.sat, &sat);
     set->cacheNext[p] = entry;
   }
+}
+
+// Did pair p's search find nothing its contacts of C0 (`previous`, sorted like found[0 .. n)) do not have, with
+// each of them tracked?
+static bool quiet(const pdContactSet* set, int p, const pdContactGeom* found, int n, const pdContactId* previous) {
+  int first = set->pairPrevious[p], count = set->pairPreviousCount[p];
+  for (int k = first; k < first + count; ++k)
+    if (!set->eval[k].tracked) return false;
+  int j = 0;
+  for (int f = 0; f < n; ++f) {
+    while (j < count && pd_contact_id_compare(&previous[j], &found[f].id) < 0) ++j;
+    if (j == count || pd_contact_id_compare(&previous[j], &found[f].id) != 0) return false;
+  }
+  return true;
 }
 
 // The contacts of the touching pairs [begin, end) into the part's found[], pair after pair (pairFound,
@@ -1243,15 +1319,30 @@ static void find_range(void* ctx, int part, int begin, int end) {
   for (int p = begin; p < end; ++p) {
     set->pairFound[p] = sp->foundCount;
     set->pairFoundCount[p] = 0;
-    if (!set->touching[p]) continue;
+    if (set->certified[p]) continue;
     int a = set->pairs[p].a, b = set->pairs[p].b, first = set->pairPrevious[p], count = set->pairPreviousCount[p];
     for (int k = 0; k < count; ++k) sp->previous[k] = set->items[first + k].id;
-    int n;
-    while ((n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous, count,
-                                 sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount)) >
-           sp->foundCapacity - sp->foundCount) {
-      sp->foundCapacity = 2 * (sp->foundCount + n);
-      sp->found = pd_grow(sp->found, sp->foundCapacity, sizeof *sp->found);
+    int n = 0;
+    if (set->touching[p]) {
+      while ((n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous,
+                                   count, sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount)) >
+             sp->foundCapacity - sp->foundCount) {
+        sp->foundCapacity = 2 * (sp->foundCount + n);
+        sp->found = pd_grow(sp->found, sp->foundCapacity, sizeof *sp->found);
+      }
+    }
+    // a pair in contact that found nothing new with all its contacts tracked is certified for the next steps (a pair
+    // apart has only its interference test to skip, itself about as dear as a certificate)
+    pairCertificate* cert = &set->certsNext[p];
+    if (job->certificates && count > 0 && quiet(set, p, sp->found + sp->foundCount, n, sp->previous)) {
+      if (cert->wait > 0) {
+        --cert->wait;
+      } else {
+        cert->cert = pd_contacts_certify(job->model, a, &poses1[a], b, &poses1[b], sp->previous, count);
+        cert->contacts = count;
+        cert->used = false;
+        if (!(cert->cert.margin > 0.0)) back_off(cert);  // none to be had here (flush parallel edges): not every step
+      }
     }
     set->pairFoundCount[p] = n;
     sp->foundCount += n;
@@ -1266,11 +1357,6 @@ static void find_range(void* ctx, int part, int begin, int end) {
 static void search(const pdModel* model, pdState* s, const double* y1, int pairCount, const pdPose* poses0,
                    const pdPose* poses1, pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
-  // every pair's interference first, timed as a whole (two clock reads per pair were 2 % of a pile's run)
-  contactLoop job = {.model = model, .set = set, .poses1 = poses1};
-  pd_help_for(set->help, pairCount, PD_HELP_MIN_PAIRS, interference_range, &job);
-  pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageInterference]);
-  set->candidateCount = 0;
   // each pair's contacts in C0 (the list is sorted by the unordered body pair first)
   int listed = 0;
   for (int p = 0; p < pairCount; ++p) {
@@ -1280,10 +1366,17 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
     while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) == 0) ++listed;
     set->pairPreviousCount[p] = listed - set->pairPrevious[p];
   }
-  contactLoop find = {.model = model, .set = set, .poses0 = poses0, .poses1 = poses1};
+  // every pair's interference first, timed as a whole (two clock reads per pair were 2 % of a pile's run)
+  contactLoop job = {.model = model, .set = set, .poses1 = poses1, .certificates = s->searchCertificates};
+  pd_help_for(set->help, pairCount, PD_HELP_MIN_PAIRS, interference_range, &job);
+  pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageInterference]);
+  set->candidateCount = 0;
+  contactLoop find = {
+      .model = model, .set = set, .poses0 = poses0, .poses1 = poses1, .certificates = s->searchCertificates};
   set->searchSplit = pairCount;
   pd_help_for(set->help, pairCount, PD_HELP_MIN_PAIRS, find_range, &find);
   for (int p = 0; p < pairCount; ++p) {
+    s->count.searchesSkipped += set->certified[p];
     if (!set->touching[p]) continue;
     int first = set->pairPrevious[p], previousCount = set->pairPreviousCount[p], n = set->pairFoundCount[p];
     const pdContactGeom* found = set->search[p >= set->searchSplit].found + set->pairFound[p];
@@ -1316,6 +1409,9 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
   pdPairSatCache* t = set->cache;
   set->cache = set->cacheNext;
   set->cacheNext = t;
+  pairCertificate* c = set->certs;
+  set->certs = set->certsNext;
+  set->certsNext = c;
   set->cacheCount = pairCount;
 }
 

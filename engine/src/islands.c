@@ -263,6 +263,7 @@ static void island_load(const pdModel* model, const pdState* s, struct pdIslandS
   pdState* sub = is->state;
   sub->stepper = s->stepper;
   sub->onsets = s->onsets;
+  sub->searchCertificates = s->searchCertificates;
   sub->t = s->t;
   sub->nextSample = s->nextSample;
   double h = INFINITY;
@@ -445,6 +446,7 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->refinements += c->refinements;
   to->stabilityTight += c->stabilityTight;
   to->implicitSteps += c->implicitSteps;
+  to->searchesSkipped += c->searchesSkipped;
   to->contactsMade += c->contactsMade;
   to->contactsVirtual += c->contactsVirtual;
   to->contactsTransferred += c->contactsTransferred;

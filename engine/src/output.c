@@ -642,14 +642,16 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   fprintf(out,
           "  \"counts\": {\"accepted_steps\": %ld, \"rejected_steps\": %ld, \"derivative_evaluations\": %ld, "
           "\"samples\": %ld, \"travel_retries\": %ld, \"onset_retries\": %ld, \"onsets_interpolated\": %ld, "
-          "\"refinements\": %ld, \"stability_tight\": %ld, \"implicit_steps\": %ld, \"contacts_made\": %ld, "
+          "\"refinements\": %ld, \"stability_tight\": %ld, \"implicit_steps\": %ld, \"searches_skipped\": %ld, "
+          "\"contacts_made\": %ld, "
           "\"contacts_virtual\": %ld, \"contacts_transferred\": %ld, \"breaks_force\": %ld, "
           "\"breaks_geometry\": %ld, \"contacts_at_end\": %d},\n",
           state->count.accepted, state->count.rejected, state->count.derivatives, state->count.samples,
           state->count.travelRetries, state->count.eventRetries, state->count.onsetsInterpolated,
-          state->count.refinements, state->count.stabilityTight, state->count.implicitSteps, state->count.contactsMade,
-          state->count.contactsVirtual, state->count.contactsTransferred, state->count.breaksForce,
-          state->count.breaksGeometry, pd_state_contact_count(state));
+          state->count.refinements, state->count.stabilityTight, state->count.implicitSteps,
+          state->count.searchesSkipped, state->count.contactsMade, state->count.contactsVirtual,
+          state->count.contactsTransferred, state->count.breaksForce, state->count.breaksGeometry,
+          pd_state_contact_count(state));
   if (!info->stepper && state->islands == pd_islandsOn)  // the soft engine's islands only
     fprintf(out,
             "  \"island_counts\": {\"islands_formed\": %ld, \"largest_island\": %ld, \"island_intervals\": %ld, "

@@ -34,6 +34,7 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   s->onsets = PD_ONSETS_DEFAULT;
   s->islands = PD_ISLANDS_DEFAULT;
   s->threads = 1;
+  s->searchCertificates = true;
   pd_island_set_free(s->islandSet);
   s->islandSet = NULL;
   pd_implicit_free(s->implicit);  // its switch (active, on probation, backing off) is the last run's

@@ -132,6 +132,7 @@ typedef struct pdCounters {
   long stabilityTight;    // accepted steps whose limit needed the tight stability bound: the cheap bound allowed
                           // less than the step the error control wanted (README, Integration)
   long implicitSteps;     // accepted steps taken by the implicit method (pd_stepperImplicit; 0 with other steppers)
+  long searchesSkipped;   // pair searches (interference and contact search) a search certificate made needless
   long contactsMade;      // contacts added at the end of a step (found, approaching)
   long contactsVirtual;   // contacts added at the start of a step (onset within the first dt_min)
   long contactsTransferred;  // VF contacts whose sliding vertex moved on to an adjacent face (§4.4.3)
@@ -152,6 +153,10 @@ typedef struct pdState {
   pdStepper stepper;
   pdOnsets onsets;   // how contacts that began inside a step join (PD_ONSETS_DEFAULT unless the caller sets it)
   pdIslands islands;  // one system or islands (PD_ISLANDS_DEFAULT unless the caller sets it)
+  bool searchCertificates;  // true (the default): a pair whose last contact search found nothing new is not
+                            // searched again while a certificate proves the search would find nothing new
+                            // (contact_analysis.h); false searches every pair after every step. The results are
+                            // the same bit for bit; false is for tests and measurements.
   int threads;        // 1 .. PD_THREADS_MAX, 1 unless the caller sets it. With pd_islandsOn, the islands of each
                       // interval run on this many threads (the caller's and threads - 1 of the state's own, created
                       // at the first pd_advance and joined by pd_state_free/reset), a thread without an island
@@ -189,8 +194,9 @@ typedef struct pdBodyState {
 // and be the model passed with it to every other call.
 PD_API pdState* pd_state_create(const pdModel* model);
 // Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to PD_STEPPER_DEFAULT, onsets to PD_ONSETS_DEFAULT, islands to PD_ISLANDS_DEFAULT and threads to 1 (set
-// state->stepper, state->onsets, state->islands, state->threads after this call).
+// to PD_STEPPER_DEFAULT, onsets to PD_ONSETS_DEFAULT, islands to PD_ISLANDS_DEFAULT, threads to 1 and search
+// certificates on (set state->stepper, state->onsets, state->islands, state->threads, state->searchCertificates
+// after this call).
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.
 PD_API void pd_state_free(pdState* state);
