@@ -133,8 +133,8 @@ static const char* const shapes[] = {
     "cube a red 1 1 0.2\ncube b blue 0.1 0.1 0.1\n",
     "cube a red 0.05 0.3 0.02\ncube b blue 0.12 0.1 0.08\n",
     "prism a red 5 0.1 0.1 0.15\ncube b blue 0.1 0.1 0.1\n",
-    "hull a red 0 0 0  0.1 0 0  0 0.12 0  0 0 0.09  0.08 0.07 0.06  -0.02 0.05 0.04\n"
-    "hull b blue 0 0 0  0.05 0.01 0  0.01 0.06 0.01  0.02 0.01 0.07  0.04 0.04 0.04\n",
+    ("hull a red 0 0 0  0.1 0 0  0 0.12 0  0 0 0.09  0.08 0.07 0.06  -0.02 0.05 0.04\n"
+     "hull b blue 0 0 0  0.05 0.01 0  0.01 0.06 0.01  0.02 0.01 0.07  0.04 0.04 0.04\n"),
     "prism a red 6 0.08 0.08 0.05\nprism b blue 3 0.1 0.1 0.2\n",
 };
 
