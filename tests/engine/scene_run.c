@@ -29,6 +29,22 @@ pdModel* compile_text(const char* text) {
   return compile_parsed(pd_scene_parse_buffer("physics.scene", text, strlen(text), &err), &err);
 }
 
+pdModel* compile_apart(const char* shapes) {
+  char text[8192];
+  size_t used = 0;
+  int objects = 0;
+  for (const char* line = shapes; *line;) {
+    const char* end = strchr(line, '\n');
+    size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
+    used += (size_t)snprintf(text + used, sizeof text - used, "%.*s", (int)len, line);
+    if (!strncmp(line, "cube ", 5) || !strncmp(line, "hull ", 5) || !strncmp(line, "prism ", 6))
+      used += (size_t)snprintf(text + used, sizeof text - used, "loc %d 0 0\n", 10 * objects++);
+    assert_true(used < sizeof text);
+    line += len;
+  }
+  return compile_text(text);
+}
+
 pdModel* compile_file(const char* path) {
   pdError err;
   memset(&err, 0, sizeof err);

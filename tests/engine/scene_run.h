@@ -20,6 +20,9 @@ typedef struct record {
 
 // Parses and compiles `text`; fails the test with the error's position otherwise.
 pdModel* compile_text(const char* text);
+// The same for the objects of `shapes` (lines of scene text; cube, hull and prism objects), each placed 10 m from the
+// last so that the scene passes the overlap check at t = 0: for tests that set the poses themselves.
+pdModel* compile_apart(const char* shapes);
 // The same for a scene file.
 pdModel* compile_file(const char* path);
 // Runs the model to its tend; asserts that it got there with finite numbers only. The record is the

@@ -12,6 +12,7 @@
 #include "contact_analysis.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
+#include "scene_run.h"
 
 // Geometry here is exact up to a few roundoffs of lengths of order 0.1 m.
 #define GEOM_TOL 1e-12
@@ -20,29 +21,9 @@
 #define SIDE 0.1
 #define PI 3.14159265358979323846
 
-// The scenes name the bodies only; every test sets the poses itself. Each object is placed 10 m from
-// the previous one so that the scene passes the overlap check of pd_model_compile.
-static pdModel* compile(const char* shapes) {
-  char text[2048];
-  size_t used = 0;
-  int objects = 0;
-  for (const char* line = shapes; *line;) {
-    const char* end = strchr(line, '\n');
-    size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
-    used += (size_t)snprintf(text + used, sizeof text - used, "%.*s", (int)len, line);
-    if (!strncmp(line, "cube ", 5) || !strncmp(line, "hull ", 5) || !strncmp(line, "prism ", 6))
-      used += (size_t)snprintf(text + used, sizeof text - used, "loc %d 0 0\n", 10 * objects++);
-    assert_true(used < sizeof text);
-    line += len;
-  }
-  pdError err = {0};
-  pdScene* scene = pd_scene_parse_buffer("test.scene", text, strlen(text), &err);
-  if (!scene) fail_msg("parse: %s:%d:%d: %s", err.file, err.line, err.col, err.message);
-  pdModel* m = pd_model_compile(scene, &err);
-  pd_scene_free(scene);
-  if (!m) fail_msg("compile: %s", err.message);
-  return m;
-}
+// The scenes name the bodies only; every test sets the poses itself (compile_apart places them 10 m apart so that
+// the scene passes the overlap check of pd_model_compile).
+static pdModel* compile(const char* shapes) { return compile_apart(shapes); }
 
 static pdPose pose(double x, double y, double z, double angleDeg, pdVec3 axis) {
   pdQuat q = angleDeg != 0.0 ? pd_quat_from_axis_angle(axis, angleDeg * PI / 180.0) : pd_quat_identity();

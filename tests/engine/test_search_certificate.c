@@ -45,23 +45,6 @@ static pdVec3 unit_vector(void) {
 }
 static pdMat3 rotation(pdVec3 axis, double angle) { return pd_quat_to_mat3(pd_quat_from_axis_angle(axis, angle)); }
 
-// Bodies placed 10 m apart so that the scene compiles; the tests set the poses.
-static pdModel* compile_apart(const char* shapes) {
-  char text[8192];
-  size_t used = 0;
-  int objects = 0;
-  for (const char* line = shapes; *line;) {
-    const char* end = strchr(line, '\n');
-    size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
-    used += (size_t)snprintf(text + used, sizeof text - used, "%.*s", (int)len, line);
-    if (!strncmp(line, "cube ", 5) || !strncmp(line, "hull ", 5) || !strncmp(line, "prism ", 6))
-      used += (size_t)snprintf(text + used, sizeof text - used, "loc %d 0 0\n", 10 * objects++);
-    assert_true(used < sizeof text);
-    line += len;
-  }
-  return compile_text(text);
-}
-
 static bool listed(const pdContactId* ids, int count, const pdContactId* id) {
   for (int i = 0; i < count; ++i)
     if (pd_contact_id_compare(&ids[i], id) == 0) return true;
