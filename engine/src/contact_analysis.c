@@ -19,6 +19,8 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "interference.h"
+
 // Relative tolerance (× body size) of "on the boundary": a point this close outside a face plane or
 // a face polygon counts as on it, so roundoff neither breaks a vertex sliding exactly along an edge
 // nor loses a corner resting exactly on a corner.
@@ -353,9 +355,29 @@ static bool end_in_vf_contact(const pdContactGeom* found, int count, int body, i
   return false;
 }
 
-// Deepest a new EE contact may be, in the pair's δ_max: contacts are found as they start (onsets are
-// interpolated to 10⁻³ δ_max), so a deeper one was missed for several δ_max of travel or is not a contact.
+// Deepest a new EE contact may be beyond the bodies' own penetration, in the pair's δ_max: contacts are found as
+// they start (onsets are interpolated to 10⁻³ δ_max), so a deeper one is not where the bodies just met unless they
+// interpenetrate that deeply (find_ee: the pair's depth against their penetration depth).
 #define EE_NEW_DEPTH_MAX_DEFLECTIONS 3.0
+
+// The bodies' penetration depth at their poses (the separating-axis test's minimum overlap over the faces of their
+// Minkowski difference, 0 when apart), m.
+static double penetration_depth(const pdPolyhedron* sa, const pdPose* pa, const pdPolyhedron* sb, const pdPose* pb) {
+  pdSatCache cache = {PD_SAT_NONE, -1, -1, {0, 0, 0}};
+  pdSatResult r;
+  pd_interference(sa, pa->x, &pa->R, sb, pb->x, &pb->R, PD_SAT_MIN_DEPTH, &cache, &r);
+  return r.depth > 0.0 ? r.depth : 0.0;
+}
+
+// The least overlap of A and B along the face normals of both (B's reversed; B's pose in A's frame rel, off), m: an
+// upper bound of their penetration depth.
+static double least_face_overlap(const pdPolyhedron* sa, const pdPolyhedron* sb, const pdMat3* rel, pdVec3 off) {
+  double least = INFINITY;
+  for (int f = 0; f < sa->faceCount; ++f) least = fmin(least, overlap_along(sa, sb, rel, off, sa->faces[f].normal));
+  for (int f = 0; f < sb->faceCount; ++f)
+    least = fmin(least, overlap_along(sa, sb, rel, off, pd_v3_scale(pd_mat3_mulv(rel, sb->faces[f].normal), -1.0)));
+  return least;
+}
 
 // find_ee's per-search caches, on the stack: A's Gauss arcs of its first this many edges, the overlaps along the
 // first this many faces of each body (a bit of a faceMask per entry).
@@ -389,6 +411,8 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   // it is formed (the first 64 edges and faces; the others are formed where used, as the same numbers).
   gaussArc arcsA[FIND_EE_CACHED];
   double overlapAlongFace[2][FIND_EE_CACHED];
+  double penetration = NAN;  // the bodies' penetration depth, once a pair needs it
+  double faceOverlap = NAN;  // the least overlap along a face normal of either body, once a pair needs it
   faceMask arcFormed = 0, overlapFormed[2] = {0, 0};
   for (int j = 0; j < sb->edgeCount; ++j) {
     const pdEdge* eb = &sb->edges[j];
@@ -437,10 +461,22 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
       // width, one tilted a little on the other): the normal, their cross product, lies in the faces
       // that press and the depth along it is nil; the VF contacts at the overlap's corners carry it
       if (in_shared_plane(sa, ea, b0, b1, sb, &rel, off, flushTol)) continue;
-      // a new edge pair deeper than this is not where the bodies just met: its lines pass each other a
-      // body's width away (two flush boxes rocking a little on each other cross their antipodal edges,
-      // lying on the shared planes, inside within any tolerance)
-      if (g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax) continue;
+      // a new edge pair deeper than the allowance beyond the bodies' own penetration is not where they just met:
+      // its lines pass each other a body's width away (two flush boxes rocking a little on each other cross
+      // their antipodal edges, lying on the shared planes, inside within any tolerance: a width against a
+      // penetration of a fraction of δ_max; cases/sweep/pile_10.scene refuses 1 663 such pairs, all 30 δ_max
+      // deep or more). An edge crossing that deepened while its features changed over is as deep as the bodies
+      // interpenetrate, and is kept (soak seed 32, scene 592: the corner of a box spinning at 560 rad/s cut an
+      // edge, the Minkowski face turning over every 40-100 µs; each successor pair, refused beyond 3 δ_max, left
+      // the pair without contact and it sank 83 δ_max). The penetration is formed once per search, when needed.
+      if (g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax) {
+        // the least overlap along the bodies' face normals bounds the penetration from above (they are among the
+        // separating-axis test's axes) and refuses most such pairs without the whole test
+        if (isnan(faceOverlap)) faceOverlap = least_face_overlap(sa, sb, &rel, off);
+        if (g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + faceOverlap) continue;
+        if (isnan(penetration)) penetration = penetration_depth(sa, pa, sb, pb);
+        if (g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + penetration) continue;
+      }
       // a crossing at a vertex in VF contact (a flush stack's corner): that vertex carries it
       if (end_in_vf_contact(out, vfCount, ia, ib, ea, g.s,
                             pd_v3_norm(pd_v3_sub(sa->vertices[ea->v[1]], sa->vertices[ea->v[0]])), vertexReach) ||
@@ -710,10 +746,12 @@ double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPos
 // - EE: the Gauss arcs meet (find_ee's first test). Margin: the sine by which both ends of one arc lie on one
 //   side of the other's great circle, beyond arcs_meet's own slack; a rotation of B by ‖ΔR‖ moves its normals by
 //   at most that much.
-// - EE: the closest points lie inside both edges and at most 3 δ_max apart (EE_NEW_DEPTH_MAX_DEFLECTIONS; for
-//   lines whose sine is at least CERT_SINE_MIN the computed closest points are the true ones to ~1e-12 of the
-//   size, so the depth is their distance), so the segments are within 3 δ_max. Margin: the segments' distance
-//   less 3 δ_max, while the sine stays above CERT_SINE_MIN.
+// - EE: the closest points lie inside both edges and at most 3 δ_max plus the bodies' penetration depth P apart
+//   (EE_NEW_DEPTH_MAX_DEFLECTIONS; for lines whose sine is at least CERT_SINE_MIN the computed closest points are
+//   the true ones to ~1e-12 of the size, so the depth is their distance), so the segments are that close. A
+//   motion m moves the segments by at most m and raises P by at most m (a separating translation of B grown by
+//   m separates B moved by m), so the margin is half the segments' distance less 3 δ_max and P, while the sine
+//   stays above CERT_SINE_MIN.
 // A feature pair in the exempt list (the pair's contacts of C0) needs none: the search reports it as a contact
 // the list already has. A feature pair meeting none of the conditions (an inside vertex not in the list, two
 // flush parallel edges) leaves no certificate (margin 0).
@@ -726,6 +764,9 @@ double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPos
 #define CERT_GUARD_REL 1e-9
 // The arcs test's rounding allowance on the sine, beyond ARC_TRIPLE_ROUNDING (both are ~1e-14; generous).
 #define CERT_ARC_ROUNDING 1e-12
+// The penetration depth's error as the separating-axis test computes it (it skips edge pairs nearer parallel than
+// PD_SAT_PARALLEL_TOL, whose sliver faces weigh ~that sine × an edge), relative to the bodies' sizes; generous.
+#define CERT_PENETRATION_ROUNDING_REL 1e-7
 
 // Largest distance of a vertex from the body's origin, m.
 static double vertex_reach(const pdPolyhedron* s) {
@@ -863,7 +904,11 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
     double thresholdB = fmax(deltaMax, tolB) + guard;
     beyondA[i] = edge_beyond_one_plane(sb, a0, a1, least + thresholdB) - thresholdB;
   }
-  double apart = EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + guard;
+  // P bounded from above by the least overlap along a face normal (one of the separating-axis test's axes; P as
+  // that test computes it is the true one or up to PD_SAT_PARALLEL_TOL × an edge above it)
+  double overlap = least_face_overlap(sa, sb, &cert.rel, cert.off);
+  double apart = EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + (overlap > 0.0 ? overlap : 0.0) +
+                 CERT_PENETRATION_ROUNDING_REL * (sizeA + sizeB) + guard;
   for (int i = 0; i < sa->edgeCount && least > 0.0; ++i) {
     const pdEdge* ea = &sa->edges[i];
     pdVec3 a0 = sa->vertices[ea->v[0]], u = pd_v3_sub(sa->vertices[ea->v[1]], a0);
@@ -877,7 +922,7 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
       pdVec3 v = pd_v3_sub(b1[j], b0[j]);
       double sine = pd_v3_norm(pd_v3_cross(u, v)) / sqrt(pd_v3_dot(u, u) * pd_v3_dot(v, v));
       if (sine > CERT_SINE_MIN) {
-        double gap = sqrt(segment_distance2(a0, u, b0[j], v)) - apart;
+        double gap = 0.5 * (sqrt(segment_distance2(a0, u, b0[j], v)) - apart);
         margin = fmax(margin, fmin(gap, (sine - CERT_SINE_MIN) * cert.reach));
       }
       least = fmin(least, margin);
