@@ -12,6 +12,7 @@
 
 #include <cmocka.h>
 
+#include "interference.h"
 #include "polydyn/scene.h"
 
 // Compiles a parsed scene (NULL: the parse failed, err says why) and frees it; fails the test with err's position.
@@ -114,4 +115,25 @@ int body_index(const pdModel* m, const char* name) {
     if (!strcmp(m->bodies[i].name, name)) return i;
   fail_msg("no body %s", name);
   return -1;
+}
+
+double deepest_overlap(const pdModel* model, const pdState* state, int* a, int* b) {
+  double deepest = 0.0;
+  int da = -1, db = -1;
+  for (int i = 0; i < model->bodyCount; ++i)
+    for (int j = i + 1; j < model->bodyCount; ++j) {
+      if (model->bodies[i].fixed && model->bodies[j].fixed) continue;
+      pdBodyState bi = pd_state_body(model, state, i), bj = pd_state_body(model, state, j);
+      if (pd_v3_norm(pd_v3_sub(bi.x, bj.x)) > model->bodies[i].radius + model->bodies[j].radius) continue;
+      pdMat3 ri = pd_quat_to_mat3(bi.q), rj = pd_quat_to_mat3(bj.q);
+      pdSatResult sat;
+      if (!pd_interference(&model->bodies[i].shape, bi.x, &ri, &model->bodies[j].shape, bj.x, &rj, PD_SAT_MIN_DEPTH,
+                           NULL, &sat))
+        continue;
+      double ratio = sat.depth / pd_model_pair_delta_max(model, i, j);
+      if (ratio > deepest) deepest = ratio, da = i, db = j;
+    }
+  if (a) *a = da;
+  if (b) *b = db;
+  return deepest;
 }

@@ -35,6 +35,10 @@ record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut);
 record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdState** stateOut);
 // The same with adaptive RK4, the given onset mode and islands on or off.
 record* run_onsets_islands(const pdModel* model, pdOnsets onsets, pdIslands islands, pdState** stateOut);
+// The deepest overlap of any two bodies at the state (each pair whose bounding spheres meet, not both fixed): the
+// separating-axis minimum depth, the shortest translation that parts them, over the pair's δ_max
+// (pd_model_pair_delta_max); 0 when none overlap. The pair goes to *a, *b (nullable; -1 when none).
+double deepest_overlap(const pdModel* model, const pdState* state, int* a, int* b);
 // The largest rise of the energy between any earlier and any later sample, relative to |E(0)|.
 double energy_gain(const record* r);
 // Index of the body called `name`; fails the test when there is none.

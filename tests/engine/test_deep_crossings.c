@@ -19,7 +19,6 @@
 
 #include <cmocka.h>
 
-#include "interference.h"
 #include "polydyn/model.h"
 #include "polydyn/state.h"
 #include "scene_run.h"
@@ -38,18 +37,9 @@ typedef struct deepest {
 static bool watch(const pdModel* model, const pdState* state, void* user) {
   deepest* d = user;
   ++d->samples;
-  for (int i = 0; i < model->bodyCount; ++i)
-    for (int j = i + 1; j < model->bodyCount; ++j) {
-      pdBodyState a = pd_state_body(model, state, i), b = pd_state_body(model, state, j);
-      if (pd_v3_norm(pd_v3_sub(a.x, b.x)) > model->bodies[i].radius + model->bodies[j].radius) continue;
-      pdMat3 ra = pd_quat_to_mat3(a.q), rb = pd_quat_to_mat3(b.q);
-      pdSatResult sat;
-      if (!pd_interference(&model->bodies[i].shape, a.x, &ra, &model->bodies[j].shape, b.x, &rb, PD_SAT_MIN_DEPTH, NULL,
-                           &sat))
-        continue;
-      double ratio = sat.depth / pd_model_pair_delta_max(model, i, j);
-      if (ratio > d->ratio) *d = (deepest){ratio, state->t, i, j, d->samples};
-    }
+  int a, b;
+  double ratio = deepest_overlap(model, state, &a, &b);
+  if (ratio > d->ratio) *d = (deepest){ratio, state->t, a, b, d->samples};
   return true;
 }
 

@@ -29,10 +29,10 @@
 
 #include <cmocka.h>
 
-#include "interference.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
+#include "scene_run.h"
 
 #define CASES_DIR PD_SOURCE_DIR "/cases/hard/"
 
@@ -95,7 +95,6 @@ static bool body_finite(pdBodyState b) {
          isfinite(b.q.y) && isfinite(b.q.z);
 }
 
-static double contact_delta_max(const pdModel* m, int a, int b) { return pd_model_pair_delta_max(m, a, b); }
 
 static bool watch_sample(const pdModel* model, const pdState* state, void* user) {
   watch* w = user;
@@ -110,21 +109,11 @@ static bool watch_sample(const pdModel* model, const pdState* state, void* user)
     finite = finite && pd_v3_isfinite(c.point) && pd_v3_isfinite(c.normal) && isfinite(c.depth) && isfinite(c.fn) &&
              pd_v3_isfinite(c.ft);
   }
-  for (int i = 0; i < model->bodyCount && finite; ++i) {
-    for (int j = i + 1; j < model->bodyCount; ++j) {
-      if (model->bodies[i].fixed && model->bodies[j].fixed) continue;
-      pdBodyState a = pd_state_body(model, state, i), b = pd_state_body(model, state, j);
-      if (pd_v3_norm(pd_v3_sub(a.x, b.x)) > model->bodies[i].radius + model->bodies[j].radius) continue;
-      pdMat3 ra = pd_quat_to_mat3(a.q), rb = pd_quat_to_mat3(b.q);
-      pdSatResult sat;
-      if (!pd_interference(&model->bodies[i].shape, a.x, &ra, &model->bodies[j].shape, b.x, &rb, PD_SAT_MIN_DEPTH, NULL,
-                           &sat))
-        continue;
-      double ratio = sat.depth / contact_delta_max(model, i, j);
-      if (ratio > w->worstDepthRatio) {
-        w->worstDepthRatio = ratio;
-        w->worstDepthT = state->t;
-      }
+  if (finite) {
+    double ratio = deepest_overlap(model, state, NULL, NULL);
+    if (ratio > w->worstDepthRatio) {
+      w->worstDepthRatio = ratio;
+      w->worstDepthT = state->t;
     }
   }
   if (!finite) {
@@ -145,13 +134,6 @@ static bool watch_sample(const pdModel* model, const pdState* state, void* user)
   }
   ++w->samples;
   return true;
-}
-
-static int body_index(const pdModel* m, const char* name) {
-  for (int i = 0; i < m->bodyCount; ++i)
-    if (!strcmp(m->bodies[i].name, name)) return i;
-  fail_msg("no body %s", name);
-  return -1;
 }
 
 static void test_hard_case(void** state) {
