@@ -493,7 +493,11 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
       pdVec3 onB = pd_v3_add(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on B's edge
       pdVec3 onAinB = pd_mat3_tmulv(&rel, pd_v3_sub(onA, off));
       if (!inside_body(sa, onB, tolA) || !inside_body(sb, onAinB, tolB)) {
-        double slack = fmin(g.depth, deltaMax);
+        // (a pair deeper than the new-pair allowance, kept above for the bodies' penetration P, may have its points
+        // up to δ_max + P outside: a 1 cm hull entering a body 58 δ_max deep with no contact, soak seed 32 scene
+        // 733, had its edge pair refused here at δ_max)
+        double slack = g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax ? fmin(g.depth, deltaMax + penetration)
+                                                                           : fmin(g.depth, deltaMax);
         if (!inside_body(sa, onB, slack) || !inside_body(sb, onAinB, slack)) continue;
         pdVec3 u = pd_v3_scale(g.normal, -1.0);  // from A to B
         double overlap = fmin(overlap_along(sa, sb, &rel, off, u), overlap_along(sa, sb, &rel, off, g.normal));
@@ -740,9 +744,11 @@ double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPos
 // - VF, vertex v of one body in the other: not outside any face plane of the other by more than max(tol,
 //   flushTol) (a face it is farther outside of is never a shared plane, and outside it, it is rejected). Margin:
 //   how far v is outside its farthest face plane, less that tolerance.
-// - EE, edges ea of A and eb of B: each edge's closest point within max(tol, δ_max) of inside the other body
-//   (the slack find_ee allows), so neither edge may lie wholly beyond one face plane of the other body by more.
-//   Margin: the farthest face plane both ends of an edge lie beyond, less that tolerance (per edge).
+// - EE, edges ea of A and eb of B: each edge's closest point within max(tol, δ_max) + P of inside the other body
+//   (the slack find_ee allows; P, the bodies' penetration depth, only for a pair deeper than 3 δ_max), so neither
+//   edge may lie wholly beyond one face plane of the other body by more. A motion m moves the edge by at most m
+//   and raises P by at most m (below), so the margin is half of how far beyond that both ends of an edge lie
+//   (per edge).
 // - EE: the Gauss arcs meet (find_ee's first test). Margin: the sine by which both ends of one arc lie on one
 //   side of the other's great circle, beyond arcs_meet's own slack; a rotation of B by ‖ΔR‖ moves its normals by
 //   at most that much.
@@ -887,13 +893,18 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   double beyondA[EDGES_MAX], beyondB[EDGES_MAX];
   pdVec3 b0[EDGES_MAX], b1[EDGES_MAX];
   gaussArc arcB[EDGES_MAX];
+  // P bounded from above by the least overlap along a face normal (one of the separating-axis test's axes; P as
+  // that test computes it is the true one or up to PD_SAT_PARALLEL_TOL × an edge above it)
+  double overlap = least_face_overlap(sa, sb, &cert.rel, cert.off);
+  double penetration = (overlap > 0.0 ? overlap : 0.0) + CERT_PENETRATION_ROUNDING_REL * (sizeA + sizeB);
   for (int j = 0; j < sb->edgeCount; ++j) {
     const pdEdge* e = &sb->edges[j];
     b0[j] = pd_v3_add(cert.off, pd_mat3_mulv(&cert.rel, sb->vertices[e->v[0]]));
     b1[j] = pd_v3_add(cert.off, pd_mat3_mulv(&cert.rel, sb->vertices[e->v[1]]));
-    // (a margin found at least `least` is as good as its full value: no edge pair needs more)
-    double thresholdA = fmax(deltaMax, tolA) + guard;
-    beyondB[j] = edge_beyond_one_plane(sa, b0[j], b1[j], least + thresholdA) - thresholdA;
+    // half of how far beyond δ_max + P (a margin found at least `least` is as good as its full value: no edge pair
+    // needs more)
+    double thresholdA = fmax(deltaMax, tolA) + penetration + guard;
+    beyondB[j] = 0.5 * (edge_beyond_one_plane(sa, b0[j], b1[j], 2.0 * least + thresholdA) - thresholdA);
     arcB[j] = gauss_arc(pd_v3_scale(pd_mat3_mulv(&cert.rel, sb->faces[e->f[0]].normal), -1.0),
                         pd_v3_scale(pd_mat3_mulv(&cert.rel, sb->faces[e->f[1]].normal), -1.0));
   }
@@ -901,14 +912,10 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
     const pdEdge* e = &sa->edges[i];
     pdVec3 a0 = pd_v3_add(offA, pd_mat3_mulv(&relT, sa->vertices[e->v[0]]));
     pdVec3 a1 = pd_v3_add(offA, pd_mat3_mulv(&relT, sa->vertices[e->v[1]]));
-    double thresholdB = fmax(deltaMax, tolB) + guard;
-    beyondA[i] = edge_beyond_one_plane(sb, a0, a1, least + thresholdB) - thresholdB;
+    double thresholdB = fmax(deltaMax, tolB) + penetration + guard;
+    beyondA[i] = 0.5 * (edge_beyond_one_plane(sb, a0, a1, 2.0 * least + thresholdB) - thresholdB);
   }
-  // P bounded from above by the least overlap along a face normal (one of the separating-axis test's axes; P as
-  // that test computes it is the true one or up to PD_SAT_PARALLEL_TOL × an edge above it)
-  double overlap = least_face_overlap(sa, sb, &cert.rel, cert.off);
-  double apart = EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + (overlap > 0.0 ? overlap : 0.0) +
-                 CERT_PENETRATION_ROUNDING_REL * (sizeA + sizeB) + guard;
+  double apart = EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + penetration + guard;
   for (int i = 0; i < sa->edgeCount && least > 0.0; ++i) {
     const pdEdge* ea = &sa->edges[i];
     pdVec3 a0 = sa->vertices[ea->v[0]], u = pd_v3_sub(sa->vertices[ea->v[1]], a0);

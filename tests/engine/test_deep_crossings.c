@@ -1,5 +1,10 @@
 // Deep edge crossings (engine/src/contact_analysis.c, find_ee): a new edge pair deeper than 3 δ_max is a contact
-// only as deep as the bodies interpenetrate.
+// only as deep as the bodies interpenetrate, and its points may then lie up to δ_max plus that penetration outside
+// the other body.
+// - A 1 cm hull meeting another body with an edge pair already as deep as the bodies' penetration
+//   (tests/engine/scenes/hull_enters_edge_first.scene, from the soak, islands off) is held below the soak's limit,
+//   3 δ_max of the pair, at every 0.5 ms sample. Refused while its points lay more than δ_max outside, it entered
+//   58 δ_max deep with no contact.
 // - A corner of a fast-spinning small box cutting another body's edge (tests/engine/scenes/spinning_corner.scene,
 //   from the soak) is held: at every 0.5 ms sample no two bodies overlap by more than HELD_LIMIT δ_max of the pair
 //   (the separating-axis minimum depth: the shortest translation that parts them). Before the rule the box sank
@@ -23,6 +28,9 @@
 #include "polydyn/state.h"
 #include "scene_run.h"
 
+// The soak's limit (refcheck/soak.c, PD_SOAK_PENETRATION_LIMIT): the springs are sized so that an impact at vmax
+// deflects them by δ_max; a few δ_max means the contacts are not holding the bodies apart.
+#define PENETRATION_LIMIT 3.0
 // The deepest overlap allowed in the spinning-corner scene, in δ_max of the pair: what the successor pairs reach
 // (14.2) with a margin; the refused successors let the box sink 83.
 #define HELD_LIMIT 16.0
@@ -43,24 +51,41 @@ static bool watch(const pdModel* model, const pdState* state, void* user) {
   return true;
 }
 
-static void test_a_spinning_corner_cutting_an_edge_is_held(void** state) {
-  (void)state;
-  pdModel* m = compile_file(PD_SOURCE_DIR "/tests/engine/scenes/spinning_corner.scene");
+// Runs the scene to its tend (islands as given) and returns the deepest overlap seen at its samples.
+static deepest run_deepest(const pdModel* m, pdIslands islands) {
   pdState* s = pd_state_create(m);
+  s->islands = islands;
   deepest d = {0.0, 0.0, -1, -1, 0};
   assert_true(pd_advance(m, s, m->settings.tend, watch, &d));
   print_message("deepest overlap %.3g delta_max (%s and %s at t = %.4f s), %d samples, %ld steps\n", d.ratio,
                 d.a >= 0 ? m->bodies[d.a].name : "-", d.b >= 0 ? m->bodies[d.b].name : "-", d.t, d.samples,
                 s->count.accepted);
+  pd_state_free(s);
+  return d;
+}
+
+static void test_a_hull_entering_edge_first_is_held(void** state) {
+  (void)state;
+  pdModel* m = compile_file(PD_SOURCE_DIR "/tests/engine/scenes/hull_enters_edge_first.scene");
+  deepest d = run_deepest(m, pd_islandsOff);
+  assert_true(d.samples > 900);
+  assert_true(d.ratio < PENETRATION_LIMIT);
+  pd_model_free(m);
+}
+
+static void test_a_spinning_corner_cutting_an_edge_is_held(void** state) {
+  (void)state;
+  pdModel* m = compile_file(PD_SOURCE_DIR "/tests/engine/scenes/spinning_corner.scene");
+  deepest d = run_deepest(m, PD_ISLANDS_DEFAULT);
   assert_true(d.samples > 500);
   assert_true(d.ratio < HELD_LIMIT);
-  pd_state_free(s);
   pd_model_free(m);
 }
 
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_spinning_corner_cutting_an_edge_is_held),
+      cmocka_unit_test(test_a_hull_entering_edge_first_is_held),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
