@@ -497,7 +497,7 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
         // up to δ_max + P outside: a 1 cm hull entering a body 58 δ_max deep with no contact, soak seed 32 scene
         // 733, had its edge pair refused here at δ_max)
         double slack = g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax ? fmin(g.depth, deltaMax + penetration)
-                                                                           : fmin(g.depth, deltaMax);
+                                                                         : fmin(g.depth, deltaMax);
         if (!inside_body(sa, onB, slack) || !inside_body(sb, onAinB, slack)) continue;
         pdVec3 u = pd_v3_scale(g.normal, -1.0);  // from A to B
         double overlap = fmin(overlap_along(sa, sb, &rel, off, u), overlap_along(sa, sb, &rel, off, g.normal));
