@@ -369,19 +369,38 @@ static double penetration_depth(const pdPolyhedron* sa, const pdPose* pa, const 
   return r.depth > 0.0 ? r.depth : 0.0;
 }
 
-// The least overlap of A and B along the face normals of both (B's reversed; B's pose in A's frame rel, off), m: an
-// upper bound of their penetration depth.
-static double least_face_overlap(const pdPolyhedron* sa, const pdPolyhedron* sb, const pdMat3* rel, pdVec3 off) {
-  double least = INFINITY;
-  for (int f = 0; f < sa->faceCount; ++f) least = fmin(least, overlap_along(sa, sb, rel, off, sa->faces[f].normal));
-  for (int f = 0; f < sb->faceCount; ++f)
-    least = fmin(least, overlap_along(sa, sb, rel, off, pd_v3_scale(pd_mat3_mulv(rel, sb->faces[f].normal), -1.0)));
-  return least;
-}
-
 // find_ee's per-search caches, on the stack: A's Gauss arcs of its first this many edges, the overlaps along the
 // first this many faces of each body (a bit of a faceMask per entry).
 #define FIND_EE_CACHED 64
+
+// Overlaps of A and B along face normals, by body (0: A's normals, 1: B's reversed) and face, each formed once when
+// first asked for (the faces past FIND_EE_CACHED are formed each time, as the same numbers).
+typedef struct faceOverlaps {
+  double value[2][FIND_EE_CACHED];
+  faceMask formed[2];
+} faceOverlaps;
+
+// The overlap of A and B along face f of body `side` (A's normal, or B's reversed; B's pose in A's frame rel, off),
+// m; cache nullable.
+static double face_overlap(const pdPolyhedron* sa, const pdPolyhedron* sb, const pdMat3* rel, pdVec3 off, int side,
+                           int f, faceOverlaps* cache) {
+  bool cached = cache && f < FIND_EE_CACHED;
+  if (cached && (cache->formed[side] >> f & 1u)) return cache->value[side][f];
+  pdVec3 axis = side == 0 ? sa->faces[f].normal : pd_v3_scale(pd_mat3_mulv(rel, sb->faces[f].normal), -1.0);
+  double overlap = overlap_along(sa, sb, rel, off, axis);
+  if (cached) cache->value[side][f] = overlap, cache->formed[side] |= 1ull << f;
+  return overlap;
+}
+
+// The least overlap of A and B along the face normals of both, m: an upper bound of their penetration depth (those
+// normals are among the separating-axis test's axes). cache nullable.
+static double least_face_overlap(const pdPolyhedron* sa, const pdPolyhedron* sb, const pdMat3* rel, pdVec3 off,
+                                 faceOverlaps* cache) {
+  double least = INFINITY;
+  for (int f = 0; f < sa->faceCount; ++f) least = fmin(least, face_overlap(sa, sb, rel, off, 0, f, cache));
+  for (int f = 0; f < sb->faceCount; ++f) least = fmin(least, face_overlap(sa, sb, rel, off, 1, f, cache));
+  return least;
+}
 
 static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
                    int capacity, int n) {
@@ -410,10 +429,11 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   // arcs (a 45° stack's flush faces) test the same four faces for most of their edge pairs. A bit per entry says
   // it is formed (the first 64 edges and faces; the others are formed where used, as the same numbers).
   gaussArc arcsA[FIND_EE_CACHED];
-  double overlapAlongFace[2][FIND_EE_CACHED];
+  faceMask arcFormed = 0;
+  faceOverlaps overlaps;
+  overlaps.formed[0] = overlaps.formed[1] = 0;
   double penetration = NAN;  // the bodies' penetration depth, once a pair needs it
   double faceOverlap = NAN;  // the least overlap along a face normal of either body, once a pair needs it
-  faceMask arcFormed = 0, overlapFormed[2] = {0, 0};
   for (int j = 0; j < sb->edgeCount; ++j) {
     const pdEdge* eb = &sb->edges[j];
     if (prune && (maskB[eb->v[0]] & maskB[eb->v[1]])) continue;
@@ -440,21 +460,10 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
       if (!edge_pair_geometry(sa, i, b0, b1, true, &g) || !(g.depth > 0.0)) continue;
       if (meet == arcsTouch) {
         // the faces around the two edges, as axes from A to B: A's normals, B's reversed (c, d)
-        const pdVec3 axes[4] = {sa->faces[ea->f[0]].normal, sa->faces[ea->f[1]].normal, c, d};
         const int faces[4] = {ea->f[0], ea->f[1], eb->f[0], eb->f[1]};
         double shallowest = INFINITY;
-        for (int k = 0; k < 4; ++k) {
-          int f = faces[k];
-          faceMask* formed = &overlapFormed[k / 2];
-          double overlap;
-          if (f < FIND_EE_CACHED && (*formed >> f & 1u)) {
-            overlap = overlapAlongFace[k / 2][f];
-          } else {
-            overlap = overlap_along(sa, sb, &rel, off, axes[k]);
-            if (f < FIND_EE_CACHED) overlapAlongFace[k / 2][f] = overlap, *formed |= 1ull << f;
-          }
-          shallowest = fmin(shallowest, overlap);
-        }
+        for (int k = 0; k < 4; ++k)
+          shallowest = fmin(shallowest, face_overlap(sa, sb, &rel, off, k / 2, faces[k], &overlaps));
         if (g.depth > shallowest + tolA + tolB) continue;
       }
       // edges crossing inside a plane both bodies share (the flush sides of a brick on a brick of its
@@ -470,9 +479,9 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
       // edge, the Minkowski face turning over every 40-100 µs; each successor pair, refused beyond 3 δ_max, left
       // the pair without contact and it sank 83 δ_max). The penetration is formed once per search, when needed.
       if (g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax) {
-        // the least overlap along the bodies' face normals bounds the penetration from above (they are among the
-        // separating-axis test's axes) and refuses most such pairs without the whole test
-        if (isnan(faceOverlap)) faceOverlap = least_face_overlap(sa, sb, &rel, off);
+        // the least overlap along the bodies' face normals bounds the penetration from above and refuses most
+        // such pairs without the whole separating-axis test
+        if (isnan(faceOverlap)) faceOverlap = least_face_overlap(sa, sb, &rel, off, &overlaps);
         if (g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + faceOverlap) continue;
         if (isnan(penetration)) penetration = penetration_depth(sa, pa, sb, pb);
         if (g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + penetration) continue;
@@ -895,7 +904,7 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   gaussArc arcB[EDGES_MAX];
   // P bounded from above by the least overlap along a face normal (one of the separating-axis test's axes; P as
   // that test computes it is the true one or up to PD_SAT_PARALLEL_TOL × an edge above it)
-  double overlap = least_face_overlap(sa, sb, &cert.rel, cert.off);
+  double overlap = least_face_overlap(sa, sb, &cert.rel, cert.off, NULL);
   double penetration = (overlap > 0.0 ? overlap : 0.0) + CERT_PENETRATION_ROUNDING_REL * (sizeA + sizeB);
   for (int j = 0; j < sb->edgeCount; ++j) {
     const pdEdge* e = &sb->edges[j];

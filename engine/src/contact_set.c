@@ -254,6 +254,7 @@ static void reserve_list(pdContactSet* set, int capacity) {
 
 // The contact search's per-pair lists, to cacheCapacity.
 static void grow_pair_lists(pdContactSet* set) {
+  set->certified = pd_grow(set->certified, set->cacheCapacity, sizeof *set->certified);
   set->certs = pd_grow(set->certs, set->cacheCapacity, sizeof *set->certs);
   set->certsNext = pd_grow(set->certsNext, set->cacheCapacity, sizeof *set->certsNext);
   set->pairPrevious = pd_grow(set->pairPrevious, set->cacheCapacity, sizeof *set->pairPrevious);
@@ -312,7 +313,6 @@ static pdContactSet* create(const pdModel* model, bool search) {
   set->cache = pd_grow(NULL, set->cacheCapacity, sizeof *set->cache);
   set->cacheNext = pd_grow(NULL, set->cacheCapacity, sizeof *set->cacheNext);
   set->touching = pd_grow(NULL, set->cacheCapacity, sizeof *set->touching);
-  set->certified = pd_grow(NULL, set->cacheCapacity, sizeof *set->certified);
   grow_pair_lists(set);
   return set;
 }
@@ -1195,7 +1195,6 @@ static int broad_phase(const pdModel* model, pdState* s, const pdPose* poses0, c
     set->cache = pd_grow(set->cache, set->cacheCapacity, sizeof *set->cache);
     set->cacheNext = pd_grow(set->cacheNext, set->cacheCapacity, sizeof *set->cacheNext);
     set->touching = pd_grow(set->touching, set->cacheCapacity, sizeof *set->touching);
-    set->certified = pd_grow(set->certified, set->cacheCapacity, sizeof *set->certified);
     grow_pair_lists(set);
   }
   return pairCount;
@@ -1242,15 +1241,20 @@ static void back_off(pairCertificate* c) {
   c->wait = c->backoff;
 }
 
+// Are all of pair p's contacts of C0 still tracked at the step's end?
+static bool all_tracked(const pdContactSet* set, int p) {
+  for (int k = set->pairPrevious[p]; k < set->pairPrevious[p] + set->pairPreviousCount[p]; ++k)
+    if (!set->eval[k].tracked) return false;
+  return true;
+}
+
 // Does pair p's certificate, issued with c->contacts of its contacts of C0, hold at the poses pa, pb: the same
 // contacts listed (the list only loses contacts between searches, at commits: the same count is the same list),
 // each still tracked, and the pair within the certificate's motion?
 static bool certificate_holds(const pdContactSet* set, int p, const pairCertificate* c, const pdPose* pa,
                               const pdPose* pb) {
-  if (c->contacts != set->pairPreviousCount[p]) return false;
-  for (int k = set->pairPrevious[p]; k < set->pairPrevious[p] + c->contacts; ++k)
-    if (!set->eval[k].tracked) return false;
-  return pd_search_motion(&c->cert, pa, pb) < c->cert.margin;
+  return c->contacts == set->pairPreviousCount[p] && all_tracked(set, p) &&
+         pd_search_motion(&c->cert, pa, pb) < c->cert.margin;
 }
 
 // Pairs [begin, end) of the contact search: touching[p] and the pair's new cache entry, or certified[p] when its
@@ -1296,10 +1300,8 @@ static void interference_range(void* ctx, int part, int begin, int end) {
 // Did pair p's search find nothing its contacts of C0 (`previous`, sorted like found[0 .. n)) do not have, with
 // each of them tracked?
 static bool quiet(const pdContactSet* set, int p, const pdContactGeom* found, int n, const pdContactId* previous) {
-  int first = set->pairPrevious[p], count = set->pairPreviousCount[p];
-  for (int k = first; k < first + count; ++k)
-    if (!set->eval[k].tracked) return false;
-  int j = 0;
+  if (!all_tracked(set, p)) return false;
+  int count = set->pairPreviousCount[p], j = 0;
   for (int f = 0; f < n; ++f) {
     while (j < count && pd_contact_id_compare(&previous[j], &found[f].id) < 0) ++j;
     if (j == count || pd_contact_id_compare(&previous[j], &found[f].id) != 0) return false;
