@@ -570,6 +570,16 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
   return n;
 }
 
+// Body 2's vertex v in body 1's frame (the frame's, placed once per frame).
+static pdVec3 frame_vertex(pdPairFrame* frame, const pdPolyhedron* s2, int v) {
+  int slot = v % PD_PAIR_FRAME_VERTICES;
+  if (frame->vertexIndex[slot] != v) {
+    frame->vertex[slot] = pd_v3_add(frame->off, pd_mat3_mulv(&frame->rel, s2->vertices[v]));
+    frame->vertexIndex[slot] = v;
+  }
+  return frame->vertex[slot];
+}
+
 // EE contact geometry of a known edge pair at the given poses, computed in body 1's frame.
 // frame (nullable): body 2's pose in body 1's frame, formed here unless it holds it for these poses already.
 static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
@@ -583,12 +593,10 @@ static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPo
     frame->rel = pd_mat3_mul(&R1T, &p2->R);
     frame->off = pd_mat3_mulv(&R1T, pd_v3_sub(p2->x, p1->x));
     frame->p1 = p1, frame->p2 = p2;
+    for (int k = 0; k < PD_PAIR_FRAME_VERTICES; ++k) frame->vertexIndex[k] = -1;
   }
-  const pdMat3* rel = &frame->rel;
-  pdVec3 off = frame->off;
   const pdEdge* e2 = &s2->edges[id->feat2];
-  pdVec3 b0 = pd_v3_add(off, pd_mat3_mulv(rel, s2->vertices[e2->v[0]]));
-  pdVec3 b1 = pd_v3_add(off, pd_mat3_mulv(rel, s2->vertices[e2->v[1]]));
+  pdVec3 b0 = frame_vertex(frame, s2, e2->v[0]), b1 = frame_vertex(frame, s2, e2->v[1]);
   edgeGeom g;
   if (!edge_pair_geometry(s1, id->feat1, b0, b1, interior, &g)) return false;
   out->id = *id;

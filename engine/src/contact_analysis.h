@@ -72,10 +72,15 @@ void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPo
 // A loop over a list of contacts sorted by id meets each pair's contacts one after another: one frame, with p1
 // NULL to start, passed to the _framed forms below for them all is formed once per pair, as the same numbers.
 // It is valid while the poses it was formed at (pointers it compares) keep their values: within one loop.
+// It also keeps body 2's vertices it has placed in that frame (a crossed pair of boxes has 8 EE contacts on 4 of
+// each box's edges: 16 edge ends, 4 vertices), each by its index modulo PD_PAIR_FRAME_VERTICES.
+enum { PD_PAIR_FRAME_VERTICES = 8 };
 typedef struct pdPairFrame {
   const pdPose *p1, *p2;
   pdMat3 rel;
   pdVec3 off;
+  int vertexIndex[PD_PAIR_FRAME_VERTICES];  // -1: empty
+  pdVec3 vertex[PD_PAIR_FRAME_VERTICES];    // off + rel · (body 2's vertex vertexIndex)
 } pdPairFrame;
 // pd_contact_track and pd_contact_geometry with a pair frame (nullable), bit for bit the same results.
 bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,

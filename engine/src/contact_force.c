@@ -248,6 +248,12 @@ void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pd
   out->force = pd_v3_muladd(out->ft, out->fn, n);
 }
 
+double pd_contact_normal_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du) {
+  pdContactForce out;
+  normal_force(p, s->s1n, s->s2n, pd_v3_dot(du, n), &out);
+  return out.fn;
+}
+
 // The smallest rotation taking unit a to unit b, applied to x (Rodrigues with v = a × b, c = a · b):
 //   R x = c x + v × x + (v · x)/(1 + c) v.
 // When a and b are (nearly) opposite the axis is undefined; any axis u ⊥ a then gives a half turn,
@@ -256,26 +262,44 @@ void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pd
 // anyway (the springs are reoriented, not lost).
 #define PD_REALIGN_ANTIPARALLEL_TOL 1e-8
 
-static pdVec3 rotate_min(pdVec3 a, pdVec3 b, pdVec3 x) {
-  double c = pd_v3_dot(a, b);
-  if (1.0 + c > PD_REALIGN_ANTIPARALLEL_TOL) {
-    pdVec3 v = pd_v3_cross(a, b);
-    pdVec3 r = pd_v3_add(pd_v3_scale(x, c), pd_v3_cross(v, x));
-    return pd_v3_muladd(r, pd_v3_dot(v, x) / (1.0 + c), v);
+// The rotation, formed once for both tangential springs of a contact (the same numbers as forming it for each).
+typedef struct minRotation {
+  bool halfTurn;       // a and b (nearly) opposite: the half turn about `axis`
+  double c, onePlusC;  // a · b and 1 + a · b
+  pdVec3 v;            // a × b (not half turn)
+  pdVec3 axis;         // unit, ⊥ a (half turn)
+} minRotation;
+
+static minRotation min_rotation(pdVec3 a, pdVec3 b) {
+  minRotation m;
+  m.c = pd_v3_dot(a, b);
+  m.onePlusC = 1.0 + m.c;
+  m.halfTurn = !(m.onePlusC > PD_REALIGN_ANTIPARALLEL_TOL);
+  if (!m.halfTurn) {
+    m.v = pd_v3_cross(a, b);
+    return m;
   }
   // a half turn about an axis ⊥ a: cross a with the coordinate axis it is least aligned with
   pdVec3 e = fabs(a.x) <= fabs(a.y) && fabs(a.x) <= fabs(a.z) ? pd_v3(1, 0, 0)
              : (fabs(a.y) <= fabs(a.z) ? pd_v3(0, 1, 0) : pd_v3(0, 0, 1));
-  pdVec3 u = pd_v3_normalize(pd_v3_cross(a, e));
-  return pd_v3_sub(pd_v3_scale(u, 2.0 * pd_v3_dot(u, x)), x);
+  m.axis = pd_v3_normalize(pd_v3_cross(a, e));
+  return m;
+}
+
+static pdVec3 rotate_min(const minRotation* m, pdVec3 x) {
+  if (!m->halfTurn) {
+    pdVec3 r = pd_v3_add(pd_v3_scale(x, m->c), pd_v3_cross(m->v, x));
+    return pd_v3_muladd(r, pd_v3_dot(m->v, x) / m->onePlusC, m->v);
+  }
+  return pd_v3_sub(pd_v3_scale(m->axis, 2.0 * pd_v3_dot(m->axis, x)), x);
 }
 
 // Rotates s into the plane ⊥ nNew keeping |s|: rotate, drop the residual normal part (from roundoff or a
 // spring that was not exactly in the old plane), restore the length.
-static pdVec3 realign_one(pdVec3 s, pdVec3 nOld, pdVec3 nNew) {
+static pdVec3 realign_one(pdVec3 s, const minRotation* m, pdVec3 nNew) {
   double len = pd_v3_norm(s);
   if (len == 0.0) return s;
-  pdVec3 r = in_plane(rotate_min(nOld, nNew, s), nNew);
+  pdVec3 r = in_plane(rotate_min(m, s), nNew);
   double rl = pd_v3_norm(r);
   return rl > 0.0 ? pd_v3_scale(r, len / rl) : (pdVec3){0, 0, 0};
 }
@@ -295,8 +319,9 @@ static void rebalance(double k1, double k2, double* s1, double* s2) {
 
 void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const pdContactParams* p, double fn) {
   PD_ASSERT(mu >= 0.0);
-  s->s1t = realign_one(s->s1t, nOld, nNew);
-  s->s2t = realign_one(s->s2t, nOld, nNew);
+  minRotation m = min_rotation(nOld, nNew);
+  s->s1t = realign_one(s->s1t, &m, nNew);
+  s->s2t = realign_one(s->s2t, &m, nNew);
   if (p->proportionalN && p->k1n + p->k2n > 0.0) rebalance(p->k1n, p->k2n, &s->s1n, &s->s2n);
   if (p->proportionalT && p->k1t + p->k2t > 0.0) {
     rebalance(p->k1t, p->k2t, &s->s1t.x, &s->s2t.x);

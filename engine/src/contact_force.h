@@ -63,6 +63,9 @@ typedef struct pdContactForce {
 // tangential rates lie in P_t.
 void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du, pdContactForce* out);
 
+// F_n of pd_contact_force alone (the same number), N: what a caller needs before it realigns the springs.
+double pd_contact_normal_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du);
+
 // The dynamics-side break (paper §4.2, DESIGN §3.3): true when the normal force would pull (fn < 0).
 static inline bool pd_contact_force_pulls(const pdContactForce* f) { return f->fn < 0.0; }
 

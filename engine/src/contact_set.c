@@ -111,6 +111,8 @@ typedef struct contactSlot {
   // at the last accepted state (for realignment, refinement and output)
   pdVec3 normal, point;
   double depth;
+  bool geometryCurrent;  // normal, point and depth are the geometry at the poses record() runs at (set by a
+                         // commit for a tracked contact: tracking formed it at those poses; record() clears it)
   pdContactForce force;
   pdSprings springs;  // used only while the list is rebuilt
   double onsetAge;    // s: a pair onset's time since the interpolated onset, until start_late_contacts (else 0)
@@ -414,11 +416,10 @@ static void poses_from(const pdModel* model, const double* y, pdPose* poses) {
   poses_of_range(model, y, poses, 0, model->movingCount);
 }
 
-// Geometry, relative velocity and force of one contact at state y (poses of y given).
+// Geometry and relative velocity of one contact at state y (poses of y given).
 // frame: the loop's pair frame (pdPairFrame), shared by a pair's contacts (consecutive in the sorted list).
-static void evaluate(const pdModel* model, const contactSlot* c, const double* y, const pdPose* poses,
-                     pdPairFrame* frame, const pdSprings* springs, pdContactGeom* geom, bool* tracked, pdVec3* du,
-                     pdContactForce* f) {
+static void contact_motion(const pdModel* model, const contactSlot* c, const double* y, const pdPose* poses,
+                           pdPairFrame* frame, pdContactGeom* geom, bool* tracked, pdVec3* du) {
   int b1 = c->id.body1, b2 = c->id.body2;
   if (tracked)
     *tracked = pd_contact_track_framed(model, &c->id, &poses[b1], &poses[b2], frame, geom);
@@ -431,6 +432,13 @@ static void evaluate(const pdModel* model, const contactSlot* c, const double* y
     geom->depth = c->depth;
   }
   *du = pd_v3_sub(point_velocity(model, y, poses, b1, geom->point), point_velocity(model, y, poses, b2, geom->point));
+}
+
+// Geometry, relative velocity and force of one contact at state y (contact_motion, then the force law).
+static void evaluate(const pdModel* model, const contactSlot* c, const double* y, const pdPose* poses,
+                     pdPairFrame* frame, const pdSprings* springs, pdContactGeom* geom, bool* tracked, pdVec3* du,
+                     pdContactForce* f) {
+  contact_motion(model, c, y, poses, frame, geom, tracked, du);
   pd_contact_force(&c->params, springs, geom->normal, *du, f);
 }
 
@@ -1025,6 +1033,15 @@ static void record_range(void* ctx, int part, int begin, int end) {
   for (int i = begin; i < end; ++i) {
     contactSlot* c = &job->set->items[i];
     pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
+    if (c->geometryCurrent) {
+      // the same geometry as evaluate() would form again (a pair onset's impulses change velocities, not poses)
+      c->geometryCurrent = false;
+      int b1 = c->id.body1, b2 = c->id.body2;
+      pdVec3 du = pd_v3_sub(point_velocity(job->model, job->y, job->poses1, b1, c->point),
+                            point_velocity(job->model, job->y, job->poses1, b2, c->point));
+      pd_contact_force(&c->params, &sp, c->normal, du, &c->force);
+      continue;
+    }
     pdContactGeom g;
     pdVec3 du;  // unused here
     evaluate(job->model, c, job->y, job->poses1, &frame, &sp, &g, NULL, &du, &c->force);
@@ -1571,6 +1588,8 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
     pd_springs_realign(&k->springs, c->normal, e->geom.normal, c->params.mu, &c->params, e->force.fn);
     k->normal = e->geom.normal;  // where the contact is now: its pair's modal dampers are set from it
     k->point = e->geom.point;
+    k->depth = e->geom.depth;
+    k->geometryCurrent = true;  // tracked at y1's poses, which the commit keeps (record_range)
   }
   for (int j = 0; j < set->candidateCount; ++j) {
     const candidate* cand = &set->candidates[j];
@@ -1626,12 +1645,14 @@ void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y)
     pdSprings sp = springs_load(yc);
     pdContactGeom g;
     pdVec3 du;
-    evaluate(model, c, y, view->poses1, &frame, &sp, &g, NULL, &du, &c->force);
-    if (!pd_contact_force_pulls(&c->force)) {
-      pd_springs_realign(&sp, c->normal, g.normal, c->params.mu, &c->params, c->force.fn);
+    contact_motion(model, c, y, view->poses1, &frame, &g, NULL, &du);
+    // the normal force decides (pd_contact_force_pulls) whether the springs are realigned before the whole force
+    double fn = pd_contact_normal_force(&c->params, &sp, g.normal, du);
+    if (!(fn < 0.0)) {
+      pd_springs_realign(&sp, c->normal, g.normal, c->params.mu, &c->params, fn);
       springs_store(yc, &sp);
-      pd_contact_force(&c->params, &sp, g.normal, du, &c->force);
     }
+    pd_contact_force(&c->params, &sp, g.normal, du, &c->force);
     record_geometry(c, &g);
   }
 }

@@ -27,10 +27,16 @@
 #include "model_contact.h"
 #include "number_format.h"
 
-// The ring: this many blocks of at least this many bytes. Four of 256 KiB: a 10-box stack's sample is ~8 KiB,
-// so the writer works on 32 samples at a time while the simulation fills the next blocks.
-#define PD_OUTPUT_BLOCKS 4
-#define PD_OUTPUT_BLOCK_BYTES (256 * 1024)
+// The ring: blocks of at least PD_OUTPUT_BLOCK_BYTES, as many as fit PD_OUTPUT_RING_BYTES with the first sample
+// (at least PD_OUTPUT_BLOCKS_MIN, at most PD_OUTPUT_BLOCKS_MAX). The block being filled at the end is printed after
+// the simulation is done (pd_run_drain), so its size is the wait at the end: four blocks of 256 KiB (32 samples of a
+// 10-box stack, ~8 KiB each) left 2.3 ms of 40 to print after the last step (cases/hard/stack_10.scene); blocks of
+// 16 KiB leave 0.3 ms. A scene whose samples are larger than a block gets fewer blocks, one sample each, so that the
+// ring stays near its size (a pile of 1 000 boxes at rest: ~0.7 MB a sample).
+#define PD_OUTPUT_BLOCK_BYTES (16 * 1024)
+#define PD_OUTPUT_RING_BYTES (1024 * 1024)
+#define PD_OUTPUT_BLOCKS_MIN 4
+#define PD_OUTPUT_BLOCKS_MAX 64
 
 typedef struct outputBlock {
   unsigned char* data;
@@ -45,7 +51,8 @@ struct pdRunWriter {
   atomic_bool ioError;  // a write failed (set by the writer thread)
   // the ring (design note): blocks filled = produced − consumed, in order
   const pdModel* model;  // the model of the samples (the same for every one; the writer reads its names)
-  outputBlock blocks[PD_OUTPUT_BLOCKS];
+  outputBlock blocks[PD_OUTPUT_BLOCKS_MAX];
+  int ringBlocks;  // blocks in the ring, set by the first sample (0 before it)
   long produced;  // blocks handed to the writer so far
   long consumed;  // blocks the writer has printed so far
   bool quit;      // the writer stops when the ring is empty (finish) or at once (abort, with `discard`)
@@ -263,7 +270,7 @@ static void* writer_main(void* user) {
   for (;;) {
     while (!run->quit && run->consumed == run->produced) pthread_cond_wait(&run->filled, &run->lock);
     if (run->discard || run->consumed == run->produced) break;  // aborted, or finished and empty
-    outputBlock* b = &run->blocks[run->consumed % PD_OUTPUT_BLOCKS];
+    outputBlock* b = &run->blocks[run->consumed % run->ringBlocks];
     pthread_mutex_unlock(&run->lock);
     if (!atomic_load(&run->ioError) && !print_block(run, b)) atomic_store(&run->ioError, true);
     pthread_mutex_lock(&run->lock);
@@ -277,7 +284,8 @@ static void* writer_main(void* user) {
 
 // Hands the block being filled to the writer (if it holds anything).
 static void hand_over(pdRunWriter* run) {
-  outputBlock* b = &run->blocks[run->produced % PD_OUTPUT_BLOCKS];
+  if (run->ringBlocks == 0) return;  // no sample yet
+  outputBlock* b = &run->blocks[run->produced % run->ringBlocks];
   if (b->used == 0) return;
   pthread_mutex_lock(&run->lock);
   ++run->produced;
@@ -287,13 +295,19 @@ static void hand_over(pdRunWriter* run) {
 
 // The block to fill next, with room for `bytes`: the current one, or the next once the writer has freed it.
 static outputBlock* block_with_room(pdRunWriter* run, size_t bytes) {
-  outputBlock* b = &run->blocks[run->produced % PD_OUTPUT_BLOCKS];
+  if (run->ringBlocks == 0) {  // the first sample: before any block is handed over, so the writer sees it set
+    size_t block = bytes > PD_OUTPUT_BLOCK_BYTES ? bytes : PD_OUTPUT_BLOCK_BYTES;
+    size_t fit = PD_OUTPUT_RING_BYTES / block;
+    run->ringBlocks = fit < PD_OUTPUT_BLOCKS_MIN ? PD_OUTPUT_BLOCKS_MIN
+                                                 : (fit > PD_OUTPUT_BLOCKS_MAX ? PD_OUTPUT_BLOCKS_MAX : (int)fit);
+  }
+  outputBlock* b = &run->blocks[run->produced % run->ringBlocks];
   if (b->used > 0 && b->used + bytes > b->capacity) {
     hand_over(run);
     pthread_mutex_lock(&run->lock);
-    while (run->produced - run->consumed >= PD_OUTPUT_BLOCKS) pthread_cond_wait(&run->freed, &run->lock);
+    while (run->produced - run->consumed >= run->ringBlocks) pthread_cond_wait(&run->freed, &run->lock);
     pthread_mutex_unlock(&run->lock);
-    b = &run->blocks[run->produced % PD_OUTPUT_BLOCKS];
+    b = &run->blocks[run->produced % run->ringBlocks];
   }
   if (bytes > b->capacity) {  // a sample larger than any so far (the first samples only)
     size_t capacity = bytes > PD_OUTPUT_BLOCK_BYTES ? bytes : PD_OUTPUT_BLOCK_BYTES;
@@ -326,7 +340,7 @@ static void writer_stop(pdRunWriter* run, bool discard) {
   pthread_cond_destroy(&run->freed);
   pthread_mutex_destroy(&run->lock);
   run->threadStarted = false;
-  for (int k = 0; k < PD_OUTPUT_BLOCKS; ++k) free(run->blocks[k].data);
+  for (int k = 0; k < PD_OUTPUT_BLOCKS_MAX; ++k) free(run->blocks[k].data);
 }
 
 pdRunWriter* pd_run_open(const char* dir, pdError* err) {

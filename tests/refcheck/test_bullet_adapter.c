@@ -20,6 +20,7 @@
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
 #include "polydyn/scene.h"
+#include "test_files.h"
 
 #define G 9.81  // m/s², the scene default
 
@@ -259,21 +260,6 @@ static void test_matched_single_contact_bounces_with_eq_15(void** state) {
 // ---------------------------------------------------------------------------------------------
 // whole runs through the driver: determinism, every scene of cases/, refusals
 
-static char* read_file(const char* path, size_t* size) {
-  FILE* f = fopen(path, "rb");
-  if (!f) fail_msg("cannot open %s", path);
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char* data = malloc((size_t)n + 1);
-  assert_non_null(data);
-  assert_int_equal(fread(data, 1, (size_t)n, f), (size_t)n);
-  data[n] = '\0';
-  fclose(f);
-  *size = (size_t)n;
-  return data;
-}
-
 static pdModel* compile_file(const char* path) {
   pdError err;
   memset(&err, 0, sizeof err);
@@ -329,9 +315,9 @@ static void test_two_runs_write_the_same_bytes(void** state) {
       assert_true(run_to(m, (pdRefVariant)v, dir, &stats, &err, &finite));
       assert_true(stats.completed && finite);
       snprintf(path, sizeof path, "%s/trajectory.csv", dir);
-      traj[r] = read_file(path, &trajSize[r]);
+      traj[r] = test_read_file(path, &trajSize[r]);
       snprintf(path, sizeof path, "%s/summary.json", dir);
-      summary[r] = read_file(path, &summarySize[r]);
+      summary[r] = test_read_file(path, &summarySize[r]);
     }
     size_t s0 = before_timing(summary[0], summarySize[0]), s1 = before_timing(summary[1], summarySize[1]);
     print_message("%s: trajectory.csv %zu bytes, summary.json %zu bytes before timing\n", variant_name((pdRefVariant)v),

@@ -29,6 +29,7 @@
 #include "polydyn/refcheck.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
+#include "test_files.h"
 
 #define G 9.81  // m/s², the scene default
 
@@ -376,21 +377,6 @@ static void test_floor_plane_becomes_convex_when_a_body_leaves_its_face(void** s
 // ---------------------------------------------------------------------------------------------
 // determinism
 
-static char* read_all(const char* path, size_t* size) {
-  FILE* f = fopen(path, "rb");
-  assert_non_null(f);
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char* text = malloc((size_t)n + 1);
-  assert_non_null(text);
-  assert_int_equal(fread(text, 1, (size_t)n, f), (size_t)n);
-  text[n] = '\0';
-  fclose(f);
-  *size = (size_t)n;
-  return text;
-}
-
 static void test_two_runs_give_identical_bytes(void** state) {
   (void)state;
   pdModel* m = compile_file(PD_SOURCE_DIR "/cases/examples/demo.scene");
@@ -414,8 +400,8 @@ static void test_two_runs_give_identical_bytes(void** state) {
       snprintf(a, sizeof a, "%s/%s", dirs[0], files[f]);
       snprintf(b, sizeof b, "%s/%s", dirs[1], files[f]);
       size_t na, nb;
-      char* ta = read_all(a, &na);
-      char* tb = read_all(b, &nb);
+      char* ta = test_read_file(a, &na);
+      char* tb = test_read_file(b, &nb);
       if (f == 1) {  // summary.json: everything before the timing part
         char* ca = strstr(ta, "\"timing\"");
         char* cb = strstr(tb, "\"timing\"");

@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include "polydyn/view.h"
+#include "test_files.h"
 
 static const char* const summary =
     "{\"engine\": \"polydyn-soft\", \"scene\": \"synthetic.scene\", \"settings\": {\"gravity\": [0, 0, -9.81]},\n"
@@ -60,18 +61,10 @@ static void make_run(const char* dir, const char* engine) {
                    "0.5,cube,floor,VF,0,5,0,0,0,0,0,1,9.81,0,0,0,stick\n");
 }
 
+// The bytes of `path` as a string.
 static char* read_all(const char* path) {
-  FILE* f = fopen(path, "rb");
-  assert_non_null(f);
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  rewind(f);
-  char* s = malloc((size_t)n + 1);
-  assert_non_null(s);
-  assert_int_equal(fread(s, 1, (size_t)n, f), (size_t)n);
-  s[n] = '\0';
-  fclose(f);
-  return s;
+  size_t size;
+  return test_read_file(path, &size);
 }
 
 static int count(const char* text, const char* needle) {
