@@ -572,7 +572,7 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
 
 // Body 2's vertex v in body 1's frame (the frame's, placed once per frame).
 static pdVec3 frame_vertex(pdPairFrame* frame, const pdPolyhedron* s2, int v) {
-  int slot = v % PD_PAIR_FRAME_VERTICES;
+  int slot = v & (PD_PAIR_FRAME_VERTICES - 1);  // v >= 0; a power of two
   if (frame->vertexIndex[slot] != v) {
     frame->vertex[slot] = pd_v3_add(frame->off, pd_mat3_mulv(&frame->rel, s2->vertices[v]));
     frame->vertexIndex[slot] = v;

@@ -73,7 +73,7 @@ void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPo
 // NULL to start, passed to the _framed forms below for them all is formed once per pair, as the same numbers.
 // It is valid while the poses it was formed at (pointers it compares) keep their values: within one loop.
 // It also keeps body 2's vertices it has placed in that frame (a crossed pair of boxes has 8 EE contacts on 4 of
-// each box's edges: 16 edge ends, 4 vertices), each by its index modulo PD_PAIR_FRAME_VERTICES.
+// each box's edges: 16 edge ends, 4 vertices), each by its index modulo PD_PAIR_FRAME_VERTICES (a power of two).
 enum { PD_PAIR_FRAME_VERTICES = 8 };
 typedef struct pdPairFrame {
   const pdPose *p1, *p2;

@@ -41,6 +41,12 @@ typedef struct pdContactParams {
   double massMin;             // kg: the pair's minimum effective mass (both bodies' m_min in series)
 } pdContactParams;
 
+// Every constant a number >= 0 (what pd_contact_force requires).
+static inline bool pd_contact_params_valid(const pdContactParams* p) {
+  return p->k1n >= 0.0 && p->k2n >= 0.0 && p->k1t >= 0.0 && p->k2t >= 0.0 && p->c1n >= 0.0 && p->c2n >= 0.0 &&
+         p->c1t >= 0.0 && p->c2t >= 0.0 && p->mu >= 0.0;
+}
+
 // The 8 numbers of a contact in the state vector: spring deflections, m.
 typedef struct pdSprings {
   double s1n, s2n;   // along n; compression: s1n <= 0 <= s2n

@@ -133,6 +133,12 @@ typedef struct pairCertificate {
 // The longest wait between certificates of a pair whose certificates save no search (it doubles each time from 1).
 #define CERT_BACKOFF_MAX 64
 
+// What pd_contact_set_present changes in a captured slot besides its force (dense output's view).
+typedef struct capturedGeometry {
+  pdVec3 normal, point;
+  double depth;
+} capturedGeometry;
+
 // Analysis of one contact of C0 at the end of a trial step.
 typedef struct contactEval {
   bool tracked;       // still geometrically valid
@@ -231,7 +237,9 @@ struct pdContactSet {
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation
-  int capturedCount;       // a dense output's view (dense_output.h): the captured list's length, its slots in next
+  int capturedCount;       // a dense output's view (dense_output.h): the captured list's length, its slots in items
+  capturedGeometry* captured;  // (capacity) a view's: each captured slot's normal, point and depth, which a
+                               // presentation overwrites in items and the next one restores
   pdHelpDesk* help;        // where the per-contact and per-pair loops post half their work, or NULL (help_desk.h)
 };
 
@@ -250,6 +258,8 @@ static void reserve_list(pdContactSet* set, int capacity) {
     for (int part = 0; part < 2; ++part)
       set->search[part].previous = pd_grow(set->search[part].previous, c, sizeof *set->search[part].previous);
     set->stability = pd_grow(set->stability, c, sizeof *set->stability);
+  } else {
+    set->captured = pd_grow(set->captured, c, sizeof *set->captured);
   }
   set->capacity = c;
 }
@@ -329,6 +339,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->eval);
   free(set->push);
   free(set->next);
+  free(set->captured);
   free(set->candidates);
   for (int part = 0; part < 2; ++part) {
     free(set->search[part].previous);
@@ -400,7 +411,7 @@ static pdVec3 velocity_at(const pdModel* model, const double* y, int b, pdVec3 r
 }
 
 // Velocity of body i's material point at world point p.
-static pdVec3 point_velocity(const pdModel* model, const double* y, const pdPose* poses, int i, pdVec3 p) {
+static inline pdVec3 point_velocity(const pdModel* model, const double* y, const pdPose* poses, int i, pdVec3 p) {
   return velocity_at(model, y, i, pd_v3_sub(p, poses[i].x));
 }
 
@@ -699,6 +710,29 @@ typedef struct modalSums {
 
 static pdMat3 cross_matrix(pdVec3 r) { return (pdMat3){{{0, -r.z, r.y}, {r.z, 0, -r.x}, {-r.y, r.x, 0}}}; }
 
+// a [r]ₓ and a [r]ₓᵀ: pd_mat3_mul with cross_matrix(r), its products with the zeros left out (the other terms added in
+// the same order, so the same numbers up to the sign of a zero sum; the stability bound takes absolute values).
+static pdMat3 mul_cross(const pdMat3* a, pdVec3 r) {
+  pdMat3 m;
+  for (int i = 0; i < 3; ++i) {
+    const double* ai = a->m[i];
+    m.m[i][0] = ai[1] * r.z + ai[2] * -r.y;
+    m.m[i][1] = ai[0] * -r.z + ai[2] * r.x;
+    m.m[i][2] = ai[0] * r.y + ai[1] * -r.x;
+  }
+  return m;
+}
+static pdMat3 mul_cross_transposed(const pdMat3* a, pdVec3 r) {
+  pdMat3 m;
+  for (int i = 0; i < 3; ++i) {
+    const double* ai = a->m[i];
+    m.m[i][0] = ai[1] * -r.z + ai[2] * r.y;
+    m.m[i][1] = ai[0] * r.z + ai[2] * -r.x;
+    m.m[i][2] = ai[0] * -r.y + ai[1] * r.x;
+  }
+  return m;
+}
+
 // invWorld: the body's R I⁻¹ Rᵀ (set->invInertiaWorld).
 static void add_body_terms(const pdBody* b, const pdMat3* invWorld, const modalSums* s, double* qn, pdMat3* mt) {
   if (b->fixed) return;
@@ -798,21 +832,22 @@ static double step_of(double omega2, double overdamp) {
 
 // Accumulates Gᵀ H into out (6 × 6) for G, H = [T | R] (3 × 6 each, given as their two 3 × 3 halves).
 static void add_gram(const pdMat3* gT, const pdMat3* gR, const pdMat3* hT, const pdMat3* hR, double out[6][6]) {
-  const pdMat3* g[2] = {gT, gR};
-  const pdMat3* h[2] = {hT, hR};
-  for (int a = 0; a < 6; ++a)
-    for (int b = 0; b < 6; ++b) {
-      const pdMat3 *ga = g[a / 3], *hb = h[b / 3];
-      int ca = a % 3, cb = b % 3;
-      out[a][b] += ga->m[0][ca] * hb->m[0][cb] + ga->m[1][ca] * hb->m[1][cb] + ga->m[2][ca] * hb->m[2][cb];
+  // G and H as 3 × 6 rows first: the loop over b then runs along contiguous rows, which the compiler vectorises
+  // (each entry the same sum in the same order)
+  double g[3][6], h[3][6];
+  for (int k = 0; k < 3; ++k)
+    for (int c = 0; c < 3; ++c) {
+      g[k][c] = gT->m[k][c], g[k][c + 3] = gR->m[k][c];
+      h[k][c] = hT->m[k][c], h[k][c + 3] = hR->m[k][c];
     }
+  for (int a = 0; a < 6; ++a)
+    for (int b = 0; b < 6; ++b) out[a][b] += g[0][a] * h[0][b] + g[1][a] * h[1][b] + g[2][a] * h[2][b];
 }
 
 // Contact i's G = K^½ J_iB 𝕄_B^-½ on its end e (body B): T = σ K^½ / √m_B, R = −σ K^½ [r]ₓ W_B^½.
 static void contact_gram_factor(const stabilityTerms* t, int e, const bodySpaceBlock* b, pdMat3* T, pdMat3* R) {
   double sigma = e == 0 ? 1.0 : -1.0;
-  pdMat3 rx = cross_matrix(t->arm[e]);
-  pdMat3 krx = pd_mat3_mul(&t->k, &rx);
+  pdMat3 krx = mul_cross(&t->k, t->arm[e]);
   pdMat3 krxw = pd_mat3_mul(&krx, &b->invSqrtInertia);
   for (int r = 0; r < 3; ++r)
     for (int q = 0; q < 3; ++q) {
@@ -969,10 +1004,8 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
       const pdBody* b = &model->bodies[ends[e]];
       if (b->fixed) continue;
       t->arm[e] = pd_v3_sub(c->point, poses[ends[e]].x);
-      pdMat3 rx = cross_matrix(t->arm[e]);
-      pdMat3 rxT = pd_mat3_transpose(&rx);
-      t->left[e] = pd_mat3_mul(&t->k, &rxT);
-      pdMat3 wrx = pd_mat3_mul(&set->invInertiaWorld[ends[e]], &rx);
+      t->left[e] = mul_cross_transposed(&t->k, t->arm[e]);
+      pdMat3 wrx = mul_cross(&set->invInertiaWorld[ends[e]], t->arm[e]);
       t->right[e] = pd_mat3_mul(&wrx, &t->k);
       set->bodyRowsK[ends[e]] = pd_v3_add(set->bodyRowsK[ends[e]], row_abs_sums(&t->k));
       set->bodyRowsRight[ends[e]] = pd_v3_add(set->bodyRowsRight[ends[e]], row_abs_sums(&t->right[e]));
@@ -1622,13 +1655,17 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
 
 void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
   reserve_list(view, from->count > 0 ? from->count : 1);  // never NULL: memcpy of nothing still wants a pointer
-  memcpy(view->next, from->items, (size_t)from->count * sizeof *view->next);
+  memcpy(view->items, from->items, (size_t)from->count * sizeof *view->items);
+  for (int i = 0; i < from->count; ++i) {
+    const contactSlot* c = &from->items[i];
+    view->captured[i] = (capturedGeometry){c->normal, c->point, c->depth};
+  }
   view->capturedCount = from->count;
+  view->count = 0;  // nothing presented yet
 }
 
 void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y) {
   int count = view->capturedCount;
-  memcpy(view->items, view->next, (size_t)count * sizeof *view->items);
   view->count = count;
   view->bodyListValid = false;
   poses_from(model, y, view->poses1);
@@ -1641,6 +1678,10 @@ void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y)
   frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = 0; i < count; ++i) {
     contactSlot* c = &view->items[i];
+    // as captured: a presentation at another time of the same step overwrote them (the rest it does not change)
+    c->normal = view->captured[i].normal;
+    c->point = view->captured[i].point;
+    c->depth = view->captured[i].depth;
     double* yc = y + base + PD_CONTACT_STATE_SIZE * i;
     pdSprings sp = springs_load(yc);
     pdContactGeom g;

@@ -318,6 +318,7 @@ void pd_contact_modal_damping(pdContactParams* p, double massN, double massT) {
     double m = fmin(massT, p->massPair);
     derived_dampers(damping_over_stiffness(p->zetaT, pd_series(p->k1t, p->k2t), m), p->k1t, p->k2t, &p->c1t, &p->c2t);
   }
+  PD_ASSERT(pd_contact_params_valid(p));  // a mass that is not a number >= 0 gives NaN or negative dampers
 }
 
 // §3.3.1 for the pair: 1/ω = √(m_min/k_s) >= Δt_min, which bounds the period 2π/ω and, for ζ <= 1, the

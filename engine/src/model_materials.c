@@ -287,8 +287,10 @@ pdContactParams pd_model_contact_params(const pdModel* model, int body1, int bod
             body1 != body2);
   PD_ASSERT(!(model->bodies[body1].fixed && model->bodies[body2].fixed));
   int a = t->classOf[body1], b = t->classOf[body2];
-  if (t->pairs) return t->pairs[(size_t)a * (size_t)t->classCount + (size_t)b];
-  return class_pair(t, a, b, -1, -1, NULL);
+  pdContactParams p =
+      t->pairs ? t->pairs[(size_t)a * (size_t)t->classCount + (size_t)b] : class_pair(t, a, b, -1, -1, NULL);
+  PD_ASSERT(pd_contact_params_valid(&p));  // what pd_contact_force requires (checked there in self-check builds only)
+  return p;
 }
 
 double pd_model_contact_period_min(const pdModel* model) {
