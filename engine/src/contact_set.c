@@ -237,6 +237,12 @@ struct pdContactSet {
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation
+  // the state record() formed every contact's force at (its slots' force, point and rates), while recordedValid:
+  // a derivative at the very same numbers takes them from there (pd_contact_forces)
+  double* recordedY;
+  const double* recordedFrom;  // where that state was (only a derivative at those numbers there is compared)
+  int recordedN, recordedCapacity;
+  bool recordedValid;      // cleared by a list installed or cleared
   int capturedCount;       // a dense output's view (dense_output.h): the captured list's length, its slots in items
   capturedGeometry* captured;  // (capacity) a view's: each captured slot's normal, point and depth, which a
                                // presentation overwrites in items and the next one restores
@@ -340,6 +346,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->push);
   free(set->next);
   free(set->captured);
+  free(set->recordedY);
   free(set->candidates);
   for (int part = 0; part < 2; ++part) {
     free(set->search[part].previous);
@@ -377,6 +384,7 @@ void pd_contact_set_free(pdContactSet* set) {
 void pd_contact_set_clear(pdContactSet* set) {
   set->count = 0;
   set->bodyListValid = false;
+  set->recordedValid = false;
   set->stableStep = set->stableCheap = INFINITY;
   set->stableKnown = true;
   set->candidateCount = 0;
@@ -547,10 +555,35 @@ static void sums_range(void* ctx, int part, int begin, int end) {
   }
 }
 
+// Contacts [begin, end) as record() formed them at this very state (pd_contact_forces): the same numbers as
+// forces_range, which would form the same geometry, relative velocity and force from the same numbers again.
+static void recorded_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const contactLoop* job = ctx;
+  pdContactSet* set = job->set;
+  int base = spring_base(job->model);
+  for (int i = begin; i < end; ++i) {
+    const contactSlot* c = &set->items[i];
+    springs_store(job->dydt + base + PD_CONTACT_STATE_SIZE * i, &c->force.rate);
+    set->push[i] = (contactPush){c->point, c->force.force, pd_contact_force_pulls(&c->force)};
+  }
+}
+
+bool pd_contact_set_recorded_at(const pdModel* model, const pdContactSet* set, const double* y) {
+  // a step's stages evaluate in the stepper's scratch: only the place the recorded state was is compared
+  if (!set->recordedValid || y != set->recordedFrom) return false;
+  int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
+  return n == set->recordedN && memcmp(y, set->recordedY, (size_t)n * sizeof *y) == 0;
+}
+
+void pd_contact_set_forget_recorded(pdContactSet* set) { set->recordedValid = false; }
+
 void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y, double* dydt) {
   contactLoop job = {.model = model, .set = set, .y = y, .dydt = dydt};
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, poses_range, &job);
-  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, forces_range, &job);
+  // the first derivative of a step after a commit is at the state record() has just evaluated (bit for bit)
+  bool recorded = pd_contact_set_recorded_at(model, set, y);
+  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, recorded ? recorded_range : forces_range, &job);
   if (!set->bodyListValid) list_bodies(model, set);  // a list installed without stability_prepare (a gather)
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, sums_range, &job);
 }
@@ -670,6 +703,7 @@ static void install(const pdModel* model, pdState* s, int count) {
   set->next = old;
   set->count = count;
   set->bodyListValid = false;
+  set->recordedValid = false;
   s->n = base + PD_CONTACT_STATE_SIZE * count;
 }
 
@@ -1085,6 +1119,18 @@ static void record_range(void* ctx, int part, int begin, int end) {
 static void record(const pdModel* model, pdContactSet* set, const double* y, const pdPose* poses) {
   contactLoop job = {.model = model, .set = set, .y = y, .poses1 = poses};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, record_range, &job);
+  // the next step's first derivative is at this state (after an accepted step: its k1)
+  set->recordedValid = false;
+  if (set->count == 0) return;  // nothing to take: not worth a copy and a comparison per derivative
+  int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
+  if (n > set->recordedCapacity) {  // grown with the list, after a step
+    set->recordedCapacity = 2 * n;
+    set->recordedY = pd_grow(set->recordedY, (size_t)set->recordedCapacity, sizeof *set->recordedY);
+  }
+  memcpy(set->recordedY, y, (size_t)n * sizeof *y);
+  set->recordedFrom = y;
+  set->recordedN = n;
+  set->recordedValid = true;
 }
 
 // The normal motion of one contact over the τ since its onset, alone at the effective mass m, undamped

@@ -33,6 +33,13 @@ int pd_contact_set_count(const pdContactSet* set);
 // its spring rates (written into dydt's contact part). A normal force that would pull is not applied
 // (normal springs are never in tension); the contact is dropped after the step.
 void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y, double* dydt);
+// Whether a derivative at y takes every contact's force and spring rates from the list's preparation: record() formed
+// them at a state of the very same numbers in the same place (the first derivative of a step after a commit, at
+// state->y), so pd_contact_forces copies them instead of forming the same numbers again. Any list installed or
+// cleared forgets them.
+bool pd_contact_set_recorded_at(const pdModel* model, const pdContactSet* set, const double* y);
+// Forgets them now: the next derivative forms every contact (tests compare the two).
+void pd_contact_set_forget_recorded(pdContactSet* set);
 // Results of the last pd_contact_forces call: poses indexed by body; force and torque (N, N·m, about the
 // centre of mass) indexed by moving body (stateIndex).
 const pdPose* pd_contact_set_poses(const pdContactSet* set);
