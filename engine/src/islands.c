@@ -729,16 +729,6 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
     }
     set->boxes[model->movingBodies[k]] = box;
   }
-  bool updated = pd_broad_phase_update(set->broad, set->boxes);
-  PD_ASSERT(updated);  // false only when memory runs out
-  int pairCount = pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
-  if (pairCount > set->pairCapacity) {
-    set->pairCapacity = 2 * pairCount;
-    set->pairs = pd_grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
-    set->sat = pd_grow(set->sat, (size_t)set->pairCapacity, sizeof *set->sat);
-    set->satNext = pd_grow(set->satNext, (size_t)set->pairCapacity, sizeof *set->satNext);
-    pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
-  }
   // bodies in contact first: a pair already in one island needs no separation test
   int contacts = pd_state_contact_count(s);
   for (int c = 0; c < contacts; ++c) {
@@ -746,6 +736,24 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
     pd_contact_set_bodies(s->contacts, c, &b1, &b2);
     const pdBody *a = &model->bodies[b1], *b = &model->bodies[b2];
     if (!a->fixed && !b->fixed) join(set->root, a->stateIndex, b->stateIndex);
+  }
+  // every moving body in one island by its contacts alone (a stack, a wall): every pair below would be skipped as
+  // joined, with no free body to activate (a free body touches nothing), so the broad phase is not asked (its pairs
+  // come sorted whatever its history: broad_phase.h)
+  bool joined = true;
+  for (int k = 1; k < m && joined; ++k) joined = find(set->root, k) == find(set->root, 0);
+  int pairCount = 0;
+  if (!joined) {
+    bool updated = pd_broad_phase_update(set->broad, set->boxes);
+    PD_ASSERT(updated);  // false only when memory runs out
+    pairCount = pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
+    if (pairCount > set->pairCapacity) {
+      set->pairCapacity = 2 * pairCount;
+      set->pairs = pd_grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
+      set->sat = pd_grow(set->sat, (size_t)set->pairCapacity, sizeof *set->sat);
+      set->satNext = pd_grow(set->satNext, (size_t)set->pairCapacity, sizeof *set->satNext);
+      pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
+    }
   }
   int cached = 0, tested = 0;
   for (int p = 0; p < pairCount; ++p) {
