@@ -30,8 +30,8 @@
 
 // The ring: blocks of at least PD_OUTPUT_BLOCK_BYTES, as many as fit PD_OUTPUT_RING_BYTES with the first sample
 // (at least PD_OUTPUT_BLOCKS_MIN, at most PD_OUTPUT_BLOCKS_MAX). The block being filled at the end is printed after
-// the simulation is done (pd_run_drain), so its size is the wait at the end: four blocks of 256 KiB (32 samples of a
-// 10-box stack, ~8 KiB each) left 2.3 ms of 40 to print after the last step (cases/hard/stack_10.scene); blocks of
+// the simulation is done (pd_run_drain), so its size is the wait at the end: four blocks of 256 KiB (29 samples of a
+// 10-box stack, 8.75 KiB each) left 2.3 ms of 40 to print after the last step (cases/hard/stack_10.scene); blocks of
 // 16 KiB leave 0.3 ms. A scene whose samples are larger than a block gets fewer blocks, one sample each, so that the
 // ring stays near its size (a pile of 1 000 boxes at rest: ~0.7 MB a sample).
 #define PD_OUTPUT_BLOCK_BYTES (16 * 1024)

@@ -1,9 +1,10 @@
 // engine/src/output.c: the files a run directory gets through the writer thread's ring (pd_run_observe) and its
 // cache of the numbers' texts hold the very bytes that pd_write_trajectory_rows and pd_write_contact_rows print for
-// the same samples (formed afresh), with their headers first: for samples far smaller than a block, so that many go
-// to one block and the ring wraps round many times (the stack of 10: ~8 KiB a sample, 301 samples), and for samples
-// larger than a block from the first sample on, so that the ring has fewer blocks, each grown to a sample, and wraps
-// round too (300 cubes resting on a floor: ~31 KiB at the first sample, ~150 KiB with their contacts).
+// the same samples (formed afresh), with their headers first: for samples smaller than a block, so that the ring keeps
+// its 64 blocks and wraps round several times (the stack of 10: 8.75 KiB a sample, one to a 16 KiB block, 301
+// samples), and for samples larger than a block from the first sample on, so that the ring has fewer blocks, each
+// grown to a sample, and wraps round too (300 cubes resting on a floor: ~31 KiB at the first sample, ~150 KiB with
+// their contacts).
 // And pd_contact_normal_force gives the normal force pd_contact_force gives, bit for bit.
 #include <setjmp.h>
 #include <stdarg.h>
