@@ -22,7 +22,9 @@
 //     of the same body, which keeps its springs (face continuity, §4.4.3); contacts whose normal springs
 //     would pull (F_n < 0) break by force; the survivors' springs are realigned to the new normal and
 //     clipped to the friction cone (§3.4); new contacts join with their springs at 0. The list is
-//     re-sorted by id and the springs re-laid in the state vector.
+//     re-sorted by id and the springs re-laid in the state vector. record() then forms every contact's
+//     geometry (a tracked contact's is tracking's, at the same poses) and force at the new state; the next
+//     step's first derivative, at that very state, takes them from there (pd_contact_set_recorded_at).
 // Contacts start at zero spring deflection where they are added, so a late start shifts a contact's rest
 // point by the depth it was found at but injects no energy; the onset tolerance bounds that shift. A pair
 // onset instead starts where its pair alone would be after the τ since the onset (start_late_contacts):
