@@ -244,8 +244,8 @@ struct pdContactSet {
   double* recordedY;
   const double* recordedFrom;  // where that state was (only a derivative at those numbers there is compared)
   int recordedN, recordedCapacity;
-  bool recordedValid;      // cleared by a list installed or cleared
-  int capturedCount;       // a dense output's view (dense_output.h): the captured list's length, its slots in items
+  bool recordedValid;          // cleared by a list installed or cleared
+  int capturedCount;           // a dense output's view (dense_output.h): the captured list's length, its slots in items
   capturedGeometry* captured;  // (capacity) a view's: each captured slot's normal, point and depth, which a
                                // presentation overwrites in items and the next one restores
   pdHelpDesk* help;        // where the per-contact and per-pair loops post half their work, or NULL (help_desk.h)
