@@ -31,6 +31,12 @@
 
 static pdVec3 to_world(const pdPose* p, pdVec3 local) { return pd_v3_add(p->x, pd_mat3_mulv(&p->R, local)); }
 static pdVec3 to_local(const pdPose* p, pdVec3 world) { return pd_mat3_tmulv(&p->R, pd_v3_sub(world, p->x)); }
+// Body b's pose in body a's frame: rotation R_aᵀ R_b, offset R_aᵀ (x_b − x_a).
+static void pose_in_frame_of(const pdPose* a, const pdPose* b, pdMat3* rel, pdVec3* off) {
+  pdMat3 RaT = pd_mat3_transpose(&a->R);
+  *rel = pd_mat3_mul(&RaT, &b->R);
+  *off = pd_mat3_mulv(&RaT, pd_v3_sub(b->x, a->x));
+}
 
 int pd_contact_id_compare(const pdContactId* a, const pdContactId* b) {
   int alo = a->body1 < a->body2 ? a->body1 : a->body2, ahi = a->body1 < a->body2 ? a->body2 : a->body1;
@@ -117,10 +123,9 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
   const pdPolyhedron* sf = &m->bodies[jf].shape;
   double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
   double flushTol = FLUSH_TOL_DEFLECTIONS * pd_model_pair_delta_max(m, iv, jf);
-  // the vertex body in the face body's frame: rotation R_fᵀ R_v, offset R_fᵀ (x_v − x_f)
-  pdMat3 RfT = pd_mat3_transpose(&pf->R);
-  pdMat3 rel = pd_mat3_mul(&RfT, &pv->R);
-  pdVec3 off = pd_mat3_mulv(&RfT, pd_v3_sub(pv->x, pf->x));
+  pdMat3 rel;  // the vertex body in the face body's frame
+  pdVec3 off;
+  pose_in_frame_of(pf, pv, &rel, &off);
   for (int i = 0; i < sv->vertexCount; ++i) {
     pdVec3 p = to_world(pv, sv->vertices[i]);
     pdVec3 q = to_local(pf, p);
@@ -406,10 +411,9 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
                    int capacity, int n) {
   const pdPolyhedron* sa = &model->bodies[ia].shape;
   const pdPolyhedron* sb = &model->bodies[ib].shape;
-  // B in A's frame: rotation R_aᵀ R_b, translation R_aᵀ (x_b − x_a)
-  pdMat3 RaT = pd_mat3_transpose(&pa->R);
-  pdMat3 rel = pd_mat3_mul(&RaT, &pb->R);
-  pdVec3 off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
+  pdMat3 rel;  // B in A's frame
+  pdVec3 off;
+  pose_in_frame_of(pa, pb, &rel, &off);
   double tolA = BOUNDARY_TOL_REL * model->bodies[ia].size, tolB = BOUNDARY_TOL_REL * model->bodies[ib].size;
   double deltaMax = pd_model_pair_delta_max(model, ia, ib);
   double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
@@ -589,9 +593,7 @@ static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPo
   pdPairFrame own;
   if (!frame) frame = &own, own.p1 = NULL;
   if (frame->p1 != p1 || frame->p2 != p2) {
-    pdMat3 R1T = pd_mat3_transpose(&p1->R);
-    frame->rel = pd_mat3_mul(&R1T, &p2->R);
-    frame->off = pd_mat3_mulv(&R1T, pd_v3_sub(p2->x, p1->x));
+    pose_in_frame_of(p1, p2, &frame->rel, &frame->off);
     frame->p1 = p1, frame->p2 = p2;
     for (int k = 0; k < PD_PAIR_FRAME_VERTICES; ++k) frame->vertexIndex[k] = -1;
   }
@@ -886,9 +888,7 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   const pdPolyhedron* sa = &model->bodies[ia].shape;
   const pdPolyhedron* sb = &model->bodies[ib].shape;
   pdSearchCertificate cert;
-  pdMat3 RaT = pd_mat3_transpose(&pa->R);
-  cert.rel = pd_mat3_mul(&RaT, &pb->R);
-  cert.off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
+  pose_in_frame_of(pa, pb, &cert.rel, &cert.off);
   double reachA = vertex_reach(sa), reachB = vertex_reach(sb);
   cert.reach = fmax(reachB, reachA + pd_v3_norm(cert.off));
   cert.margin = 0.0;
@@ -957,9 +957,9 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
 }
 
 double pd_search_motion(const pdSearchCertificate* cert, const pdPose* pa, const pdPose* pb) {
-  pdMat3 RaT = pd_mat3_transpose(&pa->R);
-  pdMat3 rel = pd_mat3_mul(&RaT, &pb->R);
-  pdVec3 off = pd_mat3_mulv(&RaT, pd_v3_sub(pb->x, pa->x));
+  pdMat3 rel;
+  pdVec3 off;
+  pose_in_frame_of(pa, pb, &rel, &off);
   double turn2 = 0.0;  // ‖Δrel‖_F², a bound on ‖Δrel‖₂²
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) turn2 += (rel.m[r][c] - cert->rel.m[r][c]) * (rel.m[r][c] - cert->rel.m[r][c]);

@@ -243,7 +243,7 @@ struct pdContactSet {
   // a derivative at the very same numbers takes them from there (pd_contact_forces)
   double* recordedY;
   const double* recordedFrom;  // where that state was (only a derivative at those numbers there is compared)
-  int recordedN, recordedCapacity;
+  int recordedCapacity;
   bool recordedValid;          // cleared by a list installed or cleared
   int capturedCount;           // a dense output's view (dense_output.h): the captured list's length, its slots in items
   capturedGeometry* captured;  // (capacity) a view's: each captured slot's normal, point and depth, which a
@@ -425,6 +425,12 @@ static inline pdVec3 point_velocity(const pdModel* model, const double* y, const
   return velocity_at(model, y, i, pd_v3_sub(p, poses[i].x));
 }
 
+// Δu = u1 − u2 of contact id's bodies at world point p (contact_force.h).
+static inline pdVec3 relative_velocity(const pdModel* model, const double* y, const pdPose* poses,
+                                       const pdContactId* id, pdVec3 p) {
+  return pd_v3_sub(point_velocity(model, y, poses, id->body1, p), point_velocity(model, y, poses, id->body2, p));
+}
+
 // The poses of moving bodies [begin, end) at y.
 static void poses_of_range(const pdModel* model, const double* y, pdPose* poses, int begin, int end) {
   for (int k = begin; k < end; ++k) {
@@ -452,7 +458,7 @@ static void contact_motion(const pdModel* model, const contactSlot* c, const dou
     geom->point = c->point;
     geom->depth = c->depth;
   }
-  *du = pd_v3_sub(point_velocity(model, y, poses, b1, geom->point), point_velocity(model, y, poses, b2, geom->point));
+  *du = relative_velocity(model, y, poses, &c->id, geom->point);
 }
 
 // Geometry, relative velocity and force of one contact at state y (contact_motion, then the force law).
@@ -572,10 +578,11 @@ static void recorded_range(void* ctx, int part, int begin, int end) {
 }
 
 bool pd_contact_set_recorded_at(const pdModel* model, const pdContactSet* set, const double* y) {
-  // a step's stages evaluate in the stepper's scratch: only the place the recorded state was is compared
+  // a step's stages evaluate in the stepper's scratch: only the place the recorded state was is compared (the list
+  // is the recorded one while recordedValid, so is the state's length)
   if (!set->recordedValid || y != set->recordedFrom) return false;
   int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
-  return n == set->recordedN && memcmp(y, set->recordedY, (size_t)n * sizeof *y) == 0;
+  return memcmp(y, set->recordedY, (size_t)n * sizeof *y) == 0;
 }
 
 void pd_contact_set_forget_recorded(pdContactSet* set) { set->recordedValid = false; }
@@ -746,8 +753,9 @@ typedef struct modalSums {
 
 static pdMat3 cross_matrix(pdVec3 r) { return (pdMat3){{{0, -r.z, r.y}, {r.z, 0, -r.x}, {-r.y, r.x, 0}}}; }
 
-// a [r]ₓ and a [r]ₓᵀ: pd_mat3_mul with cross_matrix(r), its products with the zeros left out (the other terms added in
-// the same order, so the same numbers up to the sign of a zero sum; the stability bound takes absolute values).
+// a [r]ₓ: pd_mat3_mul with cross_matrix(r), its products with the zeros left out (the other terms added in the same
+// order, so the same numbers up to the sign of a zero sum; the stability bound takes absolute values). a [r]ₓᵀ is
+// a [−r]ₓ.
 static pdMat3 mul_cross(const pdMat3* a, pdVec3 r) {
   pdMat3 m;
   for (int i = 0; i < 3; ++i) {
@@ -755,16 +763,6 @@ static pdMat3 mul_cross(const pdMat3* a, pdVec3 r) {
     m.m[i][0] = ai[1] * r.z + ai[2] * -r.y;
     m.m[i][1] = ai[0] * -r.z + ai[2] * r.x;
     m.m[i][2] = ai[0] * r.y + ai[1] * -r.x;
-  }
-  return m;
-}
-static pdMat3 mul_cross_transposed(const pdMat3* a, pdVec3 r) {
-  pdMat3 m;
-  for (int i = 0; i < 3; ++i) {
-    const double* ai = a->m[i];
-    m.m[i][0] = ai[1] * -r.z + ai[2] * r.y;
-    m.m[i][1] = ai[0] * r.z + ai[2] * -r.x;
-    m.m[i][2] = ai[0] * -r.y + ai[1] * r.x;
   }
   return m;
 }
@@ -1040,7 +1038,7 @@ static void stability_prepare(const pdModel* model, pdContactSet* set, const pdP
       const pdBody* b = &model->bodies[ends[e]];
       if (b->fixed) continue;
       t->arm[e] = pd_v3_sub(c->point, poses[ends[e]].x);
-      t->left[e] = mul_cross_transposed(&t->k, t->arm[e]);
+      t->left[e] = mul_cross(&t->k, pd_v3_scale(t->arm[e], -1.0));
       pdMat3 wrx = mul_cross(&set->invInertiaWorld[ends[e]], t->arm[e]);
       t->right[e] = pd_mat3_mul(&wrx, &t->k);
       set->bodyRowsK[ends[e]] = pd_v3_add(set->bodyRowsK[ends[e]], row_abs_sums(&t->k));
@@ -1105,9 +1103,7 @@ static void record_range(void* ctx, int part, int begin, int end) {
     if (c->geometryCurrent) {
       // the same geometry as evaluate() would form again (a pair onset's impulses change velocities, not poses)
       c->geometryCurrent = false;
-      int b1 = c->id.body1, b2 = c->id.body2;
-      pdVec3 du = pd_v3_sub(point_velocity(job->model, job->y, job->poses1, b1, c->point),
-                            point_velocity(job->model, job->y, job->poses1, b2, c->point));
+      pdVec3 du = relative_velocity(job->model, job->y, job->poses1, &c->id, c->point);
       pd_contact_force(&c->params, &sp, c->normal, du, &c->force);
       continue;
     }
@@ -1131,7 +1127,6 @@ static void record(const pdModel* model, pdContactSet* set, const double* y, con
   }
   memcpy(set->recordedY, y, (size_t)n * sizeof *y);
   set->recordedFrom = y;
-  set->recordedN = n;
   set->recordedValid = true;
 }
 
@@ -1184,8 +1179,7 @@ static int start_late_contacts(const pdModel* model, pdContactSet* set, double* 
     double k = pd_series(p->k1n, p->k2n), damper = pd_series(p->c1n, p->c2n);
     // the approach speed and the slip at the contact point
     pdVec3 n = c->normal;
-    pdVec3 du = pd_v3_sub(point_velocity(model, y, poses, c->id.body1, c->point),
-                          point_velocity(model, y, poses, c->id.body2, c->point));
+    pdVec3 du = relative_velocity(model, y, poses, &c->id, c->point);
     double approach = -pd_v3_dot(du, n);
     pdVec3 slip = pd_v3_sub(du, pd_v3_scale(n, -approach));  // tangential relative velocity
     double slipSpeed = pd_v3_norm(slip);
@@ -1488,7 +1482,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
       if (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) == 0) continue;
       candidate c = {*g, 1.0, false, 0.0, -1};
       int b1 = g->id.body1, b2 = g->id.body2;
-      pdVec3 du = pd_v3_sub(point_velocity(model, y1, poses1, b1, g->point), point_velocity(model, y1, poses1, b2, g->point));
+      pdVec3 du = relative_velocity(model, y1, poses1, &g->id, g->point);
       c.approaching = pd_v3_dot(du, g->normal) < 0.0;
       // face continuity: the vertex of a VF contact of C0 that no longer tracks its face, now on another
       for (int k = first; k < first + previousCount && g->id.kind == pd_contactVF; ++k) {
@@ -1626,8 +1620,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
         pdContactGeom g0;
         const pdContactId* id = &c->geom.id;
         pd_contact_track(model, id, &set->poses0[id->body1], &set->poses0[id->body2], &g0);
-        pdVec3 du = pd_v3_sub(point_velocity(model, s->y, set->poses0, id->body1, g0.point),
-                              point_velocity(model, s->y, set->poses0, id->body2, g0.point));
+        pdVec3 du = relative_velocity(model, s->y, set->poses0, id, g0.point);
         if (pd_v3_dot(du, g0.normal) > 0.0) continue;  // separating: with springs at 0 it would pull
         if (count == set->capacity) reserve_list(set, count + 1);
         set->next[count++] = new_slot(model, &g0);

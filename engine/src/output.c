@@ -327,11 +327,13 @@ static void hand_over(pdRunWriter* run) {
   pthread_mutex_unlock(&run->lock);
 }
 
+// The size of a block that holds a sample of `bytes`.
+static size_t block_bytes(size_t bytes) { return bytes > PD_OUTPUT_BLOCK_BYTES ? bytes : PD_OUTPUT_BLOCK_BYTES; }
+
 // The block to fill next, with room for `bytes`: the current one, or the next once the writer has freed it.
 static outputBlock* block_with_room(pdRunWriter* run, size_t bytes) {
   if (run->ringBlocks == 0) {  // the first sample: before any block is handed over, so the writer sees it set
-    size_t block = bytes > PD_OUTPUT_BLOCK_BYTES ? bytes : PD_OUTPUT_BLOCK_BYTES;
-    size_t fit = PD_OUTPUT_RING_BYTES / block;
+    size_t fit = PD_OUTPUT_RING_BYTES / block_bytes(bytes);
     run->ringBlocks = fit < PD_OUTPUT_BLOCKS_MIN ? PD_OUTPUT_BLOCKS_MIN
                                                  : (fit > PD_OUTPUT_BLOCKS_MAX ? PD_OUTPUT_BLOCKS_MAX : (int)fit);
   }
@@ -344,7 +346,7 @@ static outputBlock* block_with_room(pdRunWriter* run, size_t bytes) {
     b = &run->blocks[run->produced % run->ringBlocks];
   }
   if (bytes > b->capacity) {  // a sample larger than any so far (the first samples only)
-    size_t capacity = bytes > PD_OUTPUT_BLOCK_BYTES ? bytes : PD_OUTPUT_BLOCK_BYTES;
+    size_t capacity = block_bytes(bytes);
     unsigned char* data = realloc(b->data, capacity);
     PD_ASSERT(data != NULL);
     b->data = data;
