@@ -73,7 +73,8 @@ void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pd
 double pd_contact_normal_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du);
 
 // The dynamics-side break (paper §4.2, DESIGN §3.3): true when the normal force would pull (fn < 0).
-static inline bool pd_contact_force_pulls(const pdContactForce* f) { return f->fn < 0.0; }
+static inline bool pd_contact_fn_pulls(double fn) { return fn < 0.0; }
+static inline bool pd_contact_force_pulls(const pdContactForce* f) { return pd_contact_fn_pulls(f->fn); }
 
 // After an accepted step (paper §3.4): rotates the tangential springs from the old tangent plane (⊥ nOld)
 // into the new one (⊥ nNew) by the smallest rotation taking nOld to nNew, keeping each spring's length

@@ -1728,9 +1728,9 @@ void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y)
     pdContactGeom g;
     pdVec3 du;
     contact_motion(model, c, y, view->poses1, &frame, &g, NULL, &du);
-    // the normal force decides (pd_contact_force_pulls) whether the springs are realigned before the whole force
+    // the normal force decides (pd_contact_fn_pulls) whether the springs are realigned before the whole force
     double fn = pd_contact_normal_force(&c->params, &sp, g.normal, du);
-    if (!(fn < 0.0)) {
+    if (!pd_contact_fn_pulls(fn)) {
       pd_springs_realign(&sp, c->normal, g.normal, c->params.mu, &c->params, fn);
       springs_store(yc, &sp);
     }

@@ -1,8 +1,8 @@
 // The force law of one contact (paper §3.1): every damper branch of the normal and tangential directions
 // against hand-derived values, the friction cone (stick/slip at the boundary, |F_t| = μ F_n in slip,
 // λ from eq. (9), slip opposing the motion), eqs. (1), (2), (4) and (7) in every branch, a 1-D impact
-// integrated with RK4 against the closed-form restitution (catalogue A1), and spring realignment (§3.4,
-// catalogue A4).
+// integrated with RK4 against the closed-form restitution (catalogue A1), spring realignment (§3.4,
+// catalogue A4), and pd_contact_normal_force giving pd_contact_force's F_n bit for bit.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -564,6 +564,32 @@ static void test_realign_survives_a_flipped_normal(void** state) {
   expect_near(pd_v3_dot(s.s1t, nNew), 0.0, REALIGN_TOL_REL * len, "s1t · n_new");
 }
 
+// F_n alone, as pd_contact_force forms it, in each normal branch (both dampers, proportional or not, none, one).
+static void test_normal_force_alone(void** s) {
+  (void)s;
+  const double dampers[5][2] = {{3.0, 5.0}, {3.0, 5.0}, {0.0, 0.0}, {0.0, 5.0}, {3.0, 0.0}};
+  for (int b = 0; b < 5; ++b)
+    for (int k = 0; k < 100; ++k) {
+      pdContactParams p = {.k1n = 2e5,
+                           .k2n = 3e5,
+                           .k1t = 1e5,
+                           .k2t = 2e5,
+                           .c1n = dampers[b][0],
+                           .c2n = dampers[b][1],
+                           .c1t = 1.0,
+                           .c2t = 2.0,
+                           .mu = 0.4,
+                           .proportionalN = b == 0};
+      pdSprings sp = {-1e-5 * (k % 7), 2e-5 * (k % 5), {1e-6 * k, 0, 0}, {0, -1e-6, 0}};
+      pdVec3 n = pd_v3_normalize(pd_v3(0.1 * (k % 3), 0.2, 1.0));
+      pdVec3 du = pd_v3(0.01 * (k % 11) - 0.05, 0.02, 0.03 * (k % 13) - 0.2);
+      pdContactForce f;
+      pd_contact_force(&p, &sp, n, du, &f);
+      double fn = pd_contact_normal_force(&p, &sp, n, du);
+      assert_memory_equal(&fn, &f.fn, sizeof fn);
+    }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_normal_both_damped_matches_eqs_5_6),
@@ -588,6 +614,7 @@ int main(void) {
       cmocka_unit_test(test_realign_with_unchanged_normal_changes_nothing),
       cmocka_unit_test(test_realign_clips_to_cone_and_clamps_tension),
       cmocka_unit_test(test_realign_survives_a_flipped_normal),
+      cmocka_unit_test(test_normal_force_alone),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

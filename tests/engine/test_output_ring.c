@@ -5,7 +5,6 @@
 // samples), and for samples larger than a block from the first sample on, so that the ring has fewer blocks, each
 // grown to a sample, and wraps round too (300 cubes resting on a floor: ~31 KiB at the first sample, ~150 KiB with
 // their contacts).
-// And pd_contact_normal_force gives the normal force pd_contact_force gives, bit for bit.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -16,7 +15,6 @@
 
 #include <cmocka.h>
 
-#include "contact_force.h"
 #include "polydyn/output.h"
 #include "scene_run.h"
 #include "test_files.h"
@@ -114,37 +112,10 @@ static void test_samples_larger_than_a_block(void** s) {
   pd_model_free(model);
 }
 
-// F_n alone, as pd_contact_force forms it, in each normal branch (both dampers, proportional or not, none, one).
-static void test_normal_force_alone(void** s) {
-  (void)s;
-  const double dampers[5][2] = {{3.0, 5.0}, {3.0, 5.0}, {0.0, 0.0}, {0.0, 5.0}, {3.0, 0.0}};
-  for (int b = 0; b < 5; ++b)
-    for (int k = 0; k < 100; ++k) {
-      pdContactParams p = {.k1n = 2e5,
-                           .k2n = 3e5,
-                           .k1t = 1e5,
-                           .k2t = 2e5,
-                           .c1n = dampers[b][0],
-                           .c2n = dampers[b][1],
-                           .c1t = 1.0,
-                           .c2t = 2.0,
-                           .mu = 0.4,
-                           .proportionalN = b == 0};
-      pdSprings sp = {-1e-5 * (k % 7), 2e-5 * (k % 5), {1e-6 * k, 0, 0}, {0, -1e-6, 0}};
-      pdVec3 n = pd_v3_normalize(pd_v3(0.1 * (k % 3), 0.2, 1.0));
-      pdVec3 du = pd_v3(0.01 * (k % 11) - 0.05, 0.02, 0.03 * (k % 13) - 0.2);
-      pdContactForce f;
-      pd_contact_force(&p, &sp, n, du, &f);
-      double fn = pd_contact_normal_force(&p, &sp, n, du);
-      assert_memory_equal(&fn, &f.fn, sizeof fn);
-    }
-}
-
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_small_samples_wrap_the_ring),
       cmocka_unit_test(test_samples_larger_than_a_block),
-      cmocka_unit_test(test_normal_force_alone),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
