@@ -32,7 +32,14 @@ class Table:
         with open(path, newline="", encoding="utf-8") as f:
             reader = csv.reader(f)
             columns = next(reader)
-            rows = [tuple(_value(v) for v in row) for row in reader]
+            rows = [[_value(v) for v in row] for row in reader]
+        # an empty field of a numeric column (a metric that does not apply) is NaN
+        for i in range(len(columns)):
+            values = [r[i] for r in rows if r[i] != ""]
+            if values and all(isinstance(v, (int, float)) for v in values):
+                for r in rows:
+                    if r[i] == "":
+                        r[i] = float("nan")
         return cls(columns, rows, **extra)
 
     def __len__(self):

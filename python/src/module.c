@@ -338,6 +338,7 @@ PyMODINIT_FUNC PyInit__polydyn(void) {
     if (PyType_Ready(types[i]) < 0) return NULL;
   PyObject* m = PyModule_Create(&moduleDef);
   if (!m) return NULL;
+  pdPyMainThread = PyThread_get_thread_ident();
   pdPySceneError = PyErr_NewExceptionWithDoc(
       "polydyn._polydyn.SceneError",
       "Bad input (a scene, a data file): str() is FILE:LINE:COL: message; attributes file, line, col, message.",

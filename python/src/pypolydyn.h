@@ -73,6 +73,7 @@ extern PyMethodDef pdPyStateFunctions[];  // run(), contact_layout()
 // next sample). pd_py_interrupt_begin installs the handler when `catch` (the caller is the main thread) and
 // clears the flag; pd_py_interrupt_end puts Python's handler back. Returns the flag's address.
 extern volatile sig_atomic_t pdPyInterrupted;
+extern unsigned long pdPyMainThread;  // the thread that imported the module (Python's main thread)
 typedef struct pdPyInterruptScope {
   bool caught;
   struct sigaction previous;

@@ -53,6 +53,7 @@ static void contact_write(pdPyContact* c, const pdState* state, int j, long samp
 // ---------------------------------------------------------------- interrupts
 
 volatile sig_atomic_t pdPyInterrupted = 0;
+unsigned long pdPyMainThread = 0;
 
 static void on_interrupt(int sig) {
   (void)sig;
@@ -287,7 +288,7 @@ static PyObject* state_advance(pdPyState* self, PyObject* args, PyObject* kwargs
   static char* names[] = {"t_end", "callback", "catch_interrupt", NULL};
   double tEnd;
   PyObject* callback = Py_None;
-  int catchInterrupt = 0;
+  int catchInterrupt = PyThread_get_thread_ident() == pdPyMainThread;
   if (!PyArg_ParseTupleAndKeywords(args, kwargs, "d|Op:advance", names, &tEnd, &callback, &catchInterrupt))
     return NULL;
   if (!state_owned(self)) return NULL;
@@ -308,7 +309,7 @@ static PyObject* state_advance(pdPyState* self, PyObject* args, PyObject* kwargs
   pdPyInterruptScope scope;
   pd_py_interrupt_begin(&scope, catchInterrupt);
   r.thread = PyEval_SaveThread();
-  bool completed = pd_advance(self->model, self->state, tEnd, r.callback ? observe : NULL, &r);
+  bool completed = pd_advance(self->model, self->state, tEnd, observe, &r);  // observe also checks the interrupt flag
   PyEval_RestoreThread(r.thread);
   pd_py_interrupt_end(&scope);
   if (r.view) {
@@ -439,8 +440,9 @@ static PyObject* state_get_moving(pdPyState* self, void* closure) {
 
 static PyMethodDef stateMethods[] = {
     {"advance", (PyCFunction)(void (*)(void))state_advance, METH_VARARGS | METH_KEYWORDS,
-     "advance(t_end, callback=None, catch_interrupt=False): pd_advance to t_end (s); callback(state) at every "
-     "output sample, returning False stops. Returns True when t reached t_end."},
+     "advance(t_end, callback=None, catch_interrupt=<in the main thread>): pd_advance to t_end (s); callback(state) "
+     "at every output sample, returning False stops; Ctrl-C stops at the next sample and raises KeyboardInterrupt. "
+     "Returns True when t reached t_end."},
     {"reset", (PyCFunction)state_reset, METH_NOARGS, "back to t = 0 (pd_state_reset; options back to defaults)"},
     {"poses", (PyCFunction)(void (*)(void))state_poses, METH_VARARGS | METH_KEYWORDS,
      "poses(out=None): every moving body's x, q, v, w as 13 float64 each (a Buffer, or written into out)"},
