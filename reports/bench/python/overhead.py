@@ -8,22 +8,14 @@
                                      as arrays), and that plus one pass over every height (the largest z); prints one
                                      CSV row of medians
 """
+import os
 import statistics
 import sys
 import time
 
 import polydyn
 
-CUBE = """\
-tend 1
-sample {sample}
-cube floor grey 2 2 0.2
-fixed
-loc 0 0 -0.1
-cube block red 0.1 0.1 0.1
-loc 0 0 0.2 10 1 0 0
-restitution 0.5
-"""
+CUBE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "cube_1s.scene")  # 1 simulated second
 
 
 def runs(n, scene, out):
@@ -33,7 +25,7 @@ def runs(n, scene, out):
 
 def read(samples, repeats):
     # tend 1 s, so the sample rate is the number of samples less one (t = k / sample for k = 0 .. sample)
-    model = polydyn.Model(polydyn.Scene.from_string(CUBE.format(sample=samples - 1)))
+    model = polydyn.Model(polydyn.Scene.from_file(CUBE), sample=samples - 1)
     raw = polydyn._polydyn.run(model, contacts=False)
     handover, reading = [], []
     for _ in range(repeats):
