@@ -101,6 +101,8 @@ class Result:
         return self._offsets
 
     def contacts_at(self, k):
+        """Sample k's contacts (k < 0 counts from the end)."""
+        k = range(len(self.t))[k]
         o = self.contact_offsets
         return self.contacts[o[k]:o[k + 1]]
 

@@ -23,6 +23,13 @@ try:
         polydyn.State(polydyn.Model(long_scene)).advance(1e5)
     elif mode == "oracle":
         polydyn.oracle(random=10**9, seed=1)
+    elif mode == "gedanken":
+        polydyn.gedanken(jobs=1)
+    elif mode == "compare":
+        path = os.path.join(os.path.dirname(out), "long.scene")
+        with open(path, "w") as f:
+            f.write(CUBE_SCENE.replace("tend 3", "tend 100000"))
+        polydyn.compare(path, engines=["soft"])
     print("not interrupted", flush=True)
 except KeyboardInterrupt:
     print("interrupted", flush=True)
@@ -54,8 +61,8 @@ def test_interrupt_run_removes_its_directory(tmp_path):
     assert stopped < 30  # stops at the next output sample (0.1 s simulated), not at tend
 
 
-def test_interrupt_with_callback_state_and_oracle(tmp_path):
-    for mode in ("callback", "state", "oracle"):
+def test_interrupt_with_callback_state_and_the_bench(tmp_path):
+    for mode in ("callback", "state", "oracle", "gedanken", "compare"):
         interrupt_child(tmp_path, mode)
 
 
