@@ -129,14 +129,14 @@ class Result:
         return frame
 
     def contacts_to_pandas(self):
+        """The contacts as a pandas DataFrame with contacts.csv's column names (px ... ftz)."""
         import pandas as pd
         c = self.contacts
         columns = {name: c[name] for name in c.dtype.names if c.dtype[name].shape == ()}
-        for name, axes in (("point", "p"), ("normal", "n"), ("ft", "ft")):
+        for name, prefix in (("point", "p"), ("normal", "n"), ("ft", "ft")):
             for i, axis in enumerate("xyz"):
-                columns[(axes if axes != "ft" else "ft") + axis] = c[name][:, i]
+                columns[prefix + axis] = c[name][:, i]
         return pd.DataFrame(columns)
-
 
 def run(scene, engine="soft", *, variant=None, tend=None, sample=None, stepper=None, threads=1, onsets=None,
         islands=None, step=None, ode_friction=None, contacts=True, callback=None, out=None):
