@@ -18,6 +18,8 @@
 #include "polydyn/error.h"
 #include "polydyn/vecmath.h"
 
+PD_EXTERN_C_BEGIN
+
 typedef struct pdEdge {
   int v[2];  // vertex indices
   int f[2];  // face indices: f[0] walks v[0]→v[1], f[1] walks v[1]→v[0]
@@ -96,3 +98,5 @@ typedef struct pdMassProperties {
 // `density` in kg/m³ (> 0). Returns false with `why` if the volume is not positive or the inertia
 // is not positive definite.
 PD_API bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties* out, char* why, int whySize);
+
+PD_EXTERN_C_END

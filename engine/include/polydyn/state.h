@@ -28,6 +28,8 @@
 #include "polydyn/model.h"
 #include "polydyn/vecmath.h"
 
+PD_EXTERN_C_BEGIN
+
 enum { PD_BODY_STATE_SIZE = 13 };
 
 // Named, timed stages of a step (seconds accumulate in pdState.stageSeconds).
@@ -255,3 +257,5 @@ PD_API bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObse
 // scratch and stage timers, so it changes what pd_state_contact reports until the next step. Exposed for
 // tests and alternative steppers.
 PD_API void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt);
+
+PD_EXTERN_C_END
