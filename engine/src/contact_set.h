@@ -79,9 +79,6 @@ double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double
 // contact list whose step the cheap bound does not settle).
 long pd_contact_set_tight_formed(const pdContactSet* set);
 
-// Grows the state's y, weight and work to hold `contacts` contacts (between steps only).
-void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contacts);
-
 // ---------------------------------------------------------------- islands (islands.c)
 // An island's state runs over a model of some of the scene's bodies (its moving bodies and every fixed body,
 // in scene order, so a contact's id orders the same in both); contacts move between the scene's state and

@@ -744,15 +744,11 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
   for (int k = 1; k < m && joined; ++k) joined = find(set->root, k) == find(set->root, 0);
   int pairCount = 0;
   if (!joined) {
-    bool updated = pd_broad_phase_update(set->broad, set->boxes);
-    PD_ASSERT(updated);  // false only when memory runs out
-    pairCount = pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
-    if (pairCount > set->pairCapacity) {
-      set->pairCapacity = 2 * pairCount;
-      set->pairs = pd_grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
+    int capacity = set->pairCapacity;
+    pairCount = pd_broad_phase_pairs_grown(set->broad, set->boxes, &set->pairs, &set->pairCapacity);
+    if (set->pairCapacity != capacity) {
       set->sat = pd_grow(set->sat, (size_t)set->pairCapacity, sizeof *set->sat);
       set->satNext = pd_grow(set->satNext, (size_t)set->pairCapacity, sizeof *set->satNext);
-      pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
     }
   }
   int cached = 0, tested = 0;
