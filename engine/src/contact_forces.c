@@ -41,9 +41,9 @@ static void poses_range(void* ctx, int part, int begin, int end) {
 }
 
 // Each moving body's contacts in contact order, as 2 i + (0 on body1, 1 on body2): bodyFirst/bodyList. Read by the
-// tight stability bound (stability_bound.c) and by the force sums (sums_range), built by stability_prepare or, for a list
-// installed without it, by the first derivative evaluation (the arrays are sized with the list: nothing is
-// allocated).
+// tight stability bound (stability_bound.c) and by the force sums (sums_range), built by pd_stability_prepare or,
+// for a list installed without it, by the first derivative evaluation (the arrays are sized with the list: nothing
+// is allocated).
 void pd_contact_set_list_bodies(const pdModel* model, pdContactSet* set) {
   int bodies = model->bodyCount;
   for (int k = 0; k <= bodies; ++k) set->bodyFirst[k] = 0;
@@ -120,7 +120,8 @@ void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y,
   // the first derivative of a step after a commit is at the state record() has just evaluated (bit for bit)
   bool recorded = pd_contact_set_recorded_at(model, set, y);
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, recorded ? recorded_range : forces_range, &job);
-  if (!set->bodyListValid) pd_contact_set_list_bodies(model, set);  // a list installed without stability_prepare (a gather)
+  // a list installed without pd_stability_prepare (a gather)
+  if (!set->bodyListValid) pd_contact_set_list_bodies(model, set);
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, sums_range, &job);
 }
 

@@ -1,5 +1,7 @@
-// polydyn — the contact list of a state: contact forces inside the derivative and the contact events
-// between steps (paper Fig. 8, §3.4, §4.2–§4.4; DESIGN §3.5).
+// polydyn — the contact list of a state: its storage, the contact events between steps and their commit (paper
+// Fig. 8, §3.4, §4.2–§4.4; docs/DESIGN.md §5.3). The work they call on is in files of its own: the forces inside the
+// derivative (contact_forces.c), the modal dampers and the stability bound (stability_bound.c), the onsets (onsets.c)
+// and the contact search (contact_search.c), all over the structures of contact_set_internal.h.
 //
 // Design note. The loop of Fig. 8 runs as: the stepper proposes a step from (t0, y0) to y1 with the
 // contact list C0 fixed; the error control accepts it; pd_contact_events then analyses y1:
@@ -9,14 +11,8 @@
 //     it is shorter than a fraction of the shortest contact period (§3.4);
 //  2. the broad phase, the interference test and the contact search give the contacts C1 at y1; a
 //     contact of C1 not in C0 that approaches (Δu_n < 0: with its springs at 0 it would push) is new.
-//     A new contact found deeper than the onset tolerance began inside the step: its onset fraction δ is
-//     interpolated (App. C) and the step retried to end there (t0 + δ·h); an onset within dt_min of the
-//     start makes it a virtual contact, added at t0 with its springs at 0 and the step restarted. With
-//     pair onsets (pd_onsetsPair, or pd_onsetsAuto in a system of more than PD_ONSETS_CROWD_BODIES moving bodies:
-//     README, "Contact onsets") a contact whose onset lies less than
-//     PD_ONSET_PAIR_OMEGA_TAU / ω before the step's end (ω its undamped angular frequency) does not cut the step: the
-//     interpolation is applied to the pair alone at commit (start_late_contacts), so one onset does not send every body
-//     back.
+//     A new contact found deeper than the onset tolerance began inside the step: the step is retried to end at
+//     its onset, or it joins as a virtual contact at t0, or as a pair onset at the step's end (onsets.c).
 //  3. on acceptance, contacts of C0 whose feature left the other (vertex projected outside its face, EE
 //     closest points off an edge) break geometrically — unless a sliding vertex moved on to another face
 //     of the same body, which keeps its springs (face continuity, §4.4.3); contacts whose normal springs
@@ -25,13 +21,6 @@
 //     re-sorted by id and the springs re-laid in the state vector. record() then forms every contact's
 //     geometry (a tracked contact's is tracking's, at the same poses) and force at the new state; the next
 //     step's first derivative, at that very state, takes them from there (pd_contact_set_recorded_at).
-// Contacts start at zero spring deflection where they are added, so a late start shifts a contact's rest
-// point by the depth it was found at but injects no energy; the onset tolerance bounds that shift. A pair
-// onset instead starts where its pair alone would be after the τ since the onset (start_late_contacts):
-// springs at that deflection x and the two bodies given the impulse of those τ seconds (normal, and the
-// friction cone's when they slide), so its energy and phase are its own and its rest point sits d − x ≈
-// d (ωτ)²/6 deeper (d the depth reached without it).
-// A slip at the rounding of Δu (PD_ONSET_PAIR_SLIP_REL) counts as none: its direction is noise, and friction
 #include "contact_set.h"
 
 #include <math.h>
@@ -273,10 +262,10 @@ static void world_inverse_inertias(const pdModel* model, pdContactSet* set, cons
 // number of pair onsets started.
 static int prepare_list(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
   world_inverse_inertias(model, set, poses);
-  pd_contact_set_modal_dampers(model, set, poses);
+  pd_modal_dampers(model, set, poses);
   int started = pd_onsets_start_late(model, set, y, poses);
   record(model, set, y, poses);
-  pd_contact_set_stability_prepare(model, set, poses);
+  pd_stability_prepare(model, set, poses);
   return started;
 }
 
@@ -531,7 +520,7 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
   // what prepare_list derives from the bodies' poses; the slots (modal dampers, forces) come as they were
   poses_from(sub, to->y, set->poses1);
   world_inverse_inertias(sub, set, set->poses1);
-  pd_contact_set_stability_prepare(sub, set, set->poses1);
+  pd_stability_prepare(sub, set, set->poses1);
 }
 
 void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const pdModel* const* subs,

@@ -70,8 +70,8 @@ void pd_contact_events_commit(const pdModel* model, pdState* state, const double
 
 // min(h, fraction × the largest step the adaptive stepper may take with the committed contact list), that
 // step satisfying (step/2) ω_max ≤ 2.5 for the fastest contact mode, ω_max bounded by the smaller of two
-// Gershgorin bounds (contact_set.c, stability_prepare; INFINITY without contacts): fraction 1 for step doubling
-// (its half steps are the ones kept), ½ for a single RK4 step. The tight bound is formed only when the cheap one
+// Gershgorin bounds (stability_bound.c; INFINITY without contacts): fraction 1 for step doubling (its half steps
+// are the ones kept), ½ for a single RK4 step. The tight bound is formed only when the cheap one
 // does not let h through; *tightNeeded says whether it was needed.
 double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction, bool* tightNeeded);
 

@@ -19,7 +19,7 @@
 
 typedef struct contactSlot {
   pdContactId id;
-  pdContactParams params;  // modal dampers set per contact when its pair's contacts change (set_modal_dampers)
+  pdContactParams params;  // modal dampers set per contact when its pair's contacts change (pd_modal_dampers)
   double deltaMax;   // m: the springs' error weight, the smaller δ_max of the two bodies
   // at the last accepted state (for realignment, refinement and output)
   pdVec3 normal, point;
@@ -28,10 +28,10 @@ typedef struct contactSlot {
                          // commit for a tracked contact: tracking formed it at those poses; record() clears it)
   pdContactForce force;
   pdSprings springs;  // used only while the list is rebuilt
-  double onsetAge;    // s: a pair onset's time since the interpolated onset, until start_late_contacts (else 0)
-  pdVec3 onsetImpulse;  // N·s, on body 1: start_late_contacts' scratch
-  double modalMass;     // kg: the mass per contact of its pair's joint motion along n (set_modal_dampers; 0: none)
-  int modalCount;       // contacts its pair had when set_modal_dampers last set its dampers (0: not yet)
+  double onsetAge;    // s: a pair onset's time since the interpolated onset, until pd_onsets_start_late (else 0)
+  pdVec3 onsetImpulse;  // N·s, on body 1: pd_onsets_start_late' scratch
+  double modalMass;     // kg: the mass per contact of its pair's joint motion along n (pd_modal_dampers; 0: none)
+  int modalCount;       // contacts its pair had when pd_modal_dampers last set its dampers (0: not yet)
 } contactSlot;
 
 // A pair's search certificate (contact_analysis.h, "search certificates") and when to issue its next, kept beside
@@ -133,18 +133,18 @@ struct pdContactSet {
   pdVec3 *force, *torque;  // (movingCount) contact force and moment on each moving body, world
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
   int onsetRetries;        // onset retries of the step under way
-  // stability bound (stability_prepare, stability_tight), sized with the list
+  // stability bound (pd_stability_prepare, stability_tight), sized with the list
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])
   int* bodyList;           // (2 capacity)
-  bool bodyListValid;      // bodyFirst/bodyList list the current contacts (stability_prepare; install clears it)
+  bool bodyListValid;      // bodyFirst/bodyList list the current contacts (pd_stability_prepare; install clears it)
   double stableStep;       // s: the largest stable step for the current list, once stableKnown (INFINITY: no contacts)
-  double stableCheap;      // s: the step of the cheap bound alone, never above stableStep (stability_prepare)
+  double stableCheap;      // s: the step of the cheap bound alone, never above stableStep (pd_stability_prepare)
   double cheapOmega2;      // the cheap bound's ω_max², its rounding margin included
   bool stableKnown;        // stableStep computed for the current list (it is computed only when needed)
   long tightFormed;        // tight bounds formed for a step's limit (pd_contact_set_tight_formed)
   bodySpaceBlock* bodyBlocks;  // (bodyCount) stability_tight's
-  const pdPose* stablePoses;   // the poses of the list's stability_prepare (unchanged until the step's limit)
+  const pdPose* stablePoses;   // the poses of the list's pd_stability_prepare (unchanged until the step's limit)
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
@@ -267,8 +267,8 @@ void pd_contact_set_list_bodies(const pdModel* model, pdContactSet* set);
 
 // stability_bound.c: the modal dampers of every pair whose contacts changed (poses: the list's, world inverse
 // inertias set), and the stability bound's terms and cheap bound for a new list.
-void pd_contact_set_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses);
-void pd_contact_set_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses);
+void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses);
+void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses);
 
 // contact_search.c: the contact search's arrays (broad phase, pairs, caches, certificates, candidates) of a set
 // with contact events, and their release.

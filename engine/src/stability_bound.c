@@ -17,13 +17,13 @@
 #include "material.h"
 
 // Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can
-// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (stability_prepare). Classic
+// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (pd_stability_prepare). Classic
 // RK4 is stable to |hλ| ≈ 2.8 along both the negative real and the imaginary axis; 2.5 leaves a margin
 // for what the bound does not see (contacts coupled through a fixed body's neighbours count none). Without
 // the bound the error control walks the step up to the stability edge, where round-off grows until a
 // step is rejected: a block at rest then jitters at the tolerance (µm/s) instead of round-off.
 #define PD_STABLE_STEP_OMEGA 2.5
-// Relative margin on the stability bounds (stability_prepare, stability_tight) against the rounding of their
+// Relative margin on the stability bounds (pd_stability_prepare, stability_tight) against the rounding of their
 // sums (~1e-15 relative): where a Gershgorin bound is exact (a single contact), rounding must not take it below
 // ω_max².
 #define PD_STABLE_MARGIN 1e-9
@@ -73,7 +73,7 @@ static void add_body_terms(const pdBody* b, const pdMat3* invWorld, const modalS
 // from the pose after every step: a damper that followed the pose step by step was a staircase in time, whose
 // steps made impacts converge only as ~tol^0.24 (the exit velocity of cases/sweep/eccentric_impact.scene's first
 // impact 1.1e-5 m/s from tol 1e-12's at tol 1e-8); held, the force is smooth between contact events (1.4e-7).
-void pd_contact_set_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses) {
   for (int first = 0, last; first < set->count; first = last) {
     contactSlot* c0 = &set->items[first];
     int a = c0->id.body1 < c0->id.body2 ? c0->id.body1 : c0->id.body2;
@@ -141,7 +141,7 @@ static double step_of(double omega2, double overdamp) {
 }
 
 // The stability bound in two parts, both Gershgorin bounds on ω_max² (never below it; README, Integration).
-// stability_prepare (after every new list, O(contacts)) forms each contact's terms and a cheap bound of the
+// pd_stability_prepare (after every new list, O(contacts)) forms each contact's terms and a cheap bound of the
 // contact-space matrix M above: by |Σ_j (A B_j)_rq| ≤ Σ_p |A_rp| |(B_j)_pq|, row r of contact i's Gershgorin sum
 // is at most Σ over its moving ends B of Σ_p |(K_i^½)_rp| w_p / m_B + Σ_p |(K_i^½ [r_i]ₓᵀ)_rp| u_p, where w_p
 // and u_p are the row-p absolute sums of K_j^½ and of W_B [r_j]ₓ K_j^½ summed over B's contacts j. Only when the
@@ -297,7 +297,7 @@ static void stability_self_check(const pdModel* model, pdContactSet* set) {
 }
 #endif
 
-void pd_contact_set_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses) {
   set->stableKnown = false;
   if (set->count == 0) {
     set->stableStep = set->stableCheap = INFINITY;
