@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
     pd_error_print(&err, stderr);
     return 2;
   }
-  pdState* state = pd_state_create(model);
+  pdState* state = pd_state_create(model, NULL);
   if (seconds < 0) seconds = model->settings.tend;
   bool completed = pd_advance(model, state, seconds, print_sample, stdout);
   // a run that could not go on says why in its warning counters (state.h)

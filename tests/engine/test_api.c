@@ -1,5 +1,5 @@
-// The public API's promises about itself (polydyn/api.h, polydyn/error.h): the version query reports the build's
-// CMake project version, and misuse of the API goes through the assert handler the embedding program installed (a
+// The public API's promises about itself (polydyn/api.h, error.h, state.h): the version query reports the build's
+// CMake project version, a state keeps the options it was created with, and misuse of the API goes through the assert handler the embedding program installed (a
 // program may turn it into its own report or, as here, into a test's longjmp), while the default handler prints
 // FILE:LINE and aborts.
 #include <setjmp.h>
@@ -53,7 +53,7 @@ static void catch_assert(const char* expression, const char* file, int line) {
 static void test_misuse_calls_the_installed_handler(void** unused) {
   (void)unused;
   pdModel* model = compile_text(oneCube);
-  pdState* s = pd_state_create(model);
+  pdState* s = pd_state_create(model, NULL);
   memset(&caught, 0, sizeof caught);
   pd_set_assert_fcn(catch_assert);
   if (setjmp(caught.back) == 0) {
@@ -71,6 +71,54 @@ static void test_misuse_calls_the_installed_handler(void** unused) {
   assert_true(b.x.z > 0.1);
   assert_int_equal(caught.calls, 1);
   pd_state_free(s);
+  pd_model_free(model);
+}
+
+// pd_state_create takes the caller's settings from pdStateOptions (NULL: the defaults) and pd_state_reset returns
+// to them; options not made by pd_state_options_default (here: zeroed) are misuse.
+static void test_a_state_keeps_its_options_across_reset(void** unused) {
+  (void)unused;
+  pdModel* model = compile_text(oneCube);
+  pdStateOptions d = pd_state_options_default();
+  assert_int_equal(d.stepper, PD_STEPPER_DEFAULT);
+  assert_int_equal(d.onsets, PD_ONSETS_DEFAULT);
+  assert_int_equal(d.islands, PD_ISLANDS_DEFAULT);
+  assert_int_equal(d.threads, 1);
+  assert_true(d.searchCertificates);
+  pdState* plain = pd_state_create(model, NULL);
+  assert_int_equal(plain->stepper, PD_STEPPER_DEFAULT);
+  assert_true(plain->h == model->settings.dt);  // h = 0: the scene's dt
+  pd_state_free(plain);
+
+  pdStateOptions o = pd_state_options_default();
+  o.stepper = pd_stepperRK43Embedded;
+  o.onsets = pd_onsetsPair;
+  o.islands = pd_islandsOff;
+  o.threads = 3;
+  o.searchCertificates = false;
+  o.h = 1e-5;
+  pdState* s = pd_state_create(model, &o);
+  assert_true(pd_advance(model, s, 0.05, NULL, NULL));
+  pd_state_reset(model, s);
+  assert_true(s->t == 0.0 && s->h == 1e-5);
+  assert_int_equal(s->stepper, pd_stepperRK43Embedded);
+  assert_int_equal(s->onsets, pd_onsetsPair);
+  assert_int_equal(s->islands, pd_islandsOff);
+  assert_int_equal(s->threads, 3);
+  assert_false(s->searchCertificates);
+  pd_state_free(s);
+
+  pdStateOptions zeroed;
+  memset(&zeroed, 0, sizeof zeroed);
+  memset(&caught, 0, sizeof caught);
+  pd_set_assert_fcn(catch_assert);
+  if (setjmp(caught.back) == 0) {
+    pd_state_free(pd_state_create(model, &zeroed));
+    fail_msg("pd_state_create accepted options not made by pd_state_options_default");
+  }
+  pd_set_assert_fcn(NULL);
+  assert_int_equal(caught.calls, 1);
+  assert_non_null(strstr(caught.expression, "valid"));
   pd_model_free(model);
 }
 
@@ -92,7 +140,7 @@ static int misuse_in_child(pdAssertFcn* handler, char* errText, size_t errSize) 
     dup2(pipeFd[1], STDERR_FILENO);
     close(pipeFd[0]);
     pdModel* model = compile_text(oneCube);
-    pdState* s = pd_state_create(model);
+    pdState* s = pd_state_create(model, NULL);
     pd_set_assert_fcn(handler);
     pd_state_body(model, s, -1);
     _exit(0);  // not reached: the handler aborts, or pd_assert_failed does when it returns
@@ -132,6 +180,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_the_version_is_the_projects),
       cmocka_unit_test(test_misuse_calls_the_installed_handler),
+      cmocka_unit_test(test_a_state_keeps_its_options_across_reset),
       cmocka_unit_test(test_the_default_handler_prints_file_and_line_and_aborts),
       cmocka_unit_test(test_a_handler_that_returns_still_aborts),
   };

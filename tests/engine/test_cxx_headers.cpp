@@ -33,7 +33,7 @@ static void test_a_cxx_program_links_and_steps_a_scene(void** unused) {
   assert_non_null(scene);
   pdModel* model = pd_model_compile(scene, &err);
   assert_non_null(model);
-  pdState* state = pd_state_create(model);
+  pdState* state = pd_state_create(model, NULL);
   assert_true(pd_advance(model, state, 0.1, nullptr, nullptr));
   // 0.1 s of free fall from rest, 0.2 m up: z = 0.2 m + g t² / 2 (g < 0); 1 µm is far above the stepper's error
   pdBodyState b = pd_state_body(model, state, 1);

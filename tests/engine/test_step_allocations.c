@@ -52,9 +52,10 @@ static const char smallPile[] =
 static void expect_no_allocation_after_warm_up(const char* label, const char* text, pdStepper stepper,
                                                pdIslands islands, double warmUp, double tEnd) {
   pdModel* model = compile_text(text);
-  pdState* s = pd_state_create(model);
-  s->stepper = stepper;
-  s->islands = islands;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  options.islands = islands;
+  pdState* s = pd_state_create(model, &options);
   long before = pd_alloc_count();
   assert_true(pd_advance(model, s, warmUp, NULL, NULL));
   long warmed = pd_alloc_count();
