@@ -102,16 +102,22 @@ void pd_state_free(pdState* s) {
 void pd_state_reserve_contacts(const pdModel* model, pdState* s, int contacts) {
   pd_contact_set_reserve_list(s->contacts, contacts);
   int needed = spring_base(model) + PD_CONTACT_STATE_SIZE * contacts;
-  if (needed <= s->capacity) return;
-  int c = s->capacity > 0 ? s->capacity : 1;
-  while (c < needed) c *= 2;
-  s->y = pd_grow(s->y, c, sizeof *s->y);
-  s->weight = pd_grow(s->weight, c, sizeof *s->weight);
-  // the stepper's vectors hold no data between steps: reallocate rather than copy
-  free(s->work);
-  s->work = calloc((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
-  PD_ASSERT(s->work != NULL);
-  s->capacity = c;
+  if (needed > s->capacity) {
+    int c = s->capacity > 0 ? s->capacity : 1;
+    while (c < needed) c *= 2;
+    s->y = pd_grow(s->y, c, sizeof *s->y);
+    s->weight = pd_grow(s->weight, c, sizeof *s->weight);
+    // the stepper's vectors hold no data between steps: reallocate rather than copy
+    free(s->work);
+    s->work = calloc((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
+    PD_ASSERT(s->work != NULL);
+    s->capacity = c;
+  }
+  if (s->implicit) pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
+}
+
+int pd_state_contact_room(const pdModel* model, const pdState* s) {
+  return (s->capacity - spring_base(model)) / PD_CONTACT_STATE_SIZE;
 }
 
 int pd_state_contact_count(const pdState* s) { return s->contacts ? s->contacts->count : 0; }

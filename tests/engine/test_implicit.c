@@ -94,6 +94,7 @@ static void test_w_matches_finite_differences_of_the_derivative(void** state) {
          *jx = calloc((size_t)n, sizeof *jx);
   direction(m, s, x);
   pdImplicit* im = pd_implicit_create();
+  pd_implicit_reserve(im, m->movingCount, pd_state_contact_count(s));  // as the stepper does between steps
   pd_implicit_linearise(m, s, im, s->y);
   assert_true(pd_implicit_factor(m, s, im, 1e-3));
   pd_implicit_apply_w(m, s, im, x, w);
@@ -126,6 +127,7 @@ static void test_the_solve_inverts_m(void** state) {
   int n = s->n;
   double *r = calloc((size_t)n, sizeof *r), *u = calloc((size_t)n, sizeof *u), *wu = calloc((size_t)n, sizeof *wu);
   pdImplicit* im = pd_implicit_create();
+  pd_implicit_reserve(im, m->movingCount, pd_state_contact_count(s));  // as the stepper does between steps
   pd_implicit_linearise(m, s, im, s->y);
   for (double hg = 1e-5; hg <= 1.01e-2; hg *= 10.0) {  // hg = γh, h up to dtmax (10 ms) and beyond
     assert_true(pd_implicit_factor(m, s, im, hg));
