@@ -39,10 +39,17 @@
 #ifdef __cplusplus
 #define PD_EXTERN_C_BEGIN extern "C" {
 #define PD_EXTERN_C_END }
-#define PD_NORETURN [[noreturn]]
 #else
 #define PD_EXTERN_C_BEGIN
 #define PD_EXTERN_C_END
+#endif
+
+// A function that does not return (C11 _Noreturn, C++ [[noreturn]]; the GNU attribute goes after PD_API in both).
+#if defined(__GNUC__)
+#define PD_NORETURN __attribute__((noreturn))
+#elif defined(__cplusplus)
+#define PD_NORETURN [[noreturn]]
+#else
 #define PD_NORETURN _Noreturn
 #endif
 

@@ -41,7 +41,7 @@ typedef void pdAssertFcn(const char* expression, const char* file, int line);
 PD_API void pd_set_assert_fcn(pdAssertFcn* fcn);
 
 // Calls the installed handler, then aborts should it return (PD_ASSERT's failure path).
-PD_NORETURN PD_API void pd_assert_failed(const char* expression, const char* file, int line);
+PD_API PD_NORETURN void pd_assert_failed(const char* expression, const char* file, int line);
 
 #define PD_ASSERT(cond)                                \
   do {                                                 \
