@@ -67,6 +67,15 @@
 //   half there. A batch of one island wakes the workers only from PD_ISLAND_HELP_WEIGHT on. Each index is
 //   computed alike on either thread and combined in index order by the island's own, so this too leaves every
 //   result the same bit for bit.
+// - Sleeping (settings.sleep; sleep.h, docs/sleeping.md): at the end of an interval an island whose bodies all touch
+//   something and stayed below the speed and acceleration thresholds for its settle time falls asleep: it is kept
+//   with its state as it is and never advanced, so the gather hands the scene the same frozen numbers at every
+//   sample. Its bodies take part in every partition with their boxes where they lie (not swept, bound 0) and stay
+//   one island (join_sleepers); a sleeping island that the partition joins with a moving body or another sleeping
+//   island wakes (wake_reached) and the partition is formed again, as for a free body activated; so does one whose
+//   applied force changed (wake_pushed). A woken island is freed and its bodies set up anew from the scene's
+//   numbers, which are the frozen ones. Every decision is taken on the calling thread from numbers no thread count
+//   changes.
 //
 // Memory: islands are set up, grown and freed only at sync times; a step allocates nothing. The pool's
 // threads are created with the set (or when pdState.threads changes) and joined when it is freed.
