@@ -977,6 +977,17 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
   for (int j = 0; j < set->islandCount; ++j) {
     island* is = set->islands[j];
     if (is->asleep || set->free[is->bodies[0]]) continue;  // a free body touches nothing: never at rest
+    // the cheap test first: one body above the speed threshold keeps the island awake, and the quiet time of every
+    // body in it starts again (an island comes to rest as a whole)
+    bool slow = true;
+    for (int m = 0; m < is->bodyCount && slow; ++m) {
+      int k = is->bodies[m];
+      slow = pd_sleep_slow(sleep, &model->bodies[model->movingBodies[k]], k, s->y + PD_BODY_STATE_SIZE * k);
+    }
+    if (!slow) {
+      for (int m = 0; m < is->bodyCount; ++m) sleep->quietSince[is->bodies[m]] = NAN;
+      continue;
+    }
     double settle = pd_sleep_settle_time(&is->model, is->state);
     for (int m = 0; m < is->bodyCount; ++m) sleep->inContact[is->bodies[m]] = false;
     for (int c = 0; c < pd_state_contact_count(is->state); ++c) {

@@ -70,13 +70,16 @@ double pd_sleep_settle_time(const pdModel* sub, const pdState* state) {
   return period > 0.0 ? PD_SLEEP_SETTLE_PERIODS * period : INFINITY;
 }
 
+bool pd_sleep_slow(const pdSleepSet* set, const pdBody* body, int k, const double* yb) {
+  return fmax(set->speedPeak[k], pd_sleep_speed(body, yb)) < set->speedMax;
+}
+
 bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb, double t0, double t1,
                     double settle) {
   double dt = t1 - t0;
   pdVec3 dv = pd_v3_sub(pd_layout_v(yb), set->v0[k]), dw = pd_v3_sub(pd_layout_w(yb), set->w0[k]);
   double accel = dt > 0.0 ? (pd_v3_norm(dv) + pd_v3_norm(dw) * body->radius) / dt : 0.0;
-  double speed = fmax(set->speedPeak[k], pd_sleep_speed(body, yb));
-  bool quiet = isfinite(settle) && speed < set->speedMax && accel * settle < set->speedMax;
+  bool quiet = isfinite(settle) && pd_sleep_slow(set, body, k, yb) && accel * settle < set->speedMax;
   if (!quiet)
     set->quietSince[k] = NAN;
   else if (isnan(set->quietSince[k]))

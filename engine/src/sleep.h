@@ -65,6 +65,10 @@ static inline void pd_sleep_step_end(pdSleepSet* set, const pdBody* body, int k,
 // pair's reduced mass and k the softer of the series normal and tangential springs). INFINITY without a contact.
 double pd_sleep_settle_time(const pdModel* sub, const pdState* state);
 
+// Whether body k, with its numbers yb at the end of the interval, stayed below the speed threshold over it (the cheap
+// half of pd_sleep_quiet).
+bool pd_sleep_slow(const pdSleepSet* set, const pdBody* body, int k, const double* yb);
+
 // At the end of the interval [t0, t1] with body k's numbers yb there: whether the body was quiet over it (speed
 // peak and mean acceleration below the thresholds for the settle time `settle`), and quietSince updated
 // (set to t0 when the body turns quiet, NAN when it is not).
