@@ -77,13 +77,33 @@ static trace* run_trace(const char* text, int threads, pdModel** modelOut) {
   return r;
 }
 
-// The scene text with a `sleep` setting line first.
-static char* with_sleep(const char* text, bool on) {
+// The same scene run with `sleep on` and with `sleep off` (a setting line put first), on one thread.
+typedef struct pair {
+  pdModel* model;  // the sleeping run's (the same bodies and settings as the other's)
+  trace *slept, *awake;
+} pair;
+
+static trace* run_with_sleep(const char* text, bool on, pdModel** modelOut) {
   size_t n = strlen(text) + 16;
-  char* out = malloc(n);
-  assert_non_null(out);
-  snprintf(out, n, "sleep %s\n%s", on ? "on" : "off", text);
-  return out;
+  char* scene = malloc(n);
+  assert_non_null(scene);
+  snprintf(scene, n, "sleep %s\n%s", on ? "on" : "off", text);
+  trace* r = run_trace(scene, 1, modelOut);
+  free(scene);
+  return r;
+}
+
+static pair run_pair(const char* text) {
+  pair p = {NULL, NULL, NULL};
+  p.slept = run_with_sleep(text, true, &p.model);
+  p.awake = run_with_sleep(text, false, NULL);
+  return p;
+}
+
+static void free_pair(pair* p) {
+  free(p->slept);
+  free(p->awake);
+  pd_model_free(p->model);
 }
 
 // Every body at every sample of a and b within the tolerances (positions of each body's size, velocities of vmax).
@@ -119,9 +139,9 @@ static const char* const restingBox =
 
 static void box_at_rest_sleeps_frozen(void** unused) {
   (void)unused;
-  char *on = with_sleep(restingBox, true), *off = with_sleep(restingBox, false);
-  pdModel* model = NULL;
-  trace *slept = run_trace(on, 1, &model), *awake = run_trace(off, 1, NULL);
+  pair p = run_pair(restingBox);
+  const pdModel* model = p.model;
+  const trace *slept = p.slept, *awake = p.awake;
   int first = -1;
   for (int k = 0; k < slept->count && first < 0; ++k)
     if (slept->counts[k].islandsSlept > 0) first = k;
@@ -143,11 +163,7 @@ static void box_at_rest_sleeps_frozen(void** unused) {
   assert_true(awake->counts[awake->count - 1].bodySecondsAsleep == 0.0);
   assert_int_equal(awake->counts[awake->count - 1].islandsSlept, 0);
   assert_close(model, slept, awake, REST_TOL_REL, REST_TOL_REL);
-  free(slept);
-  free(awake);
-  free(on);
-  free(off);
-  pd_model_free(model);
+  free_pair(&p);
 }
 
 // ---------------------------------------------------------------- a sleeping pile woken by a falling box
@@ -162,9 +178,9 @@ static const char* const wokenPile =
 
 static void woken_pile_matches_never_slept(void** unused) {
   (void)unused;
-  char *on = with_sleep(wokenPile, true), *off = with_sleep(wokenPile, false);
-  pdModel* model = NULL;
-  trace *slept = run_trace(on, 1, &model), *awake = run_trace(off, 1, NULL);
+  pair p = run_pair(wokenPile);
+  const pdModel* model = p.model;
+  const trace *slept = p.slept, *awake = p.awake;
   // the pile slept before the box came near, and woke
   int impact = -1;  // the first sample at which the stack's top box moves faster than it rests
   for (int k = 1; k < awake->count && impact < 0; ++k)
@@ -175,11 +191,7 @@ static void woken_pile_matches_never_slept(void** unused) {
   assert_true(end->islandsSlept >= 2);
   assert_true(end->islandsWoken >= 1);
   assert_close(model, slept, awake, WOKEN_POS_TOL_REL, WOKEN_VEL_TOL_REL);
-  free(slept);
-  free(awake);
-  free(on);
-  free(off);
-  pd_model_free(model);
+  free_pair(&p);
 }
 
 static void woken_pile_same_on_threads(void** unused) {
@@ -245,9 +257,9 @@ static const char* const rampBox =
 
 static void force_change_wakes(void** unused) {
   (void)unused;
-  char *on = with_sleep(rampBox, true), *off = with_sleep(rampBox, false);
-  pdModel* model = NULL;
-  trace *slept = run_trace(on, 1, &model), *awake = run_trace(off, 1, NULL);
+  pair p = run_pair(rampBox);
+  const pdModel* model = p.model;
+  const trace *slept = p.slept, *awake = p.awake;
   const pdCounters* end = &slept->counts[slept->count - 1];
   print_message("slept %ld, woken %ld, %.3g body-seconds asleep\n", end->islandsSlept, end->islandsWoken,
                 end->bodySecondsAsleep);
@@ -257,11 +269,7 @@ static void force_change_wakes(void** unused) {
   // it slides at the end, as the run that never slept
   assert_true(slept->body[slept->count - 1][0].v.x > 1e-3);
   assert_close(model, slept, awake, WOKEN_POS_TOL_REL, WOKEN_VEL_TOL_REL);
-  free(slept);
-  free(awake);
-  free(on);
-  free(off);
-  pd_model_free(model);
+  free_pair(&p);
 }
 
 int main(void) {
