@@ -6,7 +6,7 @@
 // Scenes: a box settling on a floor (resting contact: four vertex–face contacts, the implicit stepper's matrices in
 // use) and a small pile (boxes on the floor and on each other, islands), each under the default stepper and islands
 // and under step doubling with islands off. Each is advanced past its settling (warm-up), then on; over the second
-// stretch the count must not move.
+// stretch the count must not move. Sleep is off: a resting island that sleeps takes no steps at all.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -21,6 +21,7 @@
 static const char boxOnFloor[] =
     "tend 3\n"
     "sample 100\n"
+    "sleep off\n"
     "cube floor grey 2 2 0.2\n"
     "fixed\n"
     "loc 0 0 -0.1\n"
@@ -32,6 +33,7 @@ static const char boxOnFloor[] =
 static const char smallPile[] =
     "tend 3\n"
     "sample 100\n"
+    "sleep off\n"
     "cube floor grey 2 2 0.2\n"
     "fixed\n"
     "loc 0 0 -0.1\n"
