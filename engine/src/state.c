@@ -86,8 +86,7 @@ void pd_state_reserve_contacts(const pdModel* model, pdState* s, int contacts) {
   s->weight = pd_grow(s->weight, c, sizeof *s->weight);
   // the stepper's vectors hold no data between steps: reallocate rather than copy
   free(s->work);
-  s->work = calloc((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
-  PD_ASSERT(s->work != NULL);
+  s->work = pd_zeroed((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
   s->capacity = c;
 }
 
