@@ -1,6 +1,7 @@
 // polydyn (internal) — the engine's allocation helpers: growing an array (pd_grow) and a zeroed one (pd_zeroed), each
 // of at least one element (an allocation of 0 bytes may return NULL), and memory that is not there is fatal
-// (PD_ASSERT). The broad phase's grid alone reports running out (broad_grid.h) instead.
+// (PD_ASSERT). The broad phase alone reports running out instead (broad_phase.h, broad_grid.h): its pair set is
+// rebuilt by the next update.
 #pragma once
 
 #include <stdlib.h>
