@@ -64,8 +64,7 @@ void pd_contact_set_reserve_list(pdContactSet* set, int capacity) {
 // A set with its per-body arrays; with `search`, also the contact search's (broad phase, pairs, caches, candidates)
 // and room for the list a state starts with.
 static pdContactSet* create(const pdModel* model, bool search) {
-  pdContactSet* set = calloc(1, sizeof *set);
-  PD_ASSERT(set != NULL);
+  pdContactSet* set = pd_zeroed(1, sizeof *set);
   int n = model->bodyCount;
   set->bodyCount = n;
   set->force = pd_grow(NULL, model->movingCount, sizeof *set->force);

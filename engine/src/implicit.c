@@ -51,8 +51,7 @@ struct pdImplicit {
 };
 
 pdImplicit* pd_implicit_create(void) {
-  pdImplicit* im = calloc(1, sizeof *im);
-  PD_ASSERT(im != NULL);
+  pdImplicit* im = pd_zeroed(1, sizeof *im);
   im->retryAt = -INFINITY;
   return im;
 }

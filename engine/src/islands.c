@@ -208,8 +208,7 @@ static void island_free(island* is) {
 
 // The model of members[0 .. count) (moving-body indices, ascending) and every fixed body, scene order.
 static island* island_create(const pdModel* model, struct pdIslandSet* set, const int* members, int count) {
-  island* is = calloc(1, sizeof *is);
-  PD_ASSERT(is != NULL);
+  island* is = pd_zeroed(1, sizeof *is);
   is->bodyCount = count;
   is->bodies = pd_grow(NULL, (size_t)count, sizeof *is->bodies);
   memcpy(is->bodies, members, (size_t)count * sizeof *members);
@@ -447,8 +446,7 @@ void pd_island_set_free(struct pdIslandSet* set) {
 }
 
 static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
-  struct pdIslandSet* set = calloc(1, sizeof *set);
-  PD_ASSERT(set != NULL);
+  struct pdIslandSet* set = pd_zeroed(1, sizeof *set);
   int m = model->movingCount, n = model->bodyCount;
   set->movingCount = m;
   set->bodyCount = n;

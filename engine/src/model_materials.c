@@ -218,8 +218,7 @@ bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
       return false;
     }
   }
-  struct pdMaterialTable* t = calloc(1, sizeof *t);
-  PD_ASSERT(t != NULL);
+  struct pdMaterialTable* t = pd_zeroed(1, sizeof *t);
   m->materials = t;
   t->bodyCount = n;
   t->settings = (pdMaterialSettings){.vmax = m->settings.vmax, .deflection = m->settings.deflection,
@@ -259,8 +258,7 @@ bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
 // ---------------------------------------------------------------- views
 
 struct pdMaterialTable* pd_material_table_view(const struct pdMaterialTable* t, const int* bodies, int count) {
-  struct pdMaterialTable* v = calloc(1, sizeof *v);
-  PD_ASSERT(v != NULL);
+  struct pdMaterialTable* v = pd_zeroed(1, sizeof *v);
   *v = *t;  // classes, pair constants and adjustments shared: bodies keep their class
   v->view = true;
   v->bodyCount = count;

@@ -16,8 +16,7 @@ const char* const pdStageNames[pd_stageCount] = {"broad_phase", "interference", 
 const char* const pdWarningNames[pd_warnCount] = {"step_at_minimum", "non_finite_step", "late_onset"};
 
 pdState* pd_state_create(const pdModel* model) {
-  pdState* s = calloc(1, sizeof *s);
-  PD_ASSERT(s != NULL);
+  pdState* s = pd_zeroed(1, sizeof *s);
   s->contacts = pd_contact_set_create(model);
   pd_state_reserve_contacts(model, s, 4 * model->movingCount + 16);
   pd_state_reset(model, s);
