@@ -44,7 +44,7 @@
 #define PD_ONSET_PAIR_DEPTH_REL 0.25
 // A pair onset's slip below this fraction of |Δu| at its point is none: removing the normal part leaves ~1e-16
 // |Δu| of rounding whose direction is noise, and friction along it broke a flush stack's symmetry (soak seed 1
-// scene 147: README, "Contact onsets"). The friction so dropped is at most 1e-9 m |Δu|.
+// scene 147: docs/contact-model.md). The friction so dropped is at most 1e-9 m |Δu|.
 #define PD_ONSET_PAIR_SLIP_REL 1e-9
 
 static pdVec3 to_world(const pdPose* p, pdVec3 local) { return pd_v3_add(p->x, pd_mat3_mulv(&p->R, local)); }
