@@ -31,7 +31,7 @@ typedef struct fitContext {
   bool stopped;
   char why[256];
   // the last evaluation's terms, and the first evaluation's objective (GSL evaluates the start first)
-  double posMean, rotMean;
+  double posMean, rotMean, bounceMean;  // bounceMean: NAN unless planar
   double startObjective;
   int failed;
 } fitContext;
@@ -73,7 +73,7 @@ static double evaluate(fitContext* c) {
     c->stopped = true;
     return HUGE_VAL;
   }
-  double pos = 0.0, rot = 0.0;
+  double pos = 0.0, rot = 0.0, bounce = 0.0;
   c->failed = 0;
   for (int i = 0; i < o->tossCount; ++i) {
     const pdTossResult* r = &c->results[i];
@@ -81,14 +81,18 @@ static double evaluate(fitContext* c) {
     c->failed += !ok;
     pos += ok ? r->posErrEnd : PD_TOSS_FAIL_POS_ERR;
     rot += ok ? r->rotErrEnd : PD_TOSS_FAIL_ROT_ERR;
+    bounce += ok && isfinite(r->impactDv[0]) ? r->impactDv[0] : PD_TOSS_FAIL_BOUNCE_ERR;
   }
   c->posMean = pos / o->tossCount;
   c->rotMean = rot / o->tossCount;
-  return c->posMean + c->rotMean;
+  bool planar = o->set->experiment->planar;
+  c->bounceMean = planar ? bounce / o->tossCount : NAN;
+  return c->posMean + c->rotMean + (planar ? c->bounceMean / PD_TOSS_BOUNCE_SCALE : 0.0);
 }
 
 void pd_toss_fit_trace_header(FILE* out) {
-  fputs("engine,variant,evaluation,mu,restitution,kn,objective,pos_err_end_mean,rot_err_end_mean_rad,failed,penalty\n",
+  fputs("engine,variant,evaluation,mu,restitution,kn,objective,pos_err_end_mean,rot_err_end_mean_rad,failed,penalty,"
+        "bounce_dv_mean\n",
         out);
 }
 
@@ -99,8 +103,10 @@ static void trace_row(const fitContext* c, double j, double penalty) {
   const char* variant = strcmp(c->o->engine.name, "soft") == 0      ? "implicit"
                         : c->o->engine.ref.variant == pd_refMatched ? "matched"
                                                                     : "native";
-  fprintf(out, "%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%.6g\n", c->o->engine.name, variant, c->evaluations,
+  fprintf(out, "%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%.6g,", c->o->engine.name, variant, c->evaluations,
           p->mu, p->restitution, p->kn, j, c->posMean, c->rotMean, c->failed, penalty);
+  if (isfinite(c->bounceMean)) fprintf(out, "%.10g", c->bounceMean);
+  fputc('\n', out);
   fflush(out);
 }
 
@@ -162,7 +168,7 @@ bool pd_toss_fit(const pdTossFitOptions* o, pdTossFitResult* result, char* why, 
     ok = !c.stopped;
     if (ok) {
       trace_row(&c, j, 0.0);
-      *result = (pdTossFitResult){.params = p, .startObjective = c.startObjective, .objective = j, .posErrEndMean = c.posMean, .rotErrEndMean = c.rotMean,
+      *result = (pdTossFitResult){.params = p, .startObjective = c.startObjective, .objective = j, .posErrEndMean = c.posMean, .rotErrEndMean = c.rotMean, .bounceDvMean = c.bounceMean,
                                   .failed = c.failed, .evaluations = c.evaluations, .converged = converged};
     }
   }
