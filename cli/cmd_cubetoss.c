@@ -578,6 +578,9 @@ static int finish_interrupted(const char* cmd, const char* tmp) {
   return 130;
 }
 
+// The noise floor has no parameters to fit.
+static bool fittable(const engineSpec* s) { return s->built && strcmp(s->name, "noise") != 0; }
+
 static int run_tosses(const options* o, const pdTossSet* set, const int* indices, int count, engineSpec* specs,
                       int engineCount) {
   char tmp[4200], runsDir[4300];
@@ -624,6 +627,7 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   resultGroup group = {o->label, results, indices, count, o->runs};
   bool written = write_result_csvs(tmp, set, specs, engineCount, &group, 1, path, sizeof path);
   for (int e = 0; e < engineCount && written; ++e) {
+    if (!fittable(&specs[e]) && specs[e].built) continue;  // the noise floor has no parameters
     snprintf(path, sizeof path, "%s/params-%s.scene", tmp, specs[e].name);
     char comment[1024], inertia[64] = "that of a uniform cube";
     if (specs[e].params.inertia > 0.0) snprintf(inertia, sizeof inertia, "%g kg m^2", specs[e].params.inertia);
@@ -662,9 +666,6 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
 }
 
 // ---------------------------------------------------------------- polydyn cubetoss fit
-
-// The noise floor has no parameters to fit.
-static bool fittable(const engineSpec* s) { return s->built && strcmp(s->name, "noise") != 0; }
 
 static int fit_tosses(const options* o, const pdTossSet* set, const int* indices, int count, engineSpec* specs,
                       int engineCount) {
