@@ -306,15 +306,13 @@ int pd_toss_impacts(const pdTossExperiment* ex, const pdBodyState* samples, int 
       ++k;
       continue;
     }
-    // within the band: the lowest sample until the block lifts above the lift band (or the record ends)
+    // within the band: the impact is the first sample after which the lowest point rises (not the lowest of the
+    // whole contact, which at rest is wherever the tracking noise dips), and the contact lasts until the
+    // block lifts above the lift band (or the record ends)
     int best = k;
-    double lowest = lowest_height(ex, &samples[k]);
-    int j = k + 1;
-    for (; j < n; ++j) {
-      double h = lowest_height(ex, &samples[j]);
-      if (h > PD_DROP_LIFT_BAND) break;
-      if (h < lowest) lowest = h, best = j;
-    }
+    while (best + 1 < n && lowest_height(ex, &samples[best + 1]) < lowest_height(ex, &samples[best])) ++best;
+    int j = best + 1;
+    while (j < n && lowest_height(ex, &samples[j]) <= PD_DROP_LIFT_BAND) ++j;
     pdTossImpact* im = &impacts[found++];
     im->sample = best;
     im->t = (double)best / ex->rate;

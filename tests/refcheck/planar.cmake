@@ -2,3 +2,6 @@
 # Gedanken restitution and incline laws for a planar body, and the scene errors.
 pd_add_test(test_planar ${CMAKE_CURRENT_LIST_DIR}/test_planar.c)
 target_link_libraries(test_planar PRIVATE polydyn_refcheck)
+# The planar drops in the cube-toss machinery, on synthetic drops (no data needed).
+pd_add_test(test_planar_drops ${CMAKE_CURRENT_LIST_DIR}/test_planar_drops.c)
+target_link_libraries(test_planar_drops PRIVATE polydyn_refcheck)

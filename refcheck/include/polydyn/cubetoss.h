@@ -87,7 +87,7 @@
 
 // Bounces (planar experiments): an impact starts when the block's lowest point comes within
 // PD_DROP_CONTACT_BAND of the surface and ends when it rises above PD_DROP_LIFT_BAND; the impact's time is the
-// sample where the lowest point is lowest in between. The post-impact velocity is the central difference of
+// first sample after which the lowest point rises (the first local minimum of its height in the band). The post-impact velocity is the central difference of
 // the samples 1 and 3 after it (centre velocity and angular velocity: the same estimate for record and run,
 // as the record's own velocities are noisy). Bands: the tracking noise of the lowest corner is about 1 mm.
 #define PD_DROP_CONTACT_BAND 0.003  // m
