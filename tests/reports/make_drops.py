@@ -10,6 +10,7 @@ import math
 import sys
 
 RATE, HALF, TOP, G, E, SAMPLES = 250.0, 0.03, 0.0005, 9.81, 0.5, 200
+REST_SPEED = 1e-3  # m/s: a bounce slower than this ends the bouncing (it would lift the block 0.05 µm)
 
 
 def main():
@@ -21,9 +22,10 @@ def main():
             vx = -0.2 + 0.1 * drop
             times, speeds = [math.sqrt(2 * h0 / G)], []
             speeds.append(E * G * times[0])
-            while times[-1] < SAMPLES / RATE:
+            while times[-1] < SAMPLES / RATE and speeds[-1] > REST_SPEED:  # the bounces' times converge
                 times.append(times[-1] + 2 * speeds[-1] / G)
                 speeds.append(E * speeds[-1])
+            speeds[-1] = 0.0  # then it rests
             for k in range(SAMPLES):
                 t = k / RATE
                 if t < times[0]:
