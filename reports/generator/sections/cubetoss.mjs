@@ -40,72 +40,72 @@ export const planarDrops = realData({ id: 'planar-drops', title: 'Planar drops a
   typicalKey: 'planarDropsTypical', dirName: 'planar-drops' });
 
 function build(ctx, ct, typical, id) {
-    if (!ct) return null;
-    const w = wordsOf(ct);
-    const split = headlineSplit(ct.summary);
-    const evs = orderEngineVariants(ct.summary).map((x) => x.ev);
-    const params = paramsOrder(ct.summary);
-    const where = ct.at === '.' ? 'this directory' : `<code>${esc(ct.at)}/</code>`;
+  if (!ct) return null;
+  const w = wordsOf(ct);
+  const split = headlineSplit(ct.summary);
+  const evs = orderEngineVariants(ct.summary).map((x) => x.ev);
+  const params = paramsOrder(ct.summary);
+  const where = ct.at === '.' ? 'this directory' : `<code>${esc(ct.at)}/</code>`;
 
-    // the headline: one row per engine-variant and parameter set at the split
-    const headline = [];
-    for (const ev of evs) {
-      for (const p of params) {
-        const of = (q) => ct.summary.find((r) => r.ev === ev && r.params === p && r.split === split && r.quantity === q);
-        const first = QUANTITIES.map(of).find(Boolean);
-        if (!first) continue;
-        const row = { engine: first.engine, variant: first.variant, ev, params: p, split, status: first.status, tosses: first.tosses,
-          completed: first.completed };
-        for (const q of QUANTITIES) {
-          const r = of(q);
-          row[q] = r ? { mean: r.mean, median: r.median, p90: r.p90 } : { mean: null, median: null, p90: null };
-        }
-        headline.push(row);
+  // the headline: one row per engine-variant and parameter set at the split
+  const headline = [];
+  for (const ev of evs) {
+    for (const p of params) {
+      const of = (q) => ct.summary.find((r) => r.ev === ev && r.params === p && r.split === split && r.quantity === q);
+      const first = QUANTITIES.map(of).find(Boolean);
+      if (!first) continue;
+      const row = { engine: first.engine, variant: first.variant, ev, params: p, split, status: first.status, tosses: first.tosses,
+        completed: first.completed };
+      for (const q of QUANTITIES) {
+        const r = of(q);
+        row[q] = r ? { mean: r.mean, median: r.median, p90: r.p90 } : { mean: null, median: null, p90: null };
       }
+      headline.push(row);
     }
-    const prov = ct.provenance;
-    let html = '<p>' + w.intro +
-      `Shown: the ${split === 'test' ? `test ${w.nouns}, which no fit has seen` : w.nouns}; median and 90th percentile over them. ` +
-      `Wall and CPU time are the mean per ${w.noun} (one ${w.noun} is one process’s work). The <code>noise shift1</code> rows are ` +
-      'the record one sample late, judged like a run: the floor that sampling and tracking set.</p>';
-    html += `<p class="muted">From ${where}${ct.readme ? ' (its README.md has the full tables)' : ''}` +
-      (prov.command ? `; command <code>${esc(prov.command)}</code>` : '') + (prov.commit ? `, commit ${esc(prov.commit)}` : '') +
-      (prov.data ? `; data ${esc(prov.data)}` : '') + (prov.machine ? `; machine ${esc(prov.machine)}` : '') + '.' +
-      (prov.fit ? ` Fit: ${esc(prov.fit)}.` : '') + '</p>';
-    const d = (x) => (x === null ? null : x * DEG);
-    html += table(['engine variant', 'parameters', 'completed', 'position end median', 'position end p90', 'rotation end median (°)',
-      'rotation end p90 (°)', 'position RMS median', 'rotation RMS median (°)', ...(ct.planar ? ['first bounce Δv median (m/s)',
-        'first bounce Δv p90 (m/s)'] : []), `wall per ${w.noun} (s)`, `CPU per ${w.noun} (s)`],
-    headline.map((r) => [
-      `<span class="key"><i style="background:${ctx.color(r.ev)}"></i>${esc(r.ev)}</span>`, esc(r.params),
-      { html: `${r.completed}/${r.tosses}`, cls: `n${r.completed < r.tosses ? ' bad' : ''}`, title: r.status },
-      { html: num(r.pos_err_end.median), cls: 'n', title: String(r.pos_err_end.median ?? '') },
-      { html: num(r.pos_err_end.p90), cls: 'n', title: String(r.pos_err_end.p90 ?? '') },
-      { html: num(d(r.rot_err_end.median)), cls: 'n', title: String(r.rot_err_end.median ?? '') + ' rad' },
-      { html: num(d(r.rot_err_end.p90)), cls: 'n', title: String(r.rot_err_end.p90 ?? '') + ' rad' },
-      { html: num(r.pos_err_rms.median), cls: 'n' }, { html: num(d(r.rot_err_rms.median)), cls: 'n' },
-      ...(ct.planar ? [{ html: num(r.impact1_dv.median), cls: 'n' }, { html: num(r.impact1_dv.p90), cls: 'n' }] : []),
-      { html: num(r.wall_seconds.mean), cls: 'n' }, { html: num(r.cpu_seconds.mean), cls: 'n' },
-    ]), id);
-    html += `<p class="muted">Positions in ${w.unit}. Parameter sets other than <code>default</code> and <code>fitted</code> are ` +
-      'diagnostics of the same fitted parameters (e.g. a tighter tolerance: the integration error’s share; the uniform cube’s inertia).</p>';
+  }
+  const prov = ct.provenance;
+  let html = '<p>' + w.intro +
+    `Shown: the ${split === 'test' ? `test ${w.nouns}, which no fit has seen` : w.nouns}; median and 90th percentile over them. ` +
+    `Wall and CPU time are the mean per ${w.noun} (one ${w.noun} is one process’s work). The <code>noise shift1</code> rows are ` +
+    'the record one sample late, judged like a run: the floor that sampling and tracking set.</p>';
+  html += `<p class="muted">From ${where}${ct.readme ? ' (its README.md has the full tables)' : ''}` +
+    (prov.command ? `; command <code>${esc(prov.command)}</code>` : '') + (prov.commit ? `, commit ${esc(prov.commit)}` : '') +
+    (prov.data ? `; data ${esc(prov.data)}` : '') + (prov.machine ? `; machine ${esc(prov.machine)}` : '') + '.' +
+    (prov.fit ? ` Fit: ${esc(prov.fit)}.` : '') + '</p>';
+  const d = (x) => (x === null ? null : x * DEG);
+  html += table(['engine variant', 'parameters', 'completed', 'position end median', 'position end p90', 'rotation end median (°)',
+    'rotation end p90 (°)', 'position RMS median', 'rotation RMS median (°)', ...(ct.planar ? ['first bounce Δv median (m/s)',
+      'first bounce Δv p90 (m/s)'] : []), `wall per ${w.noun} (s)`, `CPU per ${w.noun} (s)`],
+  headline.map((r) => [
+    `<span class="key"><i style="background:${ctx.color(r.ev)}"></i>${esc(r.ev)}</span>`, esc(r.params),
+    { html: `${r.completed}/${r.tosses}`, cls: `n${r.completed < r.tosses ? ' bad' : ''}`, title: r.status },
+    { html: num(r.pos_err_end.median), cls: 'n', title: String(r.pos_err_end.median ?? '') },
+    { html: num(r.pos_err_end.p90), cls: 'n', title: String(r.pos_err_end.p90 ?? '') },
+    { html: num(d(r.rot_err_end.median)), cls: 'n', title: String(r.rot_err_end.median ?? '') + ' rad' },
+    { html: num(d(r.rot_err_end.p90)), cls: 'n', title: String(r.rot_err_end.p90 ?? '') + ' rad' },
+    { html: num(r.pos_err_rms.median), cls: 'n' }, { html: num(d(r.rot_err_rms.median)), cls: 'n' },
+    ...(ct.planar ? [{ html: num(r.impact1_dv.median), cls: 'n' }, { html: num(r.impact1_dv.p90), cls: 'n' }] : []),
+    { html: num(r.wall_seconds.mean), cls: 'n' }, { html: num(r.cpu_seconds.mean), cls: 'n' },
+  ]), id);
+  html += `<p class="muted">Positions in ${w.unit}. Parameter sets other than <code>default</code> and <code>fitted</code> are ` +
+    'diagnostics of the same fitted parameters (e.g. a tighter tolerance: the integration error’s share; the uniform cube’s inertia).</p>';
 
-    if (ct.perToss) html += distributions(ctx, ct.perToss, split, evs, w, ct.planar);
-    if (ct.fit && ct.fit.length) html += fitTable(ctx, ct.fit, w, ct.planar, id);
-    const typ = typical ? typicalBlock(ctx, ct, typical, w, id) : null;
-    if (typ) html += typ.html;
+  if (ct.perToss) html += distributions(ctx, ct.perToss, split, evs, w, ct.planar);
+  if (ct.fit && ct.fit.length) html += fitTable(ctx, ct.fit, w, ct.planar, id);
+  const typ = typical ? typicalBlock(ctx, ct, typical, w, id) : null;
+  if (typ) html += typ.html;
 
-    return {
-      html,
-      data: { directory: ct.at, split, provenance: prov, headline, fit: ct.fit ? ct.fit.map(({ line, ev, ...f }) => f) : null,
-        typical: typ ? typ.data : null },
-      csv: [{ name: id, header: ['engine', 'variant', 'params', 'split', 'completed', 'tosses', 'pos_err_end_median',
-        'pos_err_end_p90', 'rot_err_end_median_rad', 'rot_err_end_p90_rad', 'pos_err_rms_median', 'rot_err_rms_median_rad',
-        'wall_seconds_mean', 'cpu_seconds_mean'],
-      rows: headline.map((r) => [r.engine, r.variant, r.params, r.split, r.completed, r.tosses, r.pos_err_end.median, r.pos_err_end.p90,
-        r.rot_err_end.median, r.rot_err_end.p90, r.pos_err_rms.median, r.rot_err_rms.median, r.wall_seconds.mean, r.cpu_seconds.mean]) },
-      ...(typ ? typ.csv : [])],
-    };
+  return {
+    html,
+    data: { directory: ct.at, split, provenance: prov, headline, fit: ct.fit ? ct.fit.map(({ line, ev, ...f }) => f) : null,
+      typical: typ ? typ.data : null },
+    csv: [{ name: id, header: ['engine', 'variant', 'params', 'split', 'completed', 'tosses', 'pos_err_end_median',
+      'pos_err_end_p90', 'rot_err_end_median_rad', 'rot_err_end_p90_rad', 'pos_err_rms_median', 'rot_err_rms_median_rad',
+      'wall_seconds_mean', 'cpu_seconds_mean'],
+    rows: headline.map((r) => [r.engine, r.variant, r.params, r.split, r.completed, r.tosses, r.pos_err_end.median, r.pos_err_end.p90,
+      r.rot_err_end.median, r.rot_err_end.p90, r.pos_err_rms.median, r.rot_err_rms.median, r.wall_seconds.mean, r.cpu_seconds.mean]) },
+    ...(typ ? typ.csv : [])],
+  };
 }
 
 // The distribution of the end errors over the tosses: one line per engine-variant, solid for the
