@@ -16,7 +16,7 @@ SRC=$2
 DATA_FULL=$SRC/../shared/data/planar-drops/drops-given.csv
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_planar_drops_cli.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
-. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial, skip_without
 
 DATA=$SCRATCH/drops.csv
 python3 "$SRC/tests/reports/make_drops.py" "$DATA" 4 || exit 1
@@ -45,11 +45,7 @@ run_pd "$SCRATCH/stdout" "$SCRATCH/err" report "$REPORT"
 check "the report has the planar-drop section" \
   '[ $rc -eq 0 ] && python3 -c "import json,sys; j=json.load(open(sys.argv[1])); sys.exit(0 if \"planar-drops\" in j[\"sections\"] else 1)" "$REPORT/report.json"'
 
-if [ ! -r "$DATA_FULL" ]; then
-  echo "SKIP: the planar-drop data is not at $DATA_FULL (not part of the project: docs/planar-drops.md); $passed synthetic checks passed"
-  [ $failed -eq 0 ] || exit 1
-  exit 77
-fi
+skip_without "$DATA_FULL" "the planar-drop data (docs/planar-drops.md)"
 # ---- three real drops
 REAL=$SCRATCH/three.csv
 awk -F, 'NR == 1 || $1 == 1 || $1 == 2 || $1 == 3' "$DATA_FULL" >"$REAL"
