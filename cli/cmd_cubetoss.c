@@ -671,17 +671,19 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
 
 // ---------------------------------------------------------------- polydyn cubetoss fit
 
+static void fit_started(const pdTossFitEngine* engine, void* user) {
+  progressState* progress = user;
+  progress->what = engine->label;
+  progress->evaluation = 0;
+}
+
 static int fit_tosses(const options* o, const pdTossSet* set, const int* indices, int count, engineSpec* specs,
                       int engineCount) {
-  // training: selected tosses at even positions, every K-th of them; test: selected ones at odd positions
   int* train = malloc((size_t)count * sizeof *train);
   int* test = malloc((size_t)count * sizeof *test);
   if (!train || !test) abort();
-  int trainCount = 0, testCount = 0, seenTrain = 0;
-  for (int i = 0; i < count; ++i) {
-    if (pd_toss_split(indices[i]) == pd_tossTest) test[testCount++] = indices[i];
-    else if (seenTrain++ % o->trainEvery == 0) train[trainCount++] = indices[i];
-  }
+  int trainCount, testCount;
+  pd_toss_fit_split(indices, count, o->trainEvery, train, &trainCount, test, &testCount);
   if (trainCount == 0 || testCount == 0) {
     free(train);
     free(test);
@@ -708,35 +710,34 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   }
   if (trace) pd_toss_fit_trace_header(trace);
 
-  pdTossFitResult fits[ENGINES_MAX] = {0};
+  pdTossFitResult fits[ENGINES_MAX];
   pdTossParams fitted[ENGINES_MAX];
-  bool ok = true;
-  char why[256] = "";
-  progressState progress = {.terminal = isatty(STDERR_FILENO) == 1, .start = pd_cli_wall_seconds(), .fitting = true};
-  for (int e = 0; e < engineCount && ok; ++e) {
-    fitted[e] = specs[e].params;
+  pdTossFitEngine engines[ENGINES_MAX];
+  for (int e = 0; e < engineCount; ++e) {
     if (!specs[e].built && pd_batch_is_root()) {
       fprintf(stderr, "polydyn cubetoss fit: %s: this build of polydyn has no %s adapter; not fitted\n", specs[e].label,
               specs[e].name);
     }
-    if (!fittable(&specs[e])) continue;
-    progress.what = specs[e].label;
-    progress.evaluation = 0;
-    pdTossFitOptions fo = {.set = set,
-                           .tosses = train,
-                           .tossCount = trainCount,
-                           .engine = specs[e].engine,
-                           .start = specs[e].params,
-                           .fitStiffness = strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched,
-                           .maxEvaluations = o->maxEvals,
-                           .sizeTol = o->sizeTol,
-                           .workers = o->jobs,
-                           .progress = show_progress,
-                           .progressUser = &progress,
-                           .trace = trace};
-    ok = pd_toss_fit(&fo, &fits[e], why, sizeof why);
-    if (ok) fitted[e] = fits[e].params;
+    engines[e] = (pdTossFitEngine){.label = specs[e].label,
+                                   .variant = specs[e].variant,
+                                   .engine = specs[e].engine,
+                                   .start = specs[e].params,
+                                   .built = specs[e].built,
+                                   .fit = fittable(&specs[e]),
+                                   .fitStiffness = strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched};
   }
+  char why[256] = "";
+  progressState progress = {.terminal = isatty(STDERR_FILENO) == 1, .start = pd_cli_wall_seconds(), .fitting = true};
+  pdTossFitOptions common = {.set = set,
+                             .tosses = train,
+                             .tossCount = trainCount,
+                             .maxEvaluations = o->maxEvals,
+                             .sizeTol = o->sizeTol,
+                             .workers = o->jobs,
+                             .progress = show_progress,
+                             .progressUser = &progress,
+                             .trace = trace};
+  bool ok = pd_toss_fit_engines(&common, engines, engineCount, fit_started, &progress, fits, fitted, why, sizeof why);
   bool traceOk = !trace || !ferror(trace);
   traceOk = (!trace || fclose(trace) == 0) && traceOk;
 
@@ -779,29 +780,7 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   FILE* out = written ? fopen(path, "w") : NULL;
   written = out != NULL;
   if (out) {
-    fputs("engine,variant,status,fitted,mu,restitution,kn,objective_train,pos_err_end_mean_train,"
-          "rot_err_end_mean_train_rad,failed_train,evaluations,converged,train_tosses,train_every,test_tosses,"
-          "start_mu,start_restitution,start_kn,start_objective_train,bounce_dv_mean_train\n",
-          out);
-    for (int e = 0; e < engineCount; ++e) {
-      const pdTossFitResult* f = &fits[e];
-      const pdTossParams* s = &specs[e].params;
-      bool stiff = strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched;
-      fprintf(out, "%s,%s,%s,%s,", specs[e].name, specs[e].variant,
-              fittable(&specs[e]) ? "ok" : specs[e].built ? "no parameters" : "not built",
-              !fittable(&specs[e]) ? "" : stiff ? "mu;restitution;kn" : "mu;restitution");
-      if (fittable(&specs[e]))
-        fprintf(out, "%.10g,%.10g,%.10g,%.9g,%.9g,%.9g,%d,%d,%s,", f->params.mu, f->params.restitution, f->params.kn,
-                f->objective, f->posErrEndMean, f->rotErrEndMean, f->failed, f->evaluations,
-                f->converged ? "true" : "false");
-      else
-        fputs(",,,,,,,,,", out);
-      fprintf(out, "%d,%d,%d,%.10g,%.10g,%.10g,", trainCount, o->trainEvery, testCount, s->mu, s->restitution, s->kn);
-      if (fittable(&specs[e])) fprintf(out, "%.9g", f->startObjective);
-      fputc(',', out);
-      if (fittable(&specs[e]) && isfinite(f->bounceDvMean)) fprintf(out, "%.9g", f->bounceDvMean);
-      fputc('\n', out);
-    }
+    pd_toss_fit_csv(out, engines, engineCount, fits, trainCount, o->trainEvery, testCount);
     written = !ferror(out) && written;
     written = fclose(out) == 0 && written;
   }

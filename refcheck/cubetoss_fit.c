@@ -1,5 +1,6 @@
 // polydyn refcheck — fitting an engine's free parameters to the training tosses with GSL's Nelder–Mead
-// simplex (objective, bounds and steps in cubetoss.h).
+// simplex (objective, bounds and steps in cubetoss.h); the held-out split, several engines in turn and their
+// fit.csv, for both data sets (cube tosses, planar drops).
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -179,4 +180,63 @@ bool pd_toss_fit(const pdTossFitOptions* o, pdTossFitResult* result, char* why, 
   gsl_vector_free(step);
   free(c.results);
   return ok;
+}
+
+// ---------------------------------------------------------------- several engines, the split, fit.csv
+
+void pd_toss_fit_split(const int* indices, int count, int trainEvery, int* train, int* trainCount, int* test,
+                       int* testCount) {
+  PD_ASSERT(trainEvery >= 1 && (count == 0 || (indices && train && test)));
+  int seenTrain = 0;
+  *trainCount = *testCount = 0;
+  for (int i = 0; i < count; ++i) {
+    if (pd_toss_split(indices[i]) == pd_tossTest) test[(*testCount)++] = indices[i];
+    else if (seenTrain++ % trainEvery == 0) train[(*trainCount)++] = indices[i];
+  }
+}
+
+bool pd_toss_fit_engines(const pdTossFitOptions* common, const pdTossFitEngine* engines, int count,
+                         void (*started)(const pdTossFitEngine* engine, void* user), void* user,
+                         pdTossFitResult* results, pdTossParams* fitted, char* why, size_t whySize) {
+  bool ok = true;
+  for (int e = 0; e < count; ++e) {
+    memset(&results[e], 0, sizeof results[e]);
+    fitted[e] = engines[e].start;
+  }
+  for (int e = 0; e < count && ok; ++e) {
+    if (!engines[e].fit) continue;
+    if (started) started(&engines[e], user);
+    pdTossFitOptions o = *common;
+    o.engine = engines[e].engine;
+    o.start = engines[e].start;
+    o.fitStiffness = engines[e].fitStiffness;
+    ok = pd_toss_fit(&o, &results[e], why, whySize);
+    if (ok) fitted[e] = results[e].params;
+  }
+  return ok;
+}
+
+void pd_toss_fit_csv(FILE* out, const pdTossFitEngine* engines, int count, const pdTossFitResult* results,
+                     int trainCount, int trainEvery, int testCount) {
+  fputs("engine,variant,status,fitted,mu,restitution,kn,objective_train,pos_err_end_mean_train,"
+        "rot_err_end_mean_train_rad,failed_train,evaluations,converged,train_tosses,train_every,test_tosses,"
+        "start_mu,start_restitution,start_kn,start_objective_train,bounce_dv_mean_train\n",
+        out);
+  for (int e = 0; e < count; ++e) {
+    const pdTossFitEngine* g = &engines[e];
+    const pdTossFitResult* f = &results[e];
+    const pdTossParams* s = &g->start;
+    fprintf(out, "%s,%s,%s,%s,", g->engine.name, g->variant, g->fit ? "ok" : g->built ? "no parameters" : "not built",
+            !g->fit ? "" : g->fitStiffness ? "mu;restitution;kn" : "mu;restitution");
+    if (g->fit)
+      fprintf(out, "%.10g,%.10g,%.10g,%.9g,%.9g,%.9g,%d,%d,%s,", f->params.mu, f->params.restitution, f->params.kn,
+              f->objective, f->posErrEndMean, f->rotErrEndMean, f->failed, f->evaluations, f->converged ? "true" : "false");
+    else
+      fputs(",,,,,,,,,", out);
+    fprintf(out, "%d,%d,%d,%.10g,%.10g,%.10g,", trainCount, trainEvery, testCount, s->mu, s->restitution, s->kn);
+    if (g->fit) fprintf(out, "%.9g", f->startObjective);
+    fputc(',', out);
+    if (g->fit && isfinite(f->bounceDvMean)) fprintf(out, "%.9g", f->bounceDvMean);
+    fputc('\n', out);
+  }
 }

@@ -1,6 +1,7 @@
 // Tests of the planar drops in the cube-toss machinery (refcheck/cubetoss*.c, pd_planar_drops) on synthetic
 // drops, so they need no data: a drop in free flight whose record is the closed-form parabola and uniform
-// turn, the bounces of a closed-form bouncing record, the noise floor's run, and bad drop files.
+// turn, the bounces of a closed-form bouncing record, the noise floor's run, bad drop files, and the fit's
+// held-out split (shared with the cube tosses).
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -176,11 +177,28 @@ static void test_bad_drop_files_are_refused_at_their_line_and_column(void** stat
   }
 }
 
+// ---------------------------------------------------------------- the held-out split of a fit
+
+static void test_the_split_trains_on_even_positions_every_kth_and_tests_on_odd(void** state) {
+  (void)state;
+  const int indices[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 11};  // file positions of a selection
+  int train[11], test[11], trainCount, testCount;
+  pd_toss_fit_split(indices, 11, 1, train, &trainCount, test, &testCount);
+  assert_int_equal(trainCount, 6);
+  assert_int_equal(testCount, 5);
+  assert_true(train[5] == 10 && test[0] == 1 && test[4] == 11);
+  pd_toss_fit_split(indices, 11, 2, train, &trainCount, test, &testCount);
+  assert_int_equal(trainCount, 3);  // the 1st, 3rd and 5th of 0, 2, 4, 6, 8, 10
+  assert_true(train[0] == 0 && train[1] == 4 && train[2] == 8);
+  assert_int_equal(testCount, 5);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_drop_in_free_flight_matches_its_closed_form),
       cmocka_unit_test(test_bounces_are_found_with_their_times_and_velocities),
       cmocka_unit_test(test_bad_drop_files_are_refused_at_their_line_and_column),
+      cmocka_unit_test(test_the_split_trains_on_even_positions_every_kth_and_tests_on_odd),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

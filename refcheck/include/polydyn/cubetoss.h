@@ -319,3 +319,32 @@ typedef struct pdTossFitResult {
 // Returns false with a message in `why` when the work was stopped or a worker died.
 bool pd_toss_fit(const pdTossFitOptions* options, pdTossFitResult* result, char* why, size_t whySize);
 void pd_toss_fit_trace_header(FILE* out);
+
+// The held-out split of a selection (set indices, file order): training = the selected tosses at even
+// positions, every trainEvery-th of them; test = those at odd positions. train and test hold count each.
+void pd_toss_fit_split(const int* indices, int count, int trainEvery, int* train, int* trainCount, int* test,
+                       int* testCount);
+
+// One engine of a fit over several engines (pd_toss_fit_engines).
+typedef struct pdTossFitEngine {
+  const char* label;    // soft, ode-native, ...: messages, progress
+  const char* variant;  // implicit, native, matched, shift1
+  pdTossEngine engine;
+  pdTossParams start;
+  bool built;           // this build has its adapter
+  bool fit;             // fitted (false: not built, or the noise floor, which has no parameters)
+  bool fitStiffness;    // k_n too (the soft engine, and the matched variants)
+} pdTossFitEngine;
+
+// Fits each engine with fit set (pd_toss_fit with `common`'s set, training tosses, budget, workers, progress and
+// trace; its engine, start and fitStiffness are each engine's), in order. results[e] is zero and fitted[e] its
+// start for an engine not fitted. `started` (nullable) is called before each fit, with the engine. Returns false
+// with a message in `why` when a fit was stopped.
+bool pd_toss_fit_engines(const pdTossFitOptions* common, const pdTossFitEngine* engines, int count,
+                         void (*started)(const pdTossFitEngine* engine, void* user), void* user,
+                         pdTossFitResult* results, pdTossParams* fitted, char* why, size_t whySize);
+
+// fit.csv: its header and one row per engine (status ok, not built or no parameters; what was fitted, the
+// fitted values and objective, the split's sizes and the start).
+void pd_toss_fit_csv(FILE* out, const pdTossFitEngine* engines, int count, const pdTossFitResult* results,
+                     int trainCount, int trainEvery, int testCount);
