@@ -79,12 +79,14 @@ static void scene_error(const char* text, char* out, size_t size) {
   pd_scene_free(scene);
 }
 
-// Runs the model in "soft", "ode" or "bullet" (native contact; ODE's friction aligned with the slip when
-// `aligned`); false when this build has no such adapter.
+// Runs the model in "soft", "soft-pair" (the soft engine joining contact onsets as pairs, with their impulses),
+// "ode" or "bullet" (native contact; ODE's friction aligned with the slip when `aligned`); false when this build
+// has no such adapter.
 static bool run_in(const char* engine, const pdModel* m, bool aligned, trace* tr) {
   tr->n = 0;
-  if (strcmp(engine, "soft") == 0) {
+  if (strncmp(engine, "soft", 4) == 0) {
     pdState* s = pd_state_create(m);
+    if (strcmp(engine, "soft-pair") == 0) s->onsets = pd_onsetsPair;
     assert_true(pd_advance(m, s, m->settings.tend, observe, tr));
     pd_state_free(s);
     return true;
@@ -102,7 +104,7 @@ static bool run_in(const char* engine, const pdModel* m, bool aligned, trace* tr
   return true;
 }
 
-static const char* const engines[] = {"soft", "ode", "bullet"};
+static const char* const engines[] = {"soft", "ode", "bullet", "soft-pair"};
 
 // ---------------------------------------------------------------------------------------------
 // a block lands on a corner of a board sloping across the plane
@@ -125,7 +127,7 @@ static void test_corner_drop_stays_in_its_plane_in_every_engine(void** state) {
   pdModel* m = compile(text);
   trace* tr = malloc(sizeof *tr);
   assert_non_null(tr);
-  for (int e = 0; e < 3; ++e) {
+  for (int e = 0; e < 4; ++e) {
     if (!run_in(engines[e], m, false, tr)) {
       print_message("%s: not built\n", engines[e]);
       continue;
