@@ -1,5 +1,5 @@
 // polydyn — the contact list of a state: contact forces inside the derivative and the contact events
-// between steps (paper Fig. 8, §3.4, §4.2–§4.4; DESIGN §3.5).
+// between steps (paper Fig. 8, §3.4, §4.2–§4.4; docs/DESIGN.md §5).
 //
 // Design note. The loop of Fig. 8 runs as: the stepper proposes a step from (t0, y0) to y1 with the
 // contact list C0 fixed; the error control accepts it; pd_contact_events then analyses y1:
@@ -13,7 +13,7 @@
 //     interpolated (App. C) and the step retried to end there (t0 + δ·h); an onset within dt_min of the
 //     start makes it a virtual contact, added at t0 with its springs at 0 and the step restarted. With
 //     pair onsets (pd_onsetsPair, or pd_onsetsAuto in a system of more than PD_ONSETS_CROWD_BODIES moving bodies:
-//     README, "Contact onsets") a contact whose onset lies less than
+//     docs/contact-model.md) a contact whose onset lies less than
 //     PD_ONSET_PAIR_OMEGA_TAU / ω before the step's end (ω its undamped angular frequency) does not cut the step: the
 //     interpolation is applied to the pair alone at commit (start_late_contacts), so one onset does not send every body
 //     back.
@@ -32,7 +32,7 @@
 // friction cone's when they slide), so its energy and phase are its own and its rest point sits d − x ≈
 // d (ωτ)²/6 deeper (d the depth reached without it).
 // A slip at the rounding of Δu (PD_ONSET_PAIR_SLIP_REL) counts as none: its direction is noise, and friction
-// along it broke a flush stack's bitwise symmetry (README, "Contact onsets").
+// along it broke a flush stack's bitwise symmetry (docs/contact-model.md).
 #include "contact_set.h"
 
 #ifdef PD_SELF_CHECKS
@@ -74,7 +74,7 @@
 #define PD_ONSET_PAIR_DEPTH_REL 0.25
 // A pair onset's slip below this fraction of |Δu| at its point is none: removing the normal part leaves ~1e-16
 // |Δu| of rounding whose direction is noise, and friction along it broke a flush stack's symmetry (soak seed 1
-// scene 147: README, "Contact onsets"). The friction so dropped is at most 1e-9 m |Δu|.
+// scene 147: docs/contact-model.md). The friction so dropped is at most 1e-9 m |Δu|.
 #define PD_ONSET_PAIR_SLIP_REL 1e-9
 // Steps containing a stick/slip change are halved down to this fraction of the shortest
 // contact period: the event is then located to ~5 % of the contact's own time scale. 1 % changed no
@@ -851,7 +851,7 @@ static double step_of(double omega2, double overdamp) {
   return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
 }
 
-// The stability bound in two parts, both Gershgorin bounds on ω_max² (never below it; README, Integration).
+// The stability bound in two parts, both Gershgorin bounds on ω_max² (never below it; docs/integration.md).
 // stability_prepare (after every new list, O(contacts)) forms each contact's terms and a cheap bound of the
 // contact-space matrix M above: by |Σ_j (A B_j)_rq| ≤ Σ_p |A_rp| |(B_j)_pq|, row r of contact i's Gershgorin sum
 // is at most Σ over its moving ends B of Σ_p |(K_i^½)_rp| w_p / m_B + Σ_p |(K_i^½ [r_i]ₓᵀ)_rp| u_p, where w_p

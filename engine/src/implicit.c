@@ -1,4 +1,4 @@
-// polydyn — the linear systems of the implicit stepper (implicit.h; README, Integration).
+// polydyn — the linear systems of the implicit stepper (implicit.h; docs/integration.md).
 //
 // Design note. The state is [bodies | springs]: per moving body v, ω (rows 0–5 of its 13), x, q; per contact its
 // 8 springs. W couples only v, ω and the springs. Contact c between bodies 1 and 2 (σ = +1, −1), lever arms r_k,

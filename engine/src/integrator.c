@@ -1,4 +1,4 @@
-// polydyn — the integration loop (paper §2 and Fig. 8, DESIGN §3.5).
+// polydyn — the integration loop (paper §2 and Fig. 8, docs/DESIGN.md §5).
 //
 // Design note. pd_advance walks from state->t to tEnd in steps of classic fourth-order Runge–Kutta.
 // The adaptive stepper estimates the local error by step doubling: one step of h and two of h/2
@@ -15,7 +15,7 @@
 // third-order partner, h (k4 − f(t + h, y1))/6: 5 evaluations per step instead of 11, but twice the
 // steps for the same stability bound (a single RK4 step must now be stable), and the contact events are
 // analysed once per accepted step — so it wins on impacts and free flight and loses on resting and sliding
-// contacts (README, "Integration"); step doubling, not this pair, is the default's explicit part. Both run through
+// contacts (docs/integration.md); step doubling, not this pair, is the default's explicit part. Both run through
 // adaptive_step, which takes the trial, the order of its estimate (the controller's exponents) and the bound's share.
 // The implicit stepper (pd_stepperImplicit, switching_step) runs step doubling until the contacts' stability bound
 // holds it well below what its error control wants (resting contact), then ROS34PW2, a linearly implicit method

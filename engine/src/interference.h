@@ -1,4 +1,4 @@
-// polydyn (internal) — interference of two convex polyhedra (paper §4.3, DESIGN §3.2): the
+// polydyn (internal) — interference of two convex polyhedra (paper §4.3, docs/DESIGN.md §6.1): the
 // separating-axis test over the faces of their Minkowski difference, with a per-pair cache of the
 // last separating feature (temporal coherence, §7).
 //

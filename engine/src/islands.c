@@ -1,4 +1,4 @@
-// polydyn — islands (issue 16 item 2; pd_islandsOn; README, "Islands").
+// polydyn — islands (issue 16 item 2; pd_islandsOn; docs/integration.md).
 //
 // Design note. With islands off, one state vector carries every moving body and contact: one step size,
 // one error norm (a max over all of y), and every contact onset anywhere cuts every body's step. With

@@ -124,7 +124,7 @@ int pd_adjustment_describe(const pdAdjustment* a, const char* bodyName, const ch
 
 // ---------------------------------------------------------------- per-body sides, per-pair constants
 
-// δ_max of a pair, m (README "Contact material parameters"): `deflection` times the smaller body's size (paper
+// δ_max of a pair, m (docs/contact-model.md): `deflection` times the smaller body's size (paper
 // §3.2), but at most PD_DELTA_MAX_WIDTH_FRACTION of the thinner body's width (a width of 0 is not known and
 // does not bound it). A deflection comparable to a body's thickness passes through it: a vertex pressed into a
 // plate thinner than δ_max comes out on the far side, its contact breaks (it left the body, or the rim face it

@@ -15,7 +15,7 @@
 // (a fixed floor's size says nothing about how fast anything moves).
 #define PD_MIN_SPEED_LENGTHS_PER_SECOND 1.0
 
-// Bodies may touch at t = 0 but not interpenetrate (DESIGN §4.1): a soft contact that starts deep would
+// Bodies may touch at t = 0 but not interpenetrate (docs/DESIGN.md §4.1): a soft contact that starts deep would
 // begin with springs at rest and push nothing. Tolerance on the penetration depth, relative to the
 // smaller body's size: two bodies placed touching by decimal coordinates overlap by rounding only
 // (~1e-16 relative), while 1e-6 leaves room for a scene file written with 6 significant digits.

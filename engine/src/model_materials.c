@@ -1,4 +1,4 @@
-// polydyn — the contact model's material parameters in a compiled model (paper §3.2, §3.3; DESIGN §3.4).
+// polydyn — the contact model's material parameters in a compiled model (paper §3.2, §3.3; docs/DESIGN.md §6.4).
 //
 // material.c holds the rules (per-body sides, per-pair constants from eq. (11) and eq. (15), the §3.3
 // checks, the modal dampers). This file applies them to a scene:
@@ -111,7 +111,7 @@ static void group_classes(struct pdMaterialTable* t, const pdMaterialSide* sides
 }
 
 // A pair of classes can touch when some body of one can meet some other body of the other with at
-// least one of the two moving (fixed bodies never meet: DESIGN §3.6).
+// least one of the two moving (fixed bodies never meet: docs/DESIGN.md §5.3).
 static bool classes_can_touch(const struct pdMaterialTable* t, int a, int b) {
   if (a == b) return t->classMoving[a] && t->classSize[a] >= 2;
   return t->classMoving[a] || t->classMoving[b];

@@ -1,4 +1,4 @@
-// polydyn — the scene file parser (DESIGN §4.1).
+// polydyn — the scene file parser (docs/scene-language.md).
 //
 // Design note. One lexer reads bytes from a source that is either a FILE* (read in fixed 64 KiB
 // chunks) or a caller's buffer (read in place), so pd_scene_parse_file and pd_scene_parse_buffer

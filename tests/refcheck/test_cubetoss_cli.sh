@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end tests of `polydyn cubetoss` and `polydyn cubetoss fit` (DESIGN §4.3, §5 "Real data"): usage
+# End-to-end tests of `polydyn cubetoss` and `polydyn cubetoss fit` (docs/commands.md, docs/DESIGN.md §8.4): usage
 # errors (exit 2, nothing written), bad data at its line and column, the output directory (per_toss.csv and
 # summary.csv in their documented schemas, the run directories of the record and the simulation), the
 # same bytes with one or two worker processes, --params, and a tiny fit whose fragment --params reads.
@@ -49,7 +49,7 @@ check "a refused toss: summary says failed, with no numbers" 'grep -q "^soft,imp
 "$PD" help | grep -q "cubetoss"; rc=$?; check "polydyn help lists cubetoss" '[ $rc -eq 0 ]'
 
 if [ ! -r "$DATA_FULL" ]; then
-  echo "SKIP: the cube-toss data is not at $DATA_FULL (not part of the project: see README, cube tosses); $passed usage checks passed"
+  echo "SKIP: the cube-toss data is not at $DATA_FULL (not part of the project: see docs/validation.md, cube tosses); $passed usage checks passed"
   [ $failed -eq 0 ] || exit 1
   exit 77
 fi

@@ -1,6 +1,6 @@
 // polydyn — scene description: what a scene file said, before anything is derived from it.
 //
-// The scene language (DESIGN §4.1, paper §5.1) is line oriented: `#` starts a comment, one command
+// The scene language (docs/scene-language.md, paper §5.1) is line oriented: `#` starts a comment, one command
 // per line, a trailing backslash continues the line, keywords are case sensitive. Object commands
 // start an object, property commands apply to the last object, settings may appear anywhere.
 // Units: m, kg, s; angles in degrees (converted to radians here, at parse time).
@@ -92,7 +92,7 @@ typedef struct pdSceneObject {
   pdSourceLoc where;      // the object command
 } pdSceneObject;
 
-// Defaults of the scene language, documented in README.md.
+// Defaults of the scene language, documented in docs/scene-language.md.
 #define PD_DEFAULT_GRAVITY_Z (-9.81)  // m/s²
 #define PD_DEFAULT_TEND 1.0           // s
 #define PD_DEFAULT_TOL 1e-6           // weighted max-norm of the local error estimate, dimensionless

@@ -1,4 +1,4 @@
-// Cube tosses against reality (polydyn cubetoss, issue 7): per engine and parameter set, the end and
+// Cube tosses against reality (polydyn cubetoss): per engine and parameter set, the end and
 // RMS errors on the tosses not used for fitting, their distribution, the fitted parameters, and one
 // typical toss — its errors over time and, with a viewer bundle, a 3-D replay of the record with every
 // engine's run overlaid.
