@@ -18,7 +18,7 @@
 //   vectors is the paper's "spring along the slip direction" with its direction kept in the vector.
 // - Damper branches are chosen by exact zeros (c == 0.0); the caller decides thresholds (paper §3.4).
 // - Friction is modelled only when μ > 0 and there is a tangential spring (k1t + k2t > 0); otherwise
-//   F_t = 0 and the tangential rates are 0 (docs/DESIGN.md §5.3: frictionless contacts carry no tangential springs,
+//   F_t = 0 and the tangential rates are 0 (docs/DESIGN.md §6.3: frictionless contacts carry no tangential springs,
 //   and the caller may skip their tangential state entirely).
 #pragma once
 

@@ -1,6 +1,6 @@
 // polydyn — the state derivative (paper §2): Newton–Euler with the gyroscopic term, quaternion
 // kinematics, gravity, the scene's applied forces, and the contact forces with their spring rates
-// (contact_set.c).
+// (contact_forces.c).
 
 #include "dynamics.h"
 

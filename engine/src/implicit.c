@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "contact_set.h"
+#include "grow.h"
 #include "polydyn/error.h"
 #include "state_layout.h"
 
@@ -50,8 +51,7 @@ struct pdImplicit {
 };
 
 pdImplicit* pd_implicit_create(void) {
-  pdImplicit* im = calloc(1, sizeof *im);
-  PD_ASSERT(im != NULL);
+  pdImplicit* im = pd_zeroed(1, sizeof *im);
   im->retryAt = -INFINITY;
   return im;
 }
@@ -88,17 +88,17 @@ void pd_implicit_deactivate(pdImplicit* im, bool gaveUp, double t) {
   im->active = false, im->held = 0, im->boundStep = 0.0;
 }
 
-static void reserve(pdImplicit* im, int contacts, int rows) {
+void pd_implicit_reserve(pdImplicit* im, int movingCount, int contacts) {
+  int rows = BODY_ROWS * movingCount;
+  if (contacts < 1) contacts = 1;
   if (contacts > im->contactCapacity) {
-    im->linear = realloc(im->linear, (size_t)contacts * sizeof *im->linear);
-    im->blocks = realloc(im->blocks, (size_t)contacts * sizeof *im->blocks);
-    PD_ASSERT(im->linear != NULL && im->blocks != NULL);
+    im->linear = pd_grow(im->linear, (size_t)contacts, sizeof *im->linear);
+    im->blocks = pd_grow(im->blocks, (size_t)contacts, sizeof *im->blocks);
     im->contactCapacity = contacts;
   }
   if (rows > im->rowCapacity) {
-    im->S = realloc(im->S, (size_t)rows * (size_t)rows * sizeof *im->S);
-    im->rb = realloc(im->rb, (size_t)rows * sizeof *im->rb);
-    PD_ASSERT(im->S != NULL && im->rb != NULL);
+    im->S = pd_grow(im->S, (size_t)rows * (size_t)rows, sizeof *im->S);
+    im->rb = pd_grow(im->rb, (size_t)rows, sizeof *im->rb);
     im->rowCapacity = rows;
   }
   if (!im->perm || im->perm->size != (size_t)rows) {  // an island's rows change only when its bodies do
@@ -173,7 +173,8 @@ void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im,
   PD_ASSERT(model->movingCount >= 1 && model->movingCount <= PD_IMPLICIT_BODIES_MAX);
   int contacts = pd_state_contact_count(state);
   int rows = BODY_ROWS * model->movingCount;
-  reserve(im, contacts > 0 ? contacts : 1, rows);
+  // sized between steps (pd_implicit_reserve): a trial step does not allocate
+  PD_ASSERT(contacts <= im->contactCapacity && rows <= im->rowCapacity && im->perm && im->perm->size == (size_t)rows);
   im->rows = rows;
   pd_contact_set_linearise(model, state->contacts, y, im->linear);
 }
@@ -318,9 +319,8 @@ void pd_implicit_solve(const pdModel* model, const pdState* state, pdImplicit* i
 void pd_implicit_apply_w(const pdModel* model, const pdState* state, const pdImplicit* im, const double* x, double* w) {
   int contacts = pd_state_contact_count(state);
   int base = PD_BODY_STATE_SIZE * model->movingCount;
-  double* body = calloc((size_t)(im->rows > 0 ? im->rows : 1), sizeof *body);
-  double* vel = calloc((size_t)(im->rows > 0 ? im->rows : 1), sizeof *vel);
-  PD_ASSERT(body != NULL && vel != NULL);
+  double* body = pd_zeroed((size_t)im->rows, sizeof *body);
+  double* vel = pd_zeroed((size_t)im->rows, sizeof *vel);
   for (int k = 0; k < model->movingCount; ++k)
     for (int i = 0; i < BODY_ROWS; ++i) vel[BODY_ROWS * k + i] = x[PD_BODY_STATE_SIZE * k + i];
   for (int c = 0; c < contacts; ++c) {

@@ -14,9 +14,9 @@
 
 // Moving bodies above which a system (an island, or the scene with islands off) is not stepped implicitly:
 // M's body part is a dense 6N × 6N matrix, factorised in O(N³) (~0.3 ms at 16 bodies, 8× that at 32), more than
-// the steps it saves on a larger system. Larger systems take step doubling (docs/integration.md). 16 until 3da7396:
-// at 32, with the switch's probation, stacks of 20-30 boxes took 0.72-0.83× the wall time (farm-bench), every soak
-// scene of campaigns 30 and 31 the same steps (their islands are smaller), the piles the same.
+// the steps it saves on a larger system. Larger systems take step doubling (docs/integration.md). 32 rather than
+// 16: with the switch's probation, stacks of 20-30 boxes took 0.72-0.83× the wall time of a bound at 16, and the
+// soak's random scenes (smaller islands) and the piles the same steps.
 #define PD_IMPLICIT_BODIES_MAX 32
 
 // The implicit stepper switches between step doubling and the implicit method system by system (integrator.c,
@@ -50,8 +50,11 @@
 
 typedef struct pdImplicit pdImplicit;
 
-// An empty workspace; it grows at pd_implicit_factor to the largest system it has seen (then allocates nothing).
+// An empty workspace, sized by pd_implicit_reserve before its first step and again, between steps, whenever the state
+// can hold more contacts (pd_state_reserve_contacts): a step allocates nothing (pd_implicit_linearise asserts it).
 pdImplicit* pd_implicit_create(void);
+// Room for a system of `movingCount` bodies and up to `contacts` contacts (grows only).
+void pd_implicit_reserve(pdImplicit* im, int movingCount, int contacts);
 void pd_implicit_free(pdImplicit* im);
 
 // Whether the system steps implicitly now, and the switch's bookkeeping (PD_IMPLICIT_SWITCH_STEPS).

@@ -51,12 +51,12 @@
 #include "samples.h"
 #include "state_layout.h"
 
-// Reading the clock costs about 25 ns on the machines measured (clock_gettime through the vDSO): the three reads
-// of every derivative evaluation were 14 % of cases/bench/pile_100's run (perf, 913bad4), whose islands of a
-// few boxes make an evaluation cheap. One evaluation in this many is timed and counted this many times, so the
+// Reading the clock (clock_gettime through the vDSO) is not free next to a small island's derivative: three reads
+// in every evaluation were 14 % of cases/bench/pile_100's run, whose islands of a few boxes make an evaluation
+// cheap. One evaluation in this many is timed and counted this many times, so the
 // forces and derivative stages are estimates; a prime, so that the timed ones fall on each of the step
 // doubling's 11 (10 or 7 on a retry) evaluations in turn. The count depends on the state alone: no output changes.
-// 31, not 13 as first: at 13 the reads were still ~1 % of cases/sweep/pile_10's run.
+// 31 rather than 13: at 13 the reads were still ~1 % of cases/sweep/pile_10's run.
 #define PD_DERIVATIVE_TIMING_STRIDE 31
 
 static void derivative(const pdModel* model, pdState* s, double t, const double* y, double* dydt) {
@@ -402,7 +402,10 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
 static double switching_step(const pdModel* model, pdState* s, double hMax) {
   if (model->movingCount > PD_IMPLICIT_BODIES_MAX)
     return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
-  if (!s->implicit) s->implicit = pd_implicit_create();
+  if (!s->implicit) {
+    s->implicit = pd_implicit_create();
+    pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
+  }
   pdImplicit* im = s->implicit;
   stepOutcome out = {0.0, false, false};
   if (!pd_implicit_active(im)) {

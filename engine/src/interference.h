@@ -51,7 +51,7 @@ typedef struct pdSatCache {
 } pdSatCache;
 
 // The cached feature of one pair of bodies (a < b), kept from one query to the next in a list sorted by (a, b)
-// (contact_set.c's contact search, islands.c's partition).
+// (contact_search.c, islands.c's partition).
 typedef struct pdPairSatCache {
   int a, b;
   pdSatCache sat;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "broad_phase.h"
+#include "grow.h"
 #include "interference.h"
 #include "model_contact.h"
 #include "polydyn/state.h"
@@ -15,7 +16,7 @@
 // (a fixed floor's size says nothing about how fast anything moves).
 #define PD_MIN_SPEED_LENGTHS_PER_SECOND 1.0
 
-// Bodies may touch at t = 0 but not interpenetrate (docs/DESIGN.md §4.1): a soft contact that starts deep would
+// Bodies may touch at t = 0 but not interpenetrate (docs/scene-language.md): a soft contact that starts deep would
 // begin with springs at rest and push nothing. Tolerance on the penetration depth, relative to the
 // smaller body's size: two bodies placed touching by decimal coordinates overlap by rounding only
 // (~1e-16 relative), while 1e-6 leaves room for a scene file written with 6 significant digits.
@@ -23,24 +24,23 @@
 
 static char* copy_string(const char* s) {
   size_t n = strlen(s) + 1;
-  char* c = malloc(n);
-  PD_ASSERT(c != NULL);
+  char* c = pd_grow(NULL, n, 1);
   memcpy(c, s, n);
   return c;
 }
 
-static bool build_shape(const pdSceneObject* o, pdPolyhedron* shape, char* why, int whySize) {
+static bool build_shape(const pdSceneObject* o, pdPolyhedron* shape, pdError* why) {
   switch (o->kind) {
     case pd_primCube:
-      return pd_polyhedron_cube(shape, o->scale, why, whySize);
+      return pd_polyhedron_cube(shape, o->scale, why);
     case pd_primPrism:
-      return pd_polyhedron_prism(shape, o->n, o->scale, 1.0, why, whySize);
+      return pd_polyhedron_prism(shape, o->n, o->scale, 1.0, why);
     case pd_primTprism:
-      return pd_polyhedron_prism(shape, o->n, o->scale, o->taper, why, whySize);
+      return pd_polyhedron_prism(shape, o->n, o->scale, o->taper, why);
     case pd_primSphere:
-      return pd_polyhedron_sphere(shape, o->n, o->scale, why, whySize);
+      return pd_polyhedron_sphere(shape, o->n, o->scale, why);
     case pd_primHull:
-      return pd_polyhedron_hull(shape, o->points, o->pointCount, why, whySize);
+      return pd_polyhedron_hull(shape, o->points, o->pointCount, why);
   }
   return false;
 }
@@ -199,13 +199,11 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
     pd_error_set(err, scene->path, 0, 0, "the scene defines no object");
     return NULL;
   }
-  pdModel* m = calloc(1, sizeof *m);
-  PD_ASSERT(m != NULL);
+  pdModel* m = pd_zeroed(1, sizeof *m);
   m->scenePath = copy_string(scene->path);
   m->bodyCount = scene->objectCount;
-  m->bodies = calloc((size_t)m->bodyCount, sizeof *m->bodies);
-  m->movingBodies = calloc((size_t)m->bodyCount, sizeof *m->movingBodies);
-  PD_ASSERT(m->bodies != NULL && m->movingBodies != NULL);
+  m->bodies = pd_zeroed((size_t)m->bodyCount, sizeof *m->bodies);
+  m->movingBodies = pd_zeroed((size_t)m->bodyCount, sizeof *m->movingBodies);
 
   for (int i = 0; i < scene->objectCount; ++i) {
     const pdSceneObject* o = &scene->objects[i];
@@ -217,10 +215,10 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
     b->where = o->where;
     b->density = 1000.0 * o->spgrav;
 
-    char why[256] = "";
+    pdError why = {0};
     pdMassProperties mp;
-    if (!build_shape(o, &b->shape, why, sizeof why) || !pd_mass_properties(&b->shape, b->density, &mp, why, sizeof why)) {
-      pd_error_set(err, scene->path, o->where.line, o->where.col, "object '%s': %s", o->name, why);
+    if (!build_shape(o, &b->shape, &why) || !pd_mass_properties(&b->shape, b->density, &mp, &why)) {
+      pd_error_set(err, scene->path, o->where.line, o->where.col, "object '%s': %s", o->name, why.message);
       pd_model_free(m);
       return NULL;
     }

@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   pdModel* model = scene ? pd_model_compile(scene, &err) : NULL;  // read-only: bodies, mass, materials
   pd_scene_free(scene);
   if (!model) return pd_error_print(&err, stderr), 2;  // FILE:LINE:COL: why
-  pdState* state = pd_state_create(model);             // everything a step needs is allocated here
+  pdState* state = pd_state_create(model, NULL);       // default options; all a step needs is allocated here
   bool ok = pd_advance(model, state, model->settings.tend, print_sample, stdout);
   pd_state_free(state), pd_model_free(model);
   return ok ? 0 : 1;

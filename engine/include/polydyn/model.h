@@ -15,14 +15,16 @@
 #include "polydyn/scene.h"
 #include "polydyn/vecmath.h"
 
+PD_EXTERN_C_BEGIN
+
 // The smallest restitution a scene may request (pd_model_compile refuses less, at the object's line).
 // Below e⁻² ≈ 0.135 the contact's normal damper is overdamped, which the model reproduces exactly; e = 0
 // would need an infinite damper, and below 0.01 (damping ratio 4.8) the damper's fast mode would force
 // integration steps about ten times shorter than the spring's.
 #define PD_RESTITUTION_MIN 0.01
 
-// Material of a body: as requested by the scene, and as finally used (docs/contact-model.md). In `requested`,
-// a value the scene did not set is -1 (mu always has a value: its default).
+// Material of a body: as requested by the scene, and as finally used (docs/contact-model.md). In `requested`, a
+// value the scene did not set is -1 (mu always has a value: its default).
 // In `used`, restitution is the requested e or the default (0.5); kn, kt, cn, ct are the values the scene
 // gave, or -1 where the contact model derives them for each pair of bodies (pd_model_pair_contact): springs
 // and dampers belong to a pair, not to one body.
@@ -95,7 +97,7 @@ typedef struct pdModel {
 // properties, shifts each body's frame to its centre of mass, sets initial states and settings, derives
 // the contact model's material parameters (paper §3.2, §3.3) and checks that no two bodies overlap.
 // Returns NULL and fills err (at the object's line) on a degenerate polyhedron, an empty scene, an
-// unreachable restitution (below PD_RESTITUTION_MIN) or bodies interpenetrating at t = 0 (docs/DESIGN.md §4.1).
+// unreachable restitution (below PD_RESTITUTION_MIN) or bodies interpenetrating at t = 0 (docs/scene-language.md).
 // The model copies what it needs: the scene may be freed right after. The caller owns the model
 // (pd_model_free); it is read-only from then on (any number of states and threads may share it).
 PD_API pdModel* pd_model_compile(const pdScene* scene, pdError* err);
@@ -177,3 +179,5 @@ PD_API double pd_model_pair_delta_max(const pdModel* model, int a, int b);
 
 // The pair constants of bodies a and b (model body indices, a != b, not both fixed), as used.
 PD_API pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b);
+
+PD_EXTERN_C_END
