@@ -9,7 +9,7 @@
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
 
-// Exit statuses (DESIGN §4.3).
+// Exit statuses (docs/commands.md).
 enum { PD_EXIT_OK = 0, PD_EXIT_FAILURE = 1, PD_EXIT_BAD_INPUT = 2 };
 
 int pd_cmd_run(int argc, char** argv);
@@ -56,7 +56,7 @@ bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out);
 extern volatile sig_atomic_t pd_cli_interrupted;
 void pd_cli_catch_interrupts(void);
 
-// --jobs N of the batch commands (README, Batch runs): a whole number 1..PD_CLI_MAX_JOBS; false when not.
+// --jobs N of the batch commands (docs/commands.md): a whole number 1..PD_CLI_MAX_JOBS; false when not.
 #define PD_CLI_MAX_JOBS 64
 bool pd_cli_jobs(const char* text, int* jobs);
 // The worker processes of this process: `given` when --jobs was given (> 0), else `serialDefault`, or 1

@@ -1,5 +1,5 @@
 // polydyn compare — one scene (or every scene of a directory) in every engine, metrics against a tighter
-// soft run (DESIGN §5). Each scene is one task of a batch (refcheck/include/polydyn/batch.h).
+// soft run (docs/DESIGN.md §8.1). Each scene is one task of a batch (refcheck/include/polydyn/batch.h).
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
@@ -18,7 +18,7 @@
 #include "polydyn/refcheck.h"
 #include "polydyn/state.h"
 
-// The reference run's tolerance over the scene's: DESIGN §5 ("our own run at a 100× tighter tolerance").
+// The reference run's tolerance over the scene's: docs/DESIGN.md §8.1 ("our own run at a 100× tighter tolerance").
 #define COMPARE_REFERENCE_TOL_SCALE 0.01
 // Longest --out path: the run directories' paths below it fit the fixed buffers.
 #define COMPARE_PATH_MAX 3000
@@ -38,7 +38,7 @@ static const char* const help =
     "  --step H         the reference engines' step, s (default 1e-3)\n"
     "  --tend T, --sample HZ   override the scene's settings for every run\n"
     "  --jobs N         compare N scenes at a time in worker processes (default 1); under mpirun or srun the\n"
-    "                   scenes are split over the ranks (README, Batch runs). Scenes compared side by side\n"
+    "                   scenes are split over the ranks (docs/commands.md). Scenes compared side by side\n"
     "                   share the machine: wall_per_sim_second then measures a loaded machine\n"
     "\n"
     "With SCENE_DIR, every SCENE_DIR/NAME.scene (in byte order of the names) is compared into DIR/NAME/\n"

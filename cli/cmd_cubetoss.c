@@ -1,5 +1,5 @@
 // polydyn cubetoss — real cube tosses in every engine, and fitting each engine's free parameters to them
-// (DESIGN §5 "Real data"; the library part is refcheck/include/polydyn/cubetoss.h).
+// (docs/DESIGN.md §8.4; the library part is refcheck/include/polydyn/cubetoss.h).
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -61,7 +61,7 @@ static const char* const help =
     "  --tol T          the soft engine's integration tolerance (default 1e-6)\n"
     "  --inertia I      the cube's moment of inertia, kg m^2 (default 8.1e-4, the data's), or uniform\n"
     "  --jobs N         worker processes (default 2; 1 per rank under mpirun or srun, where the tosses\n"
-    "                   are split over the ranks: README, Batch runs)\n"
+    "                   are split over the ranks: docs/commands.md)\n"
     "  --no-runs        keep no run directories (only the CSVs)\n"
     "  --train-every K  fit on every K-th training toss (default 1: all)\n"
     "  --max-evals N    objective evaluations per engine (default 100); --size-tol S simplex size (0.01)\n"

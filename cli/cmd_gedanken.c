@@ -29,7 +29,7 @@ static const char* const help =
     "                       matched variants; an engine this build has no adapter for gives NOT_BUILT rows\n"
     "  --fast               only the fast subset that CI runs\n"
     "  --jobs N             runs in N worker processes (default 2; 1 per rank under mpirun or srun, where the\n"
-    "                       runs are split over the ranks: README, Batch runs); the files are the same bytes\n"
+    "                       runs are split over the ranks: docs/commands.md); the files are the same bytes\n"
     "                       whatever N, except the measured wall times\n"
     "  --tolerance-scale F  multiply every tolerance by F > 0 (default 1: the catalogue's); only to check that\n"
     "                       failures are reported, the verdicts are then not the catalogue's\n"

@@ -1,4 +1,4 @@
-// polydyn oracle — our interference test against libccd (README "Interference oracle"): random pairs
+// polydyn oracle — our interference test against libccd (docs/validation.md): random pairs
 // near touching, every pair of a soft run at every output sample, or the rows of an earlier CSV again.
 #include <errno.h>
 #include <signal.h>

@@ -1,4 +1,4 @@
-// polydyn run — simulate a scene and write its run directory (DESIGN §4.2).
+// polydyn run — simulate a scene and write its run directory (docs/outputs.md).
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,24 +23,24 @@ static const char* const help =
     "\n"
     "  --out DIR        run directory (default: out/NAME, NAME = scene file name without extension)\n"
     "  --engine NAME    soft: polydyn's soft-contact engine (default); ode, bullet: the same model in\n"
-    "                   a reference engine (README \"Reference engines\")\n"
+    "                   a reference engine (docs/validation.md)\n"
     "  --tend T         simulated seconds, overrides the scene's tend\n"
     "  --sample HZ      output samples per second, overrides the scene's sample\n"
     "  --stepper NAME   implicit (default): RK4 with step-doubling error control, switching island by\n"
     "                   island to a linearly implicit method (ROS34PW2) where the contacts' stability\n"
     "                   bound holds RK4 to a fraction of the steps its error allows: resting and\n"
-    "                   sliding contact, islands of up to 32 bodies (README \"Integration\");\n"
+    "                   sliding contact, islands of up to 32 bodies (docs/integration.md);\n"
     "                   adaptive: RK4 with step-doubling error control alone (the paper's);\n"
     "                   fixed: RK4 with the scene's dt, no error control;\n"
     "                   embedded: RK4 with its embedded third-order error estimate\n"
     "  --onsets MODE    soft engine, a contact that began inside a step: exact cuts the whole step back\n"
     "                   to its onset; pair joins it at the step's end, run for that pair alone since its\n"
     "                   onset, when it began within 1/omega and is shallow; auto (default) pair in an island\n"
-    "                   of more than 16 moving bodies, exact in smaller ones (README \"Contact onsets\")\n"
+    "                   of more than 16 moving bodies, exact in smaller ones (docs/contact-model.md)\n"
     "  --islands on|off soft engine: on (default) splits the bodies between output samples into islands\n"
     "                   (bodies in contact or whose boxes may meet before the next sample), each with its\n"
     "                   own steps and contact events; off advances all bodies with one step size\n"
-    "                   (README \"Islands\")\n"
+    "                   (docs/integration.md)\n"
     "  --sleep on|off   soft engine with islands on: on (the scene's `sleep`, default on) stops integrating\n"
     "                   an island whose bodies stayed at rest for a few periods of its slowest contact\n"
     "                   until a moving body may reach it or an applied force changes; off integrates every\n"

@@ -1,4 +1,4 @@
-// polydyn soak — the random-scene soak (refcheck/include/polydyn/soak.h; README, Reliability). Each scene
+// polydyn soak — the random-scene soak (refcheck/include/polydyn/soak.h; docs/reliability.md). Each scene
 // is one task of a batch (refcheck/include/polydyn/batch.h); its runs go through child processes.
 #include <errno.h>
 #include <signal.h>
@@ -35,7 +35,7 @@ static const char* const help =
     "  --budget SECONDS wall-time budget of one run (default 20)\n"
     "  --jobs N         scenes in N worker processes (default 1; under mpirun or srun split over the ranks)\n"
     "  --onsets MODE    soft engine: how a contact that began inside a step joins, pair, exact or auto (default:\n"
-    "                   the engine's, as polydyn run --onsets; README \"Contact onsets\")\n"
+    "                   the engine's, as polydyn run --onsets; docs/contact-model.md)\n"
     "\n"
     "Exit status: 0 no failure, 1 a run failed (or the results could not be written), 2 bad input,\n"
     "130 interrupted (nothing written).\n";

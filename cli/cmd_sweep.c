@@ -1,4 +1,4 @@
-// polydyn sweep — work-precision: error against wall time over tolerances and step sizes (DESIGN §5,
+// polydyn sweep — work-precision: error against wall time over tolerances and step sizes (docs/DESIGN.md §8,
 // reports/FORMATS.md, protocol: shared reference speed-accuracy.md §4.4).
 //
 // Every point runs the same model (only tol, or the step, changes) with no output files, R times; the
@@ -60,7 +60,7 @@ static const char* const help =
     "Writes DIR/sweep.csv (reports/FORMATS.md) and DIR/reference.json; DIR is replaced atomically.\n"
     "\n"
     "  --jobs N   run N points at a time in worker processes (default 1); under mpirun or srun the points are\n"
-    "             split over the ranks (README, Batch runs). Every point's repeats stay in one process, one\n"
+    "             split over the ranks (docs/commands.md). Every point's repeats stay in one process, one\n"
     "             after the other, but points running side by side share the machine: the wall times then\n"
     "             measure a loaded machine. Everything but the wall times is the same bytes whatever N.\n"
     "\n"

@@ -1,4 +1,4 @@
-// polydyn gedanken — group B: friction (catalogue §2 B1–B6, and the friction cone of DESIGN §5).
+// polydyn gedanken — group B: friction (catalogue §2 B1–B6, and the friction cone of docs/DESIGN.md §8.3).
 #include <stdlib.h>
 
 #include "gedanken_internal.h"
@@ -276,7 +276,7 @@ const pdGkExperiment pd_gk_b2_stop_time = {
     .series = b2_stop_series,
 };
 
-// Friction cone (DESIGN §5: stopping distance against push direction): the same block launched at 1 m/s
+// Friction cone (docs/DESIGN.md §8.3: stopping distance against push direction): the same block launched at 1 m/s
 // at an angle to its faces. Coulomb friction is isotropic, so the distance is the same in every direction;
 // a pyramid approximation of the cone stops the block later along its diagonals.
 

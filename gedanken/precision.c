@@ -1,4 +1,4 @@
-// polydyn gedanken — work-precision against the closed form (issue 17 item 1; RESULT_SCHEMAS.md, precision.csv).
+// polydyn gedanken — work-precision against the closed form (RESULT_SCHEMAS.md, precision.csv).
 //
 // The sweep (`polydyn sweep`) measures each engine against runs of its own; here each engine is measured against
 // what physics says: every quantitative experiment runs on its precision input at every setting of each engine's
@@ -18,7 +18,7 @@
 #include "polydyn/scene.h"
 #include "polydyn/stats.h"
 
-// The knobs, loosest first (the header lists them; README "Work-precision per experiment").
+// The knobs, loosest first (the header lists them; docs/validation.md).
 static const double softTolerances[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
 static const double softFixedSteps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};                              // s
 static const double referenceSteps[] = {1.0 / 60, 1.0 / 250, 1.0 / 1000, 1.0 / 4000, 1.0 / 16000};  // s

@@ -36,7 +36,7 @@ enum { LISTED_PAIRS_MAX = 64 };
 // 3.24 that test adds an edge–edge contact at the edges' witness points when an edge pair's axis ties with
 // the face normal to round-off, far from the real contact (measured: an elastic octahedron landing vertex
 // first on a cube rebounds with e = 1.22 and spins). The GJK path has its own flaw, smaller: its EPA point
-// joins the manifold and can displace a corner of a flat face contact (README "Reference engines: Bullet").
+// joins the manifold and can displace a corner of a flat face contact (docs/validation.md, Bullet).
 // native: Bullet's rigid contact with Newton restitution (above Bullet's default approach speed of
 // 0.2 m/s); every penetration is recovered by the split impulse (threshold 0 instead of −0.04 m), so the
 // push-out never adds to the bounce velocity (with −0.04: e 0.545 for 0.5).
@@ -166,7 +166,7 @@ static pdRefWorld* bullet_create(const pdModel* model, const pdRefOptions* optio
 
   // Fixed bodies first: Bullet's hull–hull clipping takes the first-added body's face as the reference
   // face, and a vertex landing on a fixed face is placed right only when that face is the reference (see
-  // the README: with the order reversed, an octahedron dropped vertex first gets its contact point off the
+  // docs/validation.md (Bullet): with the order reversed, an octahedron dropped vertex first gets its contact point off the
   // vertex and spins). Then the moving bodies in scene order: Bullet body fixedCount + moving index.
   w->fixedCount = model->bodyCount - model->movingCount;
   for (int pass = 0; pass < 2; ++pass) {

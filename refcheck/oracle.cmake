@@ -1,4 +1,4 @@
-# The libccd interference oracle (README "Interference oracle"): Debian's libccd-dev, built in double.
+# The libccd interference oracle (docs/validation.md): Debian's libccd-dev, built in double.
 pkg_check_modules(CCD REQUIRED IMPORTED_TARGET ccd)
 target_sources(polydyn_refcheck PRIVATE ${CMAKE_CURRENT_LIST_DIR}/oracle.c ${CMAKE_CURRENT_LIST_DIR}/oracle_shapes.c
                                         ${CMAKE_CURRENT_LIST_DIR}/oracle_csv.c ${CMAKE_CURRENT_LIST_DIR}/oracle_timing.c)

@@ -2,7 +2,7 @@
 //
 //   embed [SCENE] [SECONDS]
 //
-// SCENE is a scene file (README "Scene files"); without it, the built-in scene below (a tilted 0.1 m cube
+// SCENE is a scene file (docs/scene-language.md); without it, the built-in scene below (a tilted 0.1 m cube
 // dropped onto a fixed floor). SECONDS is how long to run (default: the scene's tend). Uses the public API
 // of <polydyn/...> only. Prints, at every output sample of the scene (its `sample` rate):
 //   pose    T BODY x y z qw qx qy qz vx vy vz   each moving body: centre of mass (m), orientation, velocity (m/s)

@@ -145,7 +145,7 @@ def compare(scene, out=None, *, engines=ENGINES, variants=("native", "matched"),
 
 def cubetoss(data, out=None, *, engines=("soft",), tosses="test", variant=None, step=None, tol=None, jobs=2,
              runs=False, params=()):
-    """`polydyn cubetoss`: recorded tosses of a real cube (data: the CSV, README "Cube tosses") simulated and judged.
+    """`polydyn cubetoss`: recorded tosses of a real cube (data: the CSV, docs/validation.md) simulated and judged.
     Returns per_toss.csv as a Table (toss, split, engine, variant, params, status, samples, duration_s,
     pos_err_end, pos_err_rms, rot_err_end_rad, rot_err_rms_rad, ...); table.summary: summary.csv. runs: also keep
     every run directory (only useful with out). params: --params values ("ENGINE=FILE" or "FILE")."""

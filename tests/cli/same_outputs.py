@@ -3,7 +3,7 @@
 
 usage: same_outputs.py DIR_A DIR_B
 
-The same files must exist in both, with the same bytes, except (README, "Batch runs"):
+The same files must exist in both, with the same bytes, except (docs/commands.md):
   - CSV columns named wall_seconds, cpu_seconds or wall_per_sim_second, and CSV rows whose quantity is one of
     them (cubetoss's summary.csv): their other fields must be the same strings;
   - in JSON files the "timing" line of a run's summary.json and the value of "wall_seconds" (sweep's

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end tests of the polydyn command (DESIGN §4.2, §4.3): help and usage errors, the run
+# End-to-end tests of the polydyn command (docs/outputs.md, docs/commands.md): help and usage errors, the run
 # directory (format, atomicity, determinism, replacement), bad scenes, overrides, interruption, check.
 #
 # usage: test_cli.sh POLYDYN_BINARY PROJECT_SOURCE_DIR
@@ -112,7 +112,7 @@ printf 'loc 0 0 0\ncube a red 1 1 1\n' >"$BAD/property_before_object.scene"
 printf 'cube a red 1 1 1\ncube a blue 1 1 1\nloc 3 0 0\n' >"$BAD/duplicate_name.scene"
 printf 'hull h red 0 0 0  1 0 0  0 1 0  1 1 0\n' >"$BAD/coplanar_hull.scene"
 printf '# nothing here\n' >"$BAD/no_object.scene"
-# two cubes of side 0.1 m with centres 0.09 m apart: 1 cm of overlap at t = 0 (DESIGN §4.1)
+# two cubes of side 0.1 m with centres 0.09 m apart: 1 cm of overlap at t = 0 (docs/DESIGN.md §4.1)
 printf 'cube a red 0.1 0.1 0.1\ncube b red 0.1 0.1 0.1\nloc 0.09 0 0\n' >"$BAD/overlapping_bodies.scene"
 # below 0.01 the contact model refuses the restitution (its damper would need steps ~10x shorter)
 printf 'cube a red 1 1 1\nrestitution 0.005\n' >"$BAD/unreachable_restitution.scene"

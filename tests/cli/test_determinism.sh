@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Determinism of the commands' outputs (README, "Reliability: determinism"; issue 15 item 4): the same
+# Determinism of the commands' outputs (docs/reliability.md): the same
 # command twice gives the same files, byte for byte, except the measured times (same_outputs.py names
 # them: wall/CPU time columns, the "timing" line of summary.json, "wall_seconds" of JSON; the "time" lines
 # of oracle's summary on stdout). The second run of each pair writes to a differently named directory and

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Faults (issue 15 item 3): every command that writes an output directory — run, compare, sweep, gedanken,
+# Faults: every command that writes an output directory — run, compare, sweep, gedanken,
 # cubetoss, soak, report — against an interrupt at random moments (SIGINT and SIGTERM), a full disk (a file-size
 # limit: `ulimit -f`, which a polydyn process turns into failed writes, not SIGXFSZ) and an output directory that
 # cannot be created. Whatever happens: never a half-written result that looks complete (a directory at the

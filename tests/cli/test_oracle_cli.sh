@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end tests of `polydyn oracle` (README "Interference oracle"): help and usage errors, random
+# End-to-end tests of `polydyn oracle` (docs/validation.md): help and usage errors, random
 # pairs (summary, CSV format, determinism, no NaN), replay of the listed pairs (same verdicts again), a
 # small scene, and bad input (scene, CSV) refused with its location and nothing written.
 #

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# The random-scene soak (README, Reliability; cli/cmd_soak.c, refcheck/soak.c).
+# The random-scene soak (docs/reliability.md; cli/cmd_soak.c, refcheck/soak.c).
 # - CI's campaign: seed 1, scenes 0..SCENES-1 (500; 100 in the ASan + UBSan build, 10-40 times slower, whose
 #   runs get a budget of 300 s instead of 20), in
 #   the soft engine, ODE and Bullet: every run ok, or refused where
 #   it must be (the overlap scenes), no failure, no run over its budget; summary.csv has a row per scene and
 #   engine; the same command again gives the same rows but the measured times (scene i of campaign S is a
 #   function of S and i alone, and the runs are deterministic);
-# - regressions the soak found and that are fixed (README, Reliability): seed 2 scene 2945 (a stack of eight
+# - regressions the soak found and that are fixed (docs/reliability.md): seed 2 scene 2945 (a stack of eight
 #   flush boxes sank 29 delta_max), seed 1 scene 147 with --onsets pair (seven flush boxes fell apart), seed 1 scenes 4, 7, 19 (inside the campaign: a sliver's sharp rim pressed
 #   into a box found no edge-edge contact), seed 3 scene 1779 (such a sharp edge's pair was pruned before the
 #   contact search looked at it: two bodies sank 15 delta_max with no contact), seed 3 scenes 1931, 2429, 2707,

@@ -24,7 +24,7 @@
 #define PI 3.14159265358979323846
 #define G 9.81  // m/s², the scene default
 
-// Catalogue tolerances (A1, A3, A4, B1, B2, C2) and the (C3: 2 %).
+// Catalogue tolerances (A1, A3, A4, B1, B2, C2) and 2 % for C3, the eccentric bar.
 #define RESTITUTION_TOL 0.005
 #define ELASTIC_RESTITUTION_TOL 1e-3
 #define APEX_DRIFT_PER_BOUNCE 1e-3      // relative

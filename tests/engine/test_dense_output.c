@@ -1,4 +1,4 @@
-// Dense output (engine/src/dense_output.h; README, "Integration"): the output samples and pd_advance's end do not cut
+// Dense output (engine/src/dense_output.h; docs/integration.md): the output samples and pd_advance's end do not cut
 // the error-controlled steppers' steps; the state is presented at each sample inside the step that passes it.
 // - The steps do not depend on the sample rate: a scene with contacts sampled at 50 Hz and at 1 kHz takes the same
 //   steps, and its states at the common samples are the same bit for bit (islands off and on; step doubling, the

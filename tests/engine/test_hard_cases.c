@@ -1,4 +1,4 @@
-// The hard cases (cases/hard/*.scene, issue item 8): thin plate, mass ratio 10⁴, a fast cube onto a thin
+// The hard cases (cases/hard/*.scene): thin plate, mass ratio 10⁴, a fast cube onto a thin
 // slab, crossed bars edge on edge, vertex on vertex, equal cubes face on face, a 10-box stack, a grazing
 // impact, a running-bond brick wall (flush side faces). Each scene runs through pd_advance to its tend; at every output
 // sample the observer checks:

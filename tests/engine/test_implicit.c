@@ -1,8 +1,8 @@
 // The implicit stepper (pd_stepperImplicit; engine/src/implicit.c, integrator.c): its matrix W against finite
 // differences of the state derivative, its linear solve against W, and what it is for: a box resting on a ramp
 // below its friction angle sticks as with step doubling, in a small fraction of the steps; a switch that does not pay
-// is given up; and the same scene gives the same bytes on every run. (The closed forms of issue 13 with this stepper:
-// test_ordinary_scenes.c's third group.)
+// is given up; and the same scene gives the same bytes on every run. (The closed forms of a newcomer's scenes with this
+// stepper: test_ordinary_scenes.c's third group.)
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -224,8 +224,8 @@ static void test_a_probation_step_must_leave_room_to_grow(void** state) {
 
 // Islands of up to PD_IMPLICIT_BODIES_MAX (32) moving bodies step implicitly: the stack of 20 boxes of the scale
 // benchmark (cases/bench/stack_20.scene), one island, settles in fewer steps than step doubling takes. Measured: 1 343
-// accepted steps (247 implicit) against 2 061 for its 0.5 s; with the limit at 16 (until 3da7396) the same as step
-// doubling.
+// accepted steps (247 implicit) against 2 061 for its 0.5 s; with a limit of 16 bodies the stack took as many as
+// step doubling.
 #define STACK_20_STEP_SHARE_MAX 0.8
 
 static void test_a_stack_of_20_steps_implicitly(void** state) {

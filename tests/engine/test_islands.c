@@ -1,4 +1,4 @@
-// Islands (issue 16 item 2; engine/src/islands.c; README, "Islands"): with pd_islandsOn the moving bodies
+// Islands (engine/src/islands.c; docs/integration.md): with pd_islandsOn the moving bodies
 // advance between output samples in islands, each with its own steps and contact events.
 // - two groups far apart (a resting stack in one corner, a bouncing cube in the other) give, body for body,
 //   the same numbers bit for bit as each group run alone with islands on (an island's model holds its own
@@ -47,7 +47,7 @@
 #include "polydyn/state.h"
 #include "scene_run.h"
 
-#define RESTITUTION_TOL 0.01       // absolute, on e (issue 13's, as tests/engine/test_onsets.c)
+#define RESTITUTION_TOL 0.01       // absolute, on e (as tests/engine/test_onsets.c)
 #define PENETRATION_MAX_DELTA 3.0  // of the pair's δ_max (the soak's limit)
 #define ENERGY_GAIN_TOL 1e-6       // relative to |E(0)|: integration error only (tol 1e-6 of the scene)
 // Islands on against islands off for a group alone: both are adaptive RK4 at the scene's tol (1e-6 of the

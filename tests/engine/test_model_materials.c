@@ -1,4 +1,4 @@
-// Material parameters in a compiled model (paper §3.2, §3.3; DESIGN §3.4, §4.1): the pair's k_n from
+// Material parameters in a compiled model (paper §3.2, §3.3; docs/DESIGN.md §6.4, §4.1): the pair's k_n from
 // eq. (11) with the scene's vmax and deflection at the pair's reduced mass and the smaller body's size (a
 // floor's size does not matter; δ_max at most a quarter of the thinner body's width), the default restitution
 // and modal dampers, explicit constants winning, pair constants (symmetry, μ = √(μ₁μ₂), e = √(e₁e₂), tabulated

@@ -1,4 +1,4 @@
-// Contact onsets (issue 16 item 5; README, "Contact onsets"): a contact that began inside a step either
+// Contact onsets (docs/contact-model.md): a contact that began inside a step either
 // cuts the whole step back to its onset (pd_onsetsExact) or, when it began within 1/ω of the step's end
 // and is still shallow, joins there with the motion its pair alone would have had since the onset
 // (pd_onsetsPair, selectable). The pair mode must give the same closed forms as the exact one:
@@ -6,7 +6,7 @@
 //   within 0.01 of the requested e in both modes;
 // - the rest height of a cube dropped onto a floor: half its size less its static deflection m g/(4 k_s),
 //   within 0.05 δ_max (a pair onset's rest point sits ~d (ωτ)²/6 ≤ 0.042 δ_max deeper while it lasts)
-//   in the pair mode and 0.01 δ_max in the exact one (both measured 5.5e-3 δ_max at 8b609f1: the cube bounces
+//   in the pair mode and 0.01 δ_max in the exact one (both measured 5.5e-3 δ_max: the cube bounces
 //   and re-lands a few times, each landing located to 1e-3 δ_max), from 24 heights 2.8 mm apart: since the samples
 //   stopped cutting the steps, 2 of them land with pair onsets (8 in all; 9.1e-3 and 8.2e-3 δ_max);
 // - a column of boxes dropped onto a floor: no energy gained at any sample, and fewer onset retries than
@@ -31,7 +31,7 @@
 #include "polydyn/state.h"
 #include "scene_run.h"
 
-#define RESTITUTION_TOL 0.01       // absolute, on e (issue 13's)
+#define RESTITUTION_TOL 0.01       // absolute, on e: a hundredth of the range of e
 #define REST_PAIR_TOL_DELTA 0.05   // of δ_max: a pair onset's rest-point shift (contact_set.c) with margin
 #define REST_EXACT_TOL_DELTA 0.01  // of δ_max: several landings, each located to the onset tolerance 1e-3 δ_max
 #define ENERGY_GAIN_TOL 1e-9       // relative to |E(0)|: integration error only, no energy from the onsets

@@ -1,4 +1,4 @@
-// Scenes as a newcomer writes them (issue 13): a 0.1 m cube on fixed floors and ramps of other sizes,
+// Scenes as a newcomer writes them: a 0.1 m cube on fixed floors and ramps of other sizes,
 // only mu and perhaps restitution set, every other constant left to the defaults (vmax estimated, pair
 // stiffness, modal dampers, tangential springs damped at ζ_t = 1/√3). Each test checks a closed form:
 // - restitution (0.1 … 0.95) of face-, edge- and vertex-first impacts on floors 1×, 10× and 100× the cube's size and of
@@ -27,7 +27,7 @@
 #define G 9.81  // m/s², the scene default
 #define PI 3.14159265358979323846
 
-// The issue's tolerances.
+// Tolerances a user checking these scenes by hand would accept.
 #define RESTITUTION_TOL 0.01           // absolute, on e
 #define STICK_SPEED 1e-6               // m/s, after STICK_SETTLE
 #define STICK_SETTLE 0.5               // s
@@ -36,8 +36,8 @@
 #define REST_TIME_TOL 0.05             // s
 #define RAMP_ACCEL_REL_TOL 0.01
 #define LATERAL_DRIFT 1e-6             // m
-// A box twisting to rest on a floor: with the tangential dampers overdamping its twist (ζ_t = 1 before issue 13's
-// second round) 10.5 % of its trial steps were rejected; with the twist critically damped, under 1 % (and none once
+// A box twisting to rest on a floor: with the tangential dampers overdamping its twist (ζ_t = 1, as they once
+// were) 10.5 % of its trial steps were rejected; with the twist critically damped, under 1 % (and none once
 // it rests: counted from 0.25 s since the samples stopped cutting the steps, which left the first steps' 7 rejections
 // a share of 7 % of the 96 steps the implicit stepper then took).
 #define TWIST_REJECTED_SHARE_MAX 0.02

@@ -1,4 +1,4 @@
-// The contacts' stability bound (README, Integration; engine/src/contact_set.c): the smaller of a cheap Gershgorin
+// The contacts' stability bound (docs/integration.md; engine/src/contact_set.c): the smaller of a cheap Gershgorin
 // bound of the contact-space matrix and a tight one of the body-space matrix. The tight bound is formed only for
 // a step that the cheap one does not settle (the step the error control wants is longer than the cheap bound
 // allows), and summary.json's `stability_tight` counts those steps. Two scenes with a 0.1 m cube on a fixed floor,
@@ -6,9 +6,7 @@
 // - resting: the error control wants long steps and the bound sets them, so most steps need the tight bound;
 // - dropped tilted with restitution 0.8: in flight there is no contact and during the bounces the error control
 //   keeps the steps short, so few steps need it.
-// In both the tight bound is formed at most once per step that needs it. (Until ced591b the bound the cheap one
-// stood for was formed for every contact list in every build, by a check under #ifndef NDEBUG, which no build
-// defines: these tests would have failed.) The sanitizer build's self-check (PD_SELF_CHECKS) compares both bounds
+// In both the tight bound is formed at most once per step that needs it. The sanitizer build's self-check (PD_SELF_CHECKS) compares both bounds
 // with the largest eigenvalue of the contact-space matrix on every list of up to 32 contacts, in every test.
 #include <math.h>
 #include <setjmp.h>
@@ -84,7 +82,7 @@ static void test_a_bouncing_cube_needs_it_on_few_steps(void** state) {
 // vertical, so its modes are the bounce, ω² = 4 k/m, and the rocking about either horizontal axis,
 // ω² = 4 k (a/2)² / I = 6 k/m with I = m a²/6; k the pair's series normal stiffness. The body-space bound is exact
 // here (its off-diagonal terms cancel by symmetry), where the contact-space Gershgorin bound gave 8 k/m
-// (README, Integration): the step it allows is 2 × 2.5 / ω_max for the rocking mode, to the bound's margin.
+// (docs/integration.md): the step it allows is 2 × 2.5 / ω_max for the rocking mode, to the bound's margin.
 #define CUBE_ROCKING_REL_TOL 1e-6  // the corners' lever arms are a/2 to the static deflection (~1e-5 of a)
 
 static void test_the_tight_bound_of_a_cube_resting_on_a_face_is_its_rocking_mode(void** state) {

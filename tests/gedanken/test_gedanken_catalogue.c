@@ -15,7 +15,7 @@
 #include "polydyn/gedanken.h"
 #include "polydyn/scene.h"
 
-#define MIN_EXPERIMENTS 20  // issue 5: "at least 20 experiments"
+#define MIN_EXPERIMENTS 20  // the catalogue's promise: at least 20 experiments
 
 static void test_catalogue_covers_every_group(void** state) {
   (void)state;
@@ -49,7 +49,7 @@ static void test_every_experiment_is_complete(void** state) {
     // names are file and directory names (series/NAME.csv, runs/NAME/) and CSV fields
     assert_true(strspn(e->name, "abcdefghijklmnopqrstuvwxyz0123456789_") == strlen(e->name));
     assert_true(e->name[0] == e->group - 'A' + 'a');
-    // issue 17 item 4: a law is judged on every variant; a model prediction on the soft engine at least (its
+    // A law is judged on every variant; a model prediction on the soft engine at least (its
     // own model) and not on every variant, with the reason for the others
     assert_true(e->kind == pd_gkLaw || e->kind == pd_gkModelPrediction);
     if (e->kind == pd_gkLaw) {
@@ -80,7 +80,7 @@ static void test_applicability_follows_the_kind(void** state) {
       }
     if (e->kind == pd_gkLaw) assert_int_equal(judged, 5);
   }
-  // the issue's examples: sinkage is the soft model's, a stop distance and momentum are laws
+  // the examples of docs/validation.md: sinkage is the soft model's, a stop distance and momentum are laws
   assert_int_equal(pd_gk_find("a3_sinkage")->kind, pd_gkModelPrediction);
   assert_false(pd_gk_applies(pd_gk_find("a3_sinkage"), pd_gkOde, false));
   assert_true(pd_gk_applies(pd_gk_find("a3_sinkage"), pd_gkOde, true));

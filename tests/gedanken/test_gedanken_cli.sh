@@ -85,7 +85,7 @@ check "all engines: one soft row and ode/bullet native and matched rows" \
   '[ "$(csv_query "$REF/results.csv" "[(r[\"engine\"], r[\"variant\"]) for r in rows]")" = "[('"'"'soft'"'"', '"'"'implicit'"'"'), ('"'"'ode'"'"', '"'"'native'"'"'), ('"'"'ode'"'"', '"'"'matched'"'"'), ('"'"'bullet'"'"', '"'"'native'"'"'), ('"'"'bullet'"'"', '"'"'matched'"'"')]" ]'
 check "all engines: statuses from the schema; a run directory exactly for PASS, FAIL, NOT_APPLICABLE (and some ERRORs)" \
   '[ "$(csv_query "$REF/results.csv" "all(r[\"status\"] in (\"PASS\", \"FAIL\", \"REFUSED\", \"NOT_BUILT\", \"ERROR\", \"NOT_APPLICABLE\") and (r[\"status\"] == \"ERROR\" or (r[\"run_dir\"] != \"\") == (r[\"status\"] in (\"PASS\", \"FAIL\", \"NOT_APPLICABLE\"))) for r in rows)")" = True ]'
-# a3_sinkage is a prediction of the soft model (issue 17 item 4): judged on soft and the matched variants; the
+# a3_sinkage is a prediction of the soft model: judged on soft and the matched variants; the
 # rigid native variants still run and record their sinkage, not judged, with the reason in the note
 check "model prediction: native rows NOT_APPLICABLE (or NOT_BUILT) with the reason, matched and soft judged" \
   '[ "$(csv_query "$REF/results.csv" "all((r[\"status\"] == \"NOT_APPLICABLE\" and r[\"measured\"] != \"\" and r[\"note\"].startswith(\"not applicable: \") and \"rigid contact does not sink\" in r[\"note\"]) or r[\"status\"] == \"NOT_BUILT\" if r[\"variant\"] == \"native\" else r[\"status\"] in (\"PASS\", \"FAIL\", \"NOT_BUILT\") for r in rows)")" = True ]'
@@ -94,7 +94,7 @@ check "model prediction: experiments.json names the kind, the judged variants an
 check "a law: every variant judged, no reason" \
   '[ "$(python3 -c "import json; e = [x for x in json.load(open(\"$FAST/experiments.json\")) if x[\"name\"] == \"c2_momentum\"][0]; print(e[\"kind\"], len(e[\"applies_to\"]), e[\"not_applicable_reason\"])")" = "law 5 None" ]'
 
-# --- work-precision against the closed form (--precision, issue 17 item 1) ----------------------------
+# --- work-precision against the closed form (--precision) -------------------------------------------
 PREC=$SCRATCH/precision
 PHEADER='experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,judged,status,wall_seconds,wall_per_sim_second,steps,repeats,note'
 run_pd gedanken --only a1_restitution,c3_eccentric_bar --precision --repeats 2 --out "$PREC"

@@ -91,6 +91,14 @@ rc=$?
 check "embed runs a scene file" '[ $rc -eq 0 ]'
 x=$(awk '$1 == "pose" {x = $4} END {print x}' "$tmp/slide.out")
 check "the slide stops at x = 0.22936 m ± 1 mm (x = $x)" 'awk -v x="$x" "BEGIN {exit !(x > 0.22836 && x < 0.23036)}"'
+# The README's 20-line example (examples/embed/minimal.c) on the same scene: at its last sample the 1 kg cube
+# rests, so its contacts' normal forces sum to m g = 9.81 N (± 0.01 N: the springs' ringing has died out).
+"$tmp/cmake/embed_minimal" "$src/cases/user/floor_slide.scene" >"$tmp/minimal.out" 2>&1
+rc=$?
+fsum=$(awk '{t[NR] = $1; f[NR] = $(NF - 1)} END {for (i = 1; i <= NR; i++) if (t[i] == t[NR]) s += f[i]; print s}' \
+  "$tmp/minimal.out")
+check "the README's example runs and its last contacts carry m g = 9.81 N ± 0.01 N ($fsum)" \
+  '[ $rc -eq 0 ] && awk -v f="$fsum" "BEGIN {exit !(f > 9.80 && f < 9.82)}"'
 run_pd_installed() { "$prefix/bin/polydyn" "$@" >"$tmp/cli.out" 2>"$tmp/cli.err"; rc=$?; }
 run_pd_installed run "$src/cases/user/floor_slide.scene" --out "$tmp/slide-run"
 check "installed polydyn run works outside the build tree" '[ $rc -eq 0 ] && [ -f "$tmp/slide-run/summary.json" ]'

@@ -8,3 +8,6 @@ set_tests_properties(test_cubetoss_data PROPERTIES SKIP_RETURN_CODE 77)
 add_test(NAME test_cubetoss_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_cubetoss_cli.sh $<TARGET_FILE:polydyn> ${PROJECT_SOURCE_DIR})
 set_tests_properties(test_cubetoss_cli PROPERTIES SKIP_RETURN_CODE 77)
+pd_test_labels(unit test_cubetoss)
+pd_test_labels(physics test_cubetoss_data)
+pd_test_labels(cli test_cubetoss_cli)

@@ -9,3 +9,5 @@ target_link_libraries(test_planar_drops PRIVATE polydyn_refcheck)
 add_test(NAME test_planar_drops_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_planar_drops_cli.sh $<TARGET_FILE:polydyn> ${PROJECT_SOURCE_DIR})
 set_tests_properties(test_planar_drops_cli PROPERTIES SKIP_RETURN_CODE 77)
+set_tests_properties(test_planar test_planar_drops PROPERTIES LABELS physics)
+set_tests_properties(test_planar_drops_cli PROPERTIES LABELS cli)

@@ -24,7 +24,7 @@
 
 #define G 9.81  // m/s², the scene default
 
-// Tolerances (catalogue A1, A3, B2 and the issue).
+// Tolerances (catalogue A1, A3, B2, and 1 % for resting sinkage and stopping distance).
 #define POSE_TOL 1e-12  // initial pose: one rotation matrix ↔ quaternion round trip in Bullet
 #define SINKAGE_REL_TOL 0.01
 #define STOPPING_DISTANCE_REL_TOL 0.01
@@ -239,7 +239,7 @@ static void test_native_flat_landing_bounces_with_the_pair_restitution(void** st
 // frictionless: one contact spring-damper; with a step small against the contact time Bullet's implicit
 // spring-damper bounces with e = exp(−2ζ arccos ζ/√(1−ζ²)), ζ = c/(2√(k m)) of the pair. The vertex starts
 // 0.12345678 mm above the face so that it does not reach it exactly at the end of a step: at an exact touch
-// Bullet's GJK/EPA returns an arbitrary normal and the point made with it stays in the manifold (README).
+// Bullet's GJK/EPA returns an arbitrary normal and the point made with it stays in the manifold (docs/validation.md, Bullet).
 
 static void test_matched_single_contact_bounces_with_eq_15(void** state) {
   (void)state;

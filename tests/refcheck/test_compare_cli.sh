@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end tests of `polydyn compare` (DESIGN §4.3, §5): usage errors, the compare directory (metrics.csv
+# End-to-end tests of `polydyn compare` (docs/commands.md, docs/DESIGN.md §8.1): usage errors, the compare directory (metrics.csv
 # in its documented schema, compare.json, the run directories), atomic replacement, and that the soft run's
 # error against its 100× tighter reference is small on a scene with a known smooth answer.
 #

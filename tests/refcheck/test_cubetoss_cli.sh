@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end tests of `polydyn cubetoss` and `polydyn cubetoss fit` (DESIGN §4.3, §5 "Real data"): usage
+# End-to-end tests of `polydyn cubetoss` and `polydyn cubetoss fit` (docs/commands.md, docs/DESIGN.md §8.4): usage
 # errors (exit 2, nothing written), bad data at its line and column, the output directory (per_toss.csv and
 # summary.csv in their documented schemas, the run directories of the record and the simulation), the
 # same bytes with one or two worker processes, --params, and a tiny fit whose fragment --params reads.
@@ -48,7 +48,7 @@ check "a refused toss: summary says failed, with no numbers" 'grep -q "^soft,imp
 "$PD" cubetoss --help | grep -q "per_toss.csv"; rc=$?; check "--help documents per_toss.csv" '[ $rc -eq 0 ]'
 "$PD" help | grep -q "cubetoss"; rc=$?; check "polydyn help lists cubetoss" '[ $rc -eq 0 ]'
 
-skip_without "$DATA_FULL" "the cube-toss data (README, cube tosses)"
+skip_without "$DATA_FULL" "the cube-toss data (docs/validation.md, cube tosses)"
 
 # ---- the first 4 tosses of the real data (ids 1, 2, 3, 4: positions 0..3, two training, two test)
 DATA=$SCRATCH/four.csv

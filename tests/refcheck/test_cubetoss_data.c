@@ -92,7 +92,7 @@ static void test_three_real_tosses_end_at_rest_on_the_board(void** state) {
 
 int main(void) {
   if (access(DATA_PATH, R_OK) != 0) {
-    printf("SKIP: the cube-toss data is not at %s (it is not part of the project: see README, cube tosses)\n",
+    printf("SKIP: the cube-toss data is not at %s (it is not part of the project: see docs/validation.md, cube tosses)\n",
            DATA_PATH);
     return 77;
   }

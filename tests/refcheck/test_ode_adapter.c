@@ -33,7 +33,7 @@
 
 #define G 9.81  // m/s², the scene default
 
-// The tolerances: resting sinkage and stopping distance within 1 %.
+// Tolerances: resting sinkage and stopping distance within 1 %.
 #define SINKAGE_REL_TOL 0.01
 #define STOPPING_DISTANCE_REL_TOL 0.01
 // Speed below which the sliding cube counts as stopped, m/s: far below the 2 m/s it starts with.

@@ -25,7 +25,7 @@
 // coordinates divided by the pair's scale), a few roundings of 1e-16 each.
 #define CLOSED_TOL 1e-12
 // Random pairs: EPA's depth (at PD_ORACLE_EPA_TOL) against ours, relative to the smaller body's size.
-// Measured max 1.4e-14 on 3000 pairs (README "Interference oracle"); 1e-12 leaves a factor 70.
+// Measured max 1.4e-14 on 3000 pairs (docs/validation.md); 1e-12 leaves a factor 70.
 #define RANDOM_DEPTH_TOL_REL 1e-12
 
 static pdOracleShape shape(const char* spec) {

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes a small synthetic cube-toss file in the layout `polydyn cubetoss --data` reads (README, cube
+"""Writes a small synthetic cube-toss file in the layout `polydyn cubetoss --data` reads (docs/validation.md, cube
 tosses): N tosses of the 0.1048 m cube at 148 Hz, each thrown from 0.25–0.35 m with a spin, falling
 freely until its centre is half a width above the board top (-0.0012 m), then lying still. Not
 physics to compare against: a record with the right layout and plausible motion, for the tests of what

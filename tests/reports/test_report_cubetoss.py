@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The cube-toss section of `polydyn report` (issue 7), on what `polydyn cubetoss` writes for a small
+"""The cube-toss section of `polydyn report`, on what `polydyn cubetoss` writes for a small
 synthetic toss file (make_tosses.py): the headline numbers equal summary.csv's, the typical toss is the
 one nearest the median, its errors recomputed from the run directories equal the command's own at
 the end of the toss, the section sits among the Gedanken sections when a report directory has

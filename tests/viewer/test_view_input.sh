@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# polydyn view without a browser: the page file, and bad input (README "polydyn view"): exit status 2,
+# polydyn view without a browser: the page file, and bad input (docs/commands.md): exit status 2,
 # `FILE:LINE:COL: message` for a malformed CSV, nothing written.
 #
 # usage: test_view_input.sh POLYDYN_BINARY PROJECT_SOURCE_DIR

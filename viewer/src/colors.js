@@ -1,4 +1,4 @@
-// Scene colours: a scene names a body's colour with any word (README "Scene language"): a CSS colour
+// Scene colours: a scene names a body's colour with any word (docs/scene-language.md): a CSS colour
 // name (red, grey, steelblue), or hex digits without '#' (88aaff, 8af). Any other word gets a colour
 // of its own, the same every time (a hue from the word's hash), so that it still tells bodies apart.
 import * as THREE from 'three';

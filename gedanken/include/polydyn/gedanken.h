@@ -9,7 +9,7 @@
 // expected value is NAN and the measure decides PASS or FAIL itself.
 //
 // Every engine delivers the same samples: the pose and velocity of each moving body at t = k / sample
-// (DESIGN §4.2). The measures use only those, the energy and (soft engine only) the contact count, so one
+// (docs/outputs.md). The measures use only those, the energy and (soft engine only) the contact count, so one
 // measure serves polydyn's engine, ODE and Bullet alike.
 //
 // Units: SI (m, kg, s, rad); angles in degrees only where an input says so (push_deg).
@@ -157,7 +157,7 @@ typedef struct pdGkText {
 void pd_gk_text_printf(pdGkText* text, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 void pd_gk_text_free(pdGkText* text);
 
-// What an experiment tests (issue 17 item 4). A law is physics every engine must obey (Coulomb's stop
+// What an experiment tests. A law is physics every engine must obey (Coulomb's stop
 // distance, friction-cone isotropy, momentum, a centred impact's restitution): every engine is judged. A model
 // prediction is a consequence of the soft contact model itself (static sinkage, the elastic apex drift,
 // contact duration): it is judged only for the engine variants in `appliesTo`; the others still run and
@@ -201,7 +201,7 @@ typedef struct pdGkExperiment {
   double (*series)(const pdModel* model, const pdGkRecord* rec, int k, double input, double* analytic);
 } pdGkExperiment;
 
-// Work-precision (issue 17 item 1): each quantitative experiment also runs at every setting of each engine's
+// Work-precision: each quantitative experiment also runs at every setting of each engine's
 // accuracy knob, on one input (the middle one of its inputs, listed first when there are two), and its error
 // against the closed form is written with the wall time (out/precision.csv). The knobs, loosest first:
 //   soft adaptive: tol 1e-2 … 1e-10 (decades); soft fixed-step RK4: dt 1e-3, 3e-4, 1e-4, 3e-5, 1e-5 s;
@@ -277,7 +277,7 @@ int pd_gk_selected_count(const pdGkOptions* options);
 bool pd_gk_out_replaceable(const char* out, pdError* err);
 
 // Runs the selected experiments on the selected engines (soft; ode and bullet in their native and matched
-// variants) and writes, under a temporary name renamed into place when complete (DESIGN §4.2):
+// variants) and writes, under a temporary name renamed into place when complete (docs/outputs.md):
 //   out/results.csv, out/experiments.json, out/series/NAME.csv, out/runs/NAME/ENGINE-VARIANT[-INPUT]/.
 // An engine with no adapter in this build gives NOT_BUILT rows, a scene an adapter cannot represent REFUSED.
 // Returns false and fills err when `out` cannot be written or exists and is not a gedanken directory,

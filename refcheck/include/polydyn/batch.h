@@ -4,7 +4,7 @@
 // A task is a function of its index that may write files (under a directory every process sees) and
 // returns bytes. Whoever ran a task and in whatever order, task i's bytes land in results[i], so what the
 // caller writes from them never depends on the scheduling. Used by polydyn gedanken, sweep, cubetoss and
-// compare (README, "Batch runs").
+// compare (docs/commands.md).
 #pragma once
 
 #include <stdbool.h>

@@ -1,5 +1,5 @@
 // polydyn refcheck — comparing runs of one scene: trajectories in memory and the metrics of
-// `polydyn compare` (DESIGN §5 "Metrics").
+// `polydyn compare` (docs/DESIGN.md §8.1).
 //
 // Conventions
 // - A trajectory holds, per output sample, each moving body's pose and velocity in the model's body frame

@@ -1,4 +1,4 @@
-// polydyn refcheck — validation against real cube tosses (DESIGN §5 "Real data", `polydyn cubetoss`).
+// polydyn refcheck — validation against real cube tosses (docs/DESIGN.md §8.4, `polydyn cubetoss`).
 //
 // The data (shared/data/cube-toss/README.md): tosses of a wooden cube onto a flat board, tracked by camera
 // at 148 Hz, from the ContactNets data set (Pfrommer, Halm & Posa, CoRL 2020), also used by Acosta, Yang &
@@ -230,7 +230,7 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
 // fewer samples than the record makes the result failed.
 void pd_toss_judge(const pdToss* toss, const pdTrajectory* run, pdTossResult* result);
 
-// Writes the record of a toss as a run directory (DESIGN §4.2; engine "record" in summary.json), so a
+// Writes the record of a toss as a run directory (docs/outputs.md; engine "record" in summary.json), so a
 // viewer overlays reality and simulation; `dataPath` (nullable) is named in its engine_settings. Returns false
 // and fills err on an I/O error.
 bool pd_toss_write_record(const pdToss* toss, const pdTossParams* params, const char* dir, const char* dataPath,

@@ -58,7 +58,7 @@
 // (cases/hard/mass_ratio, block on floor: at t = 0.14 s it cycles at 1e-15 and answers at 1e-13, short
 // by 5.6e-8 m, bound 4.5e-7 m; at t = 0.164 s it cycles up to 1e-9 and answers at 1e-7, short by 1e-8 m,
 // bound 1.4e-3 m: at such a tolerance EPA says little).
-// At 1e-15 the random pairs agree with our depth to 1.4e-14 × size (README "Interference oracle").
+// At 1e-15 the random pairs agree with our depth to 1.4e-14 × size (docs/validation.md).
 #define PD_ORACLE_EPA_TOL 1e-15
 #define PD_ORACLE_EPA_RETRIES 4
 // MPR stops refining its portal when a new support point moves it by less than this, in scaled
@@ -217,7 +217,7 @@ void pd_oracle_timing_csv(const pdOracleTiming* t, FILE* out);
 
 // ---------------------------------------------------------------- shapes written as text (replayable)
 
-// A shape spec is a scene object command without NAME and COLOR (README "Scene language"):
+// A shape spec is a scene object command without NAME and COLOR (docs/scene-language.md):
 //   cube sx sy sz | prism n sx sy sz | tprism n sx sy sz taper | sphere level sx sy sz | hull x y z ...
 // The polyhedron is the primitive in its own frame (before any shift to the centre of mass).
 typedef struct pdOracleShape {

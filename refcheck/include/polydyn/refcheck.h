@@ -3,9 +3,9 @@
 // Both adapters take the compiled pdModel as it is: the same vertices and faces, mass and inertia about
 // the centre of mass, the same μ and e per pair (pd_model_pair_contact), gravity and initial state, and
 // report each moving body's pose in the model's body frame (origin at the centre of mass, object axes),
-// so the run directory they produce is byte-compatible with the soft engine's (DESIGN §4.2).
+// so the run directory they produce is byte-compatible with the soft engine's (docs/outputs.md).
 //
-// Variants (DESIGN §5):
+// Variants (docs/DESIGN.md §8.1):
 //   native   the engine's own hard contact with its restitution ("bounce") and Coulomb friction;
 //   matched  the engine's soft contact set to our per-contact k and c (ODE: ERP/CFM for the step;
 //            Bullet: contact stiffness and damping), restitution then comes from the damping alone.

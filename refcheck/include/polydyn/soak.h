@@ -1,4 +1,4 @@
-// polydyn refcheck — the random-scene soak (README, Reliability; `polydyn soak`).
+// polydyn refcheck — the random-scene soak (docs/reliability.md; `polydyn soak`).
 //
 // A campaign is a seed and a count: scene i of campaign S is a function of (S, i) alone, written as
 // scene-language text, so a failing scene is replayed with `polydyn run` on its file. The scenes are
@@ -42,7 +42,7 @@ typedef struct pdSoakScene {
 pdSoakScene pd_soak_scene(unsigned long seed, long index);
 void pd_soak_scene_free(pdSoakScene* scene);
 
-// Invariant limits (README, Reliability, says why each is what it is).
+// Invariant limits (docs/reliability.md, says why each is what it is).
 // Deepest overlap of any two bodies over the pair's δ_max (pd_model_pair_delta_max), soft engine.
 #define PD_SOAK_PENETRATION_LIMIT 3.0
 // Largest rise of the energy above its start in a dissipative scene, relative to the start (potential
@@ -82,7 +82,7 @@ typedef struct pdSoakResult {
 bool pd_soak_engine_is_soft(const char* engine, pdIslands* islands);
 
 // Runs the scene in `engine` ("soft", "soft-islands-off", "ode", "bullet") in a child process with the wall-time budget
-// and checks the invariants; the soft engine joins contact onsets as `onsets` says (README, "Contact onsets"). The
+// and checks the invariants; the soft engine joins contact onsets as `onsets` says (docs/contact-model.md). The
 // result is filled in every case.
 void pd_soak_run(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budgetSeconds,
                  pdSoakResult* out);

@@ -13,7 +13,7 @@ export default {
     const params = parameters(runs).sort((a, b) => ctx.evOrder.indexOf(a.ev) - ctx.evOrder.indexOf(b.ev));
     let html = '<p>As the runs wrote them (<code>engine_settings</code> of the reference engines; settings, materials as used, ' +
       'the contact constants of each pair of materials and adjustments of polydyn). A value used by only some runs lists them. ' +
-      'Springs and dampers belong to a pair of bodies (README, contact model): a material’s k and c are shown only where the ' +
+      'Springs and dampers belong to a pair of bodies (docs/contact-model.md): a material’s k and c are shown only where the ' +
       'scene set them (— otherwise); a modal damper’s c is the one of a single contact at the pair’s reduced mass.</p>';
     const csv = [];
     for (const p of params) {

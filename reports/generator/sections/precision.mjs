@@ -1,4 +1,4 @@
-// Work-precision per Gedanken experiment, against the closed form (issue 17 item 1): for each experiment one
+// Work-precision per Gedanken experiment, against the closed form: for each experiment one
 // log–log diagram (its own error measure against the wall time per simulated second, one curve per
 // engine-variant and knob, the tolerance as a dashed line) and one table; before them the table "cost to reach
 // the experiment's tolerance" per engine-variant, or "never" with the floor the error stalls at and why.

@@ -1,4 +1,4 @@
-// The one-screen summary that opens the report (issue 17 item 5): per engine-variant the experiments passed, the
+// The one-screen summary that opens the report: per engine-variant the experiments passed, the
 // median error over tolerance at its default setting, the cost to reach each experiment's tolerance, and one
 // diagram of every engine-variant's front (median error/tolerance against median cost over the knob's settings).
 import { esc, num, table } from '../lib/html.mjs';

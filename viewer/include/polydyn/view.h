@@ -4,7 +4,7 @@
 // replays. A replay shows one run or several runs of the same scene overlaid (e.g. soft, ODE, Bullet):
 // the first run solid in the scene's colours, the others ghosted in a key colour each.
 //
-// What a run directory gives (DESIGN §4.2): summary.json (bodies with name, colour, fixed, initial pose,
+// What a run directory gives (docs/outputs.md): summary.json (bodies with name, colour, fixed, initial pose,
 // mass, inertia and the polyhedron in the body frame — origin at the centre of mass, axes of the
 // object's own frame), trajectory.csv (x = centre of mass, q maps the body frame to the world) and,
 // optionally, contacts.csv. The geometry comes from summary.json: no scene file is read.
