@@ -50,6 +50,7 @@
 #include "interference.h"
 #include "material.h"
 #include "model_contact.h"
+#include "onset_bound.h"
 #include "state_layout.h"
 
 #define PI 3.14159265358979323846
@@ -147,6 +148,8 @@ typedef struct contactEval {
   bool transferred;   // its vertex moved on to another face (a candidate carries its springs)
   pdContactGeom geom;
   pdContactForce force;
+  pdVec3 du;            // relative velocity at the contact point, m/s
+  double modeBound;     // a stick–slip change left inside the step: its error bound (onset_bound.h), else 0
 } contactEval;
 
 // One contact's share of a derivative evaluation (pd_contact_forces), kept until the per-body sums.
@@ -170,6 +173,7 @@ typedef struct candidate {
   bool approaching;   // Δu_n < 0 at the end of the step
   double onsetAge;    // s since the interpolated onset when it joins as a pair onset (pd_onsetsPair), else 0
   int inherit;        // index in C0 of the contact whose springs it carries (face continuity), or -1
+  double onsetBound;  // the error bound of joining it as a pair onset (onset_bound.h), when it does (else 0)
 } candidate;
 
 // Contact i's share in the stiffness of the undamped contact modes. With K_i^½ = √k_t I + (√k_n − √k_t) n nᵀ
@@ -1480,7 +1484,7 @@ static void search(const pdModel* model, pdState* s, const double* y1, int pairC
       const pdContactGeom* g = &found[f];
       while (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) < 0) ++j;
       if (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) == 0) continue;
-      candidate c = {*g, 1.0, false, 0.0, -1};
+      candidate c = {*g, 1.0, false, 0.0, -1, 0.0};
       int b1 = g->id.body1, b2 = g->id.body2;
       pdVec3 du = relative_velocity(model, y1, poses1, &g->id, g->point);
       c.approaching = pd_v3_dot(du, g->normal) < 0.0;
@@ -1524,6 +1528,30 @@ static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double a
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
 
+// The error bound (onset_bound.h) of joining new contact g at y1 (poses in set->poses1) as a pair onset `age` seconds
+// after its onset.
+static double onset_bound(const pdModel* model, const pdState* s, const double* y1, const pdContactGeom* g,
+                          double age) {
+  int a = g->id.body1, b = g->id.body2;
+  pdContactParams p = pd_model_contact_params(model, a, b);
+  double approach = -pd_v3_dot(relative_velocity(model, y1, s->contacts->poses1, &g->id, g->point), g->normal);
+  double size = INFINITY;
+  if (!model->bodies[a].fixed) size = model->bodies[a].size;
+  if (!model->bodies[b].fixed) size = fmin(size, model->bodies[b].size);
+  return pd_onset_error_bound(sqrt(pd_series(p.k1n, p.k2n) / p.massMin), age, g->depth, approach,
+                              model->settings.vmax, size);
+}
+
+// The error bound (onset_bound.h) of leaving contact c's stick–slip change (evaluated at the step's end in e) inside
+// a step of h.
+static double transition_bound(const pdModel* model, const contactSlot* c, const contactEval* e, double h) {
+  const pdContactParams* p = &c->params;
+  double approach = pd_v3_dot(e->du, e->geom.normal);
+  double slide = pd_v3_norm(pd_v3_sub(e->du, pd_v3_scale(e->geom.normal, approach)));
+  return pd_transition_error_bound(pd_series(p->k1t, p->k2t) / p->massMin, pd_series(p->k1n, p->k2n) / p->massMin,
+                                   p->mu, slide, fabs(approach), h, model->settings.vmax);
+}
+
 // Contacts [begin, end) of C0 tracked to y1 and their forces there (set->eval).
 static void tracking_range(void* ctx, int part, int begin, int end) {
   (void)part;
@@ -1535,9 +1563,9 @@ static void tracking_range(void* ctx, int part, int begin, int end) {
   for (int i = begin; i < end; ++i) {
     contactEval* e = &set->eval[i];
     pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
-    pdVec3 du;
-    evaluate(job->model, &set->items[i], job->y, set->poses1, &frame, &sp, &e->geom, &e->tracked, &du, &e->force);
+    evaluate(job->model, &set->items[i], job->y, set->poses1, &frame, &sp, &e->geom, &e->tracked, &e->du, &e->force);
     e->transferred = false;
+    e->modeBound = 0.0;
   }
 }
 
@@ -1566,9 +1594,20 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   contactLoop job = {.model = model, .set = set, .y = y1};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, tracking_range, &job);
   double refineStep = 0.0;  // the largest refinement bound among the contacts that changed mode (0: none)
+  bool bounded = pd_onsets_effective(s->onsets, model->movingCount) == pd_onsetsBounded;
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
-    if (changes_mode(c, &set->eval[i].force)) refineStep = fmax(refineStep, refine_step(model, &c->params));
+    contactEval* e = &set->eval[i];
+    if (!changes_mode(c, &e->force)) continue;
+    // bounded events leave a change inside the step where its bound allows (onset_bound.h); others refine it
+    if (bounded) {
+      double bound = transition_bound(model, c, e, h);
+      if (pd_onset_bound_allows(bound, model->settings.tol)) {
+        e->modeBound = bound;
+        continue;
+      }
+    }
+    refineStep = fmax(refineStep, refine_step(model, &c->params));
   }
   pd_stopwatch_lap(watch, analysisSeconds);
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
@@ -1584,14 +1623,17 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   // 3. onsets: the earliest new contact that began inside the step and went deeper than its tolerance (a
   // pair onset close enough to the step's end joins there instead)
   double earliest = 2.0;
-  bool pairOnsets = pd_onsets_effective(s->onsets, model->movingCount) == pd_onsetsPair;
+  pdOnsets onsets = pd_onsets_effective(s->onsets, model->movingCount);
   for (int k = 0; k < set->candidateCount; ++k) {
     candidate* c = &set->candidates[k];
     if (!c->approaching || c->inherit >= 0) continue;
     double age = (1.0 - c->onset) * h;
-    if (pairOnsets && joins_as_pair(model, &c->geom, age)) {
-      c->onsetAge = age;
-      continue;
+    if (onsets != pd_onsetsExact && joins_as_pair(model, &c->geom, age)) {
+      c->onsetBound = onset_bound(model, s, y1, &c->geom, age);
+      if (onsets == pd_onsetsPair || pd_onset_bound_allows(c->onsetBound, model->settings.tol)) {
+        c->onsetAge = age;
+        continue;
+      }
     }
     double tol = PD_ONSET_DEPTH_TOL_REL * pd_model_pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
     if (c->geom.depth > tol) earliest = fmin(earliest, c->onset);
@@ -1656,6 +1698,11 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       ++s->count.breaksForce;
       continue;
     }
+    if (e->modeBound > 0.0) {
+      ++s->count.transitionsUnlocated;
+      s->count.transitionBoundMax = fmax(s->count.transitionBoundMax, e->modeBound);
+      s->count.transitionBoundSum += e->modeBound;
+    }
     contactSlot* k = &set->next[count++];
     *k = *c;
     k->springs = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
@@ -1679,6 +1726,10 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       contactSlot* k = &set->next[count++];
       *k = new_slot(model, &cand->geom);
       k->onsetAge = cand->onsetAge;
+      if (cand->onsetAge > 0.0) {
+        s->count.onsetBoundMax = fmax(s->count.onsetBoundMax, cand->onsetBound);
+        s->count.onsetBoundSum += cand->onsetBound;
+      }
       ++s->count.contactsMade;
     }
   }

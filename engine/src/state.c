@@ -109,7 +109,17 @@ const char* pd_stepper_name(pdStepper stepper) {
 }
 
 const char* pd_onsets_name(pdOnsets onsets) {
-  return onsets == pd_onsetsExact ? "exact" : onsets == pd_onsetsPair ? "pair" : "auto";
+  switch (onsets) {
+    case pd_onsetsExact:
+      return "exact";
+    case pd_onsetsPair:
+      return "pair";
+    case pd_onsetsBounded:
+      return "bounded";
+    case pd_onsetsAuto:
+      break;
+  }
+  return "auto";
 }
 
 pdOnsets pd_onsets_effective(pdOnsets onsets, int movingBodies) {
