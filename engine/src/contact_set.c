@@ -45,6 +45,7 @@
 
 #include "broad_phase.h"
 #include "clock.h"
+#include "contact_history.h"
 #include "grow.h"
 #include "help_desk.h"
 #include "interference.h"
@@ -200,6 +201,7 @@ typedef struct bodySpaceBlock {
 } bodySpaceBlock;
 
 struct pdContactSet {
+  pdContactHistory* history;  // tangential springs of contacts broken by force, for a return (contact_history.h)
   int count, capacity;
   contactSlot* items;      // (capacity) sorted by id
   contactEval* eval;       // (capacity) per contact of C0, filled by pd_contact_events
@@ -323,6 +325,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   }
   set->broad = pd_broad_phase_create(n, fixed, 0.0);
   PD_ASSERT(set->broad != NULL);
+  set->history = pd_history_create();
   free(fixed);
   reserve_list(set, 4 * model->movingCount + 16);
   set->candidateCapacity = 64;
@@ -347,6 +350,7 @@ pdContactSet* pd_contact_set_create_view(const pdModel* model) { return create(m
 
 void pd_contact_set_free(pdContactSet* set) {
   if (!set) return;
+  pd_history_free(set->history);
   free(set->items);
   free(set->eval);
   free(set->push);
@@ -388,6 +392,7 @@ void pd_contact_set_free(pdContactSet* set) {
 }
 
 void pd_contact_set_clear(pdContactSet* set) {
+  if (set->history) pd_history_clear(set->history);
   set->count = 0;
   set->bodyListValid = false;
   set->recordedValid = false;
@@ -1696,6 +1701,10 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
     }
     if (pd_contact_force_pulls(&e->force)) {
       ++s->count.breaksForce;
+      if (set->history) {
+        pdSprings left = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
+        pd_history_leave(set->history, &c->id, &left, e->geom.normal, c->deltaMax);
+      }
       continue;
     }
     if (e->modeBound > 0.0) {
@@ -1726,6 +1735,8 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       contactSlot* k = &set->next[count++];
       *k = new_slot(model, &cand->geom);
       k->onsetAge = cand->onsetAge;
+      if (set->history && pd_history_take(set->history, &cand->geom.id, cand->geom.normal, &k->params, &k->springs))
+        ++s->count.historyKept;
       if (cand->onsetAge > 0.0) {
         s->count.onsetBoundMax = fmax(s->count.onsetBoundMax, cand->onsetBound);
         s->count.onsetBoundSum += cand->onsetBound;
@@ -1740,6 +1751,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
   install(model, s, count);
   poses_from(model, s->y, set->poses1);
   s->count.onsetsInterpolated += prepare_list(model, set, s->y, set->poses1);
+  if (set->history) pd_history_age(model, set->history, set->poses1);
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageContactAnalysis]);
 }
 
@@ -1847,6 +1859,7 @@ static void install_moved(const pdModel* model, pdState* to, int count) {
 void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int* contacts, int count,
                             const pdModel* sub, pdState* to, const int* toSub) {
   pdContactSet* set = to->contacts;
+  if (set->history) pd_history_clear(set->history);  // its traces' ids are another model's
   reserve_list(set, count);
   for (int k = 0; k < count; ++k) {
     PD_ASSERT(contacts[k] >= 0 && contacts[k] < from->contacts->count);
@@ -1862,6 +1875,7 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
 void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const pdModel* const* subs,
                            const pdState* const* from, const int* const* toModel) {
   pdContactSet* set = to->contacts;
+  if (set->history) pd_history_clear(set->history);
   int total = 0;
   for (int p = 0; p < parts; ++p) total += from[p]->contacts->count;
   reserve_list(set, total);

@@ -457,6 +457,7 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->transitionsUnlocated += c->transitionsUnlocated;
   to->transitionBoundMax = fmax(to->transitionBoundMax, c->transitionBoundMax);
   to->transitionBoundSum += c->transitionBoundSum;
+  to->historyKept += c->historyKept;
   to->bodySecondsAsleep += c->bodySecondsAsleep;
 }
 

@@ -718,7 +718,8 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
     write_number(out, c->transitionBoundMax);
     fputs(", \"transition_bound_sum\": ", out);
     write_number(out, c->transitionBoundSum);
-    fprintf(out, ", \"breaks\": %ld, \"body_seconds_asleep\": ", c->breaksForce + c->breaksGeometry);
+    fprintf(out, ", \"breaks\": %ld, \"history_kept\": %ld, \"body_seconds_asleep\": ", c->breaksForce + c->breaksGeometry,
+            c->historyKept);
     write_number(out, c->bodySecondsAsleep);
     fprintf(out, ", \"implicit_steps\": %ld, \"explicit_steps\": %ld},\n", c->implicitSteps,
             c->accepted - c->implicitSteps);

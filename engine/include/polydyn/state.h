@@ -151,6 +151,8 @@ typedef struct pdCounters {
   long transitionsUnlocated;   // stick–slip changes left inside their step (bounded events), each with its bound:
   double transitionBoundMax;   // the largest
   double transitionBoundSum;   // and their sum, error-norm units as above
+  long historyKept;  // contacts that started on the features of one broken by force within the gap tolerance, with
+                     // its tangential springs (engine/src/contact_history.h)
   double bodySecondsAsleep;  // s × bodies: moving bodies not integrated because their island sleeps (0: no sleeping)
   // pd_islandsOn only (0 otherwise); the counts above are then summed over the islands
   long islandsFormed;    // islands set up (at the start, and each time the bodies of an island changed)
