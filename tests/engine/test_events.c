@@ -1,14 +1,14 @@
 // Corrected onsets and their error bound (docs/events.md; engine/src/onset_bound.h):
 // - drops whose onsets are forced to be corrected (pd_onsetsPair), a cube landing on a face, on a corner and on an
-//   edge, e 0.3, 0.5 and 0.8, at heights that put the onset anywhere in a step: the velocity after the bounce is the
-//   located run's (pd_onsetsExact) to 0.005 of the approach speed (a restitution within 0.005), and within the bound
-//   the engine computed for the run's worst corrected onset (PD_ONSET_BOUND_C (ωτ)³ v_n / vmax in the error norm's
-//   units, so the bound times vmax is the velocity it allows) — the bound is measured, not assumed;
-// - the default (pd_onsetsBounded): the same fast landings, whose bound exceeds the tolerance's share, are located
-//   (restitution as the exact run's to 1e-6 of the approach speed), while a pile of boxes (slow re-landings) corrects
-//   some of its onsets, each within the tolerance's share, with no energy gained;
-// - summary counters: onsets located + corrected = contacts made + virtual, breaks counted, implicit + explicit steps
-//   = accepted steps.
+//   edge, e 0.3, 0.5 and 0.8, at 1, 0.1 and 0.02 m/s and heights that put the onset anywhere in a step (ωτ up to
+//   0.8), at tol 1e-10: the velocity after the bounce is the located run's (pd_onsetsExact) to 0.005 of the approach
+//   speed (a restitution within 0.005), and within the bound the engine computed for the run's worst corrected onset
+//   (PD_ONSET_BOUND_C (ωτ)³ v_n / vmax in the error norm's units, so the bound times vmax is the velocity it
+//   allows): the bound is measured, not assumed;
+// - the default (pd_onsetsBounded) at tol 1e-6 on the landings at 1 m/s: no corrected onset's bound exceeds the
+//   tolerance's share (the others were located) and the exit velocity is the exact run's to 0.005 of the approach
+//   speed; a loose pile of 12 boxes (slow re-landings) corrects some of its onsets, each within the tolerance's
+//   share, gains no energy, and counts its breaks (no sleeping: 0 body-seconds asleep).
 // Every case asserts first that what it checks happened (corrected onsets in the forced runs and in the pile).
 #include <math.h>
 #include <setjmp.h>
