@@ -8,7 +8,9 @@
 // system of more than PD_ONSETS_CROWD_BODIES moving bodies: docs/contact-model.md) a contact whose onset lies less
 // than PD_ONSET_PAIR_OMEGA_TAU / ω before the step's end (ω its undamped angular frequency) does not cut the step:
 // the interpolation is applied to the pair alone at commit (pd_onsets_start_late), so one onset does not send every
-// body back.
+// body back. With bounded onsets (pd_onsetsBounded, the default) such a contact joins so only where the error bound of
+// that correction (onset_bound.h) is within the tolerance's share, in a system of any size; the others are located
+// (docs/events.md).
 // Contacts start at zero spring deflection where they are added, so a late start shifts a contact's rest point by the
 // depth it was found at but injects no energy; the onset tolerance bounds that shift. A pair onset instead starts
 // where its pair alone would be after the τ since the onset: springs at that deflection x and the two bodies given
