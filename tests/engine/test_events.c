@@ -8,7 +8,7 @@
 // - the default (pd_onsetsBounded) at tol 1e-6 on the landings at 1 m/s: no corrected onset's bound exceeds the
 //   tolerance's share (the others were located) and the exit velocity is the exact run's to 0.005 of the approach
 //   speed; a loose pile of 12 boxes (slow re-landings) corrects some of its onsets, each within the tolerance's
-//   share, gains no energy, and counts its breaks (no sleeping: 0 body-seconds asleep).
+//   share, gains no energy, and counts its breaks and its body-seconds asleep (within bodies × tend).
 // Every case asserts first that what it checks happened (corrected onsets in the forced runs and in the pile).
 #include <math.h>
 #include <setjmp.h>
@@ -156,7 +156,8 @@ static void test_bounded_events_correct_slow_onsets_in_a_pile(void** state) {
   assert_true(c->onsetBoundSum <= (double)c->onsetsInterpolated * c->onsetBoundMax);
   assert_true(energy_gain(r) <= ENERGY_GAIN_TOL);
   assert_true(c->breaksForce + c->breaksGeometry > 0);
-  assert_true(c->bodySecondsAsleep == 0.0);
+  // sleeping (docs/sleeping.md) fills it: at most every moving body asleep for the whole run
+  assert_true(c->bodySecondsAsleep >= 0.0 && c->bodySecondsAsleep <= m->movingCount * m->settings.tend);
   pd_state_free(s);
   free(r);
   pd_model_free(m);

@@ -153,7 +153,6 @@ typedef struct pdCounters {
   double transitionBoundSum;   // and their sum, error-norm units as above
   long historyKept;  // contacts that started on the features of one broken by force within the gap tolerance, with
                      // its tangential springs (engine/src/contact_history.h)
-  double bodySecondsAsleep;  // s × bodies: moving bodies not integrated because their island sleeps (0: no sleeping)
   // pd_islandsOn only (0 otherwise); the counts above are then summed over the islands
   long islandsFormed;    // islands set up (at the start, and each time the bodies of an island changed)
   long islandsLargest;   // moving bodies in the largest island formed
@@ -161,6 +160,10 @@ typedef struct pdCounters {
   long islandRedos;      // islands whose interval was redone because a body moved farther than its grown box
   long islandStrays;     // free bodies found outside their box over a sample interval (none expected: a free body
                          // has no contact to leave its ballistic path by; counted, not recovered)
+  // pd_islandsOn with settings.sleep (0 otherwise): islands at rest stop being integrated (docs/sleeping.md)
+  long islandsSlept;         // islands that fell asleep
+  long islandsWoken;         // sleeping islands woken (a body may reach them, or an applied force changed)
+  double bodySecondsAsleep;  // s: the sum over moving bodies of the time each spent asleep
 } pdCounters;
 
 typedef struct pdState {
