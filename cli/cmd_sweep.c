@@ -133,9 +133,10 @@ static pdOnsets sweepOnsets = PD_ONSETS_DEFAULT;
 // One soft run: trajectory (when wanted), wall time, steps, derivative evaluations (when wanted), completed.
 static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* trajectory, double* wall, long* steps,
                      long* derivatives) {
-  pdState* state = pd_state_create(model);
-  state->stepper = stepper;
-  state->onsets = sweepOnsets;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  options.onsets = sweepOnsets;
+  pdState* state = pd_state_create(model, &options);
   double t0 = pd_cli_wall_seconds();
   bool ok = pd_advance(model, state, model->settings.tend, observe, trajectory);
   *wall = pd_cli_wall_seconds() - t0;
