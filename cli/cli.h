@@ -71,8 +71,11 @@ bool pd_cli_list_has(const char* list, const char* word);
 // Parses a finite number > 0 from an option value; false when it is not one.
 bool pd_cli_positive(const char* text, double* value);
 
-// Parses --onsets' value, "pair" or "exact"; false when it is neither.
+// Parses --onsets' value, "pair", "exact", "auto" or "bounded"; false when it is none of them.
 bool pd_cli_onsets(const char* text, pdOnsets* onsets);
+// Parses --events' value: "exact" (the paper's loop, every onset located: pd_onsetsExact) or "bounded" (the default,
+// pd_onsetsBounded: an onset is corrected where its error bound allows, docs/events.md); false otherwise.
+bool pd_cli_events(const char* text, pdOnsets* onsets);
 
 // True when argv[i] is -h or --help.
 bool pd_cli_is_help(const char* arg);

@@ -15,8 +15,8 @@
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
     "                         [--stepper implicit|adaptive|fixed|embedded] [--variant native|matched]\n"
-    "                         [--onsets pair|exact|auto] [--islands on|off] [--sleep on|off] [--threads N]\n"
-    "                         [--step H] [--ode-friction pyramid|aligned]\n"
+    "                         [--events bounded|exact] [--onsets pair|exact|auto|bounded] [--islands on|off]\n"
+    "                         [--sleep on|off] [--threads N] [--step H] [--ode-friction pyramid|aligned]\n"
     "\n"
     "Simulates SCENE and writes DIR/trajectory.csv and DIR/summary.json. DIR is written under a\n"
     "temporary name and renamed when complete; an existing run directory DIR is replaced.\n"
@@ -33,10 +33,14 @@ static const char* const help =
     "                   adaptive: RK4 with step-doubling error control alone (the paper's);\n"
     "                   fixed: RK4 with the scene's dt, no error control;\n"
     "                   embedded: RK4 with its embedded third-order error estimate\n"
+    "  --events MODE    soft engine: bounded (default) corrects a contact onset inside a step where its\n"
+    "                   error bound is within the tolerance's share and locates the others; exact locates\n"
+    "                   every onset, the paper's loop (docs/events.md; the same as --onsets bounded|exact)\n"
     "  --onsets MODE    soft engine, a contact that began inside a step: exact cuts the whole step back\n"
     "                   to its onset; pair joins it at the step's end, run for that pair alone since its\n"
-    "                   onset, when it began within 1/omega and is shallow; auto (default) pair in an island\n"
-    "                   of more than 16 moving bodies, exact in smaller ones (docs/contact-model.md)\n"
+    "                   onset, when it began within 1/omega and is shallow; auto pair in an island of more\n"
+    "                   than 16 moving bodies, exact in smaller ones; bounded (default) as --events bounded\n"
+    "                   (docs/events.md)\n"
     "  --islands on|off soft engine: on (default) splits the bodies between output samples into islands\n"
     "                   (bodies in contact or whose boxes may meet before the next sample), each with its\n"
     "                   own steps and contact events; off advances all bodies with one step size\n"
@@ -111,7 +115,8 @@ int pd_cmd_run(int argc, char** argv) {
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--engine") == 0 || strcmp(a, "--tend") == 0 ||
                strcmp(a, "--sample") == 0 || strcmp(a, "--stepper") == 0 || strcmp(a, "--variant") == 0 ||
                strcmp(a, "--step") == 0 || strcmp(a, "--ode-friction") == 0 || strcmp(a, "--onsets") == 0 ||
-               strcmp(a, "--islands") == 0 || strcmp(a, "--sleep") == 0 || strcmp(a, "--threads") == 0) {
+               strcmp(a, "--events") == 0 || strcmp(a, "--islands") == 0 || strcmp(a, "--sleep") == 0 ||
+               strcmp(a, "--threads") == 0) {
       if (!hasValue) return pd_cli_usage_error("run", "%s needs a value", a);
       const char* v = argv[++i];
       if (strcmp(a, "--out") == 0) {
@@ -129,7 +134,11 @@ int pd_cmd_run(int argc, char** argv) {
         if (!pd_cli_positive(v, &overrides.sample)) return pd_cli_usage_error("run", "--sample needs a number > 0");
       } else if (strcmp(a, "--onsets") == 0) {
         softOptionGiven = true;
-        if (!pd_cli_onsets(v, &onsets)) return pd_cli_usage_error("run", "--onsets must be pair, exact or auto");
+        if (!pd_cli_onsets(v, &onsets))
+          return pd_cli_usage_error("run", "--onsets must be pair, exact, auto or bounded");
+      } else if (strcmp(a, "--events") == 0) {
+        softOptionGiven = true;
+        if (!pd_cli_events(v, &onsets)) return pd_cli_usage_error("run", "--events must be bounded or exact");
       } else if (strcmp(a, "--islands") == 0) {
         softOptionGiven = true;
         if (strcmp(v, "on") == 0)
@@ -191,7 +200,8 @@ int pd_cmd_run(int argc, char** argv) {
   if (soft && refOptionGiven)
     return pd_cli_usage_error("run", "--variant, --step and --ode-friction are for --engine ode or bullet");
   if (!soft && softOptionGiven)
-    return pd_cli_usage_error("run", "--stepper, --onsets, --islands, --sleep and --threads are for the soft engine");
+    return pd_cli_usage_error("run",
+                              "--stepper, --events, --onsets, --islands, --sleep and --threads are for the soft engine");
   // islands off is one system on one thread: more threads would be silently idle
   if (threads > 1 && islands != pd_islandsOn) return pd_cli_usage_error("run", "--threads N > 1 needs --islands on");
   if (strcmp(engine, "bullet") == 0 && ref.odeFriction != pd_odeFrictionPyramid)

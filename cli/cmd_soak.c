@@ -16,7 +16,7 @@
 static const char* const help =
     "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I]\n"
     "                    [--engines soft,soft-islands-off,ode,bullet] [--budget SECONDS] [--jobs N]\n"
-    "                    [--onsets pair|exact|auto]\n"
+    "                    [--onsets pair|exact|auto|bounded]\n"
     "\n"
     "Generates N random scenes (campaign S: scene i is the same text on every machine) and runs each in\n"
     "every engine, in a child process per run, checking at every output sample: no NaN or Inf; for the soft\n"
@@ -138,7 +138,7 @@ int pd_cmd_soak(int argc, char** argv) {
       if (!pd_cli_positive(v, &job.budget) || job.budget > 86400)
         return pd_cli_usage_error("soak", "--budget needs seconds > 0 (at most a day)");
     } else if (strcmp(a, "--onsets") == 0) {
-      if (!pd_cli_onsets(v, &job.onsets)) return pd_cli_usage_error("soak", "--onsets must be pair, exact or auto");
+      if (!pd_cli_onsets(v, &job.onsets)) return pd_cli_usage_error("soak", "--onsets must be pair, exact, auto or bounded");
     } else if (strcmp(a, "--jobs") == 0) {
       if (!pd_cli_jobs(v, &jobs))
         return pd_cli_usage_error("soak", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);

@@ -40,6 +40,7 @@
 
 static const char* const help =
     "usage: polydyn sweep SCENE --out DIR [--repeats R] [--engines soft,ode,bullet] [--tend T] [--jobs N]\n"
+    "                     [--events bounded|exact]\n"
     "\n"
     "Work-precision sweep of SCENE: polydyn's default stepper (implicit: step doubling switching to ROS34PW2\n"
     "where the contacts' stability bound holds it), adaptive RK4 (step doubling alone) and its embedded RK4(3)\n"
@@ -59,6 +60,8 @@ static const char* const help =
     "engine's derivative evaluations (the cost that does not depend on the machine).\n"
     "Writes DIR/sweep.csv (reports/FORMATS.md) and DIR/reference.json; DIR is replaced atomically.\n"
     "\n"
+    "  --events MODE  the soft engine's contact events in every soft run, the reference's too: bounded (default)\n"
+    "             or exact, the paper's loop (every onset located; polydyn run --events, docs/events.md)\n"
     "  --jobs N   run N points at a time in worker processes (default 1); under mpirun or srun the points are\n"
     "             split over the ranks (docs/commands.md). Every point's repeats stay in one process, one\n"
     "             after the other, but points running side by side share the machine: the wall times then\n"
@@ -124,11 +127,15 @@ static bool observe(const pdModel* model, const pdState* state, void* trajectory
   return !trajectory || pd_trajectory_observe(model, state, trajectory);
 }
 
+// The soft engine's contact events in every soft run of this sweep (--events; set before any run, workers included).
+static pdOnsets sweepOnsets = PD_ONSETS_DEFAULT;
+
 // One soft run: trajectory (when wanted), wall time, steps, derivative evaluations (when wanted), completed.
 static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* trajectory, double* wall, long* steps,
                      long* derivatives) {
   pdStateOptions options = pd_state_options_default();
   options.stepper = stepper;
+  options.onsets = sweepOnsets;
   pdState* state = pd_state_create(model, &options);
   double t0 = pd_cli_wall_seconds();
   bool ok = pd_advance(model, state, model->settings.tend, observe, trajectory);
@@ -347,7 +354,7 @@ int pd_cmd_sweep(int argc, char** argv) {
       fputs(help, stdout);
       return PD_EXIT_OK;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--repeats") == 0 || strcmp(a, "--engines") == 0 ||
-               strcmp(a, "--tend") == 0 || strcmp(a, "--jobs") == 0) {
+               strcmp(a, "--tend") == 0 || strcmp(a, "--jobs") == 0 || strcmp(a, "--events") == 0) {
       if (i + 1 >= argc) return pd_cli_usage_error("sweep", "%s needs a value", a);
       const char* v = argv[++i];
       if (strcmp(a, "--out") == 0) {
@@ -368,6 +375,8 @@ int pd_cmd_sweep(int argc, char** argv) {
           q = comma ? comma + 1 : q + len;
         }
         engines = v;
+      } else if (strcmp(a, "--events") == 0) {
+        if (!pd_cli_events(v, &sweepOnsets)) return pd_cli_usage_error("sweep", "--events must be bounded or exact");
       } else if (strcmp(a, "--jobs") == 0) {
         if (!pd_cli_jobs(v, &jobs)) return pd_cli_usage_error("sweep", "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
       } else if (!pd_cli_positive(v, &base.tend)) {

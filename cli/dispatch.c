@@ -93,6 +93,18 @@ bool pd_cli_onsets(const char* text, pdOnsets* onsets) {
     *onsets = pd_onsetsExact;
   else if (strcmp(text, "auto") == 0)
     *onsets = pd_onsetsAuto;
+  else if (strcmp(text, "bounded") == 0)
+    *onsets = pd_onsetsBounded;
+  else
+    return false;
+  return true;
+}
+
+bool pd_cli_events(const char* text, pdOnsets* onsets) {
+  if (strcmp(text, "exact") == 0)
+    *onsets = pd_onsetsExact;
+  else if (strcmp(text, "bounded") == 0)
+    *onsets = pd_onsetsBounded;
   else
     return false;
   return true;

@@ -294,7 +294,7 @@ void pd_contact_search(const pdModel* model, pdState* s, const double* y1, int p
       const pdContactGeom* g = &found[f];
       while (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) < 0) ++j;
       if (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) == 0) continue;
-      candidate c = {*g, 1.0, false, 0.0, -1};
+      candidate c = {*g, 1.0, false, 0.0, -1, 0.0};
       int b1 = g->id.body1, b2 = g->id.body2;
       pdVec3 du = relative_velocity(model, y1, poses1, &g->id, g->point);
       c.approaching = pd_v3_dot(du, g->normal) < 0.0;

@@ -31,6 +31,7 @@
 #include "grow.h"
 #include "material.h"
 #include "model_contact.h"
+#include "onset_bound.h"
 #include "onsets.h"
 
 #define PI 3.14159265358979323846
@@ -95,6 +96,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   }
   pd_contact_search_create(model, set, fixed);
   free(fixed);
+  set->history = pd_history_create();
   pd_contact_set_reserve_list(set, 4 * model->movingCount + 16);
   return set;
 }
@@ -105,6 +107,7 @@ pdContactSet* pd_contact_set_create_view(const pdModel* model) { return create(m
 
 void pd_contact_set_free(pdContactSet* set) {
   if (!set) return;
+  pd_history_free(set->history);
   free(set->items);
   free(set->eval);
   free(set->push);
@@ -131,6 +134,7 @@ void pd_contact_set_free(pdContactSet* set) {
 }
 
 void pd_contact_set_clear(pdContactSet* set) {
+  if (set->history) pd_history_clear(set->history);
   set->count = 0;
   set->bodyListValid = false;
   set->recordedValid = false;
@@ -272,6 +276,16 @@ static int prepare_list(const pdModel* model, pdContactSet* set, double* y, cons
 // error control (refining them cost pile_10 a third of its derivative evaluations).
 static bool changes_mode(const contactSlot* c, const pdContactForce* f) { return c->force.slip != f->slip; }
 
+// The error bound (onset_bound.h) of leaving contact c's stick–slip change (evaluated at the step's end in e) inside
+// a step of h.
+static double transition_bound(const pdModel* model, const contactSlot* c, const contactEval* e, double h) {
+  const pdContactParams* p = &c->params;
+  double approach = pd_v3_dot(e->du, e->geom.normal);
+  double slide = pd_v3_norm(pd_v3_sub(e->du, pd_v3_scale(e->geom.normal, approach)));
+  return pd_transition_error_bound(pd_series(p->k1t, p->k2t) / p->massMin, pd_series(p->k1n, p->k2n) / p->massMin,
+                                   p->mu, slide, fabs(approach), h, model->settings.vmax);
+}
+
 // Contacts [begin, end) of C0 tracked to y1 and their forces there (set->eval).
 static void tracking_range(void* ctx, int part, int begin, int end) {
   (void)part;
@@ -282,9 +296,9 @@ static void tracking_range(void* ctx, int part, int begin, int end) {
   for (int i = begin; i < end; ++i) {
     contactEval* e = &set->eval[i];
     pdSprings sp = loop_springs(job, i);
-    pdVec3 du;
-    evaluate(job->model, &set->items[i], job->y, set->poses1, &frame, &sp, &e->geom, &e->tracked, &du, &e->force);
+    evaluate(job->model, &set->items[i], job->y, set->poses1, &frame, &sp, &e->geom, &e->tracked, &e->du, &e->force);
     e->transferred = false;
+    e->modeBound = 0.0;
   }
 }
 
@@ -311,9 +325,20 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   contactLoop job = {.model = model, .set = set, .y = y1};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, tracking_range, &job);
   double refineStep = 0.0;  // the largest refinement bound among the contacts that changed mode (0: none)
+  bool bounded = pd_onsets_effective(s->onsets, model->movingCount) == pd_onsetsBounded;
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
-    if (changes_mode(c, &set->eval[i].force)) refineStep = fmax(refineStep, refine_step(model, &c->params));
+    contactEval* e = &set->eval[i];
+    if (!changes_mode(c, &e->force)) continue;
+    // bounded events leave a change inside the step where its bound allows (onset_bound.h); others refine it
+    if (bounded) {
+      double bound = transition_bound(model, c, e, h);
+      if (pd_onset_bound_allows(bound, model->settings.tol)) {
+        e->modeBound = bound;
+        continue;
+      }
+    }
+    refineStep = fmax(refineStep, refine_step(model, &c->params));
   }
   pd_stopwatch_lap(watch, analysisSeconds);
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
@@ -328,8 +353,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
 
   // 3. onsets: the earliest new contact that began inside the step and went deeper than its tolerance (a
   // pair onset close enough to the step's end joins there instead)
-  bool pairOnsets = pd_onsets_effective(s->onsets, model->movingCount) == pd_onsetsPair;
-  double earliest = pd_onsets_earliest(model, set, h, pairOnsets);
+  double earliest = pd_onsets_earliest(model, set, h, pd_onsets_effective(s->onsets, model->movingCount), y1);
   pdEventVerdict verdict = pd_eventAccept;
   if (earliest <= 1.0 && pd_onsets_may_retry(set)) {
     double hOnset = earliest * h;
@@ -388,7 +412,16 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
     }
     if (pd_contact_force_pulls(&e->force)) {
       ++s->count.breaksForce;
+      if (set->history) {
+        pdSprings left = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
+        pd_history_leave(set->history, &c->id, &left, e->geom.normal, c->deltaMax);
+      }
       continue;
+    }
+    if (e->modeBound > 0.0) {
+      ++s->count.transitionsUnlocated;
+      s->count.transitionBoundMax = fmax(s->count.transitionBoundMax, e->modeBound);
+      s->count.transitionBoundSum += e->modeBound;
     }
     contactSlot* k = &set->next[count++];
     *k = *c;
@@ -413,6 +446,12 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       contactSlot* k = &set->next[count++];
       *k = new_slot(model, &cand->geom);
       k->onsetAge = cand->onsetAge;
+      if (set->history && pd_history_take(set->history, &cand->geom.id, cand->geom.normal, &k->params, &k->springs))
+        ++s->count.historyKept;
+      if (cand->onsetAge > 0.0) {
+        s->count.onsetBoundMax = fmax(s->count.onsetBoundMax, cand->onsetBound);
+        s->count.onsetBoundSum += cand->onsetBound;
+      }
       ++s->count.contactsMade;
     }
   }
@@ -423,6 +462,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
   install(model, s, count);
   poses_from(model, s->y, set->poses1);
   s->count.onsetsInterpolated += prepare_list(model, set, s->y, set->poses1);
+  if (set->history) pd_history_age(model, set->history, set->poses1);
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageContactAnalysis]);
 }
 
@@ -507,6 +547,7 @@ static void install_moved(const pdModel* model, pdState* to, int count) {
 void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int* contacts, int count,
                             const pdModel* sub, pdState* to, const int* toSub) {
   pdContactSet* set = to->contacts;
+  if (set->history) pd_history_clear(set->history);  // its traces' ids are another model's
   pd_contact_set_reserve_list(set, count);
   for (int k = 0; k < count; ++k) {
     PD_ASSERT(contacts[k] >= 0 && contacts[k] < from->contacts->count);
@@ -522,6 +563,7 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
 void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const pdModel* const* subs,
                            const pdState* const* from, const int* const* toModel) {
   pdContactSet* set = to->contacts;
+  if (set->history) pd_history_clear(set->history);
   int total = 0;
   for (int p = 0; p < parts; ++p) total += from[p]->contacts->count;
   pd_contact_set_reserve_list(set, total);

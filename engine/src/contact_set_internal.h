@@ -7,6 +7,7 @@
 
 #include <stdbool.h>
 
+#include "contact_history.h"
 #include "broad_phase.h"
 #include "clock.h"
 #include "contact_analysis.h"
@@ -58,6 +59,8 @@ typedef struct contactEval {
   bool transferred;   // its vertex moved on to another face (a candidate carries its springs)
   pdContactGeom geom;
   pdContactForce force;
+  pdVec3 du;         // relative velocity at the contact point, m/s
+  double modeBound;  // a stick–slip change left inside the step: its error bound (onset_bound.h), else 0
 } contactEval;
 
 // One contact's share of a derivative evaluation (pd_contact_forces), kept until the per-body sums.
@@ -81,6 +84,7 @@ typedef struct candidate {
   bool approaching;   // Δu_n < 0 at the end of the step
   double onsetAge;    // s since the interpolated onset when it joins as a pair onset (pd_onsetsPair), else 0
   int inherit;        // index in C0 of the contact whose springs it carries (face continuity), or -1
+  double onsetBound;  // the error bound of joining it as a pair onset (onset_bound.h), when it does (else 0)
 } candidate;
 
 // Contact i's share in the stiffness of the undamped contact modes. With K_i^½ = √k_t I + (√k_n − √k_t) n nᵀ
@@ -107,6 +111,7 @@ typedef struct bodySpaceBlock {
 } bodySpaceBlock;
 
 struct pdContactSet {
+  pdContactHistory* history;  // tangential springs of contacts broken by force, for a return (contact_history.h)
   int count, capacity;
   contactSlot* items;      // (capacity) sorted by id
   contactEval* eval;       // (capacity) per contact of C0, filled by pd_contact_events

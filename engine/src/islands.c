@@ -377,6 +377,12 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->contactsTransferred += c->contactsTransferred;
   to->breaksForce += c->breaksForce;
   to->breaksGeometry += c->breaksGeometry;
+  to->onsetBoundMax = fmax(to->onsetBoundMax, c->onsetBoundMax);
+  to->onsetBoundSum += c->onsetBoundSum;
+  to->transitionsUnlocated += c->transitionsUnlocated;
+  to->transitionBoundMax = fmax(to->transitionBoundMax, c->transitionBoundMax);
+  to->transitionBoundSum += c->transitionBoundSum;
+  to->historyKept += c->historyKept;
 }
 
 static void retire(struct pdIslandSet* set, island* is) {

@@ -8,7 +8,9 @@
 // system of more than PD_ONSETS_CROWD_BODIES moving bodies: docs/contact-model.md) a contact whose onset lies less
 // than PD_ONSET_PAIR_OMEGA_TAU / ω before the step's end (ω its undamped angular frequency) does not cut the step:
 // the interpolation is applied to the pair alone at commit (pd_onsets_start_late), so one onset does not send every
-// body back.
+// body back. With bounded onsets (pd_onsetsBounded, the default) such a contact joins so only where the error bound of
+// that correction (onset_bound.h) is within the tolerance's share, in a system of any size; the others are located
+// (docs/events.md).
 // Contacts start at zero spring deflection where they are added, so a late start shifts a contact's rest point by the
 // depth it was found at but injects no energy; the onset tolerance bounds that shift. A pair onset instead starts
 // where its pair alone would be after the τ since the onset: springs at that deflection x and the two bodies given
@@ -23,6 +25,7 @@
 #include "contact_set_internal.h"
 #include "material.h"
 #include "model_contact.h"
+#include "onset_bound.h"
 
 // A new contact found deeper than this fraction of its δ_max at the end of a step is interpolated back
 // to its onset: its springs start at 0 where it is added, so a late start moves its rest point by that
@@ -117,15 +120,32 @@ static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double a
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
 
-double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, bool pairOnsets) {
+// The error bound (onset_bound.h) of joining new contact g at y1 (poses in set->poses1) as a pair onset `age` seconds
+// after its onset.
+static double onset_bound(const pdModel* model, const pdContactSet* set, const double* y1, const pdContactGeom* g,
+                          double age) {
+  int a = g->id.body1, b = g->id.body2;
+  pdContactParams p = pd_model_contact_params(model, a, b);
+  double approach = -pd_v3_dot(relative_velocity(model, y1, set->poses1, &g->id, g->point), g->normal);
+  double size = INFINITY;
+  if (!model->bodies[a].fixed) size = model->bodies[a].size;
+  if (!model->bodies[b].fixed) size = fmin(size, model->bodies[b].size);
+  return pd_onset_error_bound(sqrt(pd_series(p.k1n, p.k2n) / p.massMin), age, g->depth, approach,
+                              model->settings.vmax, size);
+}
+
+double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdOnsets onsets, const double* y1) {
   double earliest = 2.0;
   for (int k = 0; k < set->candidateCount; ++k) {
     candidate* c = &set->candidates[k];
     if (!c->approaching || c->inherit >= 0) continue;
     double age = (1.0 - c->onset) * h;
-    if (pairOnsets && joins_as_pair(model, &c->geom, age)) {
-      c->onsetAge = age;
-      continue;
+    if (onsets != pd_onsetsExact && joins_as_pair(model, &c->geom, age)) {
+      c->onsetBound = onset_bound(model, set, y1, &c->geom, age);
+      if (onsets == pd_onsetsPair || pd_onset_bound_allows(c->onsetBound, model->settings.tol)) {
+        c->onsetAge = age;
+        continue;
+      }
     }
     double tol = PD_ONSET_DEPTH_TOL_REL * pd_model_pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
     if (c->geom.depth > tol) earliest = fmin(earliest, c->onset);

@@ -709,6 +709,24 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
           state->count.searchesSkipped, state->count.contactsMade, state->count.contactsVirtual,
           state->count.contactsTransferred, state->count.breaksForce, state->count.breaksGeometry,
           pd_state_contact_count(state));
+  if (!info->stepper) {  // the soft engine's own: what it located, what it corrected and what that may cost (docs/events.md)
+    const pdCounters* c = &state->count;
+    fprintf(out,
+            "  \"events\": {\"onsets_located\": %ld, \"onsets_corrected\": %ld, \"onset_bound_max\": ",
+            c->contactsMade + c->contactsVirtual - c->onsetsInterpolated, c->onsetsInterpolated);
+    write_number(out, c->onsetBoundMax);
+    fputs(", \"onset_bound_sum\": ", out);
+    write_number(out, c->onsetBoundSum);
+    fprintf(out, ", \"transitions_unlocated\": %ld, \"transition_bound_max\": ", c->transitionsUnlocated);
+    write_number(out, c->transitionBoundMax);
+    fputs(", \"transition_bound_sum\": ", out);
+    write_number(out, c->transitionBoundSum);
+    fprintf(out, ", \"breaks\": %ld, \"history_kept\": %ld, \"body_seconds_asleep\": ", c->breaksForce + c->breaksGeometry,
+            c->historyKept);
+    write_number(out, c->bodySecondsAsleep);
+    fprintf(out, ", \"implicit_steps\": %ld, \"explicit_steps\": %ld},\n", c->implicitSteps,
+            c->accepted - c->implicitSteps);
+  }
   if (!info->stepper && state->islands == pd_islandsOn) {  // the soft engine's islands only
     fprintf(out,
             "  \"island_counts\": {\"islands_formed\": %ld, \"largest_island\": %ld, \"island_intervals\": %ld, "

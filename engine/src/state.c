@@ -34,7 +34,7 @@ pdState* pd_state_create(const pdModel* model, const pdStateOptions* options) {
   pdStateOptions o = options ? *options : pd_state_options_default();
   PD_ASSERT(o.valid == OPTIONS_VALID);  // made by pd_state_options_default
   PD_ASSERT(o.stepper >= pd_stepperRK4Adaptive && o.stepper <= pd_stepperImplicit);
-  PD_ASSERT(o.onsets >= pd_onsetsExact && o.onsets <= pd_onsetsAuto);
+  PD_ASSERT(o.onsets >= pd_onsetsExact && o.onsets <= pd_onsetsBounded);
   PD_ASSERT(o.islands == pd_islandsOff || o.islands == pd_islandsOn);
   PD_ASSERT(o.threads >= 1 && o.threads <= PD_THREADS_MAX);
   PD_ASSERT(o.h >= 0.0 && o.h < INFINITY);
@@ -173,7 +173,17 @@ const char* pd_stepper_name(pdStepper stepper) {
 }
 
 const char* pd_onsets_name(pdOnsets onsets) {
-  return onsets == pd_onsetsExact ? "exact" : onsets == pd_onsetsPair ? "pair" : "auto";
+  switch (onsets) {
+    case pd_onsetsExact:
+      return "exact";
+    case pd_onsetsPair:
+      return "pair";
+    case pd_onsetsBounded:
+      return "bounded";
+    case pd_onsetsAuto:
+      break;
+  }
+  return "auto";
 }
 
 const char* pd_islands_name(pdIslands islands) { return islands == pd_islandsOn ? "on" : "off"; }

@@ -194,8 +194,9 @@ static bool parse_onsets(const char* name, pdOnsets* out) {
   if (strcmp(name, "auto") == 0) *out = pd_onsetsAuto;
   else if (strcmp(name, "pair") == 0) *out = pd_onsetsPair;
   else if (strcmp(name, "exact") == 0) *out = pd_onsetsExact;
+  else if (strcmp(name, "bounded") == 0) *out = pd_onsetsBounded;
   else {
-    PyErr_Format(PyExc_ValueError, "onsets must be pair, exact or auto, not '%s'", name);
+    PyErr_Format(PyExc_ValueError, "onsets must be bounded, pair, exact or auto, not '%s'", name);
     return false;
   }
   return true;

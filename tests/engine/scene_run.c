@@ -71,7 +71,7 @@ static bool record_sample(const pdModel* model, const pdState* state, void* user
 record* run(const pdModel* model, pdState** stateOut) { return run_with(model, PD_STEPPER_DEFAULT, stateOut); }
 
 record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut) {
-  return run_onsets(model, stepper, pd_onsetsExact, stateOut);
+  return run_onsets(model, stepper, PD_ONSETS_DEFAULT, stateOut);
 }
 
 static record* run_state(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdIslands islands,

@@ -30,8 +30,7 @@ pdModel* compile_file(const char* path);
 record* run(const pdModel* model, pdState** stateOut);
 // The same with the given stepper (run: the default, PD_STEPPER_DEFAULT).
 record* run_with(const pdModel* model, pdStepper stepper, pdState** stateOut);
-// The same with the given onset mode too (run_with: pd_onsetsExact, which the default pd_onsetsAuto is in
-// systems of at most PD_ONSETS_CROWD_BODIES moving bodies).
+// The same with the given onset mode too (run_with: the default, PD_ONSETS_DEFAULT).
 record* run_onsets(const pdModel* model, pdStepper stepper, pdOnsets onsets, pdState** stateOut);
 // The same with adaptive RK4, the given onset mode and islands on or off.
 record* run_onsets_islands(const pdModel* model, pdOnsets onsets, pdIslands islands, pdState** stateOut);

@@ -86,9 +86,14 @@ typedef enum pdOnsets {
                    // ¼ δ_max deep joins there as if its pair had run alone since the onset (springs at that
                    // deflection, the pair's impulse given to its two bodies); the step stands, so an onset in
                    // one corner of a pile does not send every body back. Others as pd_onsetsExact.
-  pd_onsetsAuto,  // default: pd_onsetsPair in a system of more than PD_ONSETS_CROWD_BODIES moving bodies (an island, or
+  pd_onsetsAuto,  // pd_onsetsPair in a system of more than PD_ONSETS_CROWD_BODIES moving bodies (an island, or
                   // the scene with islands off), pd_onsetsExact in smaller ones: a retry costs a crowd's whole
                   // step, and a small system keeps the exact onsets' error control
+  pd_onsetsBounded,  // default: in every system, a contact that pd_onsetsPair would join at the step's end joins there
+                     // when the error bound of that correction (onset_bound.h: restitution from ωτ, in the error
+                     // norm's units) is within the share of the tolerance an onset may spend; others as
+                     // pd_onsetsExact. So the step follows the tolerance: slow onsets are corrected, fast impacts
+                     // located (docs/events.md)
 } pdOnsets;
 
 // More moving bodies than this in one system make pd_onsetsAuto join onsets as pairs. On
@@ -100,10 +105,11 @@ typedef enum pdOnsets {
 // The mode pd_onsetsAuto stands for in a system of `movingBodies` moving bodies (other modes: themselves).
 PD_API pdOnsets pd_onsets_effective(pdOnsets onsets, int movingBodies);
 
-// The onset mode of pd_state_options_default() and of the commands' --onsets.
-#define PD_ONSETS_DEFAULT pd_onsetsAuto
+// The onset mode of pd_state_options_default() and of the commands' --onsets; `--events exact` is pd_onsetsExact
+// (the paper's loop: every onset located), `--events bounded` this default.
+#define PD_ONSETS_DEFAULT pd_onsetsBounded
 
-// The onset mode's name in summary.json: "pair", "exact" or "auto".
+// The onset mode's name in summary.json: "pair", "exact", "auto" or "bounded".
 PD_API const char* pd_onsets_name(pdOnsets onsets);
 
 // Whether the moving bodies advance as one system or as islands (engine/src/islands.c; docs/integration.md).
@@ -142,6 +148,15 @@ typedef struct pdCounters {
   long contactsTransferred;  // VF contacts whose sliding vertex moved on to an adjacent face (§4.4.3)
   long breaksForce;       // contacts dropped because the normal springs would pull
   long breaksGeometry;    // contacts dropped because a feature left the other (vertex off its face, EE off an edge)
+  // What the step did not locate (docs/events.md): each corrected onset's error bound (onset_bound.h), in the units
+  // of the error norm (so comparable with tol), their largest and their sum
+  double onsetBoundMax;
+  double onsetBoundSum;
+  long transitionsUnlocated;   // stick–slip changes left inside their step (bounded events), each with its bound:
+  double transitionBoundMax;   // the largest
+  double transitionBoundSum;   // and their sum, error-norm units as above
+  long historyKept;  // contacts that started on the features of one broken by force within the gap tolerance, with
+                     // its tangential springs (engine/src/contact_history.h)
   // pd_islandsOn only (0 otherwise); the counts above are then summed over the islands
   long islandsFormed;    // islands set up (at the start, and each time the bodies of an island changed)
   long islandsLargest;   // moving bodies in the largest island formed

@@ -1,0 +1,83 @@
+// polydyn — tangential history kept through micro-separations (contact_history.h, design note there).
+#include "contact_history.h"
+
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "grow.h"
+
+typedef struct trace {
+  pdContactId id;
+  pdSprings springs;
+  pdVec3 normal;
+  double deltaMax;  // m
+  bool taken;
+} trace;
+
+struct pdContactHistory {
+  trace* items;  // [0, sortedCount) sorted by id (pd_contact_id_compare); then those left since the last age
+  int count, capacity, sortedCount;
+};
+
+pdContactHistory* pd_history_create(void) {
+  pdContactHistory* h = calloc(1, sizeof *h);
+  PD_ASSERT(h != NULL);
+  return h;
+}
+
+void pd_history_free(pdContactHistory* h) {
+  if (!h) return;
+  free(h->items);
+  free(h);
+}
+
+void pd_history_clear(pdContactHistory* h) { h->count = h->sortedCount = 0; }
+
+int pd_history_count(const pdContactHistory* h) { return h->count; }
+
+void pd_history_leave(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
+                      double deltaMax) {
+  if (h->count == h->capacity) {
+    h->capacity = h->capacity ? 2 * h->capacity : 16;
+    h->items = pd_grow(h->items, (size_t)h->capacity, sizeof *h->items);
+  }
+  h->items[h->count++] = (trace){*id, *springs, normal, deltaMax, false};
+}
+
+static int compare_traces(const void* a, const void* b) {
+  return pd_contact_id_compare(&((const trace*)a)->id, &((const trace*)b)->id);
+}
+
+void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* poses) {
+  int kept = 0;
+  for (int i = 0; i < h->count; ++i) {
+    trace* t = &h->items[i];
+    if (t->taken) continue;
+    pdContactGeom g;
+    if (!pd_contact_track(model, &t->id, &poses[t->id.body1], &poses[t->id.body2], &g)) continue;
+    if (-g.depth > PD_HISTORY_GAP_REL * t->deltaMax) continue;
+    h->items[kept++] = *t;
+  }
+  // ids are unique among traces: a contact breaks only while listed, and a listed contact has no trace left
+  if (kept > 1 && kept > h->sortedCount) qsort(h->items, (size_t)kept, sizeof *h->items, compare_traces);
+  h->count = h->sortedCount = kept;
+}
+
+bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, const pdContactParams* params,
+                     pdSprings* springs) {
+  // a trace left since the last age broke from a contact of this very list, which a new contact is not
+  if (h->sortedCount == 0) return false;
+  trace key = {.id = *id};
+  trace* t = bsearch(&key, h->items, (size_t)h->sortedCount, sizeof *h->items, compare_traces);
+  if (!t || t->taken) return false;
+  pdSprings s = t->springs;
+  s.s1n = s.s2n = 0.0;  // the normal springs start where the contact does
+  // turned to the new normal (and rebalanced where the sides are proportional), not clipped to a cone: the contact
+  // has no normal force yet, and the force law keeps its friction within the cone as the normal force grows
+  pd_springs_realign(&s, t->normal, normal, params->mu, params, DBL_MAX);
+  springs->s1t = s.s1t;
+  springs->s2t = s.s2t;
+  t->taken = true;
+  return true;
+}

@@ -1,0 +1,41 @@
+// polydyn (internal) — tangential history kept through micro-separations (docs/events.md).
+//
+// Design note. A contact whose normal springs would pull is dropped at the step's end (a break ends its history).
+// In a pile, resting contacts chatter: a corner lifts by a fraction of its rest depth and lands again a few steps
+// later on the same features, and with its tangential springs started at zero each time, what held the body in stick
+// is lost at every landing, and the pile creeps. So a contact that breaks by force leaves its tangential springs
+// behind (a "trace", keyed by its id: the same two features), as long as its features stay tracked and within
+// PD_HISTORY_GAP_REL × δ_max of touching; a contact on the same features that starts again meanwhile takes them,
+// realigned to its normal. A trace whose features part farther, or leave each other (a vertex off its face), is
+// forgotten. Traces are kept per contact set: an island set up anew starts without them (as before this history).
+#pragma once
+
+#include <stdbool.h>
+
+#include "contact_analysis.h"
+#include "contact_force.h"
+
+// A trace is kept while its features are apart by at most this fraction of the pair's δ_max. A resting contact's
+// rest depth is of the order of 0.1–0.3 δ_max (m g over the springs of a face's corners), and a micro-separation
+// lifts a corner by a small part of it; a gap of a tenth of δ_max is then still that resting contact, while a body
+// that bounces off goes beyond it within a step or two.
+#define PD_HISTORY_GAP_REL 0.1
+
+typedef struct pdContactHistory pdContactHistory;
+
+pdContactHistory* pd_history_create(void);
+void pd_history_free(pdContactHistory* h);
+void pd_history_clear(pdContactHistory* h);
+int pd_history_count(const pdContactHistory* h);
+
+// Contact `id` of the list broke by force with these springs, its normal `normal` and the pair's δ_max deltaMax (m).
+void pd_history_leave(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
+                      double deltaMax);
+// After a commit, at the bodies' new poses (indexed by model body): forgets every trace whose features no longer
+// track or are apart by more than the gap tolerance, and every trace left before this call and taken since.
+void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* poses);
+// A new contact `id` with normal `normal`: when a trace of the same features is kept, writes its tangential springs,
+// realigned from the trace's normal to `normal` (pd_springs_realign), into *springs, forgets the trace and returns
+// true; else false.
+bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, const pdContactParams* params,
+                     pdSprings* springs);

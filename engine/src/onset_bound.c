@@ -1,0 +1,17 @@
+// polydyn — the error bound of a corrected onset (onset_bound.h, design note there).
+#include "onset_bound.h"
+
+#include <math.h>
+
+double pd_onset_error_bound(double omega, double tau, double depth, double approach, double vmax, double size) {
+  double wt = omega * tau;
+  double velocity = PD_ONSET_BOUND_C * wt * wt * wt * fabs(approach) / vmax;
+  double position = fmax(depth, 0.0) * wt * wt / (6.0 * size);
+  return fmax(velocity, position);
+}
+
+double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, double slide, double approach, double h,
+                                 double vmax) {
+  double kinkSlope = omegaT2 * fabs(slide) + mu * omegaN2 * fabs(approach);  // m/s³
+  return kinkSlope * h * h / (48.0 * vmax);
+}

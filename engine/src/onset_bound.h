@@ -1,0 +1,49 @@
+// polydyn (internal) — the error a corrected onset may add, and whether the step may spend it (docs/events.md).
+//
+// Design note. A contact that began τ seconds before a step's end, found there at depth d approaching at v_n, can
+// join at the step's end as its pair alone would be after τ (contact_set.c, start_late_contacts: springs at the
+// deflection x of a Kelvin–Voigt element at the pair's modal mass, the bodies given the impulse that element took).
+// Along the normal of one point mass that is the exact motion; what it misses is the rest of the system over τ: the
+// bodies' turning under the impulse (a modal mass, not the motion of every contact of the pair), the other contacts,
+// and the interpolated onset time. Two numbers bound it, both in the units of the stepper's error norm (state.c's
+// weights), so they compare with tol:
+//   velocity: |δe| v_n / vmax, with |δe| <= PD_ONSET_BOUND_C (ωτ)³, the restitution error of a corrected onset
+//             (C measured: tests/engine/test_events.c, the drops whose onsets are forced to be corrected);
+//   position: (d − x) / L <= d (ωτ)² / (6 L), how much deeper the contact's rest point sits than a located onset's,
+//             L the smaller moving body's size,
+// with ω = √(k_s / m_min) the pair's fastest undamped frequency. An onset is corrected only where the larger of the
+// two is at most PD_ONSET_TOL_SHARE × tol, and ωτ and d stay within the ranges the correction holds in (contact_set.c,
+// PD_ONSET_PAIR_OMEGA_TAU, PD_ONSET_PAIR_DEPTH_REL); others are located, as the paper does with every one.
+#pragma once
+
+#include <stdbool.h>
+
+// Restitution error of a corrected onset over (ωτ)³: the 1-D spring–dashpot figure of the cruder impulse
+// (c v_n + ½ k δ₀) τ, 0.08, halved because the element is integrated (onset_motion), not approximated. Measured on a
+// single body (tests/engine/test_events.c: a cube landing on a face, a corner and an edge, e 0.3–0.8, ωτ 0.02–0.82,
+// at tol 1e-10): every corrected landing within 3e-3 of this bound (≤ 1.1e-4 (ωτ)³, at the integration's noise). So
+// it is conservative where measured; in a crowd a pair's other contacts act over τ too, which no test isolates.
+#define PD_ONSET_BOUND_C 0.04
+// The share of tol one corrected onset may spend: the size of one accepted step's own local error. An onset joined
+// within it changes the result no more than one more step would; beyond it the onset is located (a retried step).
+#define PD_ONSET_TOL_SHARE 1.0
+
+// The error bound of joining, corrected, an onset of a contact whose pair's fastest frequency is omega (1/s), that
+// began tau seconds before the step's end, found at depth (m) approaching at approach (m/s, > 0), in a scene whose
+// velocity scale is vmax (m/s) and whose smaller moving body of the pair is size (m) across: the larger of the two
+// terms above (dimensionless, the error norm's units).
+double pd_onset_error_bound(double omega, double tau, double depth, double approach, double vmax, double size);
+
+// Whether an onset of that bound may be corrected at tolerance tol (else it is located).
+static inline bool pd_onset_bound_allows(double bound, double tol) { return bound <= PD_ONSET_TOL_SHARE * tol; }
+
+// A stick–slip change left inside a step (docs/events.md). The contact force is continuous there but its rate jumps,
+// by at most [Ḟ] = k_t |Δu_t| + μ k_n |Δu_n| (the spring rates of stick against those of the cone; series constants),
+// so the acceleration has a kink of slope [a'] <= [Ḟ] / m_min. RK4 integrates the velocity across it like Simpson's
+// rule across a kinked integrand, whose error is at most [a'] h²/24 (the kink at the middle); with step doubling the
+// kink lies in one half step, h/2. Twice that, for the spring rates the bodies' turning adds:
+//   bound = 2 [a'] (h/2)² / 24 / vmax = (ω_t² |Δu_t| + μ ω_n² |Δu_n|) h² / (48 vmax),  ω² = k / m_min,
+// in the error norm's units; the change is left inside the step where the bound is within PD_ONSET_TOL_SHARE × tol,
+// else the step is halved towards it as the paper does (contact_set.c, refine_step).
+double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, double slide, double approach, double h,
+                                 double vmax);
