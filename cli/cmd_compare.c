@@ -228,12 +228,12 @@ static bool write_results(const char* dir, const char* scene, const pdModel* mod
   fputs(",\n  \"runs\": [\n", out);
   for (int i = 0; i < count; ++i) {
     const compareRun* r = &runs[i];
-    fputs("    {\"engine\": ", out);
-    pdu_json_string(out, r->engine);
-    fputs(", \"variant\": ", out);
-    pdu_json_string(out, r->variant);
-    fputs(", \"status\": ", out);
-    pdu_json_string(out, r->status);
+    const char* const keys[] = {"engine", "variant", "status"};
+    const char* const values[] = {r->engine, r->variant, r->status};
+    for (int k = 0; k < 3; ++k) {
+      fprintf(out, "%s\"%s\": ", k ? ", " : "    {", keys[k]);
+      pdu_json_string(out, values[k]);
+    }
     fprintf(out, ", \"run_dir\": \"runs/%s\", \"message\": ", r->name);
     pdu_json_string(out, r->message);
     fprintf(out, "}%s\n", i + 1 < count ? "," : "");

@@ -295,12 +295,11 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
     fprintf(out, ",%s,%s,%s,%s,", pdGkKindNames[e->kind], pdGkEngineNames[p->engine], p->variant, p->setting);
     if (isfinite(p->value)) fprintf(out, "%.6g", p->value);  // the setting as it is named (1/60 s: 0.0166667)
     fputc(',', out);
-    pdu_csv_text(out, c->label);
-    fputc(',', out);
-    pdu_csv_text(out, e->quantity);
-    fputc(',', out);
-    pdu_csv_text(out, e->unit);
-    fputc(',', out);
+    const char* const texts[] = {c->label, e->quantity, e->unit};
+    for (int k = 0; k < 3; ++k) {
+      pdu_csv_text(out, texts[k]);
+      fputc(',', out);
+    }
     gk_csv_number(out, p->measured);
     fputc(',', out);
     gk_csv_number(out, c->expected.value);
