@@ -78,7 +78,7 @@ static bool csv_open(csvOut* c, const char* path) {
   c->partial = malloc(n);
   if (!c->path || !c->partial) abort();
   snprintf(c->partial, n, "%s.partial-XXXXXX", path);
-  pd_cli_make_parents(path);
+  pdu_make_parents(path);
   int fd = mkstemp(c->partial);
   if (fd < 0 || !(c->f = fdopen(fd, "w"))) {
     fprintf(stderr, "polydyn oracle: %s: cannot write: %s\n", path, strerror(errno));
@@ -203,7 +203,7 @@ static int run_timing(long n, unsigned long long seed, int repeats, const char* 
   pd_oracle_timing_print(&t, stdout);
   printf("time: CPU %.2f s (shapes, placement, an untimed pass and the timed repeats)\n", cpu_now() - c0);
   if (out) {
-    pd_cli_make_parents(out);
+    pdu_make_parents(out);
     FILE* f = fopen(out, "w");
     if (!f) {
       fprintf(stderr, "polydyn oracle: %s: cannot write: %s\n", out, strerror(errno));

@@ -11,9 +11,6 @@
 #include "pdutil/files.h"
 #include "polydyn/batch.h"
 
-// mkdir -p of the directories above `path`; a real failure shows when the run directory is made
-void pd_cli_make_parents(const char* path) { pdu_make_parents(path); }
-
 // out/NAME for scene path .../NAME.ext
 char* pd_cli_default_out_dir(const char* scene) {
   const char* base = strrchr(scene, '/');
