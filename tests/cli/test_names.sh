@@ -2,7 +2,8 @@
 # Names as the scene language allows them (any word of valid UTF-8: docs/names-and-files.md) through every file
 # that carries them. A scene of bodies with random names — quotes, commas, semicolons, colons, markup, non-ASCII,
 # one of 4 000 bytes, and the name that once made `polydyn compare` write a metrics.csv `polydyn report` refused —
-# run, compared, swept (under a file name of the same kind), viewed and reported: every command succeeds and the
+# run, compared, swept (under a file name of the same kind), viewed and reported, and cube tosses read from such
+# a file name: every command succeeds and the
 # project's readers (names_check.mjs: the report generator's and the viewer's) give each name back byte for byte.
 # A name that is not UTF-8 is refused as FILE:LINE:COL with exit status 2.
 # Usage: test_names.sh POLYDYN SOURCE_DIR [SEED]
@@ -50,6 +51,16 @@ run_pd "$tmp/o" "$tmp/e" view "$tmp/run" -o "$tmp/view.html"
 check "view reads the run (C reader)" '[ $rc -eq 0 ] || { cat "$tmp/e"; false; }'
 check "every name read back by the report's and the viewer's readers" \
   'node "$src/tests/cli/names_check.mjs" "$tmp/names.json" "$tmp/run" "$tmp/compare" "$tmp/sweep" "$odd"'
+
+# cube tosses from a data file at a path of the same kind: the path is text in each record's summary.json
+tosses="$tmp/to,ss \"é\" 1;2.csv"
+python3 "$src/tests/reports/make_tosses.py" "$tosses" 2 >/dev/null
+run_pd "$tmp/o" "$tmp/e" cubetoss --data "$tosses" --engines soft --out "$tmp/toss"
+check "cubetoss succeeds" '[ $rc -eq 0 ] || { cat "$tmp/e"; false; }'
+check "the record's summary.json gives the data path back" \
+  'python3 -c "import json,sys; s=json.load(open(sys.argv[1], encoding=\"utf-8\")); sys.exit(s[\"engine_settings\"][\"source\"] != sys.argv[2])" "$tmp/toss/runs/1/record/summary.json" "$tosses"'
+run_pd "$tmp/o" "$tmp/e" report "$tmp/toss" --out "$tmp/toss.html"
+check "report reads per_toss.csv and summary.csv" '[ $rc -eq 0 ] || { cat "$tmp/e"; false; }'
 
 # a name that is not UTF-8: FILE:LINE:COL at its first bad byte, exit 2, nothing written
 printf 'cube ok red 1 1 1\ncube ab\xff\xfe red 1 1 1\n' >"$tmp/bad.scene"
