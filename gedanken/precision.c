@@ -300,18 +300,18 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
       pdu_csv_text(out, texts[k]);
       fputc(',', out);
     }
-    gk_csv_number(out, p->measured);
+    pdu_csv_number(out, p->measured, 17);
     fputc(',', out);
-    gk_csv_number(out, c->expected.value);
+    pdu_csv_number(out, c->expected.value, 17);
     fputc(',', out);
-    gk_csv_number(out, p->error);
+    pdu_csv_number(out, p->error, 17);
     fprintf(out, ",%s,", e->relative ? "true" : "false");
-    gk_csv_number(out, c->expected.tolerance);
+    pdu_csv_number(out, c->expected.tolerance, 17);
     bool judged = pd_gk_applies(e, p->engine, strcmp(p->variant, "matched") == 0);
     fprintf(out, ",%s,%s,", judged ? "true" : "false", pointStatusNames[p->status]);
-    gk_csv_number(out, p->wall);
+    pdu_csv_number(out, p->wall, 17);
     fputc(',', out);
-    gk_csv_number(out, p->wall / c->model->settings.tend);
+    pdu_csv_number(out, p->wall / c->model->settings.tend, 17);
     fprintf(out, ",%ld,%d,", p->steps, s->options->repeats);
     pdu_csv_text(out, p->note);
     fputc('\n', out);
