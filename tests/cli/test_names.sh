@@ -2,8 +2,8 @@
 # Names as the scene language allows them (any word of valid UTF-8: docs/names-and-files.md) through every file
 # that carries them. A scene of bodies with random names — quotes, commas, semicolons, colons, markup, non-ASCII,
 # one of 4 000 bytes, and the name that once made `polydyn compare` write a metrics.csv `polydyn report` refused —
-# run, compared, swept (under a file name of the same kind), viewed and reported, and cube tosses read from such
-# a file name: every command succeeds and the
+# run, compared, swept (under a file name of the same kind), viewed and reported, given to the oracle's replay
+# CSV, and cube tosses read from such a file name: every command succeeds and the
 # project's readers (names_check.mjs: the report generator's and the viewer's) give each name back byte for byte.
 # A name that is not UTF-8 is refused as FILE:LINE:COL with exit status 2.
 # Usage: test_names.sh POLYDYN SOURCE_DIR [SEED]   (SEED of the names, default 1; any other gives other names)
@@ -51,6 +51,30 @@ run_pd "$tmp/o" "$tmp/e" view "$tmp/run" -o "$tmp/view.html"
 check "view reads the run (C reader)" '[ $rc -eq 0 ] || { cat "$tmp/e"; false; }'
 check "every name read back by the report's and the viewer's readers" \
   'node "$src/tests/cli/names_check.mjs" "$tmp/names.json" "$tmp/run" "$tmp/compare" "$tmp/sweep" "$odd"'
+
+# the oracle's CSV: rows of `--random` given the names (and the scene path as source), replayed; the C reader
+# takes them back and `--out` writes each name again, read back by the report generator's reader
+run_pd "$tmp/o" "$tmp/e" oracle --random 300 --seed 7 --out "$tmp/random.oracle.csv"
+python3 - "$tmp" "$odd" <<'PY'
+import csv, json, sys
+tmp, odd = sys.argv[1], sys.argv[2]
+names = json.load(open(f'{tmp}/names.json', encoding='utf-8'))
+rows = list(csv.reader(open(f'{tmp}/random.oracle.csv', newline='', encoding='utf-8')))
+for i, r in enumerate(rows[1:]):
+    r[0], r[4], r[5] = odd, names[i % len(names)], names[(i + 1) % len(names)]
+with open(f'{tmp}/named.oracle.csv', 'w', newline='', encoding='utf-8') as f:
+    csv.writer(f, lineterminator='\n').writerows(rows)
+PY
+run_pd "$tmp/o" "$tmp/e" oracle --replay "$tmp/named.oracle.csv" --out "$tmp/replayed.oracle.csv"
+check "oracle --replay reads the named rows" '[ $rc -eq 0 ] || { cat "$tmp/e"; false; }'
+check "... and writes every name and the source back" \
+  'node -e "
+    const fs = require(\"fs\");
+    import(process.argv[1]).then(({ parseCsv }) => {
+      const read = (f) => parseCsv(fs.readFileSync(f, \"utf8\"), f).slice(1).map((r) => [r.fields[0], r.fields[4], r.fields[5]]);
+      const a = read(process.argv[2]), b = read(process.argv[3]);
+      process.exit(a.length > 0 && JSON.stringify(a) === JSON.stringify(b) ? 0 : 1);
+    });" "$src/reports/generator/lib/csv.mjs" "$tmp/named.oracle.csv" "$tmp/replayed.oracle.csv"'
 
 # cube tosses from a data file at a path of the same kind: the path is text in each record's summary.json
 tosses="$tmp/to,ss \"é\" 1;2.csv"
