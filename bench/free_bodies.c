@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
       fprintf(stderr, "pd_bench_free: generated scene refused: %d:%d: %s\n", err.line, err.col, err.message);
       return 1;
     }
-    pdState* state = pd_state_create(model);
+    pdState* state = pd_state_create(model, NULL);
     result r = {0};
     for (long k = 0; k < repeats; ++k) {
       pd_state_reset(model, state);

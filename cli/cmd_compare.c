@@ -117,7 +117,7 @@ static void run_soft(const char* scene, const pdCliOverrides* overrides, const c
     pd_model_free(model);
     return;
   }
-  pdState* state = pd_state_create(model);
+  pdState* state = pd_state_create(model, NULL);
   r->trajectory = pd_trajectory_create(model);
   softObserver o = {writer, r->trajectory};
   double e0 = pd_state_energy(model, state), t0 = pd_cli_wall_seconds();

@@ -288,7 +288,7 @@ static int run_scene(const char* path, const pdCliOverrides* overrides, const ch
   int status = PD_EXIT_BAD_INPUT;
   pdState* state = NULL;
   if (!csv_open(&c.csv, out)) goto done;
-  state = pd_state_create(model);
+  state = pd_state_create(model, NULL);
   double t0 = wall_now(), c0 = cpu_now();
   bool completed = pd_advance(model, state, model->settings.tend, observe, &c);
   double wall = wall_now() - t0, cpu = cpu_now() - c0;

@@ -246,11 +246,12 @@ int pd_cmd_run(int argc, char** argv) {
     return status;
   }
 
-  pdState* state = pd_state_create(model);
-  state->stepper = stepper;
-  state->onsets = onsets;
-  state->islands = islands;
-  state->threads = threads;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  options.onsets = onsets;
+  options.islands = islands;
+  options.threads = threads;
+  pdState* state = pd_state_create(model, &options);
   runObserver observer = {writer, isatty(STDERR_FILENO) == 1, pd_cli_wall_seconds()};
   double energyStart = pd_state_energy(model, state);
   double t0 = pd_cli_wall_seconds();

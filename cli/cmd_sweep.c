@@ -129,8 +129,9 @@ static bool observe(const pdModel* model, const pdState* state, void* trajectory
 // One soft run: trajectory (when wanted), wall time, steps, derivative evaluations (when wanted), completed.
 static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* trajectory, double* wall, long* steps,
                      long* derivatives) {
-  pdState* state = pd_state_create(model);
-  state->stepper = stepper;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  pdState* state = pd_state_create(model, &options);
   double t0 = pd_cli_wall_seconds();
   bool ok = pd_advance(model, state, model->settings.tend, observe, trajectory);
   *wall = pd_cli_wall_seconds() - t0;

@@ -143,11 +143,12 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
   for (int r = 0; r < repeats && completed && !interrupted(s); ++r) {
     gkPointObserver observer = {r == 0 ? &rec : NULL, s, p->engine == pd_gkSoft};
     if (model) {
-      pdState* state = pd_state_create(model);
-      state->stepper = strcmp(p->variant, "fixed") == 0      ? pd_stepperRK4Fixed
-                       : strcmp(p->variant, "embedded") == 0 ? pd_stepperRK43Embedded
-                       : strcmp(p->variant, "implicit") == 0 ? pd_stepperImplicit
-                                                             : pd_stepperRK4Adaptive;
+      pdStateOptions options = pd_state_options_default();
+      options.stepper = strcmp(p->variant, "fixed") == 0      ? pd_stepperRK4Fixed
+                        : strcmp(p->variant, "embedded") == 0 ? pd_stepperRK43Embedded
+                        : strcmp(p->variant, "implicit") == 0 ? pd_stepperImplicit
+                                                              : pd_stepperRK4Adaptive;
+      pdState* state = pd_state_create(model, &options);
       double t0 = gk_wall_seconds();
       completed = pd_advance(model, state, model->settings.tend, observe, &observer);
       walls[r] = gk_wall_seconds() - t0;

@@ -207,7 +207,7 @@ static void run_job(gkSuite* s, gkJob* job) {
   gkObserver observer = {&rec, writer, s};
   bool written = false, completed = false;
   if (job->engine == pd_gkSoft) {
-    pdState* state = pd_state_create(model);
+    pdState* state = pd_state_create(model, NULL);
     double energyStart = pd_state_energy(model, state), t0 = gk_wall_seconds();
     completed = pd_advance(model, state, model->settings.tend, observe_soft, &observer);
     job->wallSeconds = gk_wall_seconds() - t0;

@@ -182,7 +182,7 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
   bool ok;
   double cpu0 = cpu_now();
   if (soft) {
-    pdState* state = pd_state_create(model);
+    pdState* state = pd_state_create(model, NULL);
     softObserver o = {writer, trajectory};
     double e0 = pd_state_energy(model, state), t0 = wall_now();
     bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
@@ -279,7 +279,7 @@ bool pd_toss_write_record(const pdToss* toss, const pdTossParams* params, const 
     pd_model_free(model);
     return false;
   }
-  pdState* state = pd_state_create(model);
+  pdState* state = pd_state_create(model, NULL);
   double energyStart = 0.0;
   bool ok = true;
   for (int k = 0; k < toss->sampleCount && ok; ++k) {

@@ -21,18 +21,18 @@
 
 static const char* const kindWords[] = {"cube", "prism", "tprism", "sphere", "hull"};
 
-static bool build_object(const pdSceneObject* o, pdPolyhedron* p, char* why, int whySize) {
+static bool build_object(const pdSceneObject* o, pdPolyhedron* p, pdError* why) {
   switch (o->kind) {
     case pd_primCube:
-      return pd_polyhedron_cube(p, o->scale, why, whySize);
+      return pd_polyhedron_cube(p, o->scale, why);
     case pd_primPrism:
-      return pd_polyhedron_prism(p, o->n, o->scale, 1.0, why, whySize);
+      return pd_polyhedron_prism(p, o->n, o->scale, 1.0, why);
     case pd_primTprism:
-      return pd_polyhedron_prism(p, o->n, o->scale, o->taper, why, whySize);
+      return pd_polyhedron_prism(p, o->n, o->scale, o->taper, why);
     case pd_primSphere:
-      return pd_polyhedron_sphere(p, o->n, o->scale, why, whySize);
+      return pd_polyhedron_sphere(p, o->n, o->scale, why);
     case pd_primHull:
-      return pd_polyhedron_hull(p, o->points, o->pointCount, why, whySize);
+      return pd_polyhedron_hull(p, o->points, o->pointCount, why);
   }
   return false;
 }
@@ -68,11 +68,13 @@ bool pd_oracle_shape_parse(const char* spec, pdOracleShape* out, char* why, int 
   PD_ASSERT(scene->objectCount == 1);
   // body frame as in pd_model_compile: the centre of mass does not depend on the density
   pdMassProperties mp;
-  bool ok = build_object(&scene->objects[0], &out->poly, why, whySize);
-  if (ok && !pd_mass_properties(&out->poly, 1000.0, &mp, why, whySize)) {
+  pdError shapeErr = {0};
+  bool ok = build_object(&scene->objects[0], &out->poly, &shapeErr);
+  if (ok && !pd_mass_properties(&out->poly, 1000.0, &mp, &shapeErr)) {
     pd_polyhedron_free(&out->poly);
     ok = false;
   }
+  if (!ok) snprintf(why, (size_t)whySize, "%s", shapeErr.message);
   pd_scene_free(scene);
   if (!ok) return false;
   pd_polyhedron_translate(&out->poly, pd_v3_scale(mp.centroid, -1.0));

@@ -83,7 +83,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
     if (writer) pd_run_abort(writer);
     return false;
   }
-  pdState* state = pd_state_create(model);
+  pdState* state = pd_state_create(model, NULL);
   double energyStart = pd_state_energy(model, state);
   double tend = model->settings.tend;
   long sampleCount = (long)floor(tend / plan.sampleInterval * (1.0 + 1e-12));

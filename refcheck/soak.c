@@ -381,9 +381,10 @@ static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onse
   pdIslands islands;
   bool soft = pd_soak_engine_is_soft(engine, &islands);
   if (soft) {
-    pdState* s = pd_state_create(m);
-    s->islands = islands;
-    s->onsets = onsets;
+    pdStateOptions options = pd_state_options_default();
+    options.islands = islands;
+    options.onsets = onsets;
+    pdState* s = pd_state_create(m, &options);
     completed = pd_advance(m, s, m->settings.tend, observe, &w);
     completed = completed && !s->failed;
     o->steps = s->count.accepted;

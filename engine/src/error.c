@@ -59,3 +59,17 @@ void pd_why(char* why, int whySize, const char* fmt, ...) {
   vsnprintf(why, (size_t)whySize, fmt, ap);
   va_end(ap);
 }
+
+static void assert_default(const char* expression, const char* file, int line) {
+  fprintf(stderr, "%s:%d: polydyn API misuse: assertion `%s` failed\n", file, line, expression);
+  abort();
+}
+
+static pdAssertFcn* assertFcn = assert_default;
+
+void pd_set_assert_fcn(pdAssertFcn* fcn) { assertFcn = fcn ? fcn : assert_default; }
+
+void pd_assert_failed(const char* expression, const char* file, int line) {
+  assertFcn(expression, file, line);
+  abort();
+}

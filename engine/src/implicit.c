@@ -88,7 +88,9 @@ void pd_implicit_deactivate(pdImplicit* im, bool gaveUp, double t) {
   im->active = false, im->held = 0, im->boundStep = 0.0;
 }
 
-static void reserve(pdImplicit* im, int contacts, int rows) {
+void pd_implicit_reserve(pdImplicit* im, int movingCount, int contacts) {
+  int rows = BODY_ROWS * movingCount;
+  if (contacts < 1) contacts = 1;
   if (contacts > im->contactCapacity) {
     im->linear = realloc(im->linear, (size_t)contacts * sizeof *im->linear);
     im->blocks = realloc(im->blocks, (size_t)contacts * sizeof *im->blocks);
@@ -173,7 +175,8 @@ void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im,
   PD_ASSERT(model->movingCount >= 1 && model->movingCount <= PD_IMPLICIT_BODIES_MAX);
   int contacts = pd_state_contact_count(state);
   int rows = BODY_ROWS * model->movingCount;
-  reserve(im, contacts > 0 ? contacts : 1, rows);
+  // sized between steps (pd_implicit_reserve): a trial step does not allocate
+  PD_ASSERT(contacts <= im->contactCapacity && rows <= im->rowCapacity && im->perm && im->perm->size == (size_t)rows);
   im->rows = rows;
   pd_contact_set_linearise(model, state->contacts, y, im->linear);
 }

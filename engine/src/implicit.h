@@ -50,8 +50,11 @@
 
 typedef struct pdImplicit pdImplicit;
 
-// An empty workspace; it grows at pd_implicit_factor to the largest system it has seen (then allocates nothing).
+// An empty workspace, sized by pd_implicit_reserve before its first step and again, between steps, whenever the state
+// can hold more contacts (pd_state_reserve_contacts): a step allocates nothing (pd_implicit_linearise asserts it).
 pdImplicit* pd_implicit_create(void);
+// Room for a system of `movingCount` bodies and up to `contacts` contacts (grows only).
+void pd_implicit_reserve(pdImplicit* im, int movingCount, int contacts);
 void pd_implicit_free(pdImplicit* im);
 
 // Whether the system steps implicitly now, and the switch's bookkeeping (PD_IMPLICIT_SWITCH_STEPS).

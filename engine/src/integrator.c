@@ -402,7 +402,10 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
 static double switching_step(const pdModel* model, pdState* s, double hMax) {
   if (model->movingCount > PD_IMPLICIT_BODIES_MAX)
     return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
-  if (!s->implicit) s->implicit = pd_implicit_create();
+  if (!s->implicit) {
+    s->implicit = pd_implicit_create();
+    pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
+  }
   pdImplicit* im = s->implicit;
   stepOutcome out = {0.0, false, false};
   if (!pd_implicit_active(im)) {

@@ -252,7 +252,7 @@ static island* island_create(const pdModel* model, struct pdIslandSet* set, cons
     sub->movingBodies[k++] = l;
   }
   sub->materials = pd_material_table_view(model->materials, is->toScene, n);
-  is->state = pd_state_create(sub);
+  is->state = pd_state_create(sub, NULL);  // island_load sets its stepper and onsets
   pd_contact_set_help(is->state->contacts, &set->pool.desk);
   return is;
 }

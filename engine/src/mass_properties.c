@@ -13,7 +13,6 @@
 #include <string.h>
 
 #include "polydyn/polyhedron.h"
-#include "why.h"
 
 
 static void add_outer(double m[3][3], pdVec3 a, double s) {
@@ -55,7 +54,7 @@ static bool principal_axes(const pdMat3* inertia, double moments[3], pdMat3* axe
   return status == GSL_SUCCESS;
 }
 
-bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties* out, char* why, int whySize) {
+bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties* out, pdError* why) {
   PD_ASSERT(density > 0.0 && p->vertexCount > 0);
   memset(out, 0, sizeof *out);
   pdVec3 r = {0, 0, 0};
@@ -83,7 +82,7 @@ bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties*
   }
   double volume = volume6 / 6.0;
   if (!(volume > 0.0) || !isfinite(volume)) {
-    pd_why(why, whySize, "volume is not positive (%g m^3)", volume);
+    pd_error_set(why, NULL, 0, 0, "volume is not positive (%g m^3)", volume);
     return false;
   }
   pdVec3 offset = pd_v3_scale(first24, 1.0 / (24.0 * volume));  // centroid - r
@@ -106,7 +105,7 @@ bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties*
   bool ok = principal_axes(&out->inertia, out->principal, &out->principalAxes);
   gsl_set_error_handler(previous);
   if (!ok || !(out->principal[0] > 0.0)) {
-    pd_why(why, whySize, "inertia tensor is not positive definite");
+    pd_error_set(why, NULL, 0, 0, "inertia tensor is not positive definite");
     return false;
   }
   return true;

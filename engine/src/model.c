@@ -29,18 +29,18 @@ static char* copy_string(const char* s) {
   return c;
 }
 
-static bool build_shape(const pdSceneObject* o, pdPolyhedron* shape, char* why, int whySize) {
+static bool build_shape(const pdSceneObject* o, pdPolyhedron* shape, pdError* why) {
   switch (o->kind) {
     case pd_primCube:
-      return pd_polyhedron_cube(shape, o->scale, why, whySize);
+      return pd_polyhedron_cube(shape, o->scale, why);
     case pd_primPrism:
-      return pd_polyhedron_prism(shape, o->n, o->scale, 1.0, why, whySize);
+      return pd_polyhedron_prism(shape, o->n, o->scale, 1.0, why);
     case pd_primTprism:
-      return pd_polyhedron_prism(shape, o->n, o->scale, o->taper, why, whySize);
+      return pd_polyhedron_prism(shape, o->n, o->scale, o->taper, why);
     case pd_primSphere:
-      return pd_polyhedron_sphere(shape, o->n, o->scale, why, whySize);
+      return pd_polyhedron_sphere(shape, o->n, o->scale, why);
     case pd_primHull:
-      return pd_polyhedron_hull(shape, o->points, o->pointCount, why, whySize);
+      return pd_polyhedron_hull(shape, o->points, o->pointCount, why);
   }
   return false;
 }
@@ -217,10 +217,10 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
     b->where = o->where;
     b->density = 1000.0 * o->spgrav;
 
-    char why[256] = "";
+    pdError why = {0};
     pdMassProperties mp;
-    if (!build_shape(o, &b->shape, why, sizeof why) || !pd_mass_properties(&b->shape, b->density, &mp, why, sizeof why)) {
-      pd_error_set(err, scene->path, o->where.line, o->where.col, "object '%s': %s", o->name, why);
+    if (!build_shape(o, &b->shape, &why) || !pd_mass_properties(&b->shape, b->density, &mp, &why)) {
+      pd_error_set(err, scene->path, o->where.line, o->where.col, "object '%s': %s", o->name, why.message);
       pd_model_free(m);
       return NULL;
     }

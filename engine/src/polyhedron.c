@@ -18,7 +18,6 @@
 #include <string.h>
 
 #include "interference.h"
-#include "why.h"
 
 
 static void* xcalloc(size_t n, size_t size) {
@@ -108,7 +107,7 @@ static int compare_half_edge(const void* x, const void* y) {
 
 // Pairs directed face boundaries into edges. Returns false (with why) unless every undirected edge
 // is walked exactly once in each direction. When `edges` is NULL only counts and checks.
-static bool pair_edges(const pdPolyhedron* p, pdEdge* edges, int* edgeCount, char* why, int whySize) {
+static bool pair_edges(const pdPolyhedron* p, pdEdge* edges, int* edgeCount, pdError* why) {
   int total = 0;
   for (int f = 0; f < p->faceCount; ++f) total += p->faces[f].count;
   halfEdge* h = xcalloc((size_t)total, sizeof *h);
@@ -127,7 +126,7 @@ static bool pair_edges(const pdPolyhedron* p, pdEdge* edges, int* edgeCount, cha
     while (j < total && (h[j].a == h[i].a || h[j].a == h[i].b) && (h[j].b == h[i].a || h[j].b == h[i].b)) ++j;
     const halfEdge* fwd = &h[i];
     if (j - i != 2 || fwd->a == fwd->b || !(fwd->a < fwd->b && h[i + 1].a == fwd->b)) {
-      pd_why(why, whySize, "edge %d-%d is not shared by exactly two faces walking it in opposite directions", fwd->a,
+      pd_error_set(why, NULL, 0, 0, "edge %d-%d is not shared by exactly two faces walking it in opposite directions", fwd->a,
           fwd->b);
       ok = false;
       break;
@@ -160,8 +159,7 @@ static int compare_raw_face(const void* x, const void* y) {
 
 // Takes the faces (vertex index lists into `verts`, any order within a face, outward normal hint),
 // orders, cleans and assembles the polyhedron. Takes ownership of nothing.
-static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawFace* faces, int faceCount, char* why,
-                     int whySize) {
+static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawFace* faces, int faceCount, pdError* why) {
   memset(out, 0, sizeof *out);
   int maxCount = 3;
   for (int f = 0; f < faceCount; ++f) maxCount = faces[f].count > maxCount ? faces[f].count : maxCount;
@@ -222,7 +220,7 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
   int at = 0;
   for (int f = 0; f < faceCount; ++f) {
     if (faces[f].count < 3) {
-      pd_why(why, whySize, "a face has fewer than 3 corners (degenerate hull)");
+      pd_error_set(why, NULL, 0, 0, "a face has fewer than 3 corners (degenerate hull)");
       pd_polyhedron_free(out);
       return false;
     }
@@ -238,14 +236,14 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
   }
 
   int edgeCount = 0;
-  if (!pair_edges(out, NULL, &edgeCount, why, whySize)) {
+  if (!pair_edges(out, NULL, &edgeCount, why)) {
     pd_polyhedron_free(out);
     return false;
   }
   out->edgeCount = edgeCount;
   out->edges = xcalloc((size_t)edgeCount, sizeof *out->edges);
-  pair_edges(out, out->edges, NULL, NULL, 0);
-  if (!pd_polyhedron_validate(out, why, whySize)) {
+  pair_edges(out, out->edges, NULL, NULL);
+  if (!pd_polyhedron_validate(out, why)) {
     pd_polyhedron_free(out);
     return false;
   }
@@ -265,15 +263,15 @@ static double points_size(const double* points, int count) {
   return r;
 }
 
-bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char* why, int whySize) {
+bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, pdError* why) {
   memset(out, 0, sizeof *out);
   if (count < 4) {
-    pd_why(why, whySize, "a hull needs at least 4 points, got %d", count);
+    pd_error_set(why, NULL, 0, 0, "a hull needs at least 4 points, got %d", count);
     return false;
   }
   for (int i = 0; i < 3 * count; ++i)
     if (!isfinite(points[i])) {
-      pd_why(why, whySize, "a hull point is not finite");
+      pd_error_set(why, NULL, 0, 0, "a hull point is not finite");
       return false;
     }
 
@@ -300,7 +298,7 @@ bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char
     fflush(errfile);
     const char* text = messages ? messages : "";
     const char* code = strstr(text, "QH");
-    pd_why(why, whySize, "degenerate hull: the points are coplanar, collinear or coincident (qhull %.6s)",
+    pd_error_set(why, NULL, 0, 0, "degenerate hull: the points are coplanar, collinear or coincident (qhull %.6s)",
         code ? code : "error");
   } else {
     // vertices in input order: mark which input points are hull vertices
@@ -330,7 +328,7 @@ bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char
       faces[f].normal = (pdVec3){facet->normal[0], facet->normal[1], facet->normal[2]};
       ++f;
     }
-    ok = assemble(out, verts, vertCount, faces, faceCount, why, whySize);
+    ok = assemble(out, verts, vertCount, faces, faceCount, why);
     for (int i = 0; i < faceCount; ++i) free(faces[i].idx);
     free(faces);
     free(verts);
@@ -347,17 +345,17 @@ bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char
 
 // ---------------------------------------------------------------- primitives
 
-bool pd_polyhedron_cube(pdPolyhedron* out, const double scale[3], char* why, int whySize) {
+bool pd_polyhedron_cube(pdPolyhedron* out, const double scale[3], pdError* why) {
   double pts[8 * 3];
   for (int i = 0; i < 8; ++i) {
     pts[3 * i + 0] = ((i & 1) ? 0.5 : -0.5) * scale[0];
     pts[3 * i + 1] = ((i & 2) ? 0.5 : -0.5) * scale[1];
     pts[3 * i + 2] = ((i & 4) ? 0.5 : -0.5) * scale[2];
   }
-  return pd_polyhedron_hull(out, pts, 8, why, whySize);
+  return pd_polyhedron_hull(out, pts, 8, why);
 }
 
-bool pd_polyhedron_prism(pdPolyhedron* out, int sides, const double scale[3], double taper, char* why, int whySize) {
+bool pd_polyhedron_prism(pdPolyhedron* out, int sides, const double scale[3], double taper, pdError* why) {
   PD_ASSERT(sides >= 3 && taper > 0.0 && taper <= 1.0);
   double* pts = xcalloc((size_t)sides * 2 * 3, sizeof *pts);
   const double pi = 3.14159265358979323846;
@@ -369,7 +367,7 @@ bool pd_polyhedron_prism(pdPolyhedron* out, int sides, const double scale[3], do
     bottom[0] = c * scale[0], bottom[1] = s * scale[1], bottom[2] = -0.5 * scale[2];
     top[0] = taper * c * scale[0], top[1] = taper * s * scale[1], top[2] = 0.5 * scale[2];
   }
-  bool ok = pd_polyhedron_hull(out, pts, 2 * sides, why, whySize);
+  bool ok = pd_polyhedron_hull(out, pts, 2 * sides, why);
   free(pts);
   return ok;
 }
@@ -401,7 +399,7 @@ static void subdivide(sphereBuilder* b, pdVec3 a, pdVec3 c, pdVec3 d, int level)
   subdivide(b, ac, cd, da, level - 1);
 }
 
-bool pd_polyhedron_sphere(pdPolyhedron* out, int level, const double scale[3], char* why, int whySize) {
+bool pd_polyhedron_sphere(pdPolyhedron* out, int level, const double scale[3], pdError* why) {
   PD_ASSERT(level >= 0 && level <= 8);
   const double phi = 1.6180339887498948482;
   const pdVec3 ico[12] = {{-1, phi, 0}, {1, phi, 0}, {-1, -phi, 0}, {1, -phi, 0}, {0, -1, phi}, {0, 1, phi},
@@ -416,7 +414,7 @@ bool pd_polyhedron_sphere(pdPolyhedron* out, int level, const double scale[3], c
     subdivide(&b, on_sphere(ico[tris[t][0]]), on_sphere(ico[tris[t][1]]), on_sphere(ico[tris[t][2]]), level);
   for (int i = 0; i < b.count; ++i)
     for (int k = 0; k < 3; ++k) b.pts[3 * i + k] *= scale[k];
-  bool ok = pd_polyhedron_hull(out, b.pts, b.count, why, whySize);
+  bool ok = pd_polyhedron_hull(out, b.pts, b.count, why);
   free(b.pts);
   return ok;
 }
@@ -432,13 +430,13 @@ static int side_position(const pdPolyhedron* p, int f, int a, int b) {
   return -1;
 }
 
-bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
+bool pd_polyhedron_validate(const pdPolyhedron* p, pdError* why) {
   if (p->vertexCount < 4 || p->faceCount < 4) {
-    pd_why(why, whySize, "too few vertices or faces (V=%d, F=%d)", p->vertexCount, p->faceCount);
+    pd_error_set(why, NULL, 0, 0, "too few vertices or faces (V=%d, F=%d)", p->vertexCount, p->faceCount);
     return false;
   }
   if (p->vertexCount - p->edgeCount + p->faceCount != 2) {
-    pd_why(why, whySize, "Euler characteristic V-E+F = %d, not 2", p->vertexCount - p->edgeCount + p->faceCount);
+    pd_error_set(why, NULL, 0, 0, "Euler characteristic V-E+F = %d, not 2", p->vertexCount - p->edgeCount + p->faceCount);
     return false;
   }
   pdVec3 centre = vertex_average(p->vertices, p->vertexCount);
@@ -449,13 +447,13 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
     const pdFace* face = &p->faces[f];
     const int* idx = p->faceVertices + face->first;
     if (face->count < 3 || fabs(pd_v3_norm(face->normal) - 1.0) > 1e-12) {
-      pd_why(why, whySize, "face %d has %d vertices or a non-unit normal", f, face->count);
+      pd_error_set(why, NULL, 0, 0, "face %d has %d vertices or a non-unit normal", f, face->count);
       ok = false;
       break;
     }
     for (int i = 0; ok && i < face->count; ++i) {
       if (idx[i] < 0 || idx[i] >= p->vertexCount) {
-        pd_why(why, whySize, "face %d refers to a vertex out of range", f);
+        pd_error_set(why, NULL, 0, 0, "face %d refers to a vertex out of range", f);
         ok = false;
         break;
       }
@@ -463,31 +461,31 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
       pdVec3 a = p->vertices[idx[i]], b = p->vertices[idx[(i + 1) % face->count]],
              c = p->vertices[idx[(i + 2) % face->count]];
       if (fabs(pd_v3_dot(face->normal, a) - face->offset) > tol) {
-        pd_why(why, whySize, "face %d is not planar", f);
+        pd_error_set(why, NULL, 0, 0, "face %d is not planar", f);
         ok = false;
       } else if (pd_v3_dot(pd_v3_cross(pd_v3_sub(b, a), pd_v3_sub(c, b)), face->normal) <= 0.0) {
-        pd_why(why, whySize, "face %d is not convex and counter-clockwise seen from outside", f);
+        pd_error_set(why, NULL, 0, 0, "face %d is not convex and counter-clockwise seen from outside", f);
         ok = false;
       }
     }
     // every vertex of the body lies behind every face plane
     for (int v = 0; ok && v < p->vertexCount; ++v)
       if (pd_v3_dot(face->normal, p->vertices[v]) > face->offset + tol) {
-        pd_why(why, whySize, "not convex: vertex %d lies outside face %d", v, f);
+        pd_error_set(why, NULL, 0, 0, "not convex: vertex %d lies outside face %d", v, f);
         ok = false;
       }
   }
   for (int v = 0; ok && v < p->vertexCount; ++v)
     if (faceUses[v] < 3) {
-      pd_why(why, whySize, "vertex %d belongs to %d faces (needs at least 3)", v, faceUses[v]);
+      pd_error_set(why, NULL, 0, 0, "vertex %d belongs to %d faces (needs at least 3)", v, faceUses[v]);
       ok = false;
     }
   free(faceUses);
   if (ok) {
     int edgeCount = 0;
-    ok = pair_edges(p, NULL, &edgeCount, why, whySize);
+    ok = pair_edges(p, NULL, &edgeCount, why);
     if (ok && edgeCount != p->edgeCount) {
-      pd_why(why, whySize, "edge list has %d edges, faces imply %d", p->edgeCount, edgeCount);
+      pd_error_set(why, NULL, 0, 0, "edge list has %d edges, faces imply %d", p->edgeCount, edgeCount);
       ok = false;
     }
   }
@@ -506,7 +504,7 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
         back = side_position(p, edge->f[1], edge->v[1], edge->v[0]);
       }
       if (fwd < 0 || back < 0 || listed[fwd] || listed[back]) {
-        pd_why(why, whySize, "edge %d is not walked v0->v1 by its face f0 and v1->v0 by f1, or is listed twice", e);
+        pd_error_set(why, NULL, 0, 0, "edge %d is not walked v0->v1 by its face f0 and v1->v0 by f1, or is listed twice", e);
         ok = false;
       } else {
         listed[fwd] = listed[back] = 1;
@@ -518,7 +516,7 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize) {
     const pdEdge* edge = &p->edges[e];
     pdVec3 n0 = p->faces[edge->f[0]].normal, n1 = p->faces[edge->f[1]].normal;
     if (pd_v3_norm(pd_v3_cross(n0, n1)) <= PD_PLANARITY_TOL_REL && pd_v3_dot(n0, n1) > 0.0) {
-      pd_why(why, whySize, "faces %d and %d are coplanar neighbours", edge->f[0], edge->f[1]);
+      pd_error_set(why, NULL, 0, 0, "faces %d and %d are coplanar neighbours", edge->f[0], edge->f[1]);
       ok = false;
     }
   }

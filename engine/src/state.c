@@ -1,6 +1,7 @@
 // polydyn — the mutable state: creation, reset, growth, read-out (bodies, contacts, energy).
 #include "polydyn/state.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,9 +16,31 @@ const char* const pdStageNames[pd_stageCount] = {"broad_phase", "interference", 
                                                  "derivative",  "integrate",    "observe"};
 const char* const pdWarningNames[pd_warnCount] = {"step_at_minimum", "non_finite_step", "late_onset"};
 
-pdState* pd_state_create(const pdModel* model) {
+enum { OPTIONS_VALID = 0x5044534f };  // "PDSO": pdStateOptions.valid of options made by pd_state_options_default
+
+pdStateOptions pd_state_options_default(void) {
+  pdStateOptions o = {0};
+  o.stepper = PD_STEPPER_DEFAULT;
+  o.onsets = PD_ONSETS_DEFAULT;
+  o.islands = PD_ISLANDS_DEFAULT;
+  o.threads = 1;
+  o.searchCertificates = true;
+  o.h = 0.0;
+  o.valid = OPTIONS_VALID;
+  return o;
+}
+
+pdState* pd_state_create(const pdModel* model, const pdStateOptions* options) {
+  pdStateOptions o = options ? *options : pd_state_options_default();
+  PD_ASSERT(o.valid == OPTIONS_VALID);  // made by pd_state_options_default
+  PD_ASSERT(o.stepper >= pd_stepperRK4Adaptive && o.stepper <= pd_stepperImplicit);
+  PD_ASSERT(o.onsets >= pd_onsetsExact && o.onsets <= pd_onsetsAuto);
+  PD_ASSERT(o.islands == pd_islandsOff || o.islands == pd_islandsOn);
+  PD_ASSERT(o.threads >= 1 && o.threads <= PD_THREADS_MAX);
+  PD_ASSERT(o.h >= 0.0 && o.h < INFINITY);
   pdState* s = calloc(1, sizeof *s);
   PD_ASSERT(s != NULL);
+  s->options = o;
   s->contacts = pd_contact_set_create(model);
   pd_state_reserve_contacts(model, s, 4 * model->movingCount + 16);
   pd_state_reset(model, s);
@@ -28,14 +51,14 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   const pdSettings* set = &model->settings;
   pd_dense_discard(s);  // first: a presented state's y and contacts are the presentation's
   s->t = 0.0;
-  s->h = set->dt;
+  s->h = s->options.h > 0.0 ? s->options.h : set->dt;
   s->n = PD_BODY_STATE_SIZE * model->movingCount;
   pd_contact_set_clear(s->contacts);
-  s->stepper = PD_STEPPER_DEFAULT;
-  s->onsets = PD_ONSETS_DEFAULT;
-  s->islands = PD_ISLANDS_DEFAULT;
-  s->threads = 1;
-  s->searchCertificates = true;
+  s->stepper = s->options.stepper;
+  s->onsets = s->options.onsets;
+  s->islands = s->options.islands;
+  s->threads = s->options.threads;
+  s->searchCertificates = s->options.searchCertificates;
   pd_island_set_free(s->islandSet);
   s->islandSet = NULL;
   pd_implicit_free(s->implicit);  // its switch (active, on probation, backing off) is the last run's
@@ -79,16 +102,22 @@ void pd_state_free(pdState* s) {
 void pd_state_reserve_contacts(const pdModel* model, pdState* s, int contacts) {
   pd_contact_set_reserve_list(s->contacts, contacts);
   int needed = spring_base(model) + PD_CONTACT_STATE_SIZE * contacts;
-  if (needed <= s->capacity) return;
-  int c = s->capacity > 0 ? s->capacity : 1;
-  while (c < needed) c *= 2;
-  s->y = pd_grow(s->y, c, sizeof *s->y);
-  s->weight = pd_grow(s->weight, c, sizeof *s->weight);
-  // the stepper's vectors hold no data between steps: reallocate rather than copy
-  free(s->work);
-  s->work = calloc((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
-  PD_ASSERT(s->work != NULL);
-  s->capacity = c;
+  if (needed > s->capacity) {
+    int c = s->capacity > 0 ? s->capacity : 1;
+    while (c < needed) c *= 2;
+    s->y = pd_grow(s->y, c, sizeof *s->y);
+    s->weight = pd_grow(s->weight, c, sizeof *s->weight);
+    // the stepper's vectors hold no data between steps: reallocate rather than copy
+    free(s->work);
+    s->work = calloc((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
+    PD_ASSERT(s->work != NULL);
+    s->capacity = c;
+  }
+  if (s->implicit) pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
+}
+
+int pd_state_contact_room(const pdModel* model, const pdState* s) {
+  return (s->capacity - spring_base(model)) / PD_CONTACT_STATE_SIZE;
 }
 
 int pd_state_contact_count(const pdState* s) { return s->contacts ? s->contacts->count : 0; }

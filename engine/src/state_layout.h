@@ -27,6 +27,8 @@ static inline void pd_layout_store(double* y, pdVec3 v, pdVec3 w, pdVec3 x, pdQu
   y[PD_Y_Q] = q.w, y[PD_Y_Q + 1] = q.x, y[PD_Y_Q + 2] = q.y, y[PD_Y_Q + 3] = q.z;
 }
 
-// Grows the state's y, weight and work, and its contact list, to hold `contacts` contacts (between steps only: the
-// stepper's scratch in work is dropped, not copied). state.c.
+// Grows the state's y, weight and work, its contact list and the implicit stepper's workspace, to hold `contacts`
+// contacts (between steps only: the stepper's scratch in work is dropped, not copied). state.c.
 void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contacts);
+// How many contacts the state's vectors hold (what pd_state_reserve_contacts has made room for).
+int pd_state_contact_room(const pdModel* model, const pdState* state);

@@ -95,7 +95,9 @@ int main(int argc, char** argv) {
     pd_error_print(&err, stderr);
     return 2;
   }
-  pdState* state = pd_state_create(model);
+  // the caller's settings: the defaults (implicit stepper, islands, one thread); set fields to choose others
+  pdStateOptions options = pd_state_options_default();
+  pdState* state = pd_state_create(model, &options);
   if (seconds < 0) seconds = model->settings.tend;
   bool completed = pd_advance(model, state, seconds, print_sample, stdout);
   // a run that could not go on says why in its warning counters (state.h)

@@ -166,7 +166,7 @@ static PyObject* oracle_scene(PyObject* module, PyObject* args) {
   pdPyInterruptScope scope;
   pd_py_interrupt_begin(&scope, catchInterrupt);
   Py_BEGIN_ALLOW_THREADS
-  pdState* state = pd_state_create(model);
+  pdState* state = pd_state_create(model, NULL);
   pd_advance(model, state, model->settings.tend, oracle_observe, &c);
   pd_state_free(state);
   Py_END_ALLOW_THREADS

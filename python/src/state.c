@@ -239,11 +239,13 @@ static bool soft_options(const char* stepper, const char* onsets, const char* is
   return true;
 }
 
-static void soft_apply(const softOptions* o, pdState* state) {
-  state->stepper = o->stepper;
-  state->onsets = o->onsets;
-  state->islands = o->islands;
-  state->threads = o->threads;
+static pdState* soft_state_create(const pdModel* model, const softOptions* o) {
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = o->stepper;
+  options.onsets = o->onsets;
+  options.islands = o->islands;
+  options.threads = o->threads;
+  return pd_state_create(model, &options);
 }
 
 static PyObject* state_new(PyTypeObject* type, PyObject* args, PyObject* kwargs) {
@@ -258,8 +260,7 @@ static PyObject* state_new(PyTypeObject* type, PyObject* args, PyObject* kwargs)
   softOptions o;
   if (!soft_options(stepper, onsets, islands, threads, &o)) return NULL;
   const pdModel* model = ((pdPyModel*)modelObject)->model;
-  pdState* state = pd_state_create(model);
-  soft_apply(&o, state);
+  pdState* state = soft_state_create(model, &o);
   pdPyState* s = state_alloc(modelObject, model, state, false);
   if (!s) pd_state_free(state);
   return (PyObject*)s;
@@ -444,7 +445,7 @@ static PyMethodDef stateMethods[] = {
      "advance(t_end, callback=None, catch_interrupt=<in the main thread>): pd_advance to t_end (s); callback(state) "
      "at every output sample, returning False stops; Ctrl-C stops at the next sample and raises KeyboardInterrupt. "
      "Returns True when t reached t_end."},
-    {"reset", (PyCFunction)state_reset, METH_NOARGS, "back to t = 0 (pd_state_reset; options back to defaults)"},
+    {"reset", (PyCFunction)state_reset, METH_NOARGS, "back to t = 0 (pd_state_reset; the options stay)"},
     {"poses", (PyCFunction)(void (*)(void))state_poses, METH_VARARGS | METH_KEYWORDS,
      "poses(out=None): every moving body's x, q, v, w as 13 float64 each (a Buffer, or written into out)"},
     {"body", (PyCFunction)state_body, METH_VARARGS, "body(i): (x, q, v, w) of model body i, fixed ones included"},
@@ -579,8 +580,7 @@ static PyObject* run(PyObject* module, PyObject* args, PyObject* kwargs) {
   }
   r.thread = PyEval_SaveThread();
   if (soft) {
-    pdState* state = pd_state_create(model);
-    soft_apply(&so, state);
+    pdState* state = soft_state_create(model, &so);
     double energyStart = pd_state_energy(model, state);
     double t0 = wall_seconds();
     completed = pd_advance(model, state, model->settings.tend, observe, &r);

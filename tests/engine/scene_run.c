@@ -79,10 +79,11 @@ static record* run_state(const pdModel* model, pdStepper stepper, pdOnsets onset
   record* r = calloc(1, sizeof *r);
   assert_non_null(r);
   r->finite = true;
-  pdState* s = pd_state_create(model);
-  s->stepper = stepper;
-  s->onsets = onsets;
-  s->islands = islands;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  options.onsets = onsets;
+  options.islands = islands;
+  pdState* s = pd_state_create(model, &options);
   assert_true(pd_advance(model, s, model->settings.tend, record_sample, r));
   assert_true(r->finite);
   assert_int_equal(s->warnings[pd_warnNonFinite], 0);

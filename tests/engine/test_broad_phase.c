@@ -658,9 +658,9 @@ static void test_zero_one_and_coincident_bodies(void** state) {
 
 static void test_aabb_of_is_the_exact_box_of_the_rotated_vertices(void** state) {
   (void)state;
-  char why[128];
+  pdError why = {0};
   pdPolyhedron cube;
-  assert_true(pd_polyhedron_cube(&cube, (const double[3]){2, 1, 1}, why, sizeof why));
+  assert_true(pd_polyhedron_cube(&cube, (const double[3]){2, 1, 1}, &why));
   // 45° about z: the 2×1 footprint becomes a 3/√2-wide square
   pdMat3 R = pd_quat_to_mat3(pd_quat_from_axis_angle(pd_v3(0, 0, 1), PI / 4));
   pdAabb b = pd_aabb_of(&cube, pd_v3(10, -5, 1), &R);
@@ -670,7 +670,7 @@ static void test_aabb_of_is_the_exact_box_of_the_rotated_vertices(void** state) 
   assert_true(fabs(b.lo[2] - 0.5) < 1e-15 && fabs(b.hi[2] - 1.5) < 1e-15);
   // random poses of a geodesic sphere: equal, bit for bit, to min/max over x + R·p, and attained
   pdPolyhedron s;
-  assert_true(pd_polyhedron_sphere(&s, 1, (const double[3]){1, 2, 3}, why, sizeof why));
+  assert_true(pd_polyhedron_sphere(&s, 1, (const double[3]){1, 2, 3}, &why));
   lcg g = {5};
   for (int trial = 0; trial < 100; ++trial) {
     pdQuat q = pd_quat_normalize(

@@ -55,8 +55,9 @@ static bool watch(const pdModel* model, const pdState* state, void* user) {
 // no two bodies overlapped by `limit` δ_max of their pair or more at any of them.
 static void expect_held(const char* path, pdIslands islands, int minSamples, double limit) {
   pdModel* m = compile_file(path);
-  pdState* s = pd_state_create(m);
-  s->islands = islands;
+  pdStateOptions options = pd_state_options_default();
+  options.islands = islands;
+  pdState* s = pd_state_create(m, &options);
   deepest d = {0.0, 0.0, -1, -1, 0};
   assert_true(pd_advance(m, s, m->settings.tend, watch, &d));
   print_message("deepest overlap %.3g delta_max (%s and %s at t = %.4f s), %d samples, %ld steps\n", d.ratio,

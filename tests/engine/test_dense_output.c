@@ -58,9 +58,10 @@ static trace* run_sampled(const char* body, double sampleRate, pdStepper stepper
   // sleep off: an island falls asleep at a sync time, and the samples are sync times (docs/sleeping.md)
   snprintf(text, sizeof text, "tend 0.6\nsample %g\nsleep off\n%s", sampleRate, body);
   pdModel* m = compile_text(text);
-  pdState* s = pd_state_create(m);
-  s->stepper = stepper;
-  s->islands = islands;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  options.islands = islands;
+  pdState* s = pd_state_create(m, &options);
   trace* tr = calloc(1, sizeof *tr);
   assert_non_null(tr);
   assert_true(pd_advance(m, s, m->settings.tend, keep, tr));
@@ -153,9 +154,10 @@ static void test_a_run_stopped_between_samples_is_the_run_that_did_not_stop(void
   snprintf(text, sizeof text, "tend 0.6\nsample 100\n%s", TUMBLE);
   pdModel* m = compile_text(text);
   for (int i = 0; i < 3; ++i) {
-    pdState *whole = pd_state_create(m), *sliced = pd_state_create(m);
-    whole->stepper = sliced->stepper = steppers[i];
-    whole->islands = sliced->islands = pd_islandsOff;
+    pdStateOptions options = pd_state_options_default();
+    options.stepper = steppers[i];
+    options.islands = pd_islandsOff;
+    pdState *whole = pd_state_create(m, &options), *sliced = pd_state_create(m, &options);
     trace *a = calloc(1, sizeof *a), *b = calloc(1, sizeof *b);
     assert_true(a != NULL && b != NULL);
     assert_true(pd_advance(m, whole, m->settings.tend, keep, a));

@@ -93,7 +93,7 @@ static uint64_t run_once(const pdModel* model, pdState* state) {
 static void test_the_pile_hashes_to_the_committed_value(void** state) {
   (void)state;
   pdModel* model = load_pile();
-  pdState* s = pd_state_create(model);
+  pdState* s = pd_state_create(model, NULL);
   uint64_t hash = run_once(model, s);
   print_message("pile_10 to t = %g s: trajectory hash 0x%016llx (expected 0x%016llx), %ld steps, %ld rejected\n",
                 PILE_TEND, (unsigned long long)hash, (unsigned long long)EXPECTED_HASH, s->count.accepted,
@@ -112,11 +112,11 @@ static void test_the_pile_hashes_to_the_committed_value(void** state) {
 static void test_two_states_of_one_model_in_alternating_slices_give_the_same_hash(void** state) {
   (void)state;
   pdModel* model = load_pile();
-  pdState* alone = pd_state_create(model);
+  pdState* alone = pd_state_create(model, NULL);
   uint64_t hash = run_once(model, alone);
   pd_state_free(alone);
 
-  pdState* s[2] = {pd_state_create(model), pd_state_create(model)};
+  pdState* s[2] = {pd_state_create(model, NULL), pd_state_create(model, NULL)};
   trace tr[2] = {{fnvOffset, 0}, {fnvOffset, 0}};
   long samples = (long)(PILE_TEND * model->settings.sampleRate + 0.5);
   for (long k = SLICE_SAMPLES; k < samples + SLICE_SAMPLES; k += SLICE_SAMPLES) {

@@ -141,8 +141,9 @@ static pdBodyState recorded_body(const pdModel* model, const recording* r, int s
 }
 
 static recording run_recorded(const pdModel* model, pdStepper stepper, pdCounters* counters) {
-  pdState* s = pd_state_create(model);
-  s->stepper = stepper;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  pdState* s = pd_state_create(model, &options);
   int capacity = (int)floor(model->settings.tend * model->settings.sampleRate) + 2;
   recording r = recording_make(s->n, capacity);
   assert_true(pd_advance(model, s, model->settings.tend, record_observer, &r));
@@ -187,8 +188,9 @@ static parabolaCheck run_parabola(const char* text, pdStepper stepper, pdCounter
   pdModel* model = compile_text(text);
   // the scene's numbers, not the model's: the expectation must not lean on what it checks
   parabolaCheck c = {{0.5, -1, 2}, {1.5, -0.5, 4}, {0, 0, -9.81}, 0.0, 0.0, 0};
-  pdState* s = pd_state_create(model);
-  s->stepper = stepper;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  pdState* s = pd_state_create(model, &options);
   assert_true(pd_advance(model, s, model->settings.tend, parabola_observer, &c));
   if (counters) *counters = s->count;
   pd_state_free(s);
@@ -299,7 +301,7 @@ static torqueFreeCheck run_torque_free(int axis) {
   torqueFreeCheck c;
   memset(&c, 0, sizeof c);
   c.axis = axis;
-  pdState* s = pd_state_create(model);
+  pdState* s = pd_state_create(model, NULL);
   assert_true(pd_advance(model, s, model->settings.tend, torque_free_observer, &c));
   printf("  axis %c: %ld steps (%ld rejected), energy drift %.3g, |L| drift %.3g, sign changes %d, cone %.3g deg\n",
          "xyz"[axis], s->count.accepted, s->count.rejected, c.maxEnergyDrift, c.maxMomentumDrift, c.signChanges,
@@ -422,7 +424,7 @@ static bool sample_time_observer(const pdModel* model, const pdState* state, voi
 static sampleTimes run_sample_times(const char* text) {
   pdModel* model = compile_text(text);
   sampleTimes st = {model->settings.sampleRate, 0, true, -1.0};
-  pdState* s = pd_state_create(model);
+  pdState* s = pd_state_create(model, NULL);
   assert_true(pd_advance(model, s, model->settings.tend, sample_time_observer, &st));
   assert_true(s->t == model->settings.tend);
   assert_int_equal(s->count.samples, st.count);
@@ -454,8 +456,9 @@ static void test_samples_fall_exactly_on_k_over_rate(void** state) {
 
 static pdCounters run_counts_with(const char* text, pdStepper stepper) {
   pdModel* model = compile_text(text);
-  pdState* s = pd_state_create(model);
-  s->stepper = stepper;
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = stepper;
+  pdState* s = pd_state_create(model, &options);
   assert_true(pd_advance(model, s, model->settings.tend, NULL, NULL));
   assert_true(s->t == model->settings.tend);
   pdCounters c = s->count;
@@ -588,7 +591,7 @@ static void check_pushed_free_box(const char* scene, pdVec3 f0, pdVec3 rate) {
   pdModel* model = compile_text(scene);
   const pdBody* b = &model->bodies[0];
   assert_true(b->hasForce);
-  pdState* s = pd_state_create(model);
+  pdState* s = pd_state_create(model, NULL);
   assert_true(pd_advance(model, s, model->settings.tend, NULL, NULL));
   double t = s->t, m = b->mass;
   pdBodyState bs = pd_state_body(model, s, 0);
@@ -625,7 +628,7 @@ static void test_force_at_an_offset_point_gives_angular_acceleration_inverse_ine
   pdModel* model = compile_text("gravity 0 0 0\ncube b red 0.3 0.2 0.1\nloc 0 0 0 30 0 0 1\n"
                                 "force 2 1 -1 ramp 0 3 0 at 0.15 -0.1 0.05\n");
   const pdBody* b = &model->bodies[0];
-  pdState* s = pd_state_create(model);
+  pdState* s = pd_state_create(model, NULL);
   double* dydt = calloc((size_t)s->n, sizeof *dydt);
   assert_non_null(dydt);
   const double times[] = {0.0, 0.5};
@@ -675,8 +678,8 @@ static void test_one_model_drives_two_interleaved_states_like_one_alone(void** s
   recording alone = run_recorded(model, pd_stepperRK4Adaptive, &aloneCount);
 
   // two states advanced in turns, in chunks ending on sample times (0.1 s, then 0.05 s steps)
-  pdState* a = pd_state_create(model);
-  pdState* b = pd_state_create(model);
+  pdState* a = pd_state_create(model, NULL);
+  pdState* b = pd_state_create(model, NULL);
   int capacity = alone.count + 1;
   recording ra = recording_make(a->n, capacity), rb = recording_make(b->n, capacity);
   static const double ends[] = {0.1, 0.15, 0.2, 0.5, 0.55, 0.6, 0.8, 1.0};

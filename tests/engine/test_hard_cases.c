@@ -159,7 +159,7 @@ static void test_hard_case(void** state) {
     assert_true(m->bodies[w.tunnelBody].x0.z > w.slabTop);  // the scene drops it from above
   }
 
-  pdState* s = pd_state_create(m);
+  pdState* s = pd_state_create(m, NULL);
   double t0 = now_seconds();
   bool completed = pd_advance(m, s, m->settings.tend, watch_sample, &w);
   double wall = now_seconds() - t0;

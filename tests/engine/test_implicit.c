@@ -49,9 +49,10 @@ static pdModel* two_boxes_on_a_ramp(double tend) {
 }
 
 static pdState* settled(const pdModel* m) {
-  pdState* s = pd_state_create(m);
-  s->islands = pd_islandsOff;
-  s->stepper = pd_stepperRK4Adaptive;
+  pdStateOptions options = pd_state_options_default();
+  options.islands = pd_islandsOff;
+  options.stepper = pd_stepperRK4Adaptive;
+  pdState* s = pd_state_create(m, &options);
   assert_true(pd_advance(m, s, m->settings.tend, NULL, NULL));
   assert_true(pd_state_contact_count(s) >= 8);
   return s;
@@ -93,6 +94,7 @@ static void test_w_matches_finite_differences_of_the_derivative(void** state) {
          *jx = calloc((size_t)n, sizeof *jx);
   direction(m, s, x);
   pdImplicit* im = pd_implicit_create();
+  pd_implicit_reserve(im, m->movingCount, pd_state_contact_count(s));  // as the stepper does between steps
   pd_implicit_linearise(m, s, im, s->y);
   assert_true(pd_implicit_factor(m, s, im, 1e-3));
   pd_implicit_apply_w(m, s, im, x, w);
@@ -125,6 +127,7 @@ static void test_the_solve_inverts_m(void** state) {
   int n = s->n;
   double *r = calloc((size_t)n, sizeof *r), *u = calloc((size_t)n, sizeof *u), *wu = calloc((size_t)n, sizeof *wu);
   pdImplicit* im = pd_implicit_create();
+  pd_implicit_reserve(im, m->movingCount, pd_state_contact_count(s));  // as the stepper does between steps
   pd_implicit_linearise(m, s, im, s->y);
   for (double hg = 1e-5; hg <= 1.01e-2; hg *= 10.0) {  // hg = γh, h up to dtmax (10 ms) and beyond
     assert_true(pd_implicit_factor(m, s, im, hg));
@@ -253,12 +256,13 @@ static void test_the_same_run_twice_gives_the_same_numbers(void** state) {
 static void test_a_reset_state_runs_as_a_new_one(void** state) {
   (void)state;
   pdModel* m = two_boxes_on_a_ramp(0.6);
-  pdState* s = pd_state_create(m);
+  pdStateOptions options = pd_state_options_default();
+  options.islands = pd_islandsOff;
+  pdState* s = pd_state_create(m, &options);
   long steps[2];
   pdBodyState end[2];
   for (int k = 0; k < 2; ++k) {
-    pd_state_reset(m, s);
-    s->islands = pd_islandsOff;
+    pd_state_reset(m, s);  // keeps the options: islands off
     assert_true(pd_advance(m, s, m->settings.tend, NULL, NULL));
     steps[k] = s->count.accepted;
     end[k] = pd_state_body(m, s, m->movingBodies[0]);

@@ -54,22 +54,22 @@ static pdVec3 vertex_average(const pdPolyhedron* p) {
 // Shape `kind`: 0 cube, 1 prism (3..12 sides), 2 tapered prism, 3 geodesic sphere (level 0..2),
 // 4 hull of 6..30 random points; random scales; origin moved to the vertex average.
 static void make_shape(lcg* g, int kind, int index, shape* s) {
-  char why[128] = "";
+  pdError why = {0};
   double scale[3] = {lcg_range(g, 0.3, 2.0), lcg_range(g, 0.3, 2.0), lcg_range(g, 0.3, 2.0)};
   bool ok = false;
   int sides = 3 + (int)(lcg_uniform(g) * 10);
   switch (kind) {
     case 0:
-      ok = pd_polyhedron_cube(&s->p, scale, why, sizeof why);
+      ok = pd_polyhedron_cube(&s->p, scale, &why);
       snprintf(s->label, sizeof s->label, "cube");
       break;
     case 1:
-      ok = pd_polyhedron_prism(&s->p, sides, scale, 1.0, why, sizeof why);
+      ok = pd_polyhedron_prism(&s->p, sides, scale, 1.0, &why);
       snprintf(s->label, sizeof s->label, "prism %d", sides);
       break;
     case 2: {
       double taper = lcg_range(g, 0.1, 0.95);
-      ok = pd_polyhedron_prism(&s->p, sides, scale, taper, why, sizeof why);
+      ok = pd_polyhedron_prism(&s->p, sides, scale, taper, &why);
       snprintf(s->label, sizeof s->label, "tprism %d taper %.2f", sides, taper);
       break;
     }
@@ -78,7 +78,7 @@ static void make_shape(lcg* g, int kind, int index, shape* s) {
       // pairs × 324 vertices for two of them) would otherwise take most of the test's time
       static const int levels[5] = {0, 1, 0, 1, 2};
       int level = levels[index % 5];
-      ok = pd_polyhedron_sphere(&s->p, level, scale, why, sizeof why);
+      ok = pd_polyhedron_sphere(&s->p, level, scale, &why);
       snprintf(s->label, sizeof s->label, "sphere level %d", level);
       break;
     }
@@ -87,12 +87,12 @@ static void make_shape(lcg* g, int kind, int index, shape* s) {
       double pts[3 * 30];
       for (int i = 0; i < count; ++i)
         for (int k = 0; k < 3; ++k) pts[3 * i + k] = scale[k] * lcg_range(g, -0.5, 0.5);
-      ok = pd_polyhedron_hull(&s->p, pts, count, why, sizeof why);
+      ok = pd_polyhedron_hull(&s->p, pts, count, &why);
       snprintf(s->label, sizeof s->label, "hull of %d points", count);
       break;
     }
   }
-  if (!ok) fail_msg("shape %d (%s): %s", index, s->label, why);
+  if (!ok) fail_msg("shape %d (%s): %s", index, s->label, why.message);
   pd_polyhedron_translate(&s->p, pd_v3_scale(vertex_average(&s->p), -1.0));
   s->radius = 0.0;
   for (int v = 0; v < s->p.vertexCount; ++v) s->radius = fmax(s->radius, pd_v3_norm(s->p.vertices[v]));
@@ -285,8 +285,8 @@ static bool minkowski_depth(const shape* a, const pose* pa, const shape* b, cons
       pts[k++] = d.z;
     }
   pdPolyhedron D;
-  char why[128];
-  if (!pd_polyhedron_hull(&D, pts, n, why, sizeof why)) fail_msg("Minkowski hull: %s", why);
+  pdError why = {0};
+  if (!pd_polyhedron_hull(&D, pts, n, &why)) fail_msg("Minkowski hull: %s", why.message);
   *depth = INFINITY;
   for (int f = 0; f < D.faceCount; ++f) *depth = fmin(*depth, D.faces[f].offset);
   pd_polyhedron_free(&D);
@@ -494,8 +494,8 @@ static void test_verdict_mode_separates_only_what_the_search_separates(void** st
 
 static shape unit_cube(void) {
   shape s;
-  char why[64];
-  assert_true(pd_polyhedron_cube(&s.p, (const double[3]){1, 1, 1}, why, sizeof why));
+  pdError why = {0};
+  assert_true(pd_polyhedron_cube(&s.p, (const double[3]){1, 1, 1}, &why));
   s.radius = sqrt(3.0) / 2;
   snprintf(s.label, sizeof s.label, "unit cube");
   return s;
@@ -689,23 +689,23 @@ static void test_search_structures_change_no_result(void** state) {
   lcg g = {0xb16ull};
   shape pool[BIG + SHAPE_KINDS];
   for (int i = 0; i < BIG; ++i) {
-    char why[128] = "";
+    pdError why = {0};
     double scale[3] = {lcg_range(&g, 0.3, 2.0), lcg_range(&g, 0.3, 2.0), lcg_range(&g, 0.3, 2.0)};
     bool ok;
     if (i % 3 == 0) {
-      ok = pd_polyhedron_sphere(&pool[i].p, 1 + i / 3 % 2, scale, why, sizeof why);
+      ok = pd_polyhedron_sphere(&pool[i].p, 1 + i / 3 % 2, scale, &why);
       snprintf(pool[i].label, sizeof pool[i].label, "sphere level %d", 1 + i / 3 % 2);
     } else if (i % 3 == 1) {
       int sides = 16 + 16 * (i / 3 % 4);
-      ok = pd_polyhedron_prism(&pool[i].p, sides, scale, lcg_range(&g, 0.3, 1.0), why, sizeof why);
+      ok = pd_polyhedron_prism(&pool[i].p, sides, scale, lcg_range(&g, 0.3, 1.0), &why);
       snprintf(pool[i].label, sizeof pool[i].label, "tprism %d", sides);
     } else {
       double pts[3 * 60];
       for (int k = 0; k < 3 * 60; ++k) pts[k] = scale[k % 3] * lcg_range(&g, -0.5, 0.5);
-      ok = pd_polyhedron_hull(&pool[i].p, pts, 60, why, sizeof why);
+      ok = pd_polyhedron_hull(&pool[i].p, pts, 60, &why);
       snprintf(pool[i].label, sizeof pool[i].label, "hull of 60 points");
     }
-    if (!ok) fail_msg("%s: %s", pool[i].label, why);
+    if (!ok) fail_msg("%s: %s", pool[i].label, why.message);
     pd_polyhedron_translate(&pool[i].p, pd_v3_scale(vertex_average(&pool[i].p), -1.0));
     pool[i].radius = 0.0;
     for (int v = 0; v < pool[i].p.vertexCount; ++v) pool[i].radius = fmax(pool[i].radius, pd_v3_norm(pool[i].p.vertices[v]));

@@ -96,9 +96,10 @@ static trace* run_threads(const pdModel* model, pdIslands islands, int threads, 
   trace* r = calloc(1, sizeof *r);
   assert_non_null(r);
   r->finite = true;
-  pdState* s = pd_state_create(model);
-  s->islands = islands;
-  s->threads = threads;
+  pdStateOptions options = pd_state_options_default();
+  options.islands = islands;
+  options.threads = threads;
+  pdState* s = pd_state_create(model, &options);
   bool done = pd_advance(model, s, model->settings.tend, record_trace, r);
   assert_true(done);
   assert_false(s->failed);
@@ -507,7 +508,7 @@ static void test_whole_stages_add_up_to_at_most_the_run(void** state) {
   pdModel* m = pile_30();
   trace* r = calloc(1, sizeof *r);
   assert_non_null(r);
-  pdState* s = pd_state_create(m);
+  pdState* s = pd_state_create(m, NULL);
   double t0 = wall_seconds();
   assert_true(pd_advance(m, s, m->settings.tend, record_trace, r));
   double wall = wall_seconds() - t0;

@@ -53,8 +53,8 @@ static void expect_abs(double actual, double expected, double tol, const char* w
 static double trace3(const pdMat3* a) { return a->m[0][0] + a->m[1][1] + a->m[2][2]; }
 
 static void mass_of(const pdPolyhedron* p, double density, pdMassProperties* mp) {
-  char why[256] = "";
-  if (!pd_mass_properties(p, density, mp, why, sizeof why)) fail_msg("pd_mass_properties: %s", why);
+  pdError why = {0};
+  if (!pd_mass_properties(p, density, mp, &why)) fail_msg("pd_mass_properties: %s", why.message);
 }
 
 
@@ -100,8 +100,8 @@ static void test_box_volume_mass_and_inertia_match_closed_forms(void** state) {
     for (size_t d = 0; d < sizeof densities / sizeof densities[0]; ++d) {
       double a = boxes[k][0], b = boxes[k][1], c = boxes[k][2], rho = densities[d];
       pdPolyhedron p;
-      char why[256] = "";
-      assert_true(pd_polyhedron_cube(&p, boxes[k], why, sizeof why));
+      pdError why = {0};
+      assert_true(pd_polyhedron_cube(&p, boxes[k], &why));
       pdMassProperties mp;
       mass_of(&p, rho, &mp);
       double m = rho * a * b * c;
@@ -131,9 +131,9 @@ static void test_regular_prism_area_and_inertia_match_closed_forms(void** state)
   for (size_t k = 0; k < sizeof sides / sizeof sides[0]; ++k) {
     int n = sides[k];
     pdPolyhedron p;
-    char why[256] = "";
+    pdError why = {0};
     // the primitive is inscribed in the circle of diameter 1, so an xy scale of 2R gives radius R
-    assert_true(pd_polyhedron_prism(&p, n, (const double[3]){2 * R, 2 * R, h}, 1.0, why, sizeof why));
+    assert_true(pd_polyhedron_prism(&p, n, (const double[3]){2 * R, 2 * R, h}, 1.0, &why));
     pdMassProperties mp;
     mass_of(&p, rho, &mp);
     double A = ngon_area(n, R), m = rho * A * h, J = ngon_polar_per_area(n, R);
@@ -167,8 +167,8 @@ static void test_corner_tetrahedron_hull_matches_closed_forms(void** state) {
   const double pts[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
   const double rho = 1200.0;
   pdPolyhedron p;
-  char why[256] = "";
-  if (!pd_polyhedron_hull(&p, pts, 4, why, sizeof why)) fail_msg("%s", why);
+  pdError why = {0};
+  if (!pd_polyhedron_hull(&p, pts, 4, &why)) fail_msg("%s", why.message);
   pdMassProperties mp;
   mass_of(&p, rho, &mp);
   double m = rho / 6.0;
@@ -220,8 +220,8 @@ static void test_frustum_volume_centroid_and_inertia_match_closed_forms(void** s
       int n = sides[k];
       double t = tapers[i], R = 0.5 * sx;
       pdPolyhedron p;
-      char why[256] = "";
-      assert_true(pd_polyhedron_prism(&p, n, (const double[3]){sx, sx, h}, t, why, sizeof why));
+      pdError why = {0};
+      assert_true(pd_polyhedron_prism(&p, n, (const double[3]){sx, sx, h}, t, &why));
       pdMassProperties mp;
       mass_of(&p, 1000.0, &mp);
       double A1 = ngon_area(n, R), A2 = ngon_area(n, t * R);
@@ -256,8 +256,9 @@ static void test_geodesic_sphere_inertia_ratio_approaches_two_fifths(void** stat
   double previous = 0.0, ratio = 0.0;
   for (int level = 0; level <= 3; ++level) {
     pdPolyhedron p;
-    char why[256] = "", label[64];
-    assert_true(pd_polyhedron_sphere(&p, level, (const double[3]){1, 1, 1}, why, sizeof why));
+    pdError why = {0};
+    char label[64];
+    assert_true(pd_polyhedron_sphere(&p, level, (const double[3]){1, 1, 1}, &why));
     pdMassProperties mp;
     mass_of(&p, 1000.0, &mp);
     double mean = (mp.principal[0] + mp.principal[1] + mp.principal[2]) / 3.0;
@@ -319,8 +320,8 @@ static void test_hull_mass_properties_are_invariant_under_order_rotation_and_tra
     // stretch the ball so the inertia has three distinct moments and non-zero products
     for (int i = 0; i < invariancePoints; ++i) pts[3 * i] *= 1.7, pts[3 * i + 2] *= 0.6;
     pdPolyhedron p;
-    char why[256] = "";
-    if (!pd_polyhedron_hull(&p, pts, invariancePoints, why, sizeof why)) fail_msg("%s", why);
+    pdError why = {0};
+    if (!pd_polyhedron_hull(&p, pts, invariancePoints, &why)) fail_msg("%s", why.message);
     pdMassProperties a;
     mass_of(&p, rho, &a);
     pd_polyhedron_free(&p);
@@ -328,7 +329,7 @@ static void test_hull_mass_properties_are_invariant_under_order_rotation_and_tra
     // the same points in another order (a rotation of the index by 37 and a reversal)
     for (int i = 0; i < invariancePoints; ++i)
       memcpy(other + 3 * i, pts + 3 * ((invariancePoints - 1 - i + 37) % invariancePoints), 3 * sizeof(double));
-    if (!pd_polyhedron_hull(&p, other, invariancePoints, why, sizeof why)) fail_msg("%s", why);
+    if (!pd_polyhedron_hull(&p, other, invariancePoints, &why)) fail_msg("%s", why.message);
     pdMassProperties b;
     mass_of(&p, rho, &b);
     pd_polyhedron_free(&p);
@@ -341,7 +342,7 @@ static void test_hull_mass_properties_are_invariant_under_order_rotation_and_tra
       pdVec3 x = pd_v3_add(pd_mat3_mulv(&R, (pdVec3){pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]}), shift);
       other[3 * i] = x.x, other[3 * i + 1] = x.y, other[3 * i + 2] = x.z;
     }
-    if (!pd_polyhedron_hull(&p, other, invariancePoints, why, sizeof why)) fail_msg("%s", why);
+    if (!pd_polyhedron_hull(&p, other, invariancePoints, &why)) fail_msg("%s", why.message);
     mass_of(&p, rho, &b);
     pd_polyhedron_free(&p);
     compare_transformed(&a, &b, &R, shift, size, "rotated and translated");
@@ -400,8 +401,8 @@ static void test_principal_axes_are_a_rotation_that_diagonalises_inertia(void** 
   } hulls[] = {{"rotated box", box, 8}, {"sheared ball", ball, invariancePoints}, {"tetrahedron", tet, 4}};
   for (size_t k = 0; k < sizeof hulls / sizeof hulls[0]; ++k) {
     pdPolyhedron p;
-    char why[256] = "";
-    if (!pd_polyhedron_hull(&p, hulls[k].pts, hulls[k].count, why, sizeof why)) fail_msg("%s: %s", hulls[k].label, why);
+    pdError why = {0};
+    if (!pd_polyhedron_hull(&p, hulls[k].pts, hulls[k].count, &why)) fail_msg("%s: %s", hulls[k].label, why.message);
     pdMassProperties mp;
     mass_of(&p, 1000.0, &mp);
     check_principal_frame(&mp, hulls[k].label);
@@ -409,17 +410,17 @@ static void test_principal_axes_are_a_rotation_that_diagonalises_inertia(void** 
   }
   // primitives: moments with exact or near ties (cube, sphere, prism) and distinct (tapered box)
   pdPolyhedron p;
-  char why[256] = "";
+  pdError why = {0};
   pdMassProperties mp;
-  assert_true(pd_polyhedron_cube(&p, (const double[3]){1, 1, 1}, why, sizeof why));
+  assert_true(pd_polyhedron_cube(&p, (const double[3]){1, 1, 1}, &why));
   mass_of(&p, 1000.0, &mp);
   check_principal_frame(&mp, "unit cube");
   pd_polyhedron_free(&p);
-  assert_true(pd_polyhedron_sphere(&p, 2, (const double[3]){1, 1, 1}, why, sizeof why));
+  assert_true(pd_polyhedron_sphere(&p, 2, (const double[3]){1, 1, 1}, &why));
   mass_of(&p, 1000.0, &mp);
   check_principal_frame(&mp, "sphere level 2");
   pd_polyhedron_free(&p);
-  assert_true(pd_polyhedron_prism(&p, 5, (const double[3]){1.5, 0.7, 0.4}, 0.6, why, sizeof why));
+  assert_true(pd_polyhedron_prism(&p, 5, (const double[3]){1.5, 0.7, 0.4}, 0.6, &why));
   mass_of(&p, 1000.0, &mp);
   check_principal_frame(&mp, "tapered pentagonal prism");
   pd_polyhedron_free(&p);
@@ -430,8 +431,8 @@ static void test_principal_axes_are_a_rotation_that_diagonalises_inertia(void** 
 static void test_inside_out_polyhedron_is_refused(void** state) {
   (void)state;
   pdPolyhedron p;
-  char why[256] = "";
-  assert_true(pd_polyhedron_cube(&p, (const double[3]){1, 2, 3}, why, sizeof why));
+  pdError why = {0};
+  assert_true(pd_polyhedron_cube(&p, (const double[3]){1, 2, 3}, &why));
   for (int f = 0; f < p.faceCount; ++f) {
     int* idx = p.faceVertices + p.faces[f].first;
     for (int i = 0, j = p.faces[f].count - 1; i < j; ++i, --j) {
@@ -441,9 +442,9 @@ static void test_inside_out_polyhedron_is_refused(void** state) {
     }
   }
   pdMassProperties mp;
-  why[0] = '\0';
-  assert_false(pd_mass_properties(&p, 1000.0, &mp, why, sizeof why));
-  assert_non_null(strstr(why, "volume"));  // refused for its volume, before any eigen-solving
+  why.message[0] = '\0';
+  assert_false(pd_mass_properties(&p, 1000.0, &mp, &why));
+  assert_non_null(strstr(why.message, "volume"));  // refused for its volume, before any eigen-solving
   pd_polyhedron_free(&p);
 }
 
@@ -468,8 +469,9 @@ static void test_compiled_bodies_have_centroid_at_origin_and_tprism_centre_offse
   assert_int_equal(model->bodyCount, 6);
   for (int i = 0; i < model->bodyCount; ++i) {
     const pdBody* b = &model->bodies[i];
-    char why[256] = "", what[96];
-    if (!pd_polyhedron_validate(&b->shape, why, sizeof why)) fail_msg("%s: %s", b->name, why);
+    pdError why = {0};
+    char what[96];
+    if (!pd_polyhedron_validate(&b->shape, &why)) fail_msg("%s: %s", b->name, why.message);
     pdMassProperties mp;
     mass_of(&b->shape, b->density, &mp);
     double size = 0.0;
@@ -504,8 +506,8 @@ static void test_compiled_bodies_have_centroid_at_origin_and_tprism_centre_offse
   {
     const double pts[] = {3, 3, 3, 3.5, 3, 3, 3, 4, 3, 3, 3, 5, 3.2, 3.2, 3.1};
     pdPolyhedron p;
-    char why[256] = "";
-    assert_true(pd_polyhedron_hull(&p, pts, 5, why, sizeof why));
+    pdError why = {0};
+    assert_true(pd_polyhedron_hull(&p, pts, 5, &why));
     pdMassProperties mp;
     mass_of(&p, 1000.0, &mp);
     const pdBody* b = &model->bodies[5];

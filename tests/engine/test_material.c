@@ -275,9 +275,9 @@ static void test_effective_mass_of_a_slender_bar_hit_at_its_end(void** state) {
   const double L = 1.0, t = 0.05, scale[3] = {L, t, t};
   pdPolyhedron bar;
   pdMassProperties mp;
-  char why[256] = "";
-  assert_true(pd_polyhedron_cube(&bar, scale, why, sizeof why));
-  assert_true(pd_mass_properties(&bar, 1000.0, &mp, why, sizeof why));
+  pdError why = {0};
+  assert_true(pd_polyhedron_cube(&bar, scale, &why));
+  assert_true(pd_mass_properties(&bar, 1000.0, &mp, &why));
   pdMat3 inv = pd_mat3_zero();
   for (int i = 0; i < 3; ++i) inv.m[i][i] = 1.0 / mp.inertia.m[i][i];
   const double m = mp.mass;
@@ -302,9 +302,9 @@ static void test_minimum_effective_mass_of_a_cube(void** state) {
   const double a = 0.4, scale[3] = {a, a, a};
   pdPolyhedron cube;
   pdMassProperties mp;
-  char why[256] = "";
-  assert_true(pd_polyhedron_cube(&cube, scale, why, sizeof why));
-  assert_true(pd_mass_properties(&cube, 1000.0, &mp, why, sizeof why));
+  pdError why = {0};
+  assert_true(pd_polyhedron_cube(&cube, scale, &why));
+  assert_true(pd_mass_properties(&cube, 1000.0, &mp, &why));
   const double m = mp.mass;
   double exact = pd_min_effective_mass(m, &mp.inertia, cube.vertices, cube.vertexCount);
   // A cube's inertia is isotropic: every basis is principal and eq. (22) depends on the one chosen (GSL's

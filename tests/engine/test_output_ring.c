@@ -62,7 +62,7 @@ static void expect_ring_writes_rows(const pdModel* model, int minSamples) {
   pd_write_trajectory_header(w.trajectory);
   pd_write_contacts_header(w.contacts);
 
-  pdState* state = pd_state_create(model);
+  pdState* state = pd_state_create(model, NULL);
   double energyStart = pd_state_energy(model, state);
   bool completed = pd_advance(model, state, model->settings.tend, observe_both, &w);
   assert_true(completed);

@@ -78,8 +78,8 @@ static int face_walks(const pdPolyhedron* p, int f, int a, int b) {
 
 // Checks every structural property independently of pd_polyhedron_validate (which must agree).
 static void check_structure(const pdPolyhedron* p, const char* label) {
-  char why[256] = "";
-  if (!pd_polyhedron_validate(p, why, sizeof why)) fail_msg("%s: pd_polyhedron_validate: %s", label, why);
+  pdError why = {0};
+  if (!pd_polyhedron_validate(p, &why)) fail_msg("%s: pd_polyhedron_validate: %s", label, why.message);
   if (p->vertexCount - p->edgeCount + p->faceCount != 2)
     fail_msg("%s: V-E+F = %d", label, p->vertexCount - p->edgeCount + p->faceCount);
 
@@ -153,10 +153,11 @@ static const double tapers[] = {0.5, 1.0};
 static void test_cube_is_valid_with_v8_e12_f6_at_several_scales(void** state) {
   (void)state;
   for (size_t k = 0; k < sizeof cubeScales / sizeof cubeScales[0]; ++k) {
-    char why[256] = "", label[64];
+    pdError why = {0};
+    char label[64];
     snprintf(label, sizeof label, "cube %g %g %g", cubeScales[k][0], cubeScales[k][1], cubeScales[k][2]);
     pdPolyhedron p;
-    if (!pd_polyhedron_cube(&p, cubeScales[k], why, sizeof why)) fail_msg("%s: %s", label, why);
+    if (!pd_polyhedron_cube(&p, cubeScales[k], &why)) fail_msg("%s: %s", label, why.message);
     check_counts(&p, 8, 12, 6, label);
     check_structure(&p, label);
     pd_polyhedron_free(&p);
@@ -168,11 +169,12 @@ static void test_prism_is_valid_with_v2n_e3n_fn2(void** state) {
   for (size_t k = 0; k < sizeof prismSides / sizeof prismSides[0]; ++k)
     for (size_t s = 0; s < sizeof prismScales / sizeof prismScales[0]; ++s) {
       int n = prismSides[k];
-      char why[256] = "", label[64];
+      pdError why = {0};
+    char label[64];
       snprintf(label, sizeof label, "prism n=%d scale %g %g %g", n, prismScales[s][0], prismScales[s][1],
                prismScales[s][2]);
       pdPolyhedron p;
-      if (!pd_polyhedron_prism(&p, n, prismScales[s], 1.0, why, sizeof why)) fail_msg("%s: %s", label, why);
+      if (!pd_polyhedron_prism(&p, n, prismScales[s], 1.0, &why)) fail_msg("%s: %s", label, why.message);
       check_counts(&p, 2 * n, 3 * n, n + 2, label);
       check_structure(&p, label);
       pd_polyhedron_free(&p);
@@ -185,11 +187,12 @@ static void test_tprism_is_valid_with_prism_counts_for_taper_half_and_one(void**
     for (size_t t = 0; t < sizeof tapers / sizeof tapers[0]; ++t)
       for (size_t s = 0; s < sizeof prismScales / sizeof prismScales[0]; ++s) {
         int n = prismSides[k];
-        char why[256] = "", label[80];
+        pdError why = {0};
+    char label[80];
         snprintf(label, sizeof label, "tprism n=%d taper %g scale %g %g %g", n, tapers[t], prismScales[s][0],
                  prismScales[s][1], prismScales[s][2]);
         pdPolyhedron p;
-        if (!pd_polyhedron_prism(&p, n, prismScales[s], tapers[t], why, sizeof why)) fail_msg("%s: %s", label, why);
+        if (!pd_polyhedron_prism(&p, n, prismScales[s], tapers[t], &why)) fail_msg("%s: %s", label, why.message);
         check_counts(&p, 2 * n, 3 * n, n + 2, label);
         check_structure(&p, label);
         pd_polyhedron_free(&p);
@@ -203,10 +206,11 @@ static void test_sphere_levels_0_to_3_are_valid_with_geodesic_counts(void** stat
     for (size_t s = 0; s < sizeof scales / sizeof scales[0]; ++s) {
       int four = 1;
       for (int i = 0; i < level; ++i) four *= 4;
-      char why[256] = "", label[64];
+      pdError why = {0};
+    char label[64];
       snprintf(label, sizeof label, "sphere level %d scale %g %g %g", level, scales[s][0], scales[s][1], scales[s][2]);
       pdPolyhedron p;
-      if (!pd_polyhedron_sphere(&p, level, scales[s], why, sizeof why)) fail_msg("%s: %s", label, why);
+      if (!pd_polyhedron_sphere(&p, level, scales[s], &why)) fail_msg("%s: %s", label, why.message);
       check_counts(&p, 10 * four + 2, 30 * four, 20 * four, label);
       check_structure(&p, label);
       pd_polyhedron_free(&p);
@@ -220,8 +224,8 @@ static void test_cube_spans_exactly_its_scale(void** state) {
   for (size_t k = 0; k < sizeof cubeScales / sizeof cubeScales[0]; ++k) {
     const double* s = cubeScales[k];
     pdPolyhedron p;
-    char why[256] = "";
-    assert_true(pd_polyhedron_cube(&p, s, why, sizeof why));
+    pdError why = {0};
+    assert_true(pd_polyhedron_cube(&p, s, &why));
     for (int v = 0; v < p.vertexCount; ++v) {
       // every corner is exactly (±sx/2, ±sy/2, ±sz/2): halving is exact in binary
       assert_true(fabs(p.vertices[v].x) == 0.5 * s[0]);
@@ -253,8 +257,8 @@ static void test_prism_circumradius_is_half_scale_with_vertex_0_on_plus_x(void**
       int n = prismSides[k];
       double taper = tapers[t];
       pdPolyhedron p;
-      char why[256] = "";
-      assert_true(pd_polyhedron_prism(&p, n, scale, taper, why, sizeof why));
+      pdError why = {0};
+      assert_true(pd_polyhedron_prism(&p, n, scale, taper, &why));
       assert_int_equal(p.vertexCount, 2 * n);
       // vertex 0 is the first bottom corner, on +x
       assert_true(p.vertices[0].x == 0.5 * s && p.vertices[0].y == 0.0 && p.vertices[0].z == -0.5 * h);
@@ -283,8 +287,8 @@ static void test_sphere_vertices_lie_at_radius_half(void** state) {
   (void)state;
   for (int level = 0; level <= 3; ++level) {
     pdPolyhedron p;
-    char why[256] = "";
-    assert_true(pd_polyhedron_sphere(&p, level, unitScale, why, sizeof why));
+    pdError why = {0};
+    assert_true(pd_polyhedron_sphere(&p, level, unitScale, &why));
     for (int v = 0; v < p.vertexCount; ++v) {
       double r = pd_v3_norm(p.vertices[v]);
       if (fabs(r - 0.5) > SPHERE_RADIUS_TOL) fail_msg("level %d vertex %d at radius 0.5%+.3g", level, v, r - 0.5);
@@ -336,8 +340,8 @@ static void test_hull_of_box_with_face_edge_and_interior_points_is_the_box(void*
   assert_true(n <= maxPoints);
 
   pdPolyhedron p;
-  char why[256] = "";
-  if (!pd_polyhedron_hull(&p, pts, n, why, sizeof why)) fail_msg("hull: %s", why);
+  pdError why = {0};
+  if (!pd_polyhedron_hull(&p, pts, n, &why)) fail_msg("hull: %s", why.message);
   check_counts(&p, 8, 12, 6, "box hull");
   check_structure(&p, "box hull");
   for (int v = 0; v < p.vertexCount; ++v) {  // the vertices are the 8 corners, nothing else
@@ -368,9 +372,10 @@ static void test_hull_of_random_ball_points_is_valid_and_contains_them(void** st
   for (uint64_t seed = 1; seed <= 5; ++seed) {
     ball_points(pts, ballPoints, seed);
     pdPolyhedron p;
-    char why[256] = "", label[32];
+    pdError why = {0};
+    char label[32];
     snprintf(label, sizeof label, "ball seed %d", (int)seed);
-    if (!pd_polyhedron_hull(&p, pts, ballPoints, why, sizeof why)) fail_msg("%s: %s", label, why);
+    if (!pd_polyhedron_hull(&p, pts, ballPoints, &why)) fail_msg("%s: %s", label, why.message);
     check_structure(&p, label);
     double tol = PLANE_TOL_REL * size_of(&p);
     for (int i = 0; i < ballPoints; ++i)
@@ -428,9 +433,9 @@ static void test_hull_of_permuted_points_has_the_same_vertex_set(void** state) {
     }
   }
   pdPolyhedron a, b;
-  char why[256] = "";
-  if (!pd_polyhedron_hull(&a, pts, ballPoints, why, sizeof why)) fail_msg("%s", why);
-  if (!pd_polyhedron_hull(&b, shuffled, ballPoints, why, sizeof why)) fail_msg("%s", why);
+  pdError why = {0};
+  if (!pd_polyhedron_hull(&a, pts, ballPoints, &why)) fail_msg("%s", why.message);
+  if (!pd_polyhedron_hull(&b, shuffled, ballPoints, &why)) fail_msg("%s", why.message);
   check_counts(&b, a.vertexCount, a.edgeCount, a.faceCount, "permuted hull");
   qsort(a.vertices, (size_t)a.vertexCount, sizeof *a.vertices, compare_vec3);
   qsort(b.vertices, (size_t)b.vertexCount, sizeof *b.vertices, compare_vec3);
@@ -444,12 +449,12 @@ static void test_hull_of_permuted_points_has_the_same_vertex_set(void** state) {
 static void expect_refused(const double* pts, int n, const char* label) {
   pdPolyhedron p;
   memset(&p, 0xff, sizeof p);  // garbage in: the function must not rely on it
-  char why[256] = "";
-  if (pd_polyhedron_hull(&p, pts, n, why, sizeof why)) {
+  pdError why = {0};
+  if (pd_polyhedron_hull(&p, pts, n, &why)) {
     pd_polyhedron_free(&p);
     fail_msg("%s: a degenerate hull was accepted", label);
   }
-  if (why[0] == '\0') fail_msg("%s: refused without a reason", label);
+  if (why.message[0] == '\0') fail_msg("%s: refused without a reason", label);
   assert_null(p.vertices);  // nothing left allocated or dangling
   assert_null(p.edges);
   assert_null(p.faces);
@@ -500,9 +505,10 @@ static void test_hull_merges_points_within_tolerance_into_the_box(void** state) 
     if (variant == 1 || variant == 2)  // a point d outside the top face, away from its centre
       pts[3 * n] = 0.1, pts[3 * n + 1] = 0.2, pts[3 * n + 2] = h + d, ++n;
     pdPolyhedron p;
-    char why[256] = "", label[32];
+    pdError why = {0};
+    char label[32];
     snprintf(label, sizeof label, "near box variant %d", variant);
-    if (!pd_polyhedron_hull(&p, pts, n, why, sizeof why)) fail_msg("%s: refused: %s", label, why);
+    if (!pd_polyhedron_hull(&p, pts, n, &why)) fail_msg("%s: refused: %s", label, why.message);
     check_counts(&p, 8, 12, 6, label);
     check_structure(&p, label);
     pd_polyhedron_free(&p);
@@ -518,9 +524,9 @@ static void test_validate_refuses_damaged_polyhedra(void** state) {
                               "edge repeated",      "edge repeated reversed", "plane moved outward"};
   for (int kind = 0; kind < kinds; ++kind) {
     pdPolyhedron p;
-    char why[256] = "";
-    assert_true(pd_polyhedron_prism(&p, 5, (const double[3]){1, 1, 1}, 0.5, why, sizeof why));
-    assert_true(pd_polyhedron_validate(&p, why, sizeof why));
+    pdError why = {0};
+    assert_true(pd_polyhedron_prism(&p, 5, (const double[3]){1, 1, 1}, 0.5, &why));
+    assert_true(pd_polyhedron_validate(&p, &why));
     switch (kind) {
       case 0: {
         int t = p.edges[3].f[0];
@@ -563,9 +569,9 @@ static void test_validate_refuses_damaged_polyhedra(void** state) {
         p.faces[2].offset += 1e-6;
         break;
     }
-    why[0] = '\0';
-    if (pd_polyhedron_validate(&p, why, sizeof why)) fail_msg("%s: accepted", names[kind]);
-    if (why[0] == '\0') fail_msg("%s: refused without a reason", names[kind]);
+    why.message[0] = '\0';
+    if (pd_polyhedron_validate(&p, &why)) fail_msg("%s: accepted", names[kind]);
+    if (why.message[0] == '\0') fail_msg("%s: refused without a reason", names[kind]);
     pd_polyhedron_free(&p);
   }
 }
@@ -577,9 +583,9 @@ static void test_translate_moves_vertices_and_keeps_planes_consistent(void** sta
   const pdVec3 shifts[] = {{10, -20, 30}, {-0.125, 0.3, 1e-3}, {1e3, 1e3, -1e3}};
   for (size_t s = 0; s < sizeof shifts / sizeof shifts[0]; ++s) {
     pdPolyhedron p, q;
-    char why[256] = "";
-    assert_true(pd_polyhedron_prism(&p, 7, (const double[3]){1.3, 0.9, 2.1}, 0.5, why, sizeof why));
-    assert_true(pd_polyhedron_prism(&q, 7, (const double[3]){1.3, 0.9, 2.1}, 0.5, why, sizeof why));
+    pdError why = {0};
+    assert_true(pd_polyhedron_prism(&p, 7, (const double[3]){1.3, 0.9, 2.1}, 0.5, &why));
+    assert_true(pd_polyhedron_prism(&q, 7, (const double[3]){1.3, 0.9, 2.1}, 0.5, &why));
     pd_polyhedron_translate(&q, shifts[s]);
     double reach = 0.0;  // the largest coordinate magnitude after the shift: the scale of roundoff
     for (int v = 0; v < q.vertexCount; ++v) {
@@ -597,7 +603,7 @@ static void test_translate_moves_vertices_and_keeps_planes_consistent(void** sta
         if (fabs(off) > PLANE_TOL_REL * reach) fail_msg("shift %zu: face %d vertex off its plane by %.3g", s, f, off);
       }
     }
-    if (!pd_polyhedron_validate(&q, why, sizeof why)) fail_msg("shift %zu: %s", s, why);
+    if (!pd_polyhedron_validate(&q, &why)) fail_msg("shift %zu: %s", s, why.message);
     pd_polyhedron_free(&p);
     pd_polyhedron_free(&q);
   }

@@ -38,8 +38,9 @@ static void expect_recorded_derivative_is_fresh(const char* scene, double t) {
   char path[512];
   snprintf(path, sizeof path, "%s/%s", PD_SOURCE_DIR, scene);
   pdModel* model = compile_file(path);
-  pdState* s = pd_state_create(model);
-  s->islands = pd_islandsOff;  // one state: its own list and step
+  pdStateOptions options = pd_state_options_default();
+  options.islands = pd_islandsOff;  // one state: its own list and step
+  pdState* s = pd_state_create(model, &options);
   assert_true(pd_advance(model, s, t, NULL, NULL));
   pd_dense_resume(s);  // the integration's own state, at the end of its last step (a sample presents another)
   assert_true(pd_state_contact_count(s) > 0);

@@ -191,9 +191,10 @@ static bool keep(const pdModel* model, const pdState* state, void* user) {
 }
 
 static samples* run_certified(const pdModel* m, bool certificates, pdIslands islands, long* skipped) {
-  pdState* s = pd_state_create(m);
-  s->islands = islands;
-  s->searchCertificates = certificates;
+  pdStateOptions options = pd_state_options_default();
+  options.islands = islands;
+  options.searchCertificates = certificates;
+  pdState* s = pd_state_create(m, &options);
   samples* out = calloc(1, sizeof *out);
   assert_non_null(out);
   assert_true(pd_advance(m, s, m->settings.tend, keep, out));

@@ -64,8 +64,9 @@ static bool record_trace(const pdModel* model, const pdState* s, void* user) {
 // Runs `text` with the defaults (islands on, the implicit stepper) on `threads` threads.
 static trace* run_trace(const char* text, int threads, pdModel** modelOut) {
   pdModel* model = compile_text(text);
-  pdState* s = pd_state_create(model);
-  s->threads = threads;
+  pdStateOptions options = pd_state_options_default();
+  options.threads = threads;
+  pdState* s = pd_state_create(model, &options);
   trace* r = calloc(1, sizeof *r);
   assert_non_null(r);
   assert_true(pd_advance(model, s, model->settings.tend, record_trace, r));

@@ -144,7 +144,7 @@ static void test_soft_cube_bounce_is_found_and_below_the_single_contact_value(vo
       "tend 1\nsample 400\ntol 1e-8\n"
       "cube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nrestitution 0.5\n"
       "cube c red 0.2 0.2 0.2\nloc 0 0 0.6\nrestitution 0.5\n");
-  pdState* st = pd_state_create(model);
+  pdState* st = pd_state_create(model, NULL);
   pdTrajectory* run = pd_trajectory_create(model);
   assert_true(pd_advance(model, st, model->settings.tend, observe, run));
   pdCompareMetrics m = pd_compare_metrics(model, run, NULL);

@@ -220,7 +220,7 @@ static void test_judge_measures_a_known_offset_and_turn(void** state) {
   pdModel* m = pd_toss_model(toss, &p, &err);
   assert_non_null(m);
   pdTrajectory* tr = pd_trajectory_create(m);
-  pdState* st = pd_state_create(m);
+  pdState* st = pd_state_create(m, NULL);
   pdQuat quarter = pd_quat_from_axis_angle(pd_v3(0, 0, 1), 0.5 * kPi);
   for (int k = 0; k < toss->sampleCount; ++k) {
     // the record moved by one cube width along x, and turned by a quarter turn about z from sample 5 on

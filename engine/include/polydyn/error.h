@@ -11,6 +11,8 @@
 
 #include "polydyn/api.h"
 
+PD_EXTERN_C_BEGIN
+
 enum { PD_ERROR_MESSAGE_MAX = 512 };
 
 typedef struct pdError {
@@ -28,11 +30,22 @@ PD_API void pd_error_set(pdError* err, const char* file, int line, int col, cons
 // Writes `FILE:LINE:COL: message\n` (or `FILE: message` when the line is unknown) to `out`.
 PD_API void pd_error_print(const pdError* err, FILE* out);
 
-#define PD_ASSERT(cond)                                                                         \
-  do {                                                                                          \
-    if (!(cond)) {                                                                              \
-      fprintf(stderr, "%s:%d: polydyn API misuse: assertion `%s` failed\n", __FILE__, __LINE__, \
-              #cond);                                                                           \
-      abort();                                                                                  \
-    }                                                                                           \
+// The function PD_ASSERT calls when a check fails: `expression` is the condition's text, `file` and `line` where the
+// check is (an engine/src file). A handler must not return: it reports, then aborts, exits or longjmps out (a test
+// harness); if it returns, polydyn aborts anyway, since the code after a failed check relies on the condition.
+typedef void pdAssertFcn(const char* expression, const char* file, int line);
+
+// Installs the handler of failed checks for the whole process (NULL restores the default, which writes
+// `FILE:LINE: polydyn API misuse: assertion `EXPRESSION` failed` to stderr and aborts). Not thread-safe: call it
+// before any thread uses polydyn.
+PD_API void pd_set_assert_fcn(pdAssertFcn* fcn);
+
+// Calls the installed handler, then aborts should it return (PD_ASSERT's failure path).
+PD_API PD_NORETURN void pd_assert_failed(const char* expression, const char* file, int line);
+
+#define PD_ASSERT(cond)                                \
+  do {                                                 \
+    if (!(cond)) pd_assert_failed(#cond, __FILE__, __LINE__); \
   } while (0)
+
+PD_EXTERN_C_END

@@ -15,6 +15,8 @@
 #include "polydyn/scene.h"
 #include "polydyn/vecmath.h"
 
+PD_EXTERN_C_BEGIN
+
 // The smallest restitution a scene may request (pd_model_compile refuses less, at the object's line).
 // Below e⁻² ≈ 0.135 the contact's normal damper is overdamped, which the model reproduces exactly; e = 0
 // would need an infinite damper, and below 0.01 (damping ratio 4.8) the damper's fast mode would force
@@ -177,3 +179,5 @@ PD_API double pd_model_pair_delta_max(const pdModel* model, int a, int b);
 
 // The pair constants of bodies a and b (model body indices, a != b, not both fixed), as used.
 PD_API pdPairContact pd_model_pair_contact(const pdModel* model, int a, int b);
+
+PD_EXTERN_C_END

@@ -18,6 +18,8 @@
 #include "polydyn/model.h"
 #include "polydyn/state.h"
 
+PD_EXTERN_C_BEGIN
+
 typedef struct pdRunWriter pdRunWriter;
 
 // Starts a run directory for `dir`: creates the temporary directory and opens trajectory.csv and
@@ -64,3 +66,5 @@ PD_API void pd_run_abort(pdRunWriter* run);
 
 // Writes the summary JSON object to `out` (also used by `polydyn check --json` later).
 PD_API void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state, const pdRunInfo* info);
+
+PD_EXTERN_C_END

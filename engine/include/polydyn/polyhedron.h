@@ -18,6 +18,8 @@
 #include "polydyn/error.h"
 #include "polydyn/vecmath.h"
 
+PD_EXTERN_C_BEGIN
+
 typedef struct pdEdge {
   int v[2];  // vertex indices
   int f[2];  // face indices: f[0] walks v[0]→v[1], f[1] walks v[1]→v[0]
@@ -53,11 +55,12 @@ typedef struct pdPolyhedron {
 #define PD_PLANARITY_TOL_REL 1e-9
 
 // Builds the convex hull of `count` points (xyz triples) with qhull. Returns false and fills
-// `why` (a short phrase, e.g. "the points are coplanar") when the hull is degenerate (fewer than 4
+// `err` (a short phrase, e.g. "the points are coplanar") when the hull is degenerate (fewer than 4
 // non-coplanar points) or qhull fails. Interior points are dropped; coplanar facets are merged.
 // On success `out` holds arrays the caller frees with pd_polyhedron_free; on failure it holds none.
-// `why` receives at most whySize bytes, NUL included (every function below with `why` does the same).
-PD_API bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, char* why, int whySize);
+// `err` may be NULL; it gets a message only (file "", line and column 0: the caller knows where the shape came
+// from), as for every function below with an `err`.
+PD_API bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, pdError* err);
 
 // The scene primitives of DESIGN §4.1, already scaled by (sx, sy, sz), in the primitive's own frame
 // (origin at its geometric centre, before the shift to the centre of mass):
@@ -67,14 +70,14 @@ PD_API bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int coun
 // - tprism: as prism, with the top (z = ½) polygon scaled by `taper`;
 // - sphere: geodesic polyhedron of diameter 1: an icosahedron subdivided `level` times (each
 //   triangle into four), new vertices pushed onto the sphere.
-// Return false with `why` only on a degenerate result (cannot happen for valid arguments).
-PD_API bool pd_polyhedron_cube(pdPolyhedron* out, const double scale[3], char* why, int whySize);
-PD_API bool pd_polyhedron_prism(pdPolyhedron* out, int sides, const double scale[3], double taper, char* why, int whySize);
-PD_API bool pd_polyhedron_sphere(pdPolyhedron* out, int level, const double scale[3], char* why, int whySize);
+// Return false with `err` only on a degenerate result (cannot happen for valid arguments).
+PD_API bool pd_polyhedron_cube(pdPolyhedron* out, const double scale[3], pdError* err);
+PD_API bool pd_polyhedron_prism(pdPolyhedron* out, int sides, const double scale[3], double taper, pdError* err);
+PD_API bool pd_polyhedron_sphere(pdPolyhedron* out, int level, const double scale[3], pdError* err);
 
-// Checks every invariant listed at the top of this header. Returns false and fills `why` with the
+// Checks every invariant listed at the top of this header. Returns false and fills `err` with the
 // first violation found.
-PD_API bool pd_polyhedron_validate(const pdPolyhedron* p, char* why, int whySize);
+PD_API bool pd_polyhedron_validate(const pdPolyhedron* p, pdError* err);
 
 // Moves every vertex and plane by `shift` (x → x + shift).
 PD_API void pd_polyhedron_translate(pdPolyhedron* p, pdVec3 shift);
@@ -93,6 +96,8 @@ typedef struct pdMassProperties {
   pdMat3 principalAxes;  // columns are the principal axes (right-handed rotation), polyhedron axes
 } pdMassProperties;
 
-// `density` in kg/m³ (> 0). Returns false with `why` if the volume is not positive or the inertia
+// `density` in kg/m³ (> 0). Returns false with `err` if the volume is not positive or the inertia
 // is not positive definite.
-PD_API bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties* out, char* why, int whySize);
+PD_API bool pd_mass_properties(const pdPolyhedron* p, double density, pdMassProperties* out, pdError* err);
+
+PD_EXTERN_C_END

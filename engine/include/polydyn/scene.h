@@ -16,6 +16,8 @@
 #include "polydyn/api.h"
 #include "polydyn/error.h"
 
+PD_EXTERN_C_BEGIN
+
 typedef enum pdPrimitiveKind {
   pd_primCube,    // cube NAME COLOR sx sy sz
   pd_primPrism,   // prism NAME COLOR n sx sy sz          (3 <= n <= PD_PRISM_MAX_SIDES)
@@ -141,3 +143,5 @@ PD_API pdScene* pd_scene_parse_buffer(const char* name, const char* text, size_t
 
 // Frees the scene and everything it holds; NULL is allowed.
 PD_API void pd_scene_free(pdScene* scene);
+
+PD_EXTERN_C_END

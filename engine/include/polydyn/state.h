@@ -13,13 +13,15 @@
 //
 // Reading a state: t, count, warnings, failed and stopped directly; poses with pd_state_body, contacts with
 // pd_state_contact_count and pd_state_contact (not from y, whose layout is internal to the stepper). The
-// fields are written by pd_advance and pd_state_reset; a caller writes only `stepper`, `onsets`, `islands`,
-// `threads` (and `h`, the first step to try), between pd_state_create or pd_state_reset and the first
-// pd_advance. With pd_islandsOn, y, n and the contact list are those of the whole scene at every output sample
+// caller's settings (stepper, onsets, islands, threads, search certificates, first step) go in a pdStateOptions at
+// pd_state_create; the state's fields are written by pd_state_create, pd_state_reset and pd_advance only, and a
+// caller reads them. With pd_islandsOn, y, n and the contact list are those of the whole scene at every output sample
 // (in the observer and after pd_advance returns); between samples each island advances in a state of its own.
 //
-// Memory: pd_state_create allocates everything a step needs. A step never allocates; between two steps,
-// pd_advance grows the state's vectors (doubling) only when the contact list outgrows them.
+// Memory: pd_state_create allocates the vectors; the first steps of a stepper create its own (the dense output, the
+// implicit stepper's matrices), and between two steps pd_advance grows the state's vectors (doubling) when the
+// contact list outgrows them. Once warmed up, a step never allocates (pd_alloc_count, polydyn/api.h, counts it in
+// builds with PD_COUNT_ALLOCS: tests/engine/test_step_allocations.c).
 #pragma once
 
 #include <stdbool.h>
@@ -27,6 +29,8 @@
 #include "polydyn/api.h"
 #include "polydyn/model.h"
 #include "polydyn/vecmath.h"
+
+PD_EXTERN_C_BEGIN
 
 enum { PD_BODY_STATE_SIZE = 13 };
 
@@ -67,7 +71,7 @@ typedef enum pdStepper {
                            // (PD_IMPLICIT_BODIES_MAX) keep step doubling (README, Integration)
 } pdStepper;
 
-// The stepper a new or reset state takes (pd_state_reset) and `polydyn run` uses unless told: it takes step doubling's
+// The stepper of pd_state_options_default() and the one `polydyn run` uses unless told: it takes step doubling's
 // steps wherever the error control sets them, and longer ones where resting and sliding contacts' stability bound
 // would hold step doubling to a fraction of them (README, Integration).
 #define PD_STEPPER_DEFAULT pd_stepperImplicit
@@ -96,7 +100,7 @@ typedef enum pdOnsets {
 // The mode pd_onsetsAuto stands for in a system of `movingBodies` moving bodies (other modes: themselves).
 PD_API pdOnsets pd_onsets_effective(pdOnsets onsets, int movingBodies);
 
-// The onset mode of a new state (pd_state_reset) and of the commands' --onsets.
+// The onset mode of pd_state_options_default() and of the commands' --onsets.
 #define PD_ONSETS_DEFAULT pd_onsetsAuto
 
 // The onset mode's name in summary.json: "pair", "exact" or "auto".
@@ -114,7 +118,7 @@ typedef enum pdIslands {
 // loops over contacts, are the only work split, and more threads than cores only adds switching).
 #define PD_THREADS_MAX 64
 
-// The island mode of a new state (pd_state_reset) and of the commands' --islands.
+// The island mode of pd_state_options_default() and of the commands' --islands.
 #define PD_ISLANDS_DEFAULT pd_islandsOn
 
 // The island mode's name in summary.json: "on" or "off".
@@ -151,21 +155,41 @@ typedef struct pdCounters {
   double bodySecondsAsleep;  // s: the sum over moving bodies of the time each spent asleep
 } pdCounters;
 
-typedef struct pdState {
-  double t;          // s
-  double h;          // next step to try, s
-  pdStepper stepper;
-  pdOnsets onsets;   // how contacts that began inside a step join (PD_ONSETS_DEFAULT unless the caller sets it)
-  pdIslands islands;  // one system or islands (PD_ISLANDS_DEFAULT unless the caller sets it)
+// The caller's settings of a state. Start from pd_state_options_default() and change the fields you need:
+//   pdStateOptions o = pd_state_options_default();
+//   o.islands = pd_islandsOff;
+//   pdState* s = pd_state_create(model, &o);
+// (a struct not made by pd_state_options_default is refused: pd_state_create asserts on its `valid` field).
+typedef struct pdStateOptions {
+  pdStepper stepper;  // PD_STEPPER_DEFAULT
+  pdOnsets onsets;    // how contacts that began inside a step join: PD_ONSETS_DEFAULT
+  pdIslands islands;  // one system or islands: PD_ISLANDS_DEFAULT
+  int threads;        // 1 (default) .. PD_THREADS_MAX. With pd_islandsOn, the islands of each interval run on this
+                      // many threads (the caller's and threads - 1 of the state's own, created at the first pd_advance
+                      // and joined by pd_state_free/reset), a thread without an island helping a running one with
+                      // its long loops over contacts; the results are bit-identical for every count. Ignored with
+                      // pd_islandsOff (one system: one thread).
   bool searchCertificates;  // true (the default): a pair whose last contact search found nothing new is not
                             // searched again while a certificate proves the search would find nothing new
                             // (contact_analysis.h); false searches every pair after every step. The results are
                             // the same bit for bit; false is for tests and measurements.
-  int threads;        // 1 .. PD_THREADS_MAX, 1 unless the caller sets it. With pd_islandsOn, the islands of each
-                      // interval run on this many threads (the caller's and threads - 1 of the state's own, created
-                      // at the first pd_advance and joined by pd_state_free/reset), a thread without an island
-                      // helping a running one with its long loops over contacts; the results are bit-identical
-                      // for every count. Ignored with pd_islandsOff (one system: one thread).
+  double h;           // the first step to try, s (> 0); 0 (the default): the scene's settings.dt
+  int valid;          // set by pd_state_options_default; do not set (catches options never initialised)
+} pdStateOptions;
+
+// The default options: the values listed in pdStateOptions.
+PD_API pdStateOptions pd_state_options_default(void);
+
+typedef struct pdState {
+  double t;          // s
+  double h;          // next step to try, s
+  // The options the state was created with (pdStateOptions), as the steppers read them; read-only to the caller.
+  pdStepper stepper;
+  pdOnsets onsets;
+  pdIslands islands;
+  bool searchCertificates;
+  int threads;
+  pdStateOptions options;  // as given to pd_state_create (pd_state_reset returns to them)
   int n;             // length of y: 13 per moving body + 8 per active contact
   int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)
   double* y;         // (n) the state vector
@@ -193,14 +217,12 @@ typedef struct pdBodyState {
   pdVec3 w;  // rad/s, world
 } pdBodyState;
 
-// A new state of `model` at t = 0: the scene's initial poses and velocities, no contacts, the adaptive
-// stepper with first step settings.dt. The caller owns it (pd_state_free). `model` must outlive the state
-// and be the model passed with it to every other call.
-PD_API pdState* pd_state_create(const pdModel* model);
-// Back to t = 0 with the model's initial conditions; counters, warnings and timers cleared; the stepper back
-// to PD_STEPPER_DEFAULT, onsets to PD_ONSETS_DEFAULT, islands to PD_ISLANDS_DEFAULT, threads to 1 and search
-// certificates on (set state->stepper, state->onsets, state->islands, state->threads, state->searchCertificates
-// after this call).
+// A new state of `model` at t = 0: the scene's initial poses and velocities, no contacts, the settings of `options`
+// (NULL: pd_state_options_default(); asserted valid: threads in 1 .. PD_THREADS_MAX, h >= 0). The caller owns it
+// (pd_state_free). `model` must outlive the state and be the model passed with it to every other call.
+PD_API pdState* pd_state_create(const pdModel* model, const pdStateOptions* options);
+// Back to t = 0 with the model's initial conditions and the options the state was created with; counters,
+// warnings and timers cleared.
 PD_API void pd_state_reset(const pdModel* model, pdState* state);
 // Frees the state and everything it holds; NULL is allowed.
 PD_API void pd_state_free(pdState* state);
@@ -259,3 +281,5 @@ PD_API bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObse
 // scratch and stage timers, so it changes what pd_state_contact reports until the next step. Exposed for
 // tests and alternative steppers.
 PD_API void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt);
+
+PD_EXTERN_C_END
