@@ -180,11 +180,15 @@ void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im,
 }
 
 // Contact l's push σ_k L_k F on its end k (0: body 1, 1: body 2) into out.
+// A planar body's push keeps to its plane, as its derivative does (dynamics.c), so that its stages never
+// leave it either.
 static void push_end(const pdModel* model, const pdContactLinear* l, int k, int row, pdVec3 F, double* out) {
-  if (k == 0)
-    add_push(model->bodies[l->body1].invMass, &l->invInertia1, row, l->r1, F, 1.0, out);
-  else
-    add_push(model->bodies[l->body2].invMass, &l->invInertia2, row, l->r2, F, -1.0, out);
+  const pdBody* body = &model->bodies[k == 0 ? l->body1 : l->body2];
+  double kept[BODY_ROWS] = {0};
+  add_push(body->invMass, k == 0 ? &l->invInertia1 : &l->invInertia2, 0, k == 0 ? l->r1 : l->r2, F,
+           k == 0 ? 1.0 : -1.0, kept);
+  if (body->planar) kept[1] = kept[3] = kept[5] = 0.0;
+  for (int i = 0; i < BODY_ROWS; ++i) out[row + i] += kept[i];
 }
 
 // Whether a contact's springs drive their own rates (Gs ≠ 0, as in slip, where the friction limit follows the

@@ -229,6 +229,10 @@ int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, con
       pdVec3 v = pd_v3_add(pd_layout_v(yb), pd_v3_scale(j, body->invMass));
       pdVec3 w = pd_v3_add(pd_layout_w(yb),
                            pd_mat3_mulv(&set->invInertiaWorld[b], pd_v3_cross(pd_v3_sub(c->point, poses[b].x), j)));
+      if (body->planar) {  // the plane takes the impulse's out-of-plane part, as in the derivative (model.h)
+        v.y = pd_layout_v(yb).y;
+        w.x = pd_layout_w(yb).x, w.z = pd_layout_w(yb).z;
+      }
       pd_layout_store(yb, v, w, pd_layout_x(yb), pd_layout_q(yb));
     }
     c->onsetAge = 0.0;

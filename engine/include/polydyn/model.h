@@ -67,6 +67,13 @@ typedef struct pdBody {
   pdVec3 force0;          // N, world
   pdVec3 forceRate;       // N/s, world
   pdVec3 forcePoint;      // m, body frame
+  // Planar motion (scene `planar`): the centre of mass moves in the world x–z plane and the body turns about
+  // the world y axis only, three degrees of freedom. Contacts and their forces stay three-dimensional; the
+  // derivative drops the force's y component and the torque's x and z components (the constraint's reaction,
+  // which does no work), so v_y, ω_x and ω_z stay zero (to the round-off of the implicit stepper's solves).
+  // The reduced motion is exact because the compiled model requires a principal axis of inertia along world y
+  // and an initial velocity in the plane (pd_model_compile).
+  bool planar;
   pdSourceLoc where;      // the object command in the scene file
 } pdBody;
 

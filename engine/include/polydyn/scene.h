@@ -44,6 +44,7 @@ enum {
   PD_SET_LOC = 1u << 7,
   PD_SET_VEL = 1u << 8,
   PD_SET_FORCE = 1u << 9,
+  PD_SET_PLANAR = 1u << 10,
 };
 enum {
   PD_SET_GRAVITY = 1u << 0,
@@ -91,6 +92,7 @@ typedef struct pdSceneObject {
   double forceRate[3];    // N/s
   double forcePoint[3];   // m
   pdSourceLoc forceWhere; // the `force` command (line 0 when none)
+  pdSourceLoc planarWhere; // the `planar` command (valid when PD_SET_PLANAR)
   unsigned setMask;       // PD_SET_* bits: which properties the file set
   pdSourceLoc where;      // the object command
 } pdSceneObject;
