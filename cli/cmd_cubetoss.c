@@ -18,7 +18,7 @@
 
 // Longest --out path: the run directories' paths below it fit the fixed buffers.
 #define CUBETOSS_PATH_MAX 3000
-enum { ENGINES_MAX = 3, PARAM_FILES_MAX = 8 };
+enum { ENGINES_MAX = 4, PARAM_FILES_MAX = 8 };
 // Fit defaults: evaluations of the objective (each one run of every training toss) and the simplex size
 // (scaled units: log10 μ, e, log10 k_n) below which a further step cannot matter against the noise of
 // the objective across tosses.
@@ -37,7 +37,10 @@ static const char* const help =
     "Simulates real cube tosses (CSV `toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz` at 148 Hz, e.g.\n"
     "shared/data/cube-toss/tosses-train.csv from the ContactNets data set) from each toss's first sample to its\n"
     "last, sampled at 148 Hz, and compares them with the record: position error in cube widths and rotation\n"
-    "angle error, at the end and RMS over the toss. Writes DIR/per_toss.csv (one row per toss and engine),\n"
+    "angle error, at the end and RMS over the toss. The same for real planar drops (CSV `drop,t,x,z,th,vx,vz,vth`\n"
+    "at 250 Hz, e.g. shared/data/planar-drops/drops-given.csv; the header decides), the block held in the x-z\n"
+    "plane, errors in side lengths, plus the first three bounces (docs/planar-drops.md). Writes DIR/per_toss.csv\n"
+    "(one row per toss and engine),\n"
     "DIR/summary.csv (mean, median and 90th percentile per engine, for all, training and test tosses), the\n"
     "parameter fragments used (DIR/params-ENGINE.scene) and, unless --no-runs, DIR/runs/TOSS/record/ (the\n"
     "record as a run directory) beside DIR/runs/TOSS/ENGINE[-VARIANT]/, for replay.\n"
@@ -48,7 +51,8 @@ static const char* const help =
     "positions) with the starting and the fitted parameters. Writes DIR/fitted-ENGINE.scene (read by\n"
     "--params), DIR/fit.csv, DIR/fit_trace.csv (every evaluation), DIR/per_toss.csv and DIR/summary.csv.\n"
     "\n"
-    "  --engines LIST   soft, ode, bullet (default: all three; one without an adapter is reported, skipped)\n"
+    "  --engines LIST   soft, ode, bullet, noise (default: soft,ode,bullet; one without an adapter is reported,\n"
+    "                   skipped; noise: the record one sample late, the floor of the errors)\n"
     "  --tosses LIST    all (default), train, test, or toss ids and ranges: 1-20,35\n"
     "  --params [ENGINE=]FILE  mu/restitution/kn lines over the defaults (mu 0.18, restitution 0.125,\n"
     "                   kn 2.1e6 N/m on the cube and the board), for ENGINE or every engine; repeatable\n"
@@ -116,10 +120,13 @@ static bool positive_int(const char* text, int* value) {
   return true;
 }
 
+static const char* const engineOrder[ENGINES_MAX] = {"soft", "ode", "bullet", "noise"};
+
 static bool known_engine(const char* name, size_t len) {
-  static const char* const known[] = {"soft", "ode", "bullet"};
-  for (int i = 0; i < 3; ++i)
+  for (int i = 0; i < ENGINES_MAX; ++i) {
+    const char* const* known = engineOrder;
     if (strlen(known[i]) == len && strncmp(name, known[i], len) == 0) return true;
+  }
   return false;
 }
 
@@ -162,7 +169,7 @@ static int parse_options(int argc, char** argv, options* o) {
           const char* comma = strchr(p, ',');
           size_t len = comma ? (size_t)(comma - p) : strlen(p);
           if (!known_engine(p, len))
-            return pd_cli_usage_error(cmd, "--engines: unknown engine '%.*s' (soft, ode, bullet)", (int)(len < 40 ? len : 40), p);
+            return pd_cli_usage_error(cmd, "--engines: unknown engine '%.*s' (soft, ode, bullet, noise)", (int)(len < 40 ? len : 40), p);
           p = comma ? comma + 1 : NULL;
         }
         o->engines = v;
@@ -231,22 +238,22 @@ static int parse_options(int argc, char** argv, options* o) {
   return -1;
 }
 
-// The engines of --engines in the fixed order soft, ode, bullet, with their parameters.
-static int make_engines(const options* o, engineSpec* specs, char* why, size_t whySize) {
-  static const char* const order[] = {"soft", "ode", "bullet"};
+// The engines of --engines in the fixed order soft, ode, bullet, noise, with their parameters.
+static int make_engines(const options* o, const pdTossExperiment* experiment, engineSpec* specs, char* why,
+                        size_t whySize) {
   int n = 0;
-  for (int e = 0; e < 3; ++e) {
-    if (!pd_cli_list_has(o->engines, order[e])) continue;
+  for (int e = 0; e < ENGINES_MAX; ++e) {
+    if (!pd_cli_list_has(o->engines, engineOrder[e])) continue;
     engineSpec* s = &specs[n++];
     memset(s, 0, sizeof *s);
-    s->name = order[e];
-    bool soft = e == 0;
-    s->variant = soft ? "implicit" : o->variant == pd_refMatched ? "matched" : "native";
-    snprintf(s->label, sizeof s->label, soft ? "%s" : "%s-%s", s->name, s->variant);
+    s->name = engineOrder[e];
+    bool soft = e == 0, noise = e == 3;
+    s->variant = soft ? "implicit" : noise ? "shift1" : o->variant == pd_refMatched ? "matched" : "native";
+    snprintf(s->label, sizeof s->label, soft || noise ? "%s" : "%s-%s", s->name, s->variant);
     s->engine = (pdTossEngine){.name = s->name,
                                .ref = {.variant = o->variant, .step = o->step, .odeFriction = pd_odeFrictionPyramid}};
-    s->built = soft || pd_ref_adapter(s->name) != NULL;
-    s->params = pd_toss_default_params();
+    s->built = soft || noise || pd_ref_adapter(s->name) != NULL;
+    s->params = pd_toss_experiment_params(experiment);
     s->params.tol = o->tol;
     if (o->inertiaGiven) s->params.inertia = o->inertia;
     // files for every engine first, then the engine's own, each in the order given
@@ -336,10 +343,16 @@ static bool show_progress(int done, int total, void* user) {
   return !interrupted;
 }
 
-static void per_toss_header(FILE* out) {
+// Planar experiments add their bounces after the pose errors (pdTossResult).
+static void per_toss_header(FILE* out, const pdTossExperiment* ex) {
   fputs("toss,split,engine,variant,params,status,samples,duration_s,pos_err_end,pos_err_rms,rot_err_end_rad,"
-        "rot_err_rms_rad,wall_seconds,cpu_seconds,steps,run_dir,message\n",
+        "rot_err_rms_rad,",
         out);
+  if (ex->planar) {
+    fputs("impacts_record,impacts_run,", out);
+    for (int k = 1; k <= PD_TOSS_IMPACTS; ++k) fprintf(out, "impact%d_dt_s,impact%d_dv,impact%d_dw,", k, k, k);
+  }
+  fputs("wall_seconds,cpu_seconds,steps,run_dir,message\n", out);
 }
 
 static void per_toss_row(FILE* out, const pdToss* toss, int index, const engineSpec* s, const char* label,
@@ -351,11 +364,22 @@ static void per_toss_row(FILE* out, const pdToss* toss, int index, const engineS
     fputc(',', out);
     pdu_csv_text(out, texts[k]);
   }
-  fprintf(out, ",%d,%.9g,", r->samples, (double)(toss->sampleCount - 1) / PD_TOSS_RATE);
+  fprintf(out, ",%d,%.9g,", r->samples, (double)(toss->sampleCount - 1) / toss->experiment->rate);
   const double values[] = {r->posErrEnd, r->posErrRms, r->rotErrEnd, r->rotErrRms};
   for (int k = 0; k < 4; ++k) {
     pdu_csv_number(out, values[k], 9);
     fputc(',', out);
+  }
+  if (toss->experiment->planar) {
+    if (r->status == pd_tossOk) fprintf(out, "%d,%d,", r->impactsRecord, r->impactsRun);
+    else fputs(",,", out);
+    for (int k = 0; k < PD_TOSS_IMPACTS; ++k) {
+      const double impact[3] = {r->impactDt[k], r->impactDv[k], r->impactDw[k]};
+      for (int j = 0; j < 3; ++j) {
+        pdu_csv_number(out, impact[j], 9);
+        fputc(',', out);
+      }
+    }
   }
   if (r->status == pd_tossOk || r->status == pd_tossFailed) {
     fprintf(out, "%.6g,%.6g,%ld,", r->wallSeconds, r->cpuSeconds, r->steps);
@@ -372,15 +396,26 @@ static void summary_header(FILE* out) {
   fputs("engine,variant,params,split,status,tosses,completed,quantity,unit,mean,median,p90\n", out);
 }
 
-enum { QUANTITIES = 6 };
-static const char* const quantityNames[QUANTITIES] = {"pos_err_end", "pos_err_rms", "rot_err_end", "rot_err_rms",
-                                                      "wall_seconds", "cpu_seconds"};
-static const char* const quantityUnits[QUANTITIES] = {"cube_widths", "cube_widths", "rad", "rad", "s", "s"};
+// The first POSE_QUANTITIES for every experiment, the bounces' for planar ones only.
+enum { POSE_QUANTITIES = 6, QUANTITIES = POSE_QUANTITIES + 3 * PD_TOSS_IMPACTS };
+static const char* const quantityNames[QUANTITIES] = {
+    "pos_err_end", "pos_err_rms", "rot_err_end", "rot_err_rms", "wall_seconds", "cpu_seconds",
+    "impact1_dt",  "impact1_dv",  "impact1_dw",  "impact2_dt",  "impact2_dv",   "impact2_dw",
+    "impact3_dt",  "impact3_dv",  "impact3_dw"};
+static const char* const quantityUnits[QUANTITIES] = {"", "", "rad", "rad", "s", "s", "s", "m/s", "rad/s",
+                                                      "s", "m/s", "rad/s", "s", "m/s", "rad/s"};
+
+static int quantity_count(const pdTossExperiment* ex) { return ex->planar ? QUANTITIES : POSE_QUANTITIES; }
+static const char* quantity_unit(const pdTossExperiment* ex, int q) { return q < 2 ? ex->lengthUnit : quantityUnits[q]; }
 
 static double quantity(const pdTossResult* r, int q) {
-  const double v[QUANTITIES] = {r->posErrEnd, r->posErrRms, r->rotErrEnd, r->rotErrRms,
-                                r->status == pd_tossOk ? r->wallSeconds : NAN,
-                                r->status == pd_tossOk ? r->cpuSeconds : NAN};
+  if (q >= POSE_QUANTITIES) {
+    int k = (q - POSE_QUANTITIES) / 3, j = (q - POSE_QUANTITIES) % 3;
+    return j == 0 ? r->impactDt[k] : j == 1 ? r->impactDv[k] : r->impactDw[k];
+  }
+  const double v[POSE_QUANTITIES] = {r->posErrEnd, r->posErrRms, r->rotErrEnd, r->rotErrRms,
+                                     r->status == pd_tossOk ? r->wallSeconds : NAN,
+                                     r->status == pd_tossOk ? r->cpuSeconds : NAN};
   return v[q];
 }
 
@@ -416,13 +451,13 @@ static const char* summary_status(const engineSpec* spec, const splitStats* s) {
   return s->completed == 0 ? "failed" : "partial";
 }
 
-static void summary_rows(FILE* out, const engineSpec* spec, const char* label, const pdTossResult* const* results,
-                         const int* indices, int count) {
+static void summary_rows(FILE* out, const pdTossExperiment* ex, const engineSpec* spec, const char* label,
+                         const pdTossResult* const* results, const int* indices, int count) {
   static const char* const splits[] = {"all", "train", "test"};
   for (int k = 0; k < 3; ++k) {
     splitStats s = split_stats(results, indices, count, splits[k]);
     if (s.tosses == 0) continue;
-    for (int q = 0; q < QUANTITIES; ++q) {
+    for (int q = 0; q < quantity_count(ex); ++q) {
       const char* const texts[] = {spec->name, spec->variant, label, splits[k], summary_status(spec, &s)};
       for (int t = 0; t < 5; ++t) {
         pdu_csv_text(out, texts[t]);
@@ -431,7 +466,7 @@ static void summary_rows(FILE* out, const engineSpec* spec, const char* label, c
       fprintf(out, "%d,%d,", s.tosses, s.completed);
       pdu_csv_text(out, quantityNames[q]);
       fputc(',', out);
-      pdu_csv_text(out, quantityUnits[q]);
+      pdu_csv_text(out, quantity_unit(ex, q));
       fputc(',', out);
       pdu_csv_number(out, s.q[q].mean, 9);
       fputc(',', out);
@@ -470,6 +505,10 @@ static void print_table(const engineSpec* spec, const char* label, const pdTossR
     printf("%-15s %-8s %-6s %9s  med %5.3f p90 %5.3f  med %5.1f p90 %5.1f  med %5.3f p90 %5.3f %8.3f s %8.3f s\n",
            name, label, splits[k], completed, s.q[0].median, s.q[0].p90, s.q[2].median * deg, s.q[2].p90 * deg,
            s.q[1].median, s.q[1].p90, s.q[4].mean, s.q[5].mean);
+    if (s.q[POSE_QUANTITIES + 1].n > 0)  // planar experiments: the first bounce
+      printf("%-15s %-8s %-6s %9s  first bounce: %d/%d found, time med %.4f s, velocity med %.3f m/s, spin med %.2f rad/s\n",
+             "", "", "", "", s.q[POSE_QUANTITIES + 1].n, s.tosses, s.q[POSE_QUANTITIES].median,
+             s.q[POSE_QUANTITIES + 1].median, s.q[POSE_QUANTITIES + 2].median);
   }
 }
 
@@ -496,7 +535,7 @@ static bool write_result_csvs(const char* dir, const pdTossSet* set, const engin
   snprintf(path, pathSize, "%s/per_toss.csv", dir);
   FILE* out = fopen(path, "w");
   if (!out) return false;
-  per_toss_header(out);
+  per_toss_header(out, set->experiment);
   for (int k = 0; k < groupCount; ++k) {
     const resultGroup* g = &groups[k];
     for (int i = 0; i < g->count; ++i)
@@ -513,7 +552,7 @@ static bool write_result_csvs(const char* dir, const pdTossSet* set, const engin
   for (int k = 0; k < groupCount; ++k)
     for (int e = 0; e < engineCount; ++e) {
       const pdTossResult** column = engine_column(&groups[k], e);
-      summary_rows(out, &specs[e], groups[k].label, column, groups[k].indices, groups[k].count);
+      summary_rows(out, set->experiment, &specs[e], groups[k].label, column, groups[k].indices, groups[k].count);
       free(column);
     }
   written = !ferror(out);
@@ -553,6 +592,9 @@ static int finish_interrupted(const char* cmd, const char* tmp) {
   pd_cli_remove_tree(tmp);
   return 130;
 }
+
+// The noise floor has no parameters to fit.
+static bool fittable(const engineSpec* s) { return s->built && strcmp(s->name, "noise") != 0; }
 
 static int run_tosses(const options* o, const pdTossSet* set, const int* indices, int count, engineSpec* specs,
                       int engineCount) {
@@ -600,6 +642,7 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
   resultGroup group = {o->label, results, indices, count, o->runs};
   bool written = write_result_csvs(tmp, set, specs, engineCount, &group, 1, path, sizeof path);
   for (int e = 0; e < engineCount && written; ++e) {
+    if (!fittable(&specs[e]) && specs[e].built) continue;  // the noise floor has no parameters
     snprintf(path, sizeof path, "%s/params-%s.scene", tmp, specs[e].name);
     char comment[1024], inertia[64] = "that of a uniform cube";
     if (specs[e].params.inertia > 0.0) snprintf(inertia, sizeof inertia, "%g kg m^2", specs[e].params.inertia);
@@ -639,17 +682,19 @@ static int run_tosses(const options* o, const pdTossSet* set, const int* indices
 
 // ---------------------------------------------------------------- polydyn cubetoss fit
 
+static void fit_started(const pdTossFitEngine* engine, void* user) {
+  progressState* progress = user;
+  progress->what = engine->label;
+  progress->evaluation = 0;
+}
+
 static int fit_tosses(const options* o, const pdTossSet* set, const int* indices, int count, engineSpec* specs,
                       int engineCount) {
-  // training: selected tosses at even positions, every K-th of them; test: selected ones at odd positions
   int* train = malloc((size_t)count * sizeof *train);
   int* test = malloc((size_t)count * sizeof *test);
   if (!train || !test) abort();
-  int trainCount = 0, testCount = 0, seenTrain = 0;
-  for (int i = 0; i < count; ++i) {
-    if (pd_toss_split(indices[i]) == pd_tossTest) test[testCount++] = indices[i];
-    else if (seenTrain++ % o->trainEvery == 0) train[trainCount++] = indices[i];
-  }
+  int trainCount, testCount;
+  pd_toss_fit_split(indices, count, o->trainEvery, train, &trainCount, test, &testCount);
   if (trainCount == 0 || testCount == 0) {
     free(train);
     free(test);
@@ -676,35 +721,34 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   }
   if (trace) pd_toss_fit_trace_header(trace);
 
-  pdTossFitResult fits[ENGINES_MAX] = {0};
+  pdTossFitResult fits[ENGINES_MAX];
   pdTossParams fitted[ENGINES_MAX];
-  bool ok = true;
-  char why[256] = "";
-  progressState progress = {.terminal = isatty(STDERR_FILENO) == 1, .start = pd_cli_wall_seconds(), .fitting = true};
-  for (int e = 0; e < engineCount && ok; ++e) {
-    fitted[e] = specs[e].params;
+  pdTossFitEngine engines[ENGINES_MAX];
+  for (int e = 0; e < engineCount; ++e) {
     if (!specs[e].built && pd_batch_is_root()) {
       fprintf(stderr, "polydyn cubetoss fit: %s: this build of polydyn has no %s adapter; not fitted\n", specs[e].label,
               specs[e].name);
     }
-    if (!specs[e].built) continue;
-    progress.what = specs[e].label;
-    progress.evaluation = 0;
-    pdTossFitOptions fo = {.set = set,
-                           .tosses = train,
-                           .tossCount = trainCount,
-                           .engine = specs[e].engine,
-                           .start = specs[e].params,
-                           .fitStiffness = strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched,
-                           .maxEvaluations = o->maxEvals,
-                           .sizeTol = o->sizeTol,
-                           .workers = o->jobs,
-                           .progress = show_progress,
-                           .progressUser = &progress,
-                           .trace = trace};
-    ok = pd_toss_fit(&fo, &fits[e], why, sizeof why);
-    if (ok) fitted[e] = fits[e].params;
+    engines[e] = (pdTossFitEngine){.label = specs[e].label,
+                                   .variant = specs[e].variant,
+                                   .engine = specs[e].engine,
+                                   .start = specs[e].params,
+                                   .built = specs[e].built,
+                                   .fit = fittable(&specs[e]),
+                                   .fitStiffness = strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched};
   }
+  char why[256] = "";
+  progressState progress = {.terminal = isatty(STDERR_FILENO) == 1, .start = pd_cli_wall_seconds(), .fitting = true};
+  pdTossFitOptions common = {.set = set,
+                             .tosses = train,
+                             .tossCount = trainCount,
+                             .maxEvaluations = o->maxEvals,
+                             .sizeTol = o->sizeTol,
+                             .workers = o->jobs,
+                             .progress = show_progress,
+                             .progressUser = &progress,
+                             .trace = trace};
+  bool ok = pd_toss_fit_engines(&common, engines, engineCount, fit_started, &progress, fits, fitted, why, sizeof why);
   bool traceOk = !trace || !ferror(trace);
   traceOk = (!trace || fclose(trace) == 0) && traceOk;
 
@@ -747,40 +791,22 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
   FILE* out = written ? fopen(path, "w") : NULL;
   written = out != NULL;
   if (out) {
-    fputs("engine,variant,status,fitted,mu,restitution,kn,objective_train,pos_err_end_mean_train,"
-          "rot_err_end_mean_train_rad,failed_train,evaluations,converged,train_tosses,train_every,test_tosses,"
-          "start_mu,start_restitution,start_kn,start_objective_train\n",
-          out);
-    for (int e = 0; e < engineCount; ++e) {
-      const pdTossFitResult* f = &fits[e];
-      const pdTossParams* s = &specs[e].params;
-      bool stiff = strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched;
-      fprintf(out, "%s,%s,%s,%s,", specs[e].name, specs[e].variant, specs[e].built ? "ok" : "not built",
-              stiff ? "mu;restitution;kn" : "mu;restitution");
-      if (specs[e].built)
-        fprintf(out, "%.10g,%.10g,%.10g,%.9g,%.9g,%.9g,%d,%d,%s,", f->params.mu, f->params.restitution, f->params.kn,
-                f->objective, f->posErrEndMean, f->rotErrEndMean, f->failed, f->evaluations,
-                f->converged ? "true" : "false");
-      else
-        fputs(",,,,,,,,,", out);
-      fprintf(out, "%d,%d,%d,%.10g,%.10g,%.10g,", trainCount, o->trainEvery, testCount, s->mu, s->restitution, s->kn);
-      if (specs[e].built) fprintf(out, "%.9g", f->startObjective);
-      fputc('\n', out);
-    }
+    pd_toss_fit_csv(out, engines, engineCount, fits, trainCount, o->trainEvery, testCount);
     written = !ferror(out) && written;
     written = fclose(out) == 0 && written;
   }
   for (int e = 0; e < engineCount && written; ++e) {
-    if (!specs[e].built) continue;
+    if (!fittable(&specs[e])) continue;
     snprintf(path, sizeof path, "%s/fitted-%s.scene", tmp, specs[e].name);
     char comment[2048];
     const pdTossFitResult* f = &fits[e];
     snprintf(comment, sizeof comment,
              "polydyn cubetoss fit: %s engine, fitted on %d training tosses of %.300s (even positions%s)\n"
-             "objective (mean end position error in cube widths + mean end rotation error in rad): %.4g at the\n"
+             "objective (mean end position error in %s + mean end rotation error in rad%s): %.4g at the\n"
              "start, %.4g fitted (%d evaluations, %s); %s\n"
              "put these lines under the cube and the board of a scene, or: polydyn cubetoss --params %s=FILE",
-             specs[e].label, trainCount, set->path, o->trainEvery > 1 ? ", every K-th" : "", f->startObjective,
+             specs[e].label, trainCount, set->path, o->trainEvery > 1 ? ", every K-th" : "", set->experiment->lengthUnit,
+             set->experiment->planar ? " + mean first-bounce velocity error in m/s" : "", f->startObjective,
              f->objective, f->evaluations, f->converged ? "converged" : "stopped at --max-evals",
              strcmp(specs[e].name, "soft") == 0 || o->variant == pd_refMatched ? "mu, restitution, kn fitted"
                                                                                : "mu, restitution fitted; kn as given",
@@ -799,7 +825,7 @@ static int fit_tosses(const options* o, const pdTossSet* set, const int* indices
     status = PD_EXIT_FAILURE;
   } else {
     for (int e = 0; e < engineCount; ++e) {
-      if (!specs[e].built) continue;
+      if (!fittable(&specs[e])) continue;
       printf("%s: mu %.4g, restitution %.4g, kn %.4g N/m; objective on %d training tosses %.4g -> %.4g (%d evaluations%s)\n",
              specs[e].label, fits[e].params.mu, fits[e].params.restitution, fits[e].params.kn, trainCount,
              fits[e].startObjective, fits[e].objective, fits[e].evaluations, fits[e].converged ? ", converged" : "");
@@ -852,7 +878,7 @@ int pd_cmd_cubetoss(int argc, char** argv) {
     return pd_cli_usage_error(cmd, "--tosses: %s", why);
   }
   engineSpec specs[ENGINES_MAX];
-  int engineCount = make_engines(&o, specs, why, sizeof why);
+  int engineCount = make_engines(&o, set->experiment, specs, why, sizeof why);
   if (engineCount < 0) {
     fprintf(stderr, "%s\n", why);
     free(indices);

@@ -73,6 +73,8 @@ struct pdRefWorld {
   pdQuat* principal;        // (movingCount) q_P of each moving body
   pdQuat* last;             // (movingCount) last orientation reported: the next keeps its sign
   long steps;               // steps taken: the step starts at t = steps·h
+  int bodiesAdded;          // Bullet's index of the next body added
+  int planarBodies;         // bodies held in the x–z plane (bts_hold_in_xz_plane)
 };
 
 static void pair_material(void* user, int a, int b, btsContactMaterial* out) {
@@ -181,6 +183,11 @@ static pdRefWorld* bullet_create(const pdModel* model, const pdRefOptions* optio
       const double none[3] = {0.0, 0.0, 0.0};
       bts_add_hull(w->bullet, i, &hull, b->fixed ? 0.0 : b->mass, b->fixed ? none : b->principal, x, quat, v, omega);
       free_hull(&hull);
+      if (b->planar) {
+        bts_hold_in_xz_plane(w->bullet, w->bodiesAdded);
+        ++w->planarBodies;
+      }
+      ++w->bodiesAdded;
       if (!b->fixed) {
         w->principal[b->stateIndex] = qP;
         w->last[b->stateIndex] = b->q0;
@@ -308,6 +315,9 @@ static void bullet_settings_json(const pdRefWorld* w, FILE* out) {
     fputs("\"applied_force_call\": \"btRigidBody::applyForce (world force, world-oriented R p from the centre of "
           "mass) before stepSimulation\", ",
           out);
+  if (w->planarBodies)
+    fprintf(out, "\"planar_bodies\": %d, \"planar_constraint\": \"setLinearFactor(1, 0, 1), setAngularFactor(0, 1, "
+                 "0)\", ", w->planarBodies);
   write_pairs(w, out);
   fputc('}', out);
 }

@@ -134,6 +134,12 @@ extern "C" void bts_add_hull(btsWorld* w, int id, const btsHull* hull, double ma
   w->bodies.push_back(std::move(body));
 }
 
+extern "C" void bts_hold_in_xz_plane(btsWorld* w, int index) {
+  btRigidBody& b = *w->bodies[(size_t)index];
+  b.setLinearFactor(btVector3(1, 0, 1));
+  b.setAngularFactor(btVector3(0, 1, 0));
+}
+
 extern "C" void bts_apply_force(btsWorld* w, int index, const double force[3], const double relPos[3]) {
   w->bodies[(size_t)index]->applyForce(btVector3(force[0], force[1], force[2]), btVector3(relPos[0], relPos[1], relPos[2]));
 }

@@ -78,6 +78,10 @@ void bts_add_hull(btsWorld* world, int id, const btsHull* hull, double mass, con
                   const double position[3], const double quaternion[4], const double velocity[3],
                   const double angularVelocity[3]);
 
+// Holds the body added as number `index` in the world x–z plane: linear factor (1, 0, 1), angular factor
+// (0, 1, 0) (btRigidBody::setLinearFactor, setAngularFactor: world-frame masks on its velocity changes).
+void bts_hold_in_xz_plane(btsWorld* world, int index);
+
 void bts_solver_info(const btsWorld* world, btsSolverInfo* out);
 
 // Adds a force (N, world) at `relPos` (m, world-oriented, from the centre of mass) to the body added as number

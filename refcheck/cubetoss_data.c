@@ -9,7 +9,29 @@
 #include "polydyn/cubetoss.h"
 
 #define TOSS_HEADER "toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz"
-enum { TOSS_FIELDS = 15 };
+#define DROP_HEADER "drop,t,x,z,th,vx,vz,vth"
+enum { TOSS_FIELDS = 15, DROP_FIELDS = 8 };
+
+const pdTossExperiment pd_cube_tosses = {.name = "cube tosses",
+                                         .header = TOSS_HEADER,
+                                         .rate = PD_TOSS_RATE,
+                                         .size = {PD_TOSS_CUBE_SIDE, PD_TOSS_CUBE_SIDE, PD_TOSS_CUBE_SIDE},
+                                         .side = PD_TOSS_CUBE_SIDE,
+                                         .mass = PD_TOSS_CUBE_MASS,
+                                         .boardTop = PD_TOSS_BOARD_TOP,
+                                         .vmax = PD_TOSS_VMAX,
+                                         .planar = false,
+                                         .lengthUnit = "cube_widths"};
+const pdTossExperiment pd_planar_drops = {.name = "planar drops",
+                                          .header = DROP_HEADER,
+                                          .rate = PD_DROP_RATE,
+                                          .size = {PD_DROP_SIDE, PD_DROP_SIDE, PD_DROP_SIDE},
+                                          .side = PD_DROP_SIDE,
+                                          .mass = PD_DROP_MASS,
+                                          .boardTop = PD_DROP_BOARD_TOP,
+                                          .vmax = PD_DROP_VMAX,
+                                          .planar = true,
+                                          .lengthUnit = "side_lengths"};
 
 static void* grow(void* p, size_t count, size_t size) {
   void* q = realloc(p, count * size);
@@ -85,13 +107,19 @@ static pdTossSet* parse(const char* path, lineSource* src, pdError* err) {
       break;
     }
     if (lineNo == 1) {
-      if (strcmp(line, TOSS_HEADER) != 0) {
-        pd_error_set(err, path, 1, 1, "header is not `" TOSS_HEADER "`");
+      if (strcmp(line, TOSS_HEADER) == 0) {
+        set->experiment = &pd_cube_tosses;
+      } else if (strcmp(line, DROP_HEADER) == 0) {
+        set->experiment = &pd_planar_drops;
+      } else {
+        pd_error_set(err, path, 1, 1, "header is not `" TOSS_HEADER "` (cube tosses) nor `" DROP_HEADER "` (planar drops)");
         ok = false;
       }
       continue;
     }
     if (len == 0) continue;  // a blank line (e.g. at the end) carries nothing
+    const pdTossExperiment* ex = set->experiment;
+    const int fieldCount = ex->planar ? DROP_FIELDS : TOSS_FIELDS;
     // one line, one record (RFC 4180, pdutil/csv.h); room to count a few fields too many
     char* fields[4 * TOSS_FIELDS];
     int cols[4 * TOSS_FIELDS];
@@ -103,8 +131,8 @@ static pdTossSet* parse(const char* path, lineSource* src, pdError* err) {
       ok = false;
       break;
     }
-    if (n != TOSS_FIELDS) {
-      pd_error_set(err, path, (int)lineNo, 1, "%d fields, expected %d (" TOSS_HEADER ")", n, TOSS_FIELDS);
+    if (n != fieldCount) {
+      pd_error_set(err, path, (int)lineNo, 1, "%d fields, expected %d (%s)", n, fieldCount, ex->header);
       ok = false;
       break;
     }
@@ -115,7 +143,7 @@ static pdTossSet* parse(const char* path, lineSource* src, pdError* err) {
       break;
     }
     double v[TOSS_FIELDS - 1];
-    for (int f = 1; f < TOSS_FIELDS && ok; ++f) {
+    for (int f = 1; f < fieldCount && ok; ++f) {
       if (!parse_number(fields[f], &v[f - 1])) {
         pd_error_set(err, path, (int)lineNo, cols[f], "not a finite number: '%.40s'", fields[f]);
         ok = false;
@@ -140,32 +168,42 @@ static pdTossSet* parse(const char* path, lineSource* src, pdError* err) {
         set->tosses = grow(set->tosses, (size_t)capacity, sizeof *set->tosses);
       }
       cur = &set->tosses[set->count++];
-      *cur = (pdToss){.id = id, .line = lineNo};
+      *cur = (pdToss){.experiment = ex, .id = id, .line = lineNo};
       sampleCapacity = 0;
     }
     int k = cur->sampleCount;
-    double expected = (double)k / PD_TOSS_RATE;
+    double expected = (double)k / ex->rate;
     if (fabs(v[0] - expected) > PD_TOSS_TIME_TOL) {
-      pd_error_set(err, path, (int)lineNo, cols[1], "t = %.9g s, expected %.9g s (sample %d of toss %ld at %g Hz)", v[0],
-                   expected, k, id, PD_TOSS_RATE);
+      pd_error_set(err, path, (int)lineNo, cols[1], "t = %.9g s, expected %.9g s (sample %d of %s %ld at %g Hz)", v[0],
+                   expected, k, ex->planar ? "drop" : "toss", id, ex->rate);
       ok = false;
       break;
     }
-    pdQuat q = {v[4], v[5], v[6], v[7]};
-    double norm = sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-    if (fabs(norm - 1.0) > PD_TOSS_QUAT_NORM_TOL) {
-      pd_error_set(err, path, (int)lineNo, cols[5], "quaternion norm %.9g, expected 1", norm);
-      ok = false;
-      break;
+    pdBodyState b;
+    if (ex->planar) {
+      // (x, z, th) in the x–z plane: th turns x towards z, a rotation about −y (cubetoss.h)
+      b = (pdBodyState){.x = {v[1], 0.0, v[2]},
+                        .q = {cos(0.5 * v[3]), 0.0, -sin(0.5 * v[3]), 0.0},
+                        .v = {v[4], 0.0, v[5]},
+                        .w = {0.0, -v[6], 0.0}};
+    } else {
+      pdQuat q = {v[4], v[5], v[6], v[7]};
+      double norm = sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+      if (fabs(norm - 1.0) > PD_TOSS_QUAT_NORM_TOL) {
+        pd_error_set(err, path, (int)lineNo, cols[5], "quaternion norm %.9g, expected 1", norm);
+        ok = false;
+        break;
+      }
+      b = (pdBodyState){.x = {v[1], v[2], v[3]},
+                        .q = {q.w / norm, q.x / norm, q.y / norm, q.z / norm},
+                        .v = {v[8], v[9], v[10]},
+                        .w = {v[11], v[12], v[13]}};
     }
     if (k == sampleCapacity) {
       sampleCapacity = sampleCapacity ? 2 * sampleCapacity : 128;
       cur->samples = grow(cur->samples, (size_t)sampleCapacity, sizeof *cur->samples);
     }
-    cur->samples[k] = (pdBodyState){.x = {v[1], v[2], v[3]},
-                                    .q = {q.w / norm, q.x / norm, q.y / norm, q.z / norm},
-                                    .v = {v[8], v[9], v[10]},
-                                    .w = {v[11], v[12], v[13]}};
+    cur->samples[k] = b;
     ++cur->sampleCount;
   }
   if (ok && src->file && ferror(src->file)) {
@@ -173,7 +211,7 @@ static pdTossSet* parse(const char* path, lineSource* src, pdError* err) {
     ok = false;
   }
   if (ok && lineNo == 0) {
-    pd_error_set(err, path, 0, 0, "empty file (expected the header `" TOSS_HEADER "`)");
+    pd_error_set(err, path, 0, 0, "empty file (expected the header `" TOSS_HEADER "` or `" DROP_HEADER "`)");
     ok = false;
   }
   if (ok && set->count == 0) {

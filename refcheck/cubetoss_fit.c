@@ -1,5 +1,6 @@
 // polydyn refcheck — fitting an engine's free parameters to the training tosses with GSL's Nelder–Mead
-// simplex (objective, bounds and steps in cubetoss.h).
+// simplex (objective, bounds and steps in cubetoss.h); the held-out split, several engines in turn and their
+// fit.csv, for both data sets (cube tosses, planar drops).
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,7 +32,7 @@ typedef struct fitContext {
   bool stopped;
   char why[256];
   // the last evaluation's terms, and the first evaluation's objective (GSL evaluates the start first)
-  double posMean, rotMean;
+  double posMean, rotMean, bounceMean;  // bounceMean: NAN unless planar
   double startObjective;
   int failed;
 } fitContext;
@@ -73,7 +74,7 @@ static double evaluate(fitContext* c) {
     c->stopped = true;
     return HUGE_VAL;
   }
-  double pos = 0.0, rot = 0.0;
+  double pos = 0.0, rot = 0.0, bounce = 0.0;
   c->failed = 0;
   for (int i = 0; i < o->tossCount; ++i) {
     const pdTossResult* r = &c->results[i];
@@ -81,14 +82,18 @@ static double evaluate(fitContext* c) {
     c->failed += !ok;
     pos += ok ? r->posErrEnd : PD_TOSS_FAIL_POS_ERR;
     rot += ok ? r->rotErrEnd : PD_TOSS_FAIL_ROT_ERR;
+    bounce += ok && isfinite(r->impactDv[0]) ? r->impactDv[0] : PD_TOSS_FAIL_BOUNCE_ERR;
   }
   c->posMean = pos / o->tossCount;
   c->rotMean = rot / o->tossCount;
-  return c->posMean + c->rotMean;
+  bool planar = o->set->experiment->planar;
+  c->bounceMean = planar ? bounce / o->tossCount : NAN;
+  return c->posMean + c->rotMean + (planar ? c->bounceMean / PD_TOSS_BOUNCE_SCALE : 0.0);
 }
 
 void pd_toss_fit_trace_header(FILE* out) {
-  fputs("engine,variant,evaluation,mu,restitution,kn,objective,pos_err_end_mean,rot_err_end_mean_rad,failed,penalty\n",
+  fputs("engine,variant,evaluation,mu,restitution,kn,objective,pos_err_end_mean,rot_err_end_mean_rad,failed,penalty,"
+        "bounce_dv_mean\n",
         out);
 }
 
@@ -99,8 +104,10 @@ static void trace_row(const fitContext* c, double j, double penalty) {
   const char* variant = strcmp(c->o->engine.name, "soft") == 0      ? "implicit"
                         : c->o->engine.ref.variant == pd_refMatched ? "matched"
                                                                     : "native";
-  fprintf(out, "%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%.6g\n", c->o->engine.name, variant, c->evaluations,
+  fprintf(out, "%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%.6g,", c->o->engine.name, variant, c->evaluations,
           p->mu, p->restitution, p->kn, j, c->posMean, c->rotMean, c->failed, penalty);
+  if (isfinite(c->bounceMean)) fprintf(out, "%.10g", c->bounceMean);
+  fputc('\n', out);
   fflush(out);
 }
 
@@ -162,7 +169,7 @@ bool pd_toss_fit(const pdTossFitOptions* o, pdTossFitResult* result, char* why, 
     ok = !c.stopped;
     if (ok) {
       trace_row(&c, j, 0.0);
-      *result = (pdTossFitResult){.params = p, .startObjective = c.startObjective, .objective = j, .posErrEndMean = c.posMean, .rotErrEndMean = c.rotMean,
+      *result = (pdTossFitResult){.params = p, .startObjective = c.startObjective, .objective = j, .posErrEndMean = c.posMean, .rotErrEndMean = c.rotMean, .bounceDvMean = c.bounceMean,
                                   .failed = c.failed, .evaluations = c.evaluations, .converged = converged};
     }
   }
@@ -173,4 +180,63 @@ bool pd_toss_fit(const pdTossFitOptions* o, pdTossFitResult* result, char* why, 
   gsl_vector_free(step);
   free(c.results);
   return ok;
+}
+
+// ---------------------------------------------------------------- several engines, the split, fit.csv
+
+void pd_toss_fit_split(const int* indices, int count, int trainEvery, int* train, int* trainCount, int* test,
+                       int* testCount) {
+  PD_ASSERT(trainEvery >= 1 && (count == 0 || (indices && train && test)));
+  int seenTrain = 0;
+  *trainCount = *testCount = 0;
+  for (int i = 0; i < count; ++i) {
+    if (pd_toss_split(indices[i]) == pd_tossTest) test[(*testCount)++] = indices[i];
+    else if (seenTrain++ % trainEvery == 0) train[(*trainCount)++] = indices[i];
+  }
+}
+
+bool pd_toss_fit_engines(const pdTossFitOptions* common, const pdTossFitEngine* engines, int count,
+                         void (*started)(const pdTossFitEngine* engine, void* user), void* user,
+                         pdTossFitResult* results, pdTossParams* fitted, char* why, size_t whySize) {
+  bool ok = true;
+  for (int e = 0; e < count; ++e) {
+    memset(&results[e], 0, sizeof results[e]);
+    fitted[e] = engines[e].start;
+  }
+  for (int e = 0; e < count && ok; ++e) {
+    if (!engines[e].fit) continue;
+    if (started) started(&engines[e], user);
+    pdTossFitOptions o = *common;
+    o.engine = engines[e].engine;
+    o.start = engines[e].start;
+    o.fitStiffness = engines[e].fitStiffness;
+    ok = pd_toss_fit(&o, &results[e], why, whySize);
+    if (ok) fitted[e] = results[e].params;
+  }
+  return ok;
+}
+
+void pd_toss_fit_csv(FILE* out, const pdTossFitEngine* engines, int count, const pdTossFitResult* results,
+                     int trainCount, int trainEvery, int testCount) {
+  fputs("engine,variant,status,fitted,mu,restitution,kn,objective_train,pos_err_end_mean_train,"
+        "rot_err_end_mean_train_rad,failed_train,evaluations,converged,train_tosses,train_every,test_tosses,"
+        "start_mu,start_restitution,start_kn,start_objective_train,bounce_dv_mean_train\n",
+        out);
+  for (int e = 0; e < count; ++e) {
+    const pdTossFitEngine* g = &engines[e];
+    const pdTossFitResult* f = &results[e];
+    const pdTossParams* s = &g->start;
+    fprintf(out, "%s,%s,%s,%s,", g->engine.name, g->variant, g->fit ? "ok" : g->built ? "no parameters" : "not built",
+            !g->fit ? "" : g->fitStiffness ? "mu;restitution;kn" : "mu;restitution");
+    if (g->fit)
+      fprintf(out, "%.10g,%.10g,%.10g,%.9g,%.9g,%.9g,%d,%d,%s,", f->params.mu, f->params.restitution, f->params.kn,
+              f->objective, f->posErrEndMean, f->rotErrEndMean, f->failed, f->evaluations, f->converged ? "true" : "false");
+    else
+      fputs(",,,,,,,,,", out);
+    fprintf(out, "%d,%d,%d,%.10g,%.10g,%.10g,", trainCount, trainEvery, testCount, s->mu, s->restitution, s->kn);
+    if (g->fit) fprintf(out, "%.9g", f->startObjective);
+    fputc(',', out);
+    if (g->fit && isfinite(f->bounceDvMean)) fprintf(out, "%.9g", f->bounceDvMean);
+    fputc('\n', out);
+  }
 }

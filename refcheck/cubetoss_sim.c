@@ -45,6 +45,21 @@ pdTossParams pd_toss_default_params(void) {
                         .inertia = PD_TOSS_CUBE_INERTIA};
 }
 
+// Planar drops without fitting (cubetoss.h): the soft engine's stiffness by eq. (11) for the block,
+// m vmax²/(0.01 side)² = 1 × 3² / (6e-4)² = 2.5e7 N/m; μ and e in the middle of what the data's literature fits.
+#define DROP_DEFAULT_KN 2.5e7
+#define DROP_DEFAULT_MU 0.2
+#define DROP_DEFAULT_RESTITUTION 0.5
+
+pdTossParams pd_toss_experiment_params(const pdTossExperiment* experiment) {
+  if (!experiment->planar) return pd_toss_default_params();
+  return (pdTossParams){.mu = DROP_DEFAULT_MU,
+                        .restitution = DROP_DEFAULT_RESTITUTION,
+                        .kn = DROP_DEFAULT_KN,
+                        .tol = TOSS_DEFAULT_TOL,
+                        .inertia = 0.0};
+}
+
 const char* pd_toss_status_name(pdTossStatus status) {
   switch (status) {
     case pd_tossOk: return "ok";
@@ -63,17 +78,19 @@ static void append_material(pdTextBuffer* b, const pdTossParams* p) {
 
 char* pd_toss_scene(const pdToss* toss, const pdTossParams* p) {
   PD_ASSERT(toss && p && toss->sampleCount >= 2);
+  const pdTossExperiment* ex = toss->experiment;
   const pdBodyState* s0 = &toss->samples[0];
   pdTextBuffer b = {0};
-  pd_text_appendf(&b, "# polydyn cubetoss: toss %ld from its first sample (generated)\n", toss->id);
-  pd_text_appendf(&b, "tend %.17g\nsample %.17g\ntol %.17g\nvmax %.17g\n",
-                  (double)(toss->sampleCount - 1) / PD_TOSS_RATE, PD_TOSS_RATE, p->tol, PD_TOSS_VMAX);
+  pd_text_appendf(&b, "# polydyn cubetoss: %s, %s %ld from its first sample (generated)\n", ex->name,
+                  ex->planar ? "drop" : "toss", toss->id);
+  pd_text_appendf(&b, "tend %.17g\nsample %.17g\ntol %.17g\nvmax %.17g\n", (double)(toss->sampleCount - 1) / ex->rate,
+                  ex->rate, p->tol, ex->vmax);
   pd_text_appendf(&b, "cube board grey %.17g %.17g %.17g\nfixed\nloc 0 0 %.17g\n", PD_TOSS_BOARD_WIDTH,
-                  PD_TOSS_BOARD_WIDTH, PD_TOSS_BOARD_THICKNESS, PD_TOSS_BOARD_TOP - 0.5 * PD_TOSS_BOARD_THICKNESS);
+                  PD_TOSS_BOARD_WIDTH, PD_TOSS_BOARD_THICKNESS, ex->boardTop - 0.5 * PD_TOSS_BOARD_THICKNESS);
   append_material(&b, p);
-  const double side = PD_TOSS_CUBE_SIDE;
-  pd_text_appendf(&b, "cube cube red %.17g %.17g %.17g\nspgrav %.17g\n", side, side, side,
-                  PD_TOSS_CUBE_MASS / (side * side * side) / 1000.0);
+  const double* size = ex->size;
+  pd_text_appendf(&b, "cube cube red %.17g %.17g %.17g\nspgrav %.17g\n%s", size[0], size[1], size[2],
+                  ex->mass / (size[0] * size[1] * size[2]) / 1000.0, ex->planar ? "planar\n" : "");
   // orientation as an angle about a world axis: q = (cos θ/2, sin θ/2 u), θ ∈ [0, 2π] keeps q's sign
   pdVec3 qv = {s0->q.x, s0->q.y, s0->q.z};
   double qvNorm = pd_v3_norm(qv);
@@ -149,7 +166,31 @@ static void error_text(const pdError* err, char* buf, size_t size) {
     snprintf(buf, size, "%.150s%s%.400s", err->file, err->file[0] ? ": " : "", err->message);
 }
 
-static void clear_errors(pdTossResult* r) { r->posErrEnd = r->posErrRms = r->rotErrEnd = r->rotErrRms = NAN; }
+static void clear_errors(pdTossResult* r) {
+  r->posErrEnd = r->posErrRms = r->rotErrEnd = r->rotErrRms = NAN;
+  r->impactsRecord = r->impactsRun = 0;
+  for (int k = 0; k < PD_TOSS_IMPACTS; ++k) r->impactDt[k] = r->impactDv[k] = r->impactDw[k] = NAN;
+}
+
+// The moving block's state vector from a recorded sample (the first 13 numbers: state.h).
+static void set_block_state(pdState* state, const pdBodyState* b) {
+  const double y[PD_BODY_STATE_SIZE] = {b->v.x, b->v.y, b->v.z, b->w.x, b->w.y, b->w.z, b->x.x,
+                                        b->x.y, b->x.z, b->q.w, b->q.x, b->q.y, b->q.z};
+  memcpy(state->y, y, sizeof y);
+}
+
+// The "noise" engine's run (cubetoss.h): the record one sample late, at the record's sample times.
+static pdTrajectory* delayed_record(const pdModel* model, const pdToss* toss) {
+  pdTrajectory* tr = pd_trajectory_create(model);
+  pdState* state = pd_state_create(model, NULL);
+  for (int k = 0; k < toss->sampleCount; ++k) {
+    set_block_state(state, &toss->samples[k > 0 ? k - 1 : 0]);
+    state->t = (double)k / toss->experiment->rate;
+    pd_trajectory_observe(model, state, tr);
+  }
+  pd_state_free(state);
+  return tr;
+}
 
 pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, const pdTossEngine* engine,
                                const char* runDir, pdTossResult* r) {
@@ -157,9 +198,9 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
   memset(r, 0, sizeof *r);
   clear_errors(r);
   r->samples = toss->sampleCount;
-  bool soft = strcmp(engine->name, "soft") == 0;
-  const pdRefAdapter* adapter = soft ? NULL : pd_ref_adapter(engine->name);
-  if (!soft && !adapter) {
+  bool soft = strcmp(engine->name, "soft") == 0, noise = strcmp(engine->name, "noise") == 0;
+  const pdRefAdapter* adapter = soft || noise ? NULL : pd_ref_adapter(engine->name);
+  if (!soft && !noise && !adapter) {
     fail(r, pd_tossNotBuilt, "this build of polydyn has no %s adapter", engine->name);
     return NULL;
   }
@@ -169,6 +210,15 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
   if (!model) {
     error_text(&err, text, sizeof text);
     fail(r, pd_tossRefused, "%s", text);
+    return NULL;
+  }
+  if (noise) {
+    pdTrajectory* delayed = delayed_record(model, toss);
+    pd_model_free(model);
+    pd_toss_judge(toss, delayed, r);
+    if (r->status == pd_tossOk) return delayed;
+    clear_errors(r);
+    pd_trajectory_free(delayed);
     return NULL;
   }
   pdRunWriter* writer = NULL;
@@ -233,11 +283,71 @@ static double rotation_angle(pdQuat q, pdQuat ref) {
   return 2.0 * atan2(sqrt(d.x * d.x + d.y * d.y + d.z * d.z), fabs(d.w));
 }
 
+// Height of the block's lowest point above the surface, m: the box's half sizes along world z.
+static double lowest_height(const pdTossExperiment* ex, const pdBodyState* b) {
+  pdMat3 r = pd_quat_to_mat3(b->q);
+  double below = 0.0;
+  for (int j = 0; j < 3; ++j) below += 0.5 * ex->size[j] * fabs(r.m[2][j]);
+  return b->x.z - below - ex->boardTop;
+}
+
+// Rotation vector of q1 q0⁻¹ (world frame), rad.
+static pdVec3 rotation_between(pdQuat q0, pdQuat q1) {
+  pdQuat d = pd_quat_mul(q1, (pdQuat){q0.w, -q0.x, -q0.y, -q0.z});
+  if (d.w < 0.0) d = (pdQuat){-d.w, -d.x, -d.y, -d.z};
+  pdVec3 u = {d.x, d.y, d.z};
+  double s = pd_v3_norm(u);
+  return s > 0.0 ? pd_v3_scale(u, 2.0 * atan2(s, d.w) / s) : (pdVec3){0, 0, 0};
+}
+
+int pd_toss_impacts(const pdTossExperiment* ex, const pdBodyState* samples, int n, pdTossImpact impacts[PD_TOSS_IMPACTS]) {
+  int found = 0;
+  for (int k = 0; k < n && found < PD_TOSS_IMPACTS;) {
+    if (lowest_height(ex, &samples[k]) >= PD_DROP_CONTACT_BAND) {
+      ++k;
+      continue;
+    }
+    // within the band: the impact is the first sample after which the lowest point rises (not the lowest of the
+    // whole contact, which at rest is wherever the tracking noise dips), and the contact lasts until the
+    // block lifts above the lift band (or the record ends)
+    int best = k;
+    while (best + 1 < n && lowest_height(ex, &samples[best + 1]) < lowest_height(ex, &samples[best])) ++best;
+    int j = best + 1;
+    while (j < n && lowest_height(ex, &samples[j]) <= PD_DROP_LIFT_BAND) ++j;
+    pdTossImpact* im = &impacts[found++];
+    im->sample = best;
+    im->t = (double)best / ex->rate;
+    im->v = im->w = (pdVec3){NAN, NAN, NAN};
+    if (best + 3 < n) {
+      double scale = 0.5 * ex->rate;
+      im->v = pd_v3_scale(pd_v3_sub(samples[best + 3].x, samples[best + 1].x), scale);
+      im->w = pd_v3_scale(rotation_between(samples[best + 1].q, samples[best + 3].q), scale);
+    }
+    if (j >= n) break;  // never lifted again: at rest or rocking
+    k = j;
+  }
+  return found;
+}
+
+// The bounces of the run against the record's (pdTossResult).
+static void judge_impacts(const pdToss* toss, const pdTrajectory* run, pdTossResult* r) {
+  pdTossImpact rec[PD_TOSS_IMPACTS], sim[PD_TOSS_IMPACTS];
+  r->impactsRecord = pd_toss_impacts(toss->experiment, toss->samples, toss->sampleCount, rec);
+  r->impactsRun = pd_toss_impacts(toss->experiment, run->bodies, toss->sampleCount, sim);
+  for (int k = 0; k < PD_TOSS_IMPACTS; ++k) {
+    bool both = k < r->impactsRecord && k < r->impactsRun;
+    r->impactDt[k] = both ? fabs(sim[k].t - rec[k].t) : NAN;
+    r->impactDv[k] = both ? pd_v3_norm(pd_v3_sub(sim[k].v, rec[k].v)) : NAN;
+    r->impactDw[k] = both ? pd_v3_norm(pd_v3_sub(sim[k].w, rec[k].w)) : NAN;
+  }
+}
+
 // Sample times of a run may differ from k/148 by round-off only (both are computed as k/rate), s.
 #define TOSS_SAMPLE_TIME_TOL 1e-9
 
 void pd_toss_judge(const pdToss* toss, const pdTrajectory* run, pdTossResult* r) {
   PD_ASSERT(toss && run && r && run->movingCount == 1);
+  const pdTossExperiment* ex = toss->experiment;
   clear_errors(r);
   r->samples = toss->sampleCount;
   if (run->samples < toss->sampleCount) {
@@ -246,12 +356,12 @@ void pd_toss_judge(const pdToss* toss, const pdTrajectory* run, pdTossResult* r)
   }
   double pos2 = 0.0, rot2 = 0.0, pos = 0.0, rot = 0.0;
   for (int k = 0; k < toss->sampleCount; ++k) {
-    if (fabs(run->t[k] - (double)k / PD_TOSS_RATE) > TOSS_SAMPLE_TIME_TOL) {
-      fail(r, pd_tossFailed, "sample %d of the run is at t = %.9g s, not %.9g s", k, run->t[k], (double)k / PD_TOSS_RATE);
+    if (fabs(run->t[k] - (double)k / ex->rate) > TOSS_SAMPLE_TIME_TOL) {
+      fail(r, pd_tossFailed, "sample %d of the run is at t = %.9g s, not %.9g s", k, run->t[k], (double)k / ex->rate);
       return;
     }
     const pdBodyState *sim = &run->bodies[k], *rec = &toss->samples[k];
-    pos = pd_v3_norm(pd_v3_sub(sim->x, rec->x)) / PD_TOSS_CUBE_SIDE;
+    pos = pd_v3_norm(pd_v3_sub(sim->x, rec->x)) / ex->side;
     rot = rotation_angle(sim->q, rec->q);
     if (!isfinite(pos) || !isfinite(rot)) {
       fail(r, pd_tossFailed, "non-finite pose at sample %d", k);
@@ -266,6 +376,7 @@ void pd_toss_judge(const pdToss* toss, const pdTrajectory* run, pdTossResult* r)
   r->rotErrEnd = rot;
   r->posErrRms = sqrt(pos2 / toss->sampleCount);
   r->rotErrRms = sqrt(rot2 / toss->sampleCount);
+  if (ex->planar) judge_impacts(toss, run, r);
 }
 
 // ---------------------------------------------------------------- the record as a run directory
@@ -283,11 +394,8 @@ bool pd_toss_write_record(const pdToss* toss, const pdTossParams* params, const 
   double energyStart = 0.0;
   bool ok = true;
   for (int k = 0; k < toss->sampleCount && ok; ++k) {
-    const pdBodyState* b = &toss->samples[k];
-    const double y[PD_BODY_STATE_SIZE] = {b->v.x, b->v.y, b->v.z, b->w.x, b->w.y, b->w.z, b->x.x,
-                                          b->x.y, b->x.z, b->q.w, b->q.x, b->q.y, b->q.z};
-    memcpy(state->y, y, sizeof y);  // the cube is the only moving body: the first 13 numbers (state.h)
-    state->t = (double)k / PD_TOSS_RATE;
+    set_block_state(state, &toss->samples[k]);  // the block is the only moving body
+    state->t = (double)k / toss->experiment->rate;
     ++state->count.samples;
     if (k == 0) energyStart = pd_state_energy(model, state);
     ok = pd_run_observe(model, state, writer);
@@ -299,7 +407,7 @@ bool pd_toss_write_record(const pdToss* toss, const pdTossParams* params, const 
   fputs("{\"source\": ", mem);
   pdu_json_string(mem, dataPath ? dataPath : "");
   fprintf(mem, ", \"toss\": %ld, \"first_line\": %ld, \"rate_hz\": %.17g, \"quaternions\": \"normalised on reading\"}",
-          toss->id, toss->line, PD_TOSS_RATE);
+          toss->id, toss->line, toss->experiment->rate);
   fclose(mem);
   pdRunInfo info = {.engine = "record",
                     .energyStart = energyStart,

@@ -102,6 +102,7 @@ struct pdRefWorld {
   dWorldID world;
   dSpaceID space;
   dJointGroupID contactGroup;
+  int planarBodies;  // bodies held in the x–z plane (hold_in_plane)
   odeGeom* geoms;            // (bodyCount) dGeomGetData of each body's geom points here
   odeConvexData* convex;     // (bodyCount)
   dBodyID* bodies;           // (movingCount)
@@ -414,6 +415,33 @@ static void ode_destroy(pdRefWorld* w) {
   free(w);
 }
 
+// A planar body (model.h): ODE's plane-2D joint holds the x–y plane (z = 0) only, and ours is the x–z plane
+// under z-up gravity, so two motors do it instead, each an unbounded velocity constraint against the world
+// frame with zero target and zero CFM: a linear motor along world y and an angular motor (user mode) about
+// world x and z. Velocity-level, so the pose leaves the plane only by round-off.
+static void hold_in_plane(pdRefWorld* w, dBodyID body) {
+  dJointID lin = dJointCreateLMotor(w->world, 0);
+  dJointAttach(lin, body, 0);
+  dJointSetLMotorNumAxes(lin, 1);
+  dJointSetLMotorAxis(lin, 0, 0, 0.0, 1.0, 0.0);  // rel 0: the world frame
+  dJointSetLMotorParam(lin, dParamVel, 0.0);
+  dJointSetLMotorParam(lin, dParamFMax, dInfinity);
+  dJointSetLMotorParam(lin, dParamCFM, 0.0);
+  dJointID ang = dJointCreateAMotor(w->world, 0);
+  dJointAttach(ang, body, 0);
+  dJointSetAMotorMode(ang, dAMotorUser);
+  dJointSetAMotorNumAxes(ang, 2);
+  dJointSetAMotorAxis(ang, 0, 0, 1.0, 0.0, 0.0);
+  dJointSetAMotorAxis(ang, 1, 0, 0.0, 0.0, 1.0);
+  static const int vel[2] = {dParamVel, dParamVel2}, fmax[2] = {dParamFMax, dParamFMax2}, cfm[2] = {dParamCFM, dParamCFM2};
+  for (int k = 0; k < 2; ++k) {
+    dJointSetAMotorParam(ang, vel[k], 0.0);
+    dJointSetAMotorParam(ang, fmax[k], dInfinity);
+    dJointSetAMotorParam(ang, cfm[k], 0.0);
+  }
+  ++w->planarBodies;
+}
+
 static pdRefWorld* ode_create(const pdModel* model, const pdRefOptions* options, pdError* err) {
   PD_ASSERT(model && options && options->step > 0.0);
   pthread_once(&odeOnce, init_ode);
@@ -485,6 +513,7 @@ static pdRefWorld* ode_create(const pdModel* model, const pdRefOptions* options,
     dBodySetGyroscopicMode(body, 1);
     dBodySetFiniteRotationMode(body, 0);
     dGeomSetBody(create_convex(w, i), body);
+    if (b->planar) hold_in_plane(w, body);
     w->bodies[m] = body;
   }
 
@@ -699,6 +728,10 @@ static void ode_settings_json(const pdRefWorld* w, FILE* out) {
   fputc('}', out);
   if (pd_model_has_applied_force(w->model))
     fputs(", \"applied_force_call\": \"dBodyAddForceAtRelPos (world force, body-frame point) before dWorldStep\"", out);
+  if (w->planarBodies)
+    fprintf(out, ", \"planar_bodies\": %d, \"planar_constraint\": \"dJointCreateLMotor along world y and "
+                 "dJointCreateAMotor (user mode) about world x and z: velocity 0, unbounded force, CFM 0 (the "
+                 "plane-2D joint holds the x-y plane only)\"", w->planarBodies);
   fprintf(out, ", \"max_contacts_per_collide\": %d", w->maxContacts);
   fputs(", \"colliders\": {\"convex-convex\": \"dCollideConvexConvexCCD (libccd MPR): 1 contact per pair\", "
         "\"convex-plane\": \"dCollideConvexPlane (native): 1 contact per vertex below the plane\"}, ",

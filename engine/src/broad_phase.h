@@ -1,5 +1,5 @@
 // polydyn (internal) — broad phase: which body pairs have overlapping axis-aligned boxes
-// (incremental sweep and prune on all three axes, DESIGN §3.2 and §3.6; Baraff 1992, Cohen et al. 1995).
+// (incremental sweep and prune on all three axes, docs/DESIGN.md §6.1; Baraff 1992, Cohen et al. 1995).
 //
 // Conventions
 // - A box is closed: [lo, hi] on each world axis. Two boxes overlap when, on every axis,

@@ -18,7 +18,7 @@
 //   vectors is the paper's "spring along the slip direction" with its direction kept in the vector.
 // - Damper branches are chosen by exact zeros (c == 0.0); the caller decides thresholds (paper §3.4).
 // - Friction is modelled only when μ > 0 and there is a tangential spring (k1t + k2t > 0); otherwise
-//   F_t = 0 and the tangential rates are 0 (DESIGN §3.6: frictionless contacts carry no tangential springs,
+//   F_t = 0 and the tangential rates are 0 (docs/DESIGN.md §6.3: frictionless contacts carry no tangential springs,
 //   and the caller may skip their tangential state entirely).
 #pragma once
 
@@ -72,7 +72,7 @@ void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pd
 // F_n of pd_contact_force alone (the same number), N: what a caller needs before it realigns the springs.
 double pd_contact_normal_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du);
 
-// The dynamics-side break (paper §4.2, DESIGN §3.3): true when the normal force would pull (fn < 0).
+// The dynamics-side break (paper §4.2, docs/DESIGN.md §6.3): true when the normal force would pull (fn < 0).
 static inline bool pd_contact_fn_pulls(double fn) { return fn < 0.0; }
 static inline bool pd_contact_force_pulls(const pdContactForce* f) { return pd_contact_fn_pulls(f->fn); }
 

@@ -23,7 +23,7 @@ static void forces_range(void* ctx, int part, int begin, int end) {
   pdPairFrame frame;
   frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = begin; i < end; ++i) {
-    pdSprings s = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
+    pdSprings s = loop_springs(job, i);
     pdContactGeom g;
     pdVec3 du;
     pdContactForce f;

@@ -64,8 +64,7 @@ void pd_contact_set_reserve_list(pdContactSet* set, int capacity) {
 // A set with its per-body arrays; with `search`, also the contact search's (broad phase, pairs, caches, candidates)
 // and room for the list a state starts with.
 static pdContactSet* create(const pdModel* model, bool search) {
-  pdContactSet* set = calloc(1, sizeof *set);
-  PD_ASSERT(set != NULL);
+  pdContactSet* set = pd_zeroed(1, sizeof *set);
   int n = model->bodyCount;
   set->bodyCount = n;
   set->force = pd_grow(NULL, model->movingCount, sizeof *set->force);
@@ -77,8 +76,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   set->bodyRowsK = pd_grow(NULL, n, sizeof *set->bodyRowsK);
   set->bodyBlocks = pd_grow(NULL, n, sizeof *set->bodyBlocks);
   set->bodyRowsRight = pd_grow(NULL, n, sizeof *set->bodyRowsRight);
-  set->travel = calloc((size_t)(n > 0 ? n : 1), sizeof *set->travel);
-  PD_ASSERT(set->travel != NULL);
+  set->travel = pd_zeroed((size_t)n, sizeof *set->travel);
   set->torque = pd_grow(NULL, model->movingCount, sizeof *set->torque);
   set->poses = pd_grow(NULL, n, sizeof *set->poses);
   set->poses0 = pd_grow(NULL, n, sizeof *set->poses0);
@@ -210,12 +208,11 @@ static void record_geometry(contactSlot* c, const pdContactGeom* g) {
 static void record_range(void* ctx, int part, int begin, int end) {
   (void)part;
   const contactLoop* job = ctx;
-  int base = spring_base(job->model);
   pdPairFrame frame;
   frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = begin; i < end; ++i) {
     contactSlot* c = &job->set->items[i];
-    pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
+    pdSprings sp = loop_springs(job, i);
     if (c->geometryCurrent) {
       // the same geometry as evaluate() would form again (a pair onset's impulses change velocities, not poses)
       c->geometryCurrent = false;
@@ -280,12 +277,11 @@ static void tracking_range(void* ctx, int part, int begin, int end) {
   (void)part;
   const contactLoop* job = ctx;
   pdContactSet* set = job->set;
-  int base = spring_base(job->model);
   pdPairFrame frame;
   frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = begin; i < end; ++i) {
     contactEval* e = &set->eval[i];
-    pdSprings sp = springs_load(job->y + base + PD_CONTACT_STATE_SIZE * i);
+    pdSprings sp = loop_springs(job, i);
     pdVec3 du;
     evaluate(job->model, &set->items[i], job->y, set->poses1, &frame, &sp, &e->geom, &e->tracked, &du, &e->force);
     e->transferred = false;

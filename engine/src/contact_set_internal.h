@@ -256,6 +256,11 @@ typedef struct contactLoop {
 } contactLoop;
 
 
+// Contact i's springs in the state the loop evaluates (job->y).
+static inline pdSprings loop_springs(const contactLoop* job, int i) {
+  return springs_load(job->y + spring_base(job->model) + PD_CONTACT_STATE_SIZE * i);
+}
+
 // ---------------------------------------------------------------- between the files
 
 // contact_set.c: grows the list's per-contact arrays to hold `capacity` contacts (between steps).

@@ -31,8 +31,7 @@ struct pdDense {
 };
 
 pdDense* pd_dense_create(void) {
-  pdDense* d = calloc(1, sizeof *d);
-  PD_ASSERT(d != NULL);
+  pdDense* d = pd_zeroed(1, sizeof *d);
   d->tExpected = INFINITY;
   return d;
 }

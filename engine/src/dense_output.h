@@ -1,4 +1,4 @@
-// polydyn (internal) — dense output: the state between step ends (integrator.c, islands.c; README, "Integration").
+// polydyn (internal) — dense output: the state between step ends (integrator.c, islands.c; docs/integration.md).
 //
 // The error-controlled steppers do not cut their steps at output samples or at pd_advance's tEnd. The step that
 // passes such a time keeps what it needs to give the state anywhere inside it (captured before its commit, in its

@@ -1,6 +1,6 @@
 // polydyn — the state derivative (paper §2): Newton–Euler with the gyroscopic term, quaternion
 // kinematics, gravity, the scene's applied forces, and the contact forces with their spring rates
-// (contact_set.c).
+// (contact_forces.c).
 
 #include "dynamics.h"
 
@@ -58,6 +58,11 @@ static void bodies_range(void* ctx, int part, int begin, int end) {
     pdVec3 alphaB = pd_mat3_mulv(&b->invInertia, pd_v3_sub(tb, gyro));
     pdVec3 alpha = pd_mat3_mulv(r, alphaB);
     pdVec3 a = pd_v3_scale(force, b->invMass);
+    if (b->planar) {
+      // the plane's reaction cancels what would leave it (model.h: exact for a principal y axis)
+      a.y = 0.0;
+      alpha.x = alpha.z = 0.0;
+    }
 
     // q̇ = ½ (0, ω) ⊗ q with ω in the world frame
     pdQuat dq = pd_quat_mul((pdQuat){0.0, w.x, w.y, w.z}, q);

@@ -5,10 +5,9 @@
 // written before the task is posted (a sequentially consistent exchange) and the server's outputs before its
 // done flag (release; the poster reads it with acquire).
 //
-// Two guards keep help from costing more than it gives (measured on a 360-brick block, one island: the second
-// thread sometimes ran its half 3× slower than the first and the first's own loops 3× slower while it spun,
-// as when both virtual CPUs share one physical core; the run then took 12.5 s on two threads against 9.7 s on
-// one):
+// Two guards keep help from costing more than it gives (on a 360-brick block, one island, the second thread
+// sometimes ran its half 3× slower than the first and the first's own loops 3× slower while it spun, as when both
+// virtual CPUs share one physical core: two threads were then slower than one):
 // - a server that found nothing to do for PD_HELP_SPIN_SECONDS sleeps on a condition variable; a post wakes it
 //   (the poster takes its half back if the server is late) and so does the end of the batch;
 // - when most of PD_HELP_VOTES helped loops waited for the server's half longer than their own half took, the

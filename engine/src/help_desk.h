@@ -1,4 +1,4 @@
-// polydyn (internal) — a second thread's hands inside one island (issue 16 item 3; README, "Threads").
+// polydyn (internal) — a second thread's hands inside one island (docs/DESIGN.md §5.4; docs/integration.md).
 //
 // With pdState.threads > 1 the islands of a sync interval are taken in turn by the pool's threads
 // (islands.c). A thread left without an island while another still runs serves the help desk instead of

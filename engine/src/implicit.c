@@ -1,4 +1,4 @@
-// polydyn — the linear systems of the implicit stepper (implicit.h; README, Integration).
+// polydyn — the linear systems of the implicit stepper (implicit.h; docs/integration.md).
 //
 // Design note. The state is [bodies | springs]: per moving body v, ω (rows 0–5 of its 13), x, q; per contact its
 // 8 springs. W couples only v, ω and the springs. Contact c between bodies 1 and 2 (σ = +1, −1), lever arms r_k,
@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "contact_set.h"
+#include "grow.h"
 #include "polydyn/error.h"
 #include "state_layout.h"
 
@@ -50,8 +51,7 @@ struct pdImplicit {
 };
 
 pdImplicit* pd_implicit_create(void) {
-  pdImplicit* im = calloc(1, sizeof *im);
-  PD_ASSERT(im != NULL);
+  pdImplicit* im = pd_zeroed(1, sizeof *im);
   im->retryAt = -INFINITY;
   return im;
 }
@@ -92,15 +92,13 @@ void pd_implicit_reserve(pdImplicit* im, int movingCount, int contacts) {
   int rows = BODY_ROWS * movingCount;
   if (contacts < 1) contacts = 1;
   if (contacts > im->contactCapacity) {
-    im->linear = realloc(im->linear, (size_t)contacts * sizeof *im->linear);
-    im->blocks = realloc(im->blocks, (size_t)contacts * sizeof *im->blocks);
-    PD_ASSERT(im->linear != NULL && im->blocks != NULL);
+    im->linear = pd_grow(im->linear, (size_t)contacts, sizeof *im->linear);
+    im->blocks = pd_grow(im->blocks, (size_t)contacts, sizeof *im->blocks);
     im->contactCapacity = contacts;
   }
   if (rows > im->rowCapacity) {
-    im->S = realloc(im->S, (size_t)rows * (size_t)rows * sizeof *im->S);
-    im->rb = realloc(im->rb, (size_t)rows * sizeof *im->rb);
-    PD_ASSERT(im->S != NULL && im->rb != NULL);
+    im->S = pd_grow(im->S, (size_t)rows * (size_t)rows, sizeof *im->S);
+    im->rb = pd_grow(im->rb, (size_t)rows, sizeof *im->rb);
     im->rowCapacity = rows;
   }
   if (!im->perm || im->perm->size != (size_t)rows) {  // an island's rows change only when its bodies do
@@ -182,11 +180,15 @@ void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im,
 }
 
 // Contact l's push σ_k L_k F on its end k (0: body 1, 1: body 2) into out.
+// A planar body's push keeps to its plane, as its derivative does (dynamics.c), so that its stages never
+// leave it either.
 static void push_end(const pdModel* model, const pdContactLinear* l, int k, int row, pdVec3 F, double* out) {
-  if (k == 0)
-    add_push(model->bodies[l->body1].invMass, &l->invInertia1, row, l->r1, F, 1.0, out);
-  else
-    add_push(model->bodies[l->body2].invMass, &l->invInertia2, row, l->r2, F, -1.0, out);
+  const pdBody* body = &model->bodies[k == 0 ? l->body1 : l->body2];
+  double kept[BODY_ROWS] = {0};
+  add_push(body->invMass, k == 0 ? &l->invInertia1 : &l->invInertia2, 0, k == 0 ? l->r1 : l->r2, F,
+           k == 0 ? 1.0 : -1.0, kept);
+  if (body->planar) kept[1] = kept[3] = kept[5] = 0.0;
+  for (int i = 0; i < BODY_ROWS; ++i) out[row + i] += kept[i];
 }
 
 // Whether a contact's springs drive their own rates (Gs ≠ 0, as in slip, where the friction limit follows the
@@ -321,9 +323,8 @@ void pd_implicit_solve(const pdModel* model, const pdState* state, pdImplicit* i
 void pd_implicit_apply_w(const pdModel* model, const pdState* state, const pdImplicit* im, const double* x, double* w) {
   int contacts = pd_state_contact_count(state);
   int base = PD_BODY_STATE_SIZE * model->movingCount;
-  double* body = calloc((size_t)(im->rows > 0 ? im->rows : 1), sizeof *body);
-  double* vel = calloc((size_t)(im->rows > 0 ? im->rows : 1), sizeof *vel);
-  PD_ASSERT(body != NULL && vel != NULL);
+  double* body = pd_zeroed((size_t)im->rows, sizeof *body);
+  double* vel = pd_zeroed((size_t)im->rows, sizeof *vel);
   for (int k = 0; k < model->movingCount; ++k)
     for (int i = 0; i < BODY_ROWS; ++i) vel[BODY_ROWS * k + i] = x[PD_BODY_STATE_SIZE * k + i];
   for (int c = 0; c < contacts; ++c) {

@@ -14,9 +14,9 @@
 
 // Moving bodies above which a system (an island, or the scene with islands off) is not stepped implicitly:
 // M's body part is a dense 6N × 6N matrix, factorised in O(N³) (~0.3 ms at 16 bodies, 8× that at 32), more than
-// the steps it saves on a larger system. Larger systems take step doubling (README, Integration). 16 until 3da7396:
-// at 32, with the switch's probation, stacks of 20-30 boxes took 0.72-0.83× the wall time (farm-bench), every soak
-// scene of campaigns 30 and 31 the same steps (their islands are smaller), the piles the same.
+// the steps it saves on a larger system. Larger systems take step doubling (docs/integration.md). 32 rather than
+// 16: with the switch's probation, stacks of 20-30 boxes took 0.72-0.83× the wall time of a bound at 16, and the
+// soak's random scenes (smaller islands) and the piles the same steps.
 #define PD_IMPLICIT_BODIES_MAX 32
 
 // The implicit stepper switches between step doubling and the implicit method system by system (integrator.c,
@@ -40,7 +40,7 @@
 // stack that spent it so (soak seed 30, scene 1797, 0.84 tol) had its modes stirred to tol where step doubling's
 // steps at the bound had left them at ~1e-3 of it, and step doubling then took 1.5× its steps and 1.8× its
 // evaluations to resolve them. 0.09 (a next step of twice this one) cost up to 8 % more evaluations on the cost
-// scenes (tests/engine/test_implicit.c; README, Integration).
+// scenes (tests/engine/test_implicit.c; docs/integration.md).
 #define PD_IMPLICIT_PROBATION_ERROR 0.3
 #define PD_IMPLICIT_BACKOFF_FIRST 8.0
 #define PD_IMPLICIT_BACKOFF_MAX 256.0

@@ -17,7 +17,7 @@
 // third-order partner, h (k4 − f(t + h, y1))/6: 5 evaluations per step instead of 11, but twice the
 // steps for the same stability bound (a single RK4 step must now be stable), and the contact events are
 // analysed once per accepted step — so it wins on impacts and free flight and loses on resting and sliding
-// contacts (README, "Integration"); step doubling, not this pair, is the default's explicit part. Both run through
+// contacts (docs/integration.md); step doubling, not this pair, is the default's explicit part. Both run through
 // adaptive_step, which takes the trial, the order of its estimate (the controller's exponents) and the bound's share.
 // The implicit stepper (pd_stepperImplicit, switching_step) runs step doubling until the contacts' stability bound
 // holds it well below what its error control wants (resting contact), then ROS34PW2, a linearly implicit method
@@ -51,12 +51,12 @@
 #include "samples.h"
 #include "state_layout.h"
 
-// Reading the clock costs about 25 ns on the machines measured (clock_gettime through the vDSO): the three reads
-// of every derivative evaluation were 14 % of cases/bench/pile_100's run (perf, 913bad4), whose islands of a
-// few boxes make an evaluation cheap. One evaluation in this many is timed and counted this many times, so the
+// Reading the clock (clock_gettime through the vDSO) is not free next to a small island's derivative: three reads
+// in every evaluation were 14 % of cases/bench/pile_100's run, whose islands of a few boxes make an evaluation
+// cheap. One evaluation in this many is timed and counted this many times, so the
 // forces and derivative stages are estimates; a prime, so that the timed ones fall on each of the step
 // doubling's 11 (10 or 7 on a retry) evaluations in turn. The count depends on the state alone: no output changes.
-// 31, not 13 as first: at 13 the reads were still ~1 % of cases/sweep/pile_10's run.
+// 31 rather than 13: at 13 the reads were still ~1 % of cases/sweep/pile_10's run.
 #define PD_DERIVATIVE_TIMING_STRIDE 31
 
 static void derivative(const pdModel* model, pdState* s, double t, const double* y, double* dydt) {

@@ -67,8 +67,7 @@
 //   separating-axis search's verdict too (a proof, or the cached axis evaluated by the search's own helper),
 //   and "touching" may include pairs apart by up to ~m (1e-7 of the size): the contact search then runs the
 //   contact analysis on them, whose own depth tests (1e-12 of the size) find no contact where nothing
-//   penetrates. Until issue 16's last round the separating-axis search decided those pairs, exactly; they are
-//   about a fifth of the oracle's random pairs (drawn log-uniformly near touching) and took three quarters of
+//   penetrates. The separating-axis search would decide those pairs exactly, but they are about a fifth of the oracle's random pairs (drawn log-uniformly near touching) and took three quarters of
 //   the mode's time there, and in a simulation they are the rare steps that end within 1e-7 of the size of an
 //   onset. GJK's support points come from vertex scans (support_vertex).
 #include "interference.h"
@@ -77,6 +76,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "grow.h"
 #include "polydyn/error.h"
 
 // A z band is widened by this (no unit: z of unit vectors) on each side. Arcs that really cross share a
@@ -142,12 +142,6 @@ static inline const satEdge* edge_at(const pdPolyhedron* P, int i, satEdge* scra
   return scratch;
 }
 
-static void* index_alloc(size_t n, size_t size) {
-  void* p = calloc(n ? n : 1, size);
-  PD_ASSERT(p != NULL);
-  return p;
-}
-
 // The band [lo, hi] of u·axis (axis a unit vector) over the Gauss-map arc from unit n0 to unit n1 (not
 // antipodal), widened by PD_SAT_CAP_MARGIN: the arc lies in the cap of centre c = (n0 + n1)/|n0 + n1| and
 // half-angle r (cos r = c·n0), whose polar angle about the axis spans [θc − r, θc + r], clipped to
@@ -175,7 +169,7 @@ static int compare_z(const void* a, const void* b) {
 }
 
 void pd_sat_index_build(pdPolyhedron* p) {
-  struct pdSatIndex* x = index_alloc(1, sizeof *x);
+  struct pdSatIndex* x = pd_zeroed(1, sizeof *x);
   p->satIndex = x;
   int V = p->vertexCount, E = p->edgeCount, F = p->faceCount;
   pdVec3 c = {0, 0, 0};
@@ -187,22 +181,22 @@ void pd_sat_index_build(pdPolyhedron* p) {
   x->inradius = fmax(0.0, x->inradius);
   for (int v = 0; v < V; ++v) x->circumradius = fmax(x->circumradius, pd_v3_norm(pd_v3_sub(p->vertices[v], c)));
   if (E < PD_SAT_INDEX_MIN_EDGES) return;
-  x->edge = index_alloc((size_t)E, sizeof *x->edge);
+  x->edge = pd_zeroed((size_t)E, sizeof *x->edge);
   for (int e = 0; e < E; ++e) x->edge[e] = edge_record(p, e);
-  x->neighbourFirst = index_alloc((size_t)V + 1, sizeof *x->neighbourFirst);
-  x->neighbours = index_alloc(2 * (size_t)E, sizeof *x->neighbours);
+  x->neighbourFirst = pd_zeroed((size_t)V + 1, sizeof *x->neighbourFirst);
+  x->neighbours = pd_zeroed(2 * (size_t)E, sizeof *x->neighbours);
   for (int e = 0; e < E; ++e) ++x->neighbourFirst[p->edges[e].v[0] + 1], ++x->neighbourFirst[p->edges[e].v[1] + 1];
   for (int v = 0; v < V; ++v) x->neighbourFirst[v + 1] += x->neighbourFirst[v];
-  int* fill = index_alloc((size_t)V, sizeof *fill);
+  int* fill = pd_zeroed((size_t)V, sizeof *fill);
   for (int e = 0; e < E; ++e)
     for (int k = 0; k < 2; ++k) {
       int v = p->edges[e].v[k];
       x->neighbours[x->neighbourFirst[v] + fill[v]++] = p->edges[e].v[1 - k];
     }
   free(fill);
-  double* lo = index_alloc((size_t)E, sizeof *lo);
-  double* hi = index_alloc((size_t)E, sizeof *hi);
-  x->byZ = index_alloc((size_t)E, sizeof *x->byZ);
+  double* lo = pd_zeroed((size_t)E, sizeof *lo);
+  double* hi = pd_zeroed((size_t)E, sizeof *hi);
+  x->byZ = pd_zeroed((size_t)E, sizeof *x->byZ);
   for (int e = 0; e < E; ++e) {
     arc_band(p->faces[p->edges[e].f[0]].normal, p->faces[p->edges[e].f[1]].normal, (pdVec3){0, 0, 1}, &lo[e], &hi[e]);
     x->byZ[e] = e;
@@ -210,8 +204,8 @@ void pd_sat_index_build(pdPolyhedron* p) {
   sortKeys = lo;
   qsort(x->byZ, (size_t)E, sizeof *x->byZ, compare_z);
   sortKeys = NULL;
-  x->zLo = index_alloc((size_t)E, sizeof *x->zLo);
-  x->zHi = index_alloc((size_t)E, sizeof *x->zHi);
+  x->zLo = pd_zeroed((size_t)E, sizeof *x->zLo);
+  x->zHi = pd_zeroed((size_t)E, sizeof *x->zHi);
   for (int k = 0; k < E; ++k) {
     x->zLo[k] = lo[x->byZ[k]];
     x->zHi[k] = hi[x->byZ[k]];

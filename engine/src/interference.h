@@ -1,4 +1,4 @@
-// polydyn (internal) — interference of two convex polyhedra (paper §4.3, DESIGN §3.2): the
+// polydyn (internal) — interference of two convex polyhedra (paper §4.3, docs/DESIGN.md §6.1): the
 // separating-axis test over the faces of their Minkowski difference, with a per-pair cache of the
 // last separating feature (temporal coherence, §7).
 //
@@ -51,7 +51,7 @@ typedef struct pdSatCache {
 } pdSatCache;
 
 // The cached feature of one pair of bodies (a < b), kept from one query to the next in a list sorted by (a, b)
-// (contact_set.c's contact search, islands.c's partition).
+// (contact_search.c, islands.c's partition).
 typedef struct pdPairSatCache {
   int a, b;
   pdSatCache sat;

@@ -1,4 +1,4 @@
-// polydyn — islands (issue 16 item 2; pd_islandsOn; README, "Islands").
+// polydyn — islands (pd_islandsOn; docs/DESIGN.md §5.4; docs/integration.md).
 //
 // Design note. With islands off, one state vector carries every moving body and contact: one step size,
 // one error norm (a max over all of y), and every contact onset anywhere cuts every body's step. With
@@ -9,7 +9,7 @@
 // interval); otherwise the samples are the sync times, and one island of every body is islands off, bit for bit.
 // Over each sync interval [T, T'] the moving bodies are partitioned into islands and each island advances
 // alone from T to T', in a pdState of its own over a model of its own, with its own step size, error norm,
-// contact events, onset retries and stability bound: the unchanged stepper of integrator.c.
+// contact events, onset retries and stability bound: the unchanged steppers of integrator.c (pd_step_until).
 //
 // - An island's model holds its moving bodies and every fixed body, in scene order (bodies copied, their
 //   polyhedra and names shared, the material table a view with the classes remapped:
@@ -54,8 +54,8 @@
 //   are listed, then run on the set's pool of threads, each island whole on one thread. The islands are
 //   ordered by size (bodies + contacts, largest first, ties in job order) and each thread takes the next one
 //   from a shared counter when it is free: which thread runs an island depends on timing, what the island
-//   computes does not. A split fixed in advance from the sizes left the busier thread 0.25-0.35 s of 3.1 s of
-//   island work on the pile of 1 000 (cases/bench/pile_1000.scene) after the other had finished, because size
+//   computes does not. A split fixed in advance from the sizes left the busier thread 8-11 % of the island work
+//   on the pile of 1 000 (cases/bench/pile_1000.scene) after the other had finished, because size
 //   predicts an island's cost poorly (a falling island is cheap, a colliding one dear); taken in turn, the
 //   last island is all that is left over. While they run, a thread writes only its islands' states, their
 //   jobOk entries and its bodies' entries of travel/ctravel; everything else (partition, rebuild,
@@ -102,19 +102,19 @@
 // its size: what its velocity at T does not show (its springs' deflection as loads shift, a push from a
 // neighbour inside its island, the integration's own error from the ballistic path). A body that moves
 // farther makes its island redo the interval (the bound is then grown), so the slack only trades redos
-// against islands joined for nothing: the tighter, the smaller the islands. Measured on
-// cases/bench/pile_1000.scene (0.5 s, with the separating-axis test, one run each): 2 δ_max + 0.01 size
-// 11.9 s (largest island 222, no redo), 0.5 + 0.002 8.35 s (84, 7 redos), 0.25 + 0.001 8.04 s (65, 23),
-// 0.1 + 0 7.69 s (48, 119), 0 + 0 7.76 s with 7414 free bodies straying (never recovered: see the note).
+// against islands joined for nothing: the tighter, the smaller the islands. On cases/bench/pile_1000.scene (0.5 s,
+// with the separating-axis test), the run time relative to 0.25 δ_max + 0.001 size (largest island 65, 23 redos):
+// 2 + 0.01 1.48× (222, no redo), 0.5 + 0.002 1.04× (84, 7 redos), 0.1 + 0 0.96× (48, 119 redos), 0 + 0 0.97× with
+// 7414 free bodies straying (never recovered: see the note).
 #define PD_ISLAND_SLACK_DEFLECTIONS 0.25
 #define PD_ISLAND_SLACK_SIZE 0.001
 // Sync times: a sample interval is cut into equal parts so that a body at the characteristic speed vmax travels
 // at most this fraction of the smallest moving body's size over one part, at most PD_ISLAND_SYNC_PARTS_MAX parts.
 // The bounds grow with the interval: with short ones, bodies that fall or bounce near each other stay in
-// islands of their own; each cut also cuts every island's step. With boxes only (before the separating-axis
-// test in the partition), on cases/bench/pile_1000.scene (0.5 s, one run each): the samples alone (10 ms)
-// 140 s, 0.05 (11 parts) 41.9 s, 0.02 (16 parts) 38.9 s. With the separating-axis test the islands stay small
-// with fewer cuts: 0.05 against 0.02 (farm-bench, CPU time) cases/sweep/pile_10.scene 0.90x,
+// islands of their own; each cut also cuts every island's step. With boxes only (no separating-axis test in the
+// partition), on cases/bench/pile_1000.scene (0.5 s): the samples alone (10 ms) took 3.3× as long as 0.05 (11
+// parts), 0.02 (16 parts) 0.93× of it. With the separating-axis test the islands stay small with fewer cuts:
+// 0.05 against 0.02 (CPU time, side by side) cases/sweep/pile_10.scene 0.90x,
 // cases/bench/pile_1000.scene 0.96x, pile_100, the bin of 100 and the demo 1.00x; 0.1 the same on pile_10,
 // 0.2 1.01x (the samples alone: pile_1000 10x slower, its largest island 751 boxes).
 #define PD_ISLAND_SYNC_SIZE_FRACTION 0.05
@@ -126,7 +126,7 @@
 // rough guess; the heaviest go first, so that the last ones taken are small).
 #define PD_ISLAND_CONTACT_WEIGHT 1
 // A batch of one island wakes the other threads to serve its help desk (help_desk.h) from this weight on (bodies +
-// contacts): below it the per-contact loops are too short to split (PD_HELP_MIN_CONTACTS in contact_set.c).
+// contacts): below it the per-contact loops are too short to split (PD_HELP_MIN_CONTACTS in contact_set_internal.h).
 #define PD_ISLAND_HELP_WEIGHT 128
 
 typedef struct island {
@@ -220,8 +220,7 @@ static void island_free(island* is) {
 
 // The model of members[0 .. count) (moving-body indices, ascending) and every fixed body, scene order.
 static island* island_create(const pdModel* model, struct pdIslandSet* set, const int* members, int count) {
-  island* is = calloc(1, sizeof *is);
-  PD_ASSERT(is != NULL);
+  island* is = pd_zeroed(1, sizeof *is);
   is->bodyCount = count;
   is->bodies = pd_grow(NULL, (size_t)count, sizeof *is->bodies);
   memcpy(is->bodies, members, (size_t)count * sizeof *members);
@@ -472,8 +471,7 @@ void pd_island_set_free(struct pdIslandSet* set) {
 }
 
 static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
-  struct pdIslandSet* set = calloc(1, sizeof *set);
-  PD_ASSERT(set != NULL);
+  struct pdIslandSet* set = pd_zeroed(1, sizeof *set);
   int m = model->movingCount, n = model->bodyCount;
   set->movingCount = m;
   set->bodyCount = n;
@@ -512,8 +510,7 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->v0 = pd_grow(NULL, (size_t)m, sizeof *set->v0);
   set->box0 = pd_grow(NULL, (size_t)m, sizeof *set->box0);
   set->touching = pd_grow(NULL, (size_t)m, sizeof *set->touching);
-  set->free = calloc((size_t)(m > 0 ? m : 1), sizeof *set->free);
-  PD_ASSERT(set->free != NULL);
+  set->free = pd_zeroed((size_t)m, sizeof *set->free);
   set->cx0 = pd_grow(NULL, (size_t)m, sizeof *set->cx0);
   set->cv0 = pd_grow(NULL, (size_t)m, sizeof *set->cv0);
   set->cq0 = pd_grow(NULL, (size_t)m, sizeof *set->cq0);

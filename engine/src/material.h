@@ -13,7 +13,7 @@
 //   (equal sides: the surface elements sit in the middle). kt = kn of the same side unless set.
 //   Damping: when neither side gives cn (ct), the pair's dampers are "modal": each contact gets
 //   c_s = 2ζ√(k_s m_c), with m_c the mass per contact of the pair's joint motion along the normals (in the
-//   tangent plane), set from the pair's active contacts whenever they change (contact_set.c) — so the
+//   tangent plane), set from the pair's active contacts whenever they change (stability_bound.c) — so the
 //   requested e holds for one vertex, an edge (2 contacts) or a face (4) alike. Both sides get the same
 //   c/k (c_i = (c_s/k_s) k_i): two Kelvin–Voigt elements with one c/k ARE one Kelvin–Voigt element, which
 //   is what makes eq. (15) exact for any two bodies; the contact force then takes its "proportional"
@@ -42,7 +42,7 @@ static inline double pd_series(double a, double b) { return (a > 0.0 && b > 0.0)
 
 // PD_RESTITUTION_MIN (polydyn/model.h) is reached at ζ = 4.807: the contact's fast mode,
 // ω(ζ + √(ζ² − 1)) ≈ 2ζω, then bounds the step about ten times below what the spring alone needs
-// (contact_set.c, the stability bound).
+// (stability_bound.c).
 #define PD_DAMPING_RATIO_MAX 4.807  // ζ at PD_RESTITUTION_MIN; for the refusal message
 
 // ζ for a requested restitution e ∈ [PD_RESTITUTION_MIN, 1]: in [0, 1) for e > e⁻², above 1 (overdamped)
@@ -124,7 +124,7 @@ int pd_adjustment_describe(const pdAdjustment* a, const char* bodyName, const ch
 
 // ---------------------------------------------------------------- per-body sides, per-pair constants
 
-// δ_max of a pair, m (README "Contact material parameters"): `deflection` times the smaller body's size (paper
+// δ_max of a pair, m (docs/contact-model.md): `deflection` times the smaller body's size (paper
 // §3.2), but at most PD_DELTA_MAX_WIDTH_FRACTION of the thinner body's width (a width of 0 is not known and
 // does not bound it). A deflection comparable to a body's thickness passes through it: a vertex pressed into a
 // plate thinner than δ_max comes out on the far side, its contact breaks (it left the body, or the rim face it

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "broad_phase.h"
+#include "grow.h"
 #include "interference.h"
 #include "model_contact.h"
 #include "polydyn/state.h"
@@ -15,7 +16,7 @@
 // (a fixed floor's size says nothing about how fast anything moves).
 #define PD_MIN_SPEED_LENGTHS_PER_SECOND 1.0
 
-// Bodies may touch at t = 0 but not interpenetrate (DESIGN §4.1): a soft contact that starts deep would
+// Bodies may touch at t = 0 but not interpenetrate (docs/scene-language.md): a soft contact that starts deep would
 // begin with springs at rest and push nothing. Tolerance on the penetration depth, relative to the
 // smaller body's size: two bodies placed touching by decimal coordinates overlap by rounding only
 // (~1e-16 relative), while 1e-6 leaves room for a scene file written with 6 significant digits.
@@ -23,8 +24,7 @@
 
 static char* copy_string(const char* s) {
   size_t n = strlen(s) + 1;
-  char* c = malloc(n);
-  PD_ASSERT(c != NULL);
+  char* c = pd_grow(NULL, n, 1);
   memcpy(c, s, n);
   return c;
 }
@@ -194,18 +194,47 @@ static bool check_initial_overlap(const pdModel* m, pdError* err) {
   return ok;
 }
 
+// A planar body's out-of-plane inertia coupling and initial velocity, relative to its largest principal
+// moment and to its speed scale: the scene's numbers are exact in the common cases (a box turned about y) and
+// reach this only through round-off of the rotation (about 1e-16); anything larger is a different scene.
+#define PLANAR_TOL 1e-12
+
+// Checks a `planar` body (model.h) and makes its initial velocity exactly planar.
+static bool make_planar(pdBody* b, const pdSceneObject* o, const char* path, pdError* err) {
+  PD_ASSERT(!b->fixed);
+  pdMat3 r = pd_quat_to_mat3(b->q0);
+  pdVec3 yb = pd_mat3_tmulv(&r, (pdVec3){0, 1, 0});  // world y in body axes
+  pdVec3 iy = pd_mat3_mulv(&b->inertia, yb);
+  pdVec3 off = pd_v3_sub(iy, pd_v3_scale(yb, pd_v3_dot(yb, iy)));
+  if (pd_v3_norm(off) > PLANAR_TOL * b->principal[2]) {
+    pd_error_set(err, path, o->planarWhere.line, o->planarWhere.col,
+                 "planar body '%s': world y is not a principal axis of its inertia at its initial orientation (turn it "
+                 "so that one of its principal axes is along y)", o->name);
+    return false;
+  }
+  double speed = pd_v3_norm(b->v0) + pd_v3_norm(b->w0) * b->radius;
+  if (fabs(b->v0.y) > PLANAR_TOL * speed || hypot(b->w0.x, b->w0.z) * b->radius > PLANAR_TOL * speed) {
+    pd_error_set(err, path, o->planarWhere.line, o->planarWhere.col,
+                 "planar body '%s': its initial velocity leaves the x-z plane (v_y = %g m/s, spin about x, z = %g, %g "
+                 "rad/s)", o->name, b->v0.y, b->w0.x, b->w0.z);
+    return false;
+  }
+  b->v0.y = 0.0;
+  b->w0.x = b->w0.z = 0.0;
+  b->planar = true;
+  return true;
+}
+
 pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
   if (scene->objectCount == 0) {
     pd_error_set(err, scene->path, 0, 0, "the scene defines no object");
     return NULL;
   }
-  pdModel* m = calloc(1, sizeof *m);
-  PD_ASSERT(m != NULL);
+  pdModel* m = pd_zeroed(1, sizeof *m);
   m->scenePath = copy_string(scene->path);
   m->bodyCount = scene->objectCount;
-  m->bodies = calloc((size_t)m->bodyCount, sizeof *m->bodies);
-  m->movingBodies = calloc((size_t)m->bodyCount, sizeof *m->movingBodies);
-  PD_ASSERT(m->bodies != NULL && m->movingBodies != NULL);
+  m->bodies = pd_zeroed((size_t)m->bodyCount, sizeof *m->bodies);
+  m->movingBodies = pd_zeroed((size_t)m->bodyCount, sizeof *m->movingBodies);
 
   for (int i = 0; i < scene->objectCount; ++i) {
     const pdSceneObject* o = &scene->objects[i];
@@ -250,6 +279,10 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
       b->v0 = (pdVec3){o->vel[0], o->vel[1], o->vel[2]};
       pdVec3 spinAxis = pd_v3_normalize((pdVec3){o->spinAxis[0], o->spinAxis[1], o->spinAxis[2]});
       b->w0 = o->spin != 0.0 ? pd_quat_rotate(b->q0, pd_v3_scale(spinAxis, o->spin)) : (pdVec3){0, 0, 0};
+    }
+    if ((o->setMask & PD_SET_PLANAR) && !make_planar(b, o, scene->path, err)) {
+      pd_model_free(m);
+      return NULL;
     }
     b->requested = requested_material(o);
     b->used = b->requested;

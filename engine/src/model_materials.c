@@ -1,4 +1,4 @@
-// polydyn — the contact model's material parameters in a compiled model (paper §3.2, §3.3; DESIGN §3.4).
+// polydyn — the contact model's material parameters in a compiled model (paper §3.2, §3.3; docs/DESIGN.md §6.4).
 //
 // material.c holds the rules (per-body sides, per-pair constants from eq. (11) and eq. (15), the §3.3
 // checks, the modal dampers). This file applies them to a scene:
@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "grow.h"
 #include "material.h"
 #include "model_contact.h"
 
@@ -67,12 +68,6 @@ void pd_material_table_free(struct pdMaterialTable* t) {
   free(t);
 }
 
-static void* alloc_array(size_t count, size_t size) {
-  void* p = calloc(count > 0 ? count : 1, size);
-  PD_ASSERT(p != NULL);
-  return p;
-}
-
 // ---------------------------------------------------------------- material classes
 
 static uint64_t hash_side(const pdMaterialSide* u) {
@@ -87,12 +82,12 @@ static uint64_t hash_side(const pdMaterialSide* u) {
 static void group_classes(struct pdMaterialTable* t, const pdMaterialSide* sides, const pdModel* m) {
   size_t slots = 16;
   while (slots < 2 * (size_t)t->bodyCount) slots *= 2;
-  int* slot = alloc_array(slots, sizeof *slot);  // class + 1, 0 = empty
-  t->classOf = alloc_array((size_t)t->bodyCount, sizeof *t->classOf);
-  t->classSide = alloc_array((size_t)t->bodyCount, sizeof *t->classSide);
-  t->classFirst = alloc_array((size_t)t->bodyCount, sizeof *t->classFirst);
-  t->classSize = alloc_array((size_t)t->bodyCount, sizeof *t->classSize);
-  t->classMoving = alloc_array((size_t)t->bodyCount, sizeof *t->classMoving);
+  int* slot = pd_zeroed(slots, sizeof *slot);  // class + 1, 0 = empty
+  t->classOf = pd_zeroed((size_t)t->bodyCount, sizeof *t->classOf);
+  t->classSide = pd_zeroed((size_t)t->bodyCount, sizeof *t->classSide);
+  t->classFirst = pd_zeroed((size_t)t->bodyCount, sizeof *t->classFirst);
+  t->classSize = pd_zeroed((size_t)t->bodyCount, sizeof *t->classSize);
+  t->classMoving = pd_zeroed((size_t)t->bodyCount, sizeof *t->classMoving);
   for (int i = 0; i < t->bodyCount; ++i) {
     size_t s = (size_t)hash_side(&sides[i]) & (slots - 1);
     while (slot[s] != 0 && memcmp(&t->classSide[slot[s] - 1], &sides[i], sizeof sides[i]) != 0) s = (s + 1) & (slots - 1);
@@ -111,7 +106,7 @@ static void group_classes(struct pdMaterialTable* t, const pdMaterialSide* sides
 }
 
 // A pair of classes can touch when some body of one can meet some other body of the other with at
-// least one of the two moving (fixed bodies never meet: DESIGN §3.6).
+// least one of the two moving (fixed bodies never meet: docs/DESIGN.md §5).
 static bool classes_can_touch(const struct pdMaterialTable* t, int a, int b) {
   if (a == b) return t->classMoving[a] && t->classSize[a] >= 2;
   return t->classMoving[a] || t->classMoving[b];
@@ -201,7 +196,7 @@ bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
   PD_ASSERT(m->materials == NULL && scene->objectCount == m->bodyCount);
   if (!check_restitutions(scene, err)) return false;
   const int n = m->bodyCount;
-  pdMaterialSide* sides = alloc_array((size_t)n, sizeof *sides);
+  pdMaterialSide* sides = pd_zeroed((size_t)n, sizeof *sides);
   const unsigned requestBits = PD_SET_KN | PD_SET_KT | PD_SET_CN | PD_SET_CT | PD_SET_RESTITUTION;
   for (int i = 0; i < n; ++i) {
     const pdBody* b = &m->bodies[i];
@@ -223,13 +218,12 @@ bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
       return false;
     }
   }
-  struct pdMaterialTable* t = calloc(1, sizeof *t);
-  PD_ASSERT(t != NULL);
+  struct pdMaterialTable* t = pd_zeroed(1, sizeof *t);
   m->materials = t;
   t->bodyCount = n;
   t->settings = (pdMaterialSettings){.vmax = m->settings.vmax, .deflection = m->settings.deflection,
                                      .dtmin = m->settings.dtmin};
-  t->info = alloc_array((size_t)n, sizeof *t->info);
+  t->info = pd_zeroed((size_t)n, sizeof *t->info);
   for (int i = 0; i < n; ++i) {
     const pdMaterialSide* u = &sides[i];
     pdBody* b = &m->bodies[i];
@@ -244,11 +238,11 @@ bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
                                      .zeta = zeta};
   }
   group_classes(t, sides, m);
-  t->adj = alloc_array(PD_MODEL_ADJUSTMENTS_MAX, sizeof *t->adj);
+  t->adj = pd_zeroed(PD_MODEL_ADJUSTMENTS_MAX, sizeof *t->adj);
   visit_pairs(t);
   if (t->classCount <= PD_MATERIAL_DENSE_CLASSES) {
     size_t c = (size_t)t->classCount;
-    t->pairs = alloc_array(c * c, sizeof *t->pairs);
+    t->pairs = pd_zeroed(c * c, sizeof *t->pairs);
     for (int a = 0; a < t->classCount; ++a)
       for (int b = a; b < t->classCount; ++b) {
         if (!classes_have_mass(t, a, b)) continue;  // two fixed classes: never asked for
@@ -264,13 +258,12 @@ bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
 // ---------------------------------------------------------------- views
 
 struct pdMaterialTable* pd_material_table_view(const struct pdMaterialTable* t, const int* bodies, int count) {
-  struct pdMaterialTable* v = calloc(1, sizeof *v);
-  PD_ASSERT(v != NULL);
+  struct pdMaterialTable* v = pd_zeroed(1, sizeof *v);
   *v = *t;  // classes, pair constants and adjustments shared: bodies keep their class
   v->view = true;
   v->bodyCount = count;
-  v->info = alloc_array((size_t)(count > 0 ? count : 1), sizeof *v->info);
-  v->classOf = alloc_array((size_t)(count > 0 ? count : 1), sizeof *v->classOf);
+  v->info = pd_zeroed((size_t)(count > 0 ? count : 1), sizeof *v->info);
+  v->classOf = pd_zeroed((size_t)(count > 0 ? count : 1), sizeof *v->classOf);
   for (int i = 0; i < count; ++i) {
     PD_ASSERT(bodies[i] >= 0 && bodies[i] < t->bodyCount);
     v->info[i] = t->info[bodies[i]];

@@ -44,7 +44,7 @@
 #define PD_ONSET_PAIR_DEPTH_REL 0.25
 // A pair onset's slip below this fraction of |Δu| at its point is none: removing the normal part leaves ~1e-16
 // |Δu| of rounding whose direction is noise, and friction along it broke a flush stack's symmetry (soak seed 1
-// scene 147: README, "Contact onsets"). The friction so dropped is at most 1e-9 m |Δu|.
+// scene 147: docs/contact-model.md). The friction so dropped is at most 1e-9 m |Δu|.
 #define PD_ONSET_PAIR_SLIP_REL 1e-9
 
 static pdVec3 to_world(const pdPose* p, pdVec3 local) { return pd_v3_add(p->x, pd_mat3_mulv(&p->R, local)); }
@@ -229,6 +229,10 @@ int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, con
       pdVec3 v = pd_v3_add(pd_layout_v(yb), pd_v3_scale(j, body->invMass));
       pdVec3 w = pd_v3_add(pd_layout_w(yb),
                            pd_mat3_mulv(&set->invInertiaWorld[b], pd_v3_cross(pd_v3_sub(c->point, poses[b].x), j)));
+      if (body->planar) {  // the plane takes the impulse's out-of-plane part, as in the derivative (model.h)
+        v.y = pd_layout_v(yb).y;
+        w.x = pd_layout_w(yb).x, w.z = pd_layout_w(yb).z;
+      }
       pd_layout_store(yb, v, w, pd_layout_x(yb), pd_layout_q(yb));
     }
     c->onsetAge = 0.0;

@@ -17,14 +17,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "grow.h"
 #include "interference.h"
 
-
-static void* xcalloc(size_t n, size_t size) {
-  void* p = calloc(n ? n : 1, size);
-  PD_ASSERT(p != NULL);
-  return p;
-}
 
 // Turn angles below this (sine) make a face vertex collinear with its neighbours: the vertex lies
 // on an edge of the hull and carries no corner.
@@ -110,7 +105,7 @@ static int compare_half_edge(const void* x, const void* y) {
 static bool pair_edges(const pdPolyhedron* p, pdEdge* edges, int* edgeCount, pdError* why) {
   int total = 0;
   for (int f = 0; f < p->faceCount; ++f) total += p->faces[f].count;
-  halfEdge* h = xcalloc((size_t)total, sizeof *h);
+  halfEdge* h = pd_zeroed((size_t)total, sizeof *h);
   int k = 0;
   for (int f = 0; f < p->faceCount; ++f) {
     const pdFace* face = &p->faces[f];
@@ -163,13 +158,13 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
   memset(out, 0, sizeof *out);
   int maxCount = 3;
   for (int f = 0; f < faceCount; ++f) maxCount = faces[f].count > maxCount ? faces[f].count : maxCount;
-  angleKey* keys = xcalloc((size_t)maxCount, sizeof *keys);
+  angleKey* keys = pd_zeroed((size_t)maxCount, sizeof *keys);
   for (int f = 0; f < faceCount; ++f) order_ccw(verts, faces[f].idx, faces[f].count, faces[f].normal, keys);
   free(keys);
 
   // drop vertices that are collinear in every face that holds them (they lie on a hull edge)
-  int* uses = xcalloc((size_t)vertCount, sizeof *uses);
-  int* straight = xcalloc((size_t)vertCount, sizeof *straight);
+  int* uses = pd_zeroed((size_t)vertCount, sizeof *uses);
+  int* straight = pd_zeroed((size_t)vertCount, sizeof *straight);
   for (int f = 0; f < faceCount; ++f) {
     int n = faces[f].count;
     for (int i = 0; i < n; ++i) {
@@ -188,11 +183,11 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
   }
 
   // compact the vertex numbering to the vertices still used, keeping their order
-  int* remap = xcalloc((size_t)vertCount, sizeof *remap);
+  int* remap = pd_zeroed((size_t)vertCount, sizeof *remap);
   int used = 0;
   for (int v = 0; v < vertCount; ++v) remap[v] = (uses[v] > 0 && straight[v] < uses[v]) ? used++ : -1;
   out->vertexCount = used;
-  out->vertices = xcalloc((size_t)used, sizeof *out->vertices);
+  out->vertices = pd_zeroed((size_t)used, sizeof *out->vertices);
   for (int v = 0; v < vertCount; ++v)
     if (remap[v] >= 0) out->vertices[remap[v]] = verts[v];
 
@@ -203,7 +198,7 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
     for (int i = 0; i < n; ++i) faces[f].idx[i] = remap[faces[f].idx[i]];
     for (int i = 1; i < n; ++i)
       if (faces[f].idx[i] < faces[f].idx[lo]) lo = i;
-    int* rotated = xcalloc((size_t)n, sizeof *rotated);
+    int* rotated = pd_zeroed((size_t)n, sizeof *rotated);
     for (int i = 0; i < n; ++i) rotated[i] = faces[f].idx[(lo + i) % n];
     memcpy(faces[f].idx, rotated, (size_t)n * sizeof *rotated);
     free(rotated);
@@ -215,8 +210,8 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
   free(remap);
 
   out->faceCount = faceCount;
-  out->faces = xcalloc((size_t)faceCount, sizeof *out->faces);
-  out->faceVertices = xcalloc((size_t)total, sizeof *out->faceVertices);
+  out->faces = pd_zeroed((size_t)faceCount, sizeof *out->faces);
+  out->faceVertices = pd_zeroed((size_t)total, sizeof *out->faceVertices);
   int at = 0;
   for (int f = 0; f < faceCount; ++f) {
     if (faces[f].count < 3) {
@@ -241,7 +236,7 @@ static bool assemble(pdPolyhedron* out, const pdVec3* verts, int vertCount, rawF
     return false;
   }
   out->edgeCount = edgeCount;
-  out->edges = xcalloc((size_t)edgeCount, sizeof *out->edges);
+  out->edges = pd_zeroed((size_t)edgeCount, sizeof *out->edges);
   pair_edges(out, out->edges, NULL, NULL);
   if (!pd_polyhedron_validate(out, why)) {
     pd_polyhedron_free(out);
@@ -276,7 +271,7 @@ bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, pdEr
     }
 
   // qhull wants a writable array; its messages go to a memory stream we read on failure
-  coordT* coords = xcalloc((size_t)count * 3, sizeof *coords);
+  coordT* coords = pd_zeroed((size_t)count * 3, sizeof *coords);
   memcpy(coords, points, (size_t)count * 3 * sizeof(double));
   char* messages = NULL;
   size_t messagesSize = 0;
@@ -302,12 +297,12 @@ bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, pdEr
         code ? code : "error");
   } else {
     // vertices in input order: mark which input points are hull vertices
-    int* vertexOf = xcalloc((size_t)count, sizeof *vertexOf);
+    int* vertexOf = pd_zeroed((size_t)count, sizeof *vertexOf);
     for (int i = 0; i < count; ++i) vertexOf[i] = -1;
     vertexT* vertex;
     FORALLvertices vertexOf[qh_pointid(qh, vertex->point)] = 0;
     int vertCount = 0;
-    pdVec3* verts = xcalloc((size_t)count, sizeof *verts);
+    pdVec3* verts = pd_zeroed((size_t)count, sizeof *verts);
     for (int i = 0; i < count; ++i)
       if (vertexOf[i] == 0) {
         vertexOf[i] = vertCount;
@@ -317,12 +312,12 @@ bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, pdEr
     int faceCount = 0;
     facetT* facet;
     FORALLfacets++ faceCount;
-    rawFace* faces = xcalloc((size_t)faceCount, sizeof *faces);
+    rawFace* faces = pd_zeroed((size_t)faceCount, sizeof *faces);
     int f = 0;
     FORALLfacets {
       vertexT** vertexp;
       int n = qh_setsize(qh, facet->vertices);
-      faces[f].idx = xcalloc((size_t)n, sizeof(int));
+      faces[f].idx = pd_zeroed((size_t)n, sizeof(int));
       faces[f].count = 0;
       FOREACHvertex_(facet->vertices) faces[f].idx[faces[f].count++] = vertexOf[qh_pointid(qh, vertex->point)];
       faces[f].normal = (pdVec3){facet->normal[0], facet->normal[1], facet->normal[2]};
@@ -357,7 +352,7 @@ bool pd_polyhedron_cube(pdPolyhedron* out, const double scale[3], pdError* why) 
 
 bool pd_polyhedron_prism(pdPolyhedron* out, int sides, const double scale[3], double taper, pdError* why) {
   PD_ASSERT(sides >= 3 && taper > 0.0 && taper <= 1.0);
-  double* pts = xcalloc((size_t)sides * 2 * 3, sizeof *pts);
+  double* pts = pd_zeroed((size_t)sides * 2 * 3, sizeof *pts);
   const double pi = 3.14159265358979323846;
   for (int i = 0; i < sides; ++i) {
     double a = 2.0 * pi * i / sides;
@@ -409,7 +404,7 @@ bool pd_polyhedron_sphere(pdPolyhedron* out, int level, const double scale[3], p
                                   {3, 8, 9},   {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   int perFace = 1;
   for (int i = 0; i < level; ++i) perFace *= 4;
-  sphereBuilder b = {xcalloc((size_t)20 * perFace * 3 * 3, sizeof(double)), 0};
+  sphereBuilder b = {pd_zeroed((size_t)20 * perFace * 3 * 3, sizeof(double)), 0};
   for (int t = 0; t < 20; ++t)
     subdivide(&b, on_sphere(ico[tris[t][0]]), on_sphere(ico[tris[t][1]]), on_sphere(ico[tris[t][2]]), level);
   for (int i = 0; i < b.count; ++i)
@@ -441,7 +436,7 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, pdError* why) {
   }
   pdVec3 centre = vertex_average(p->vertices, p->vertexCount);
   double tol = PD_PLANARITY_TOL_REL * size_about(p->vertices, p->vertexCount, centre);
-  int* faceUses = xcalloc((size_t)p->vertexCount, sizeof *faceUses);
+  int* faceUses = pd_zeroed((size_t)p->vertexCount, sizeof *faceUses);
   bool ok = true;
   for (int f = 0; ok && f < p->faceCount; ++f) {
     const pdFace* face = &p->faces[f];
@@ -494,7 +489,7 @@ bool pd_polyhedron_validate(const pdPolyhedron* p, pdError* why) {
     // (with the count checked above, the list is then exactly the faces' edges)
     int sides = 0;
     for (int f = 0; f < p->faceCount; ++f) sides += p->faces[f].count;
-    char* listed = xcalloc((size_t)sides, sizeof *listed);
+    char* listed = pd_zeroed((size_t)sides, sizeof *listed);
     for (int e = 0; ok && e < p->edgeCount; ++e) {
       const pdEdge* edge = &p->edges[e];
       int fwd = -1, back = -1;

@@ -1,4 +1,4 @@
-// polydyn — the scene file parser (DESIGN §4.1).
+// polydyn — the scene file parser (docs/scene-language.md).
 //
 // Design note. One lexer reads bytes from a source that is either a FILE* (read in fixed 64 KiB
 // chunks) or a caller's buffer (read in place), so pd_scene_parse_file and pd_scene_parse_buffer
@@ -239,6 +239,7 @@ typedef enum CommandId {
   cmd_gravity, cmd_tend, cmd_tol, cmd_dt, cmd_dtmin, cmd_dtmax, cmd_sample, cmd_vmax, cmd_deflection, cmd_sleep,
   cmd_cube, cmd_prism, cmd_tprism, cmd_sphere, cmd_hull,
   cmd_fixed, cmd_loc, cmd_vel, cmd_spgrav, cmd_mu, cmd_kn, cmd_kt, cmd_cn, cmd_ct, cmd_restitution, cmd_force,
+  cmd_planar,
 } CommandId;
 
 typedef enum CommandClass { class_setting, class_object, class_property } CommandClass;
@@ -278,6 +279,7 @@ static const Command commands[] = {
     {"ct", cmd_ct, class_property, 1, 1, "c"},
     {"restitution", cmd_restitution, class_property, 1, 1, "e"},
     {"force", cmd_force, class_property, 3, 11, "fx fy fz [ramp rx ry rz] [at x y z]"},
+    {"planar", cmd_planar, class_property, 0, 0, ""},
 };
 
 static const Command* find_command(const Token* tok) {
@@ -676,7 +678,19 @@ static bool property_command(Parser* ps, const Command* cmd, int nargs) {
         return fail(ps, ps->toks[0].loc, "'fixed' on body '%s', which has a force (line %d): a fixed body cannot "
                     "be pushed", o->name, o->forceWhere.line);
       }
+      if (o->setMask & PD_SET_PLANAR) {
+        return fail(ps, ps->toks[0].loc, "'fixed' on body '%s', which is planar (line %d): a fixed body has no "
+                    "motion to constrain", o->name, o->planarWhere.line);
+      }
       o->fixed = true;
+      return true;
+    case cmd_planar:
+      if (o->fixed) return fail(ps, ps->toks[0].loc, "'planar' on the fixed body '%s': it has no motion to constrain", o->name);
+      if (o->setMask & PD_SET_PLANAR) {
+        return fail(ps, ps->toks[0].loc, "body '%s' is already planar (line %d)", o->name, o->planarWhere.line);
+      }
+      o->planarWhere = ps->toks[0].loc;
+      o->setMask |= PD_SET_PLANAR;
       return true;
     case cmd_force: return force_command(ps, nargs, o);
     case cmd_loc:

@@ -140,7 +140,7 @@ static double step_of(double omega2, double overdamp) {
   return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
 }
 
-// The stability bound in two parts, both Gershgorin bounds on ω_max² (never below it; README, Integration).
+// The stability bound in two parts, both Gershgorin bounds on ω_max² (never below it; docs/integration.md).
 // pd_stability_prepare (after every new list, O(contacts)) forms each contact's terms and a cheap bound of the
 // contact-space matrix M above: by |Σ_j (A B_j)_rq| ≤ Σ_p |A_rp| |(B_j)_pq|, row r of contact i's Gershgorin sum
 // is at most Σ over its moving ends B of Σ_p |(K_i^½)_rp| w_p / m_B + Σ_p |(K_i^½ [r_i]ₓᵀ)_rp| u_p, where w_p

@@ -38,8 +38,7 @@ pdState* pd_state_create(const pdModel* model, const pdStateOptions* options) {
   PD_ASSERT(o.islands == pd_islandsOff || o.islands == pd_islandsOn);
   PD_ASSERT(o.threads >= 1 && o.threads <= PD_THREADS_MAX);
   PD_ASSERT(o.h >= 0.0 && o.h < INFINITY);
-  pdState* s = calloc(1, sizeof *s);
-  PD_ASSERT(s != NULL);
+  pdState* s = pd_zeroed(1, sizeof *s);
   s->options = o;
   s->contacts = pd_contact_set_create(model);
   pd_state_reserve_contacts(model, s, 4 * model->movingCount + 16);
@@ -109,8 +108,7 @@ void pd_state_reserve_contacts(const pdModel* model, pdState* s, int contacts) {
     s->weight = pd_grow(s->weight, c, sizeof *s->weight);
     // the stepper's vectors hold no data between steps: reallocate rather than copy
     free(s->work);
-    s->work = calloc((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
-    PD_ASSERT(s->work != NULL);
+    s->work = pd_zeroed((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
     s->capacity = c;
   }
   if (s->implicit) pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));

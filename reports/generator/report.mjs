@@ -47,6 +47,7 @@ plus the numbers it shows as JSON and CSV beside it. Sections appear when their 
   metrics.csv                     comparison metrics
   cubetoss/summary.csv            cube tosses against reality (per_toss.csv, fit.csv, replay/TOSS/ or
                                   runs/TOSS/ beside it); DIR may also be a polydyn cubetoss directory
+  planar-drops/summary.csv        planar drops against reality (the same files)
 
   -o FILE         the page (default DIR/report.html); FILE.json (without .html) and FILE-TABLE.csv
                   are written beside it
@@ -90,11 +91,14 @@ export function loadInputs(dir) {
     precision: readPrecision(dir),
     metrics: readMetrics(dir),
     cubetoss: readCubetoss(dir),
+    planarDrops: readCubetoss(dir, 'planar-drops'),
   };
-  if (!inputs.results && !inputs.experiments && !inputs.series && !inputs.sweep && !inputs.precision && !inputs.metrics && !inputs.cubetoss)
+  if (!inputs.results && !inputs.experiments && !inputs.series && !inputs.sweep && !inputs.precision && !inputs.metrics && !inputs.cubetoss &&
+    !inputs.planarDrops)
     throw new InputError(dir, 0, 'nothing to report: none of results.csv, experiments.json, series/*.csv, sweep.csv, precision.csv, metrics.csv, ' +
       'cubetoss/summary.csv is there');
   inputs.cubetossTypical = inputs.cubetoss ? loadTypical(dir, inputs.cubetoss) : null;
+  inputs.planarDropsTypical = inputs.planarDrops ? loadTypical(dir, inputs.planarDrops) : null;
   // run directories named in results.csv, each once
   inputs.runs = [];
   if (inputs.results) {
@@ -152,7 +156,8 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
   const prec = lazy(() => (inputs.precision && inputs.precision.rows.length ? derivePrecision(inputs.precision, inputs.experiments) : null));
   const evOrder = derive.orderEngineVariants([...(results ? results.rows : []), ...(inputs.sweep ? inputs.sweep.rows : []),
     ...(inputs.precision ? inputs.precision.rows : []),
-    ...(inputs.metrics ? inputs.metrics.rows : []), ...(inputs.cubetoss ? inputs.cubetoss.summary : [])]).map((x) => x.ev);
+    ...(inputs.metrics ? inputs.metrics.rows : []), ...(inputs.cubetoss ? inputs.cubetoss.summary : []),
+    ...(inputs.planarDrops ? inputs.planarDrops.summary : [])]).map((x) => x.ev);
   const ctx = {
     dir,
     results,
@@ -162,6 +167,8 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
     metrics: inputs.metrics,
     cubetoss: inputs.cubetoss,
     cubetossTypical: inputs.cubetossTypical,
+    planarDrops: inputs.planarDrops,
+    planarDropsTypical: inputs.planarDropsTypical,
     runs: inputs.runs,
     viewer: viewerSource,
     evOrder,
@@ -268,6 +275,7 @@ function inputList(inputs) {
   if (inputs.precision) list.push('precision.csv');
   if (inputs.metrics) list.push('metrics.csv');
   if (inputs.cubetoss) list.push(`${inputs.cubetoss.at === '.' ? '' : inputs.cubetoss.at + '/'}summary.csv`);
+  if (inputs.planarDrops) list.push('planar-drops/summary.csv');
   return list;
 }
 
@@ -283,6 +291,7 @@ function shortInputs(inputs) {
   if (inputs.precision) list.push(`precision.csv (${inputs.precision.rows.length} points)`);
   if (inputs.metrics) list.push('metrics.csv');
   if (inputs.cubetoss) list.push(`cube-toss results (${new Set(inputs.cubetoss.summary.map((r) => r.ev)).size} engines)`);
+  if (inputs.planarDrops) list.push(`planar-drop results (${new Set(inputs.planarDrops.summary.map((r) => r.ev)).size} engines)`);
   return list.join(', ');
 }
 

@@ -15,7 +15,7 @@ PD=$1
 DATA_FULL=$2/../shared/data/cube-toss/tosses-train.csv
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/pd_test_cubetoss_cli.XXXXXX") || exit 1
 trap 'rm -rf "$SCRATCH"' EXIT
-. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial
+. "$(dirname "${BASH_SOURCE[0]}")/../lib.sh"  # check, run_pd, no_partial, skip_without
 
 # ---- usage errors: exit 2, a message naming the problem, nothing written (no data needed)
 BAD=$SCRATCH/bad.csv
@@ -48,11 +48,7 @@ check "a refused toss: summary says failed, with no numbers" 'grep -q "^soft,imp
 "$PD" cubetoss --help | grep -q "per_toss.csv"; rc=$?; check "--help documents per_toss.csv" '[ $rc -eq 0 ]'
 "$PD" help | grep -q "cubetoss"; rc=$?; check "polydyn help lists cubetoss" '[ $rc -eq 0 ]'
 
-if [ ! -r "$DATA_FULL" ]; then
-  echo "SKIP: the cube-toss data is not at $DATA_FULL (not part of the project: see README, cube tosses); $passed usage checks passed"
-  [ $failed -eq 0 ] || exit 1
-  exit 77
-fi
+skip_without "$DATA_FULL" "the cube-toss data (README, cube tosses)"
 
 # ---- the first 4 tosses of the real data (ids 1, 2, 3, 4: positions 0..3, two training, two test)
 DATA=$SCRATCH/four.csv

@@ -23,8 +23,8 @@ PD_EXTERN_C_BEGIN
 // integration steps about ten times shorter than the spring's.
 #define PD_RESTITUTION_MIN 0.01
 
-// Material of a body: as requested by the scene, and as finally used (README "Contact material
-// parameters"). In `requested`, a value the scene did not set is -1 (mu always has a value: its default).
+// Material of a body: as requested by the scene, and as finally used (docs/contact-model.md). In `requested`, a
+// value the scene did not set is -1 (mu always has a value: its default).
 // In `used`, restitution is the requested e or the default (0.5); kn, kt, cn, ct are the values the scene
 // gave, or -1 where the contact model derives them for each pair of bodies (pd_model_pair_contact): springs
 // and dampers belong to a pair, not to one body.
@@ -67,6 +67,13 @@ typedef struct pdBody {
   pdVec3 force0;          // N, world
   pdVec3 forceRate;       // N/s, world
   pdVec3 forcePoint;      // m, body frame
+  // Planar motion (scene `planar`): the centre of mass moves in the world x–z plane and the body turns about
+  // the world y axis only, three degrees of freedom. Contacts and their forces stay three-dimensional; the
+  // derivative drops the force's y component and the torque's x and z components (the constraint's reaction,
+  // which does no work), so v_y, ω_x and ω_z stay zero (to the round-off of the implicit stepper's solves).
+  // The reduced motion is exact because the compiled model requires a principal axis of inertia along world y
+  // and an initial velocity in the plane (pd_model_compile).
+  bool planar;
   pdSourceLoc where;      // the object command in the scene file
 } pdBody;
 
@@ -97,7 +104,7 @@ typedef struct pdModel {
 // properties, shifts each body's frame to its centre of mass, sets initial states and settings, derives
 // the contact model's material parameters (paper §3.2, §3.3) and checks that no two bodies overlap.
 // Returns NULL and fills err (at the object's line) on a degenerate polyhedron, an empty scene, an
-// unreachable restitution (below PD_RESTITUTION_MIN) or bodies interpenetrating at t = 0 (DESIGN §4.1).
+// unreachable restitution (below PD_RESTITUTION_MIN) or bodies interpenetrating at t = 0 (docs/scene-language.md).
 // The model copies what it needs: the scene may be freed right after. The caller owns the model
 // (pd_model_free); it is read-only from then on (any number of states and threads may share it).
 PD_API pdModel* pd_model_compile(const pdScene* scene, pdError* err);
@@ -173,7 +180,7 @@ typedef struct pdPairContact {
 } pdPairContact;
 
 // δ_max of bodies a and b, m: deflection × the smaller body's size, at most a quarter of the thinner body's
-// width (README "Contact material parameters": a deeper deflection passes through a thin plate). The deflection
+// width (docs/contact-model.md: a deeper deflection passes through a thin plate). The deflection
 // the pair's springs are sized for, and the scale of the contact search's tolerances.
 PD_API double pd_model_pair_delta_max(const pdModel* model, int a, int b);
 

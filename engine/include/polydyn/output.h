@@ -1,4 +1,4 @@
-// polydyn — run directories (DESIGN §4.2): trajectory.csv and summary.json.
+// polydyn — run directories (docs/outputs.md): trajectory.csv and summary.json.
 //
 // contacts.csv: see pd_write_contact_rows.
 //
@@ -39,7 +39,7 @@ PD_API void pd_run_drain(pdRunWriter* run);
 // Writes one trajectory row per moving body at the state's time.
 PD_API void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state);
 PD_API void pd_write_trajectory_header(FILE* out);
-// contacts.csv (DESIGN §4.2): header `t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode`;
+// contacts.csv (docs/outputs.md): header `t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode`;
 // one row per active contact per sample, in contact-id order; kind VF or EE; body_a carries the vertex
 // (VF) or the first edge (EE); n points from body_b into body_a; (fn, ft) is the force on body_a, N;
 // mode stick or slip.

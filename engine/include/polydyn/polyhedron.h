@@ -62,7 +62,7 @@ typedef struct pdPolyhedron {
 // from), as for every function below with an `err`.
 PD_API bool pd_polyhedron_hull(pdPolyhedron* out, const double* points, int count, pdError* err);
 
-// The scene primitives of DESIGN §4.1, already scaled by (sx, sy, sz), in the primitive's own frame
+// The scene primitives of docs/scene-language.md, already scaled by (sx, sy, sz), in the primitive's own frame
 // (origin at its geometric centre, before the shift to the centre of mass):
 // - cube: the unit cube [-½, ½]³;
 // - prism: regular n-gon inscribed in the circle of diameter 1 in the xy plane (vertex 0 on +x),

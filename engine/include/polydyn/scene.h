@@ -1,6 +1,6 @@
 // polydyn — scene description: what a scene file said, before anything is derived from it.
 //
-// The scene language (DESIGN §4.1, paper §5.1) is line oriented: `#` starts a comment, one command
+// The scene language (docs/scene-language.md, paper §5.1) is line oriented: `#` starts a comment, one command
 // per line, a trailing backslash continues the line, keywords are case sensitive. Object commands
 // start an object, property commands apply to the last object, settings may appear anywhere.
 // Units: m, kg, s; angles in degrees (converted to radians here, at parse time).
@@ -44,6 +44,7 @@ enum {
   PD_SET_LOC = 1u << 7,
   PD_SET_VEL = 1u << 8,
   PD_SET_FORCE = 1u << 9,
+  PD_SET_PLANAR = 1u << 10,
 };
 enum {
   PD_SET_GRAVITY = 1u << 0,
@@ -91,11 +92,12 @@ typedef struct pdSceneObject {
   double forceRate[3];    // N/s
   double forcePoint[3];   // m
   pdSourceLoc forceWhere; // the `force` command (line 0 when none)
+  pdSourceLoc planarWhere; // the `planar` command (valid when PD_SET_PLANAR)
   unsigned setMask;       // PD_SET_* bits: which properties the file set
   pdSourceLoc where;      // the object command
 } pdSceneObject;
 
-// Defaults of the scene language, documented in README.md.
+// Defaults of the scene language, documented in docs/scene-language.md.
 #define PD_DEFAULT_GRAVITY_Z (-9.81)  // m/s²
 #define PD_DEFAULT_TEND 1.0           // s
 #define PD_DEFAULT_TOL 1e-6           // weighted max-norm of the local error estimate, dimensionless

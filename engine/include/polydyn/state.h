@@ -68,18 +68,18 @@ typedef enum pdStepper {
   pd_stepperImplicit,      // step doubling, switching system by system to ROS34PW2 (a linearly implicit method of
                            // order 3 with an order-2 estimate and no stability bound) where the contacts' stability
                            // bound holds step doubling: resting contact. Systems of more than 32 moving bodies
-                           // (PD_IMPLICIT_BODIES_MAX) keep step doubling (README, Integration)
+                           // (PD_IMPLICIT_BODIES_MAX) keep step doubling (docs/integration.md)
 } pdStepper;
 
 // The stepper of pd_state_options_default() and the one `polydyn run` uses unless told: it takes step doubling's
 // steps wherever the error control sets them, and longer ones where resting and sliding contacts' stability bound
-// would hold step doubling to a fraction of them (README, Integration).
+// would hold step doubling to a fraction of them (docs/integration.md).
 #define PD_STEPPER_DEFAULT pd_stepperImplicit
 
 // The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed", "rk43-embedded" or "ros34pw2".
 PD_API const char* pd_stepper_name(pdStepper stepper);
 
-// How a contact that began inside a step joins the list (paper App. C; README, "Contact onsets").
+// How a contact that began inside a step joins the list (paper App. C; docs/contact-model.md).
 typedef enum pdOnsets {
   pd_onsetsExact,  // every onset found deeper than 1e-3 δ_max cuts the whole step back to it
   pd_onsetsPair,   // a contact that began less than 1/ω before the step's end (ω of its pair) and is at most
@@ -91,9 +91,9 @@ typedef enum pdOnsets {
                   // step, and a small system keeps the exact onsets' error control
 } pdOnsets;
 
-// More moving bodies than this in one system make pd_onsetsAuto join onsets as pairs. Measured on
-// cases/bench/pile_1000.scene over 1 s (its settling pile is one island of ~900 boxes from 0.6 s): exact 257 s,
-// auto 108 s, pair 114 s; the piles of 10 and 100 and the bin of 100 polyhedra never form islands of more than
+// More moving bodies than this in one system make pd_onsetsAuto join onsets as pairs. On
+// cases/bench/pile_1000.scene over 1 s (its settling pile is one island of ~900 boxes from 0.6 s) exact onsets took
+// 2.4× the time of auto, pair 1.06×; the piles of 10 and 100 and the bin of 100 polyhedra never form islands of more than
 // 8 bodies, nor does any sweep scene or Gedanken experiment but G3 (a board with 25 cubes): they keep exact onsets.
 #define PD_ONSETS_CROWD_BODIES 16
 
@@ -106,7 +106,7 @@ PD_API pdOnsets pd_onsets_effective(pdOnsets onsets, int movingBodies);
 // The onset mode's name in summary.json: "pair", "exact" or "auto".
 PD_API const char* pd_onsets_name(pdOnsets onsets);
 
-// Whether the moving bodies advance as one system or as islands (engine/src/islands.c; README, "Islands").
+// Whether the moving bodies advance as one system or as islands (engine/src/islands.c; docs/integration.md).
 typedef enum pdIslands {
   pd_islandsOff,  // one state vector, one step size, every onset cuts every body's step
   pd_islandsOn,   // default: between output samples, bodies joined by a contact or whose boxes, grown by how far they
@@ -134,7 +134,7 @@ typedef struct pdCounters {
   long travelRetries;     // trial steps cut short because two bodies that may meet moved too far (tunnelling)
   long refinements;       // trial steps halved around a reversal or a stick/slip change (§3.4)
   long stabilityTight;    // accepted steps whose limit needed the tight stability bound: the cheap bound allowed
-                          // less than the step the error control wanted (README, Integration)
+                          // less than the step the error control wanted (docs/integration.md)
   long implicitSteps;     // accepted steps taken by the implicit method (pd_stepperImplicit; 0 with other steppers)
   long searchesSkipped;   // pair searches (interference and contact search) a search certificate made needless
   long contactsMade;      // contacts added at the end of a step (found, approaching)
@@ -235,7 +235,7 @@ PD_API pdBodyState pd_state_body(const pdModel* model, const pdState* state, int
 // springs (½ k s² each), J (gravitational potential zero at the origin).
 PD_API double pd_state_energy(const pdModel* model, const pdState* state);
 
-// One active contact at the state's time, for output (DESIGN §4.2 contacts.csv).
+// One active contact at the state's time, for output (docs/outputs.md, contacts.csv).
 typedef struct pdContactReport {
   int bodyA, bodyB;     // body indices: A carries the vertex (VF) or the first edge (EE)
   bool edgeEdge;        // false: VF, true: EE
@@ -264,7 +264,7 @@ typedef bool pdObserverFcn(const pdModel* model, const pdState* state, void* use
 // Advances the state to tEnd, s (tEnd >= state->t, asserted; clamping to settings.tend is the caller's
 // choice), calling `observer` (nullable) with `user` at every output sample t = k / sampleRate <= tEnd,
 // including t = 0 when the state is there. Neither the samples nor tEnd cut the error-controlled steppers' steps
-// (dense output, README "Integration"): at a sample inside a step, and at tEnd when the last step passed it, the
+// (dense output, docs/integration.md): at a sample inside a step, and at tEnd when the last step passed it, the
 // state is presented there (its bodies and springs interpolated within that step, its contacts' forces evaluated
 // there), and the integration's own state waits at that step's end; writing to state->y between calls does not
 // reach it. The fixed stepper ends its steps on every sample and on tEnd. Call it again with a later tEnd to go

@@ -64,9 +64,56 @@
 // The default restitution: the data's authors' fit for their own model (Pfrommer et al. 2020).
 #define PD_TOSS_DEFAULT_RESTITUTION 0.125
 
+// ---------------------------------------------------------------- the experiments
+
+// Real planar drops (shared/data/planar-drops/README.md): a square block of side 0.06 m dropped in a vertical
+// plane onto a flat surface, tracked at 250 Hz (Fazeli et al., ICRA 2017, ISRR 2017; data from the
+// repository DAIRLab/ImpactModeling, BSD 3-Clause). One CSV file, header exactly
+//   drop,t,x,z,th,vx,vz,vth
+// rows of one drop consecutive, t = k/250 s from 0, (x, z) the centre (m, z up), th the angle in the plane
+// (rad, counter-clockwise seen from −y: x turns towards z), v (m/s), vth (rad/s). The same machinery runs
+// them: each drop is read as a pose in 3-D (x, 0, z), q = rotation by th about −y, ω = (0, −vth, 0); the
+// block is a 0.06 m cube held in the x–z plane (scene `planar`), mass 1 kg and the uniform block's inertia
+// m s²/6 about y, as the data's repository takes them (the data give neither; a uniform block's motion does
+// not depend on its mass). The surface's top is at PD_DROP_BOARD_TOP.
+#define PD_DROP_RATE 250.0         // Hz
+#define PD_DROP_SIDE 0.06          // m
+#define PD_DROP_MASS 1.0           // kg
+// Height of the surface, m: the median over the drops of the lowest corner's height at the last sample
+// (at rest on a face): 0.52 mm, with the resting centre's median height 0.0315 m = 0.0005 + 0.03.
+#define PD_DROP_BOARD_TOP 0.0005
+// Characteristic speed, m/s: impacts arrive at about 2.5 m/s; the fastest first sample is 5.0 m/s (noise).
+#define PD_DROP_VMAX 3.0
+
+// Bounces (planar experiments): an impact starts when the block's lowest point comes within
+// PD_DROP_CONTACT_BAND of the surface and ends when it rises above PD_DROP_LIFT_BAND; the impact's time is the
+// first sample after which the lowest point rises (the first local minimum of its height in the band). The post-impact velocity is the central difference of
+// the samples 1 and 3 after it (centre velocity and angular velocity: the same estimate for record and run,
+// as the record's own velocities are noisy). Bands: the tracking noise of the lowest corner is about 1 mm.
+#define PD_DROP_CONTACT_BAND 0.003  // m
+#define PD_DROP_LIFT_BAND 0.006     // m
+enum { PD_TOSS_IMPACTS = 3 };       // bounces compared
+
+// What differs between the data sets; everything else (the scene's board, the errors, the fit) is shared.
+typedef struct pdTossExperiment {
+  const char* name;      // "cube tosses", "planar drops"
+  const char* header;    // the CSV's header line
+  double rate;           // Hz: the record's and our sample rate
+  double size[3];        // m: the block's box sx sy sz
+  double side;           // m: position errors are in these lengths
+  double mass;           // kg
+  double boardTop;       // m: height of the surface
+  double vmax;           // m/s: the scenes' vmax
+  bool planar;           // the block moves in the x–z plane (scene `planar`); bounces are compared
+  const char* lengthUnit;  // "cube_widths", "side_lengths"
+} pdTossExperiment;
+
+extern const pdTossExperiment pd_cube_tosses, pd_planar_drops;
+
 // ---------------------------------------------------------------- the data
 
 typedef struct pdToss {
+  const pdTossExperiment* experiment;
   long id;               // the toss column
   int sampleCount;       // >= 2
   long line;             // line of its first row in the file (1-based)
@@ -74,12 +121,13 @@ typedef struct pdToss {
 } pdToss;
 
 typedef struct pdTossSet {
+  const pdTossExperiment* experiment;  // chosen by the file's header
   char* path;      // as given (owned)
   int count;
   pdToss* tosses;  // (count) in file order (owned)
 } pdTossSet;
 
-// Reads a cube-toss CSV (layout above). Returns NULL and fills err with `FILE:LINE:COL: message` on a
+// Reads a cube-toss or a planar-drop CSV (layouts above; the header says which). Returns NULL and fills err with `FILE:LINE:COL: message` on a
 // file that cannot be read, a wrong header, a field that is not a finite number, a toss whose rows are
 // not consecutive, a t that is not k/148, a quaternion that is not unit, or a toss of fewer than 2 rows.
 pdTossSet* pd_toss_read(const char* path, pdError* err);
@@ -106,12 +154,16 @@ typedef struct pdTossParams {
   double restitution;  // requested e, in [PD_TOSS_RESTITUTION_MIN, 1] (derives c_n and c_t, eq. (15))
   double kn;           // normal spring of each side, N/m (k_t = k_n); the pair's is kn/2
   double tol;          // the soft engine's integration tolerance
-  double inertia;      // kg·m² about every axis; 0: the uniform-density cube's
+  double inertia;      // kg·m² about every axis; 0: the uniform-density block's
 } pdTossParams;
 
 // The parameters without fitting: μ = 0.18 and e = 0.125 (the data's authors' fit), k_n by the engine's own rule eq. (11) for the cube,
 // m vmax²/(0.01 side)² = 2.105e6 N/m (deflection 0.01, the engine default), tol 1e-6, inertia 8.1e-4.
 pdTossParams pd_toss_default_params(void);
+// The parameters of an experiment without fitting (cube tosses: pd_toss_default_params; planar drops: μ 0.2,
+// e 0.5 (the middle of the ranges the data's literature fits), k_n 2.5e7 N/m (eq. (11): m vmax²/(0.01 s)²),
+// tol 1e-6, the uniform block's inertia).
+pdTossParams pd_toss_experiment_params(const pdTossExperiment* experiment);
 
 // The scene text of toss `toss` (malloc'd, NUL-terminated; free it). Valid input to pd_scene_parse_buffer.
 char* pd_toss_scene(const pdToss* toss, const pdTossParams* params);
@@ -125,8 +177,10 @@ enum { PD_TOSS_BOARD_BODY = 0, PD_TOSS_CUBE_BODY = 1 };
 
 // ---------------------------------------------------------------- running and judging one toss
 
+// "noise" is no engine: its run is the record delayed by one sample (the first sample repeated), judged like
+// a simulation, so its errors are the floor that the data's own sampling and noise set.
 typedef struct pdTossEngine {
-  const char* name;   // "soft", "ode", "bullet"
+  const char* name;   // "soft", "ode", "bullet", "noise"
   pdRefOptions ref;   // ode, bullet: variant, step
 } pdTossEngine;
 
@@ -149,7 +203,22 @@ typedef struct pdTossResult {
   long steps;                     // accepted steps
   bool runWritten;                // the run directory asked for was written (also for a run that failed)
   char message[640];              // why, unless ok
+  // bounces (planar experiments; see PD_DROP_CONTACT_BAND): found in the record and in the run, and per
+  // bounce k the errors |t_run − t_rec| (s), |v_run − v_rec| of the centre after it (m/s), |ω_run − ω_rec|
+  // (rad/s); NAN where either has no k-th bounce (or no samples after it)
+  int impactsRecord, impactsRun;
+  double impactDt[PD_TOSS_IMPACTS], impactDv[PD_TOSS_IMPACTS], impactDw[PD_TOSS_IMPACTS];
 } pdTossResult;
+
+typedef struct pdTossImpact {
+  int sample;     // index of the sample at the impact
+  double t;       // s
+  pdVec3 v, w;    // after it (NAN when the samples end too soon), m/s and rad/s
+} pdTossImpact;
+
+// The first (at most PD_TOSS_IMPACTS) bounces of `n` samples at the experiment's rate; returns how many.
+int pd_toss_impacts(const pdTossExperiment* experiment, const pdBodyState* samples, int n,
+                    pdTossImpact impacts[PD_TOSS_IMPACTS]);
 
 // Simulates one toss in one engine from its first sample to its last, sampled at 148 Hz, and judges it
 // against the record (fills result). With runDir non-NULL writes that run directory too. Returns the
@@ -209,6 +278,10 @@ bool pd_toss_parallel(int count, int workers, size_t resultSize, void* results, 
 // Failed runs enter the objective with these errors (a lost toss, never better than a real one).
 #define PD_TOSS_FAIL_POS_ERR 10.0          // cube widths
 #define PD_TOSS_FAIL_ROT_ERR 3.141592653589793  // rad
+#define PD_TOSS_FAIL_BOUNCE_ERR PD_DROP_VMAX     // m/s: a first bounce missing in the run or the record
+// Planar experiments add the first bounce's velocity error to the objective in units of this speed, m/s: a
+// 0.1 m/s error weighs as much as 0.1 side lengths of end position or 0.1 rad of end angle.
+#define PD_TOSS_BOUNCE_SCALE 1.0
 
 typedef struct pdTossFitOptions {
   const pdTossSet* set;
@@ -229,7 +302,8 @@ typedef struct pdTossFitResult {
   pdTossParams params;       // the best point, rounded to 4 significant digits
   double startObjective;     // at the start, on the training tosses
   double objective;          // at params, on the training tosses
-  double posErrEndMean, rotErrEndMean;  // its two terms
+  double posErrEndMean, rotErrEndMean;  // its terms
+  double bounceDvMean;       // planar experiments: the mean first-bounce velocity error, m/s (else NAN)
   int failed;                // training tosses that failed at params
   int evaluations;
   bool converged;            // the simplex reached sizeTol (else maxEvaluations ended it)
@@ -237,10 +311,40 @@ typedef struct pdTossFitResult {
 
 // Fits μ, e (and k_n) with GSL's Nelder–Mead simplex (nmsimplex2) to minimise
 //   J = mean over the training tosses of the end position error (cube widths)
-//     + mean over the training tosses of the end rotation error (rad).
+//     + mean over the training tosses of the end rotation error (rad)
+//     [+ planar experiments: mean first-bounce velocity error / PD_TOSS_BOUNCE_SCALE].
 // Scaled coordinates: log10 μ ∈ [−2, log10 1.5], e ∈ [PD_TOSS_RESTITUTION_MIN, 1], log10 k_n ∈ [4, 8];
 // a point outside is evaluated at the nearest point inside plus a penalty of 1 per unit of distance, so
 // the simplex stays in the box. Start steps: 0.15 (μ × 1.4), 0.15 (e), 0.5 (k_n × 3.2).
 // Returns false with a message in `why` when the work was stopped or a worker died.
 bool pd_toss_fit(const pdTossFitOptions* options, pdTossFitResult* result, char* why, size_t whySize);
 void pd_toss_fit_trace_header(FILE* out);
+
+// The held-out split of a selection (set indices, file order): training = the selected tosses at even
+// positions, every trainEvery-th of them; test = those at odd positions. train and test hold count each.
+void pd_toss_fit_split(const int* indices, int count, int trainEvery, int* train, int* trainCount, int* test,
+                       int* testCount);
+
+// One engine of a fit over several engines (pd_toss_fit_engines).
+typedef struct pdTossFitEngine {
+  const char* label;    // soft, ode-native, ...: messages, progress
+  const char* variant;  // implicit, native, matched, shift1
+  pdTossEngine engine;
+  pdTossParams start;
+  bool built;           // this build has its adapter
+  bool fit;             // fitted (false: not built, or the noise floor, which has no parameters)
+  bool fitStiffness;    // k_n too (the soft engine, and the matched variants)
+} pdTossFitEngine;
+
+// Fits each engine with fit set (pd_toss_fit with `common`'s set, training tosses, budget, workers, progress and
+// trace; its engine, start and fitStiffness are each engine's), in order. results[e] is zero and fitted[e] its
+// start for an engine not fitted. `started` (nullable) is called before each fit, with the engine. Returns false
+// with a message in `why` when a fit was stopped.
+bool pd_toss_fit_engines(const pdTossFitOptions* common, const pdTossFitEngine* engines, int count,
+                         void (*started)(const pdTossFitEngine* engine, void* user), void* user,
+                         pdTossFitResult* results, pdTossParams* fitted, char* why, size_t whySize);
+
+// fit.csv: its header and one row per engine (status ok, not built or no parameters; what was fitted, the
+// fitted values and objective, the split's sizes and the start).
+void pd_toss_fit_csv(FILE* out, const pdTossFitEngine* engines, int count, const pdTossFitResult* results,
+                     int trainCount, int trainEvery, int testCount);

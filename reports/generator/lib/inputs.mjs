@@ -332,9 +332,14 @@ export const TOSS_SUMMARY_HEADER = ['engine', 'variant', 'params', 'split', 'sta
   'mean', 'median', 'p90'];
 export const PER_TOSS_HEADER = ['toss', 'split', 'engine', 'variant', 'params', 'status', 'samples', 'duration_s', 'pos_err_end',
   'pos_err_rms', 'rot_err_end_rad', 'rot_err_rms_rad', 'wall_seconds', 'cpu_seconds', 'steps', 'run_dir', 'message'];
-export const FIT_HEADER = ['engine', 'variant', 'status', 'fitted', 'mu', 'restitution', 'kn', 'objective_train',
+// Planar experiments (the planar drops) add their bounces after the pose errors.
+export const IMPACT_FIELDS = [1, 2, 3].flatMap((k) => [`impact${k}_dt_s`, `impact${k}_dv`, `impact${k}_dw`]);
+export const PER_TOSS_HEADER_PLANAR = [...PER_TOSS_HEADER.slice(0, 12), 'impacts_record', 'impacts_run', ...IMPACT_FIELDS,
+  ...PER_TOSS_HEADER.slice(12)];
+const FIT_HEADER_POSE = ['engine', 'variant', 'status', 'fitted', 'mu', 'restitution', 'kn', 'objective_train',
   'pos_err_end_mean_train', 'rot_err_end_mean_train_rad', 'failed_train', 'evaluations', 'converged', 'train_tosses',
   'train_every', 'test_tosses', 'start_mu', 'start_restitution', 'start_kn', 'start_objective_train'];
+export const FIT_HEADER = [...FIT_HEADER_POSE, 'bounce_dv_mean_train'];
 const TOSS_SPLITS = ['all', 'train', 'test'];
 const TOSS_SUMMARY_STATUSES = ['ok', 'partial', 'failed', 'not built'];
 const TOSS_STATUSES = ['ok', 'failed', 'refused', 'not built'];
@@ -353,15 +358,19 @@ function exists(file) {
 // committed reports/cubetoss/ there), or DIR itself when it is what `polydyn cubetoss --out DIR` wrote
 // (per_toss.csv and summary.csv). Reads summary.csv, per_toss.csv, fit.csv and the provenance lines of
 // README.md (scripts/cubetoss-all writes them) when present; null when there are no cube-toss results.
-// `at` is the directory relative to DIR ('cubetoss' or '.').
-export function readCubetoss(dir) {
+// `at` is the directory relative to DIR ('cubetoss' or '.'). With `sub` ('planar-drops') only DIR/sub/ is
+// read. `planar`: the results hold bounces (per_toss.csv of the planar drops).
+export function readCubetoss(dir, sub = null) {
   let at;
-  if (fs.existsSync(path.join(dir, 'cubetoss'))) at = 'cubetoss';
+  if (sub) {
+    if (!fs.existsSync(path.join(dir, sub))) return null;
+    at = sub;
+  } else if (fs.existsSync(path.join(dir, 'cubetoss'))) at = 'cubetoss';
   else if (exists(path.join(dir, 'per_toss.csv')) && exists(path.join(dir, 'summary.csv'))) at = '.';
   else return null;
-  const sub = path.join(dir, at);
-  const summarySrc = readText(sub, 'summary.csv');
-  if (!summarySrc) throw new InputError(path.join(sub, 'summary.csv'), 0, 'missing (a cube-toss directory needs the summary.csv of polydyn cubetoss)');
+  const where = path.join(dir, at);
+  const summarySrc = readText(where, 'summary.csv');
+  if (!summarySrc) throw new InputError(path.join(where, 'summary.csv'), 0, 'missing (a cube-toss directory needs the summary.csv of polydyn cubetoss)');
   const summary = [];
   for (const { line, f } of table(summarySrc, TOSS_SUMMARY_HEADER)) {
     const file = summarySrc.file;
@@ -386,11 +395,11 @@ export function readCubetoss(dir) {
   }
   if (!summary.length) throw new InputError(summarySrc.file, 1, 'no rows');
 
-  let perToss = null;
-  const perSrc = readText(sub, 'per_toss.csv');
+  let perToss = null, planar = summary.some((r) => r.quantity.startsWith('impact'));
+  const perSrc = readText(where, 'per_toss.csv');
   if (perSrc) {
     perToss = [];
-    for (const { line, f } of table(perSrc, PER_TOSS_HEADER)) {
+    for (const { line, f } of table(perSrc, PER_TOSS_HEADER, [PER_TOSS_HEADER_PLANAR])) {
       const file = perSrc.file;
       const row = {
         line,
@@ -406,6 +415,11 @@ export function readCubetoss(dir) {
       for (const h of ['samples', 'steps']) row[h] = number(f[h], h, file, line, { integer: true });
       for (const h of ['duration_s', 'pos_err_end', 'pos_err_rms', 'rot_err_end_rad', 'rot_err_rms_rad', 'wall_seconds', 'cpu_seconds'])
         row[h] = number(f[h], h, file, line);
+      if ('impacts_record' in f) {
+        planar = true;
+        for (const h of ['impacts_record', 'impacts_run']) row[h] = number(f[h], h, file, line, { integer: true });
+        for (const h of IMPACT_FIELDS) row[h] = number(f[h], h, file, line);
+      }
       if (row.status === 'ok' && !(Number.isFinite(row.pos_err_end) && Number.isFinite(row.rot_err_end_rad)))
         throw new InputError(file, line, 'status ok needs finite pos_err_end and rot_err_end_rad');
       row.ev = `${row.engine} ${row.variant}`;
@@ -414,13 +428,15 @@ export function readCubetoss(dir) {
   }
 
   let fit = null;
-  const fitSrc = readText(sub, 'fit.csv');
+  const fitSrc = readText(where, 'fit.csv');
   if (fitSrc) {
     fit = [];
-    for (const { line, f } of table(fitSrc, FIT_HEADER)) {
+    for (const { line, f } of table(fitSrc, FIT_HEADER, [FIT_HEADER_POSE])) {
       const file = fitSrc.file;
       const row = { line, engine: word(f.engine, 'engine', file, line), variant: word(f.variant, 'variant', file, line),
-        status: oneOf(f.status, ['ok', 'not built'], 'status', file, line), fitted: f.fitted.split(';').filter((x) => x !== '') };
+        status: oneOf(f.status, ['ok', 'not built', 'no parameters'], 'status', file, line),
+        fitted: f.fitted.split(';').filter((x) => x !== '') };
+      row.bounce_dv_mean_train = 'bounce_dv_mean_train' in f ? number(f.bounce_dv_mean_train, 'bounce_dv_mean_train', file, line) : null;
       if (f.converged !== '' && f.converged !== 'true' && f.converged !== 'false')
         throw new InputError(file, line, `converged: expected true, false or empty, found '${f.converged}'`);
       row.converged = f.converged === '' ? null : f.converged === 'true';
@@ -434,14 +450,14 @@ export function readCubetoss(dir) {
   }
 
   const provenance = {};
-  const readme = readText(sub, 'README.md');
+  const readme = readText(where, 'README.md');
   if (readme) {
     for (const l of readme.text.split('\n')) {
       const m = PROVENANCE.exec(l.trimEnd());
       if (m && !(m[1] in provenance)) provenance[m[1]] = m[2].replace(/`/g, '');
     }
   }
-  return { at, file: summarySrc.file, summary, perToss, fit, provenance, readme: readme ? readme.file : null };
+  return { at, file: summarySrc.file, summary, perToss, fit, provenance, readme: readme ? readme.file : null, planar };
 }
 
 export const TRAJECTORY_HEADER = ['t', 'body', 'x', 'y', 'z', 'qw', 'qx', 'qy', 'qz', 'vx', 'vy', 'vz', 'wx', 'wy', 'wz'];

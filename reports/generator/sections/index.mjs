@@ -16,6 +16,6 @@ import cost from './cost.mjs';
 import compare from './compare.mjs';
 import experiments from './experiments.mjs';
 import parameters from './parameters.mjs';
-import cubetoss from './cubetoss.mjs';
+import cubetoss, { planarDrops } from './cubetoss.mjs';
 
-export const sections = [summary, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, experiments, parameters];
+export const sections = [summary, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, planarDrops, experiments, parameters];
