@@ -85,8 +85,9 @@ static void scene_error(const char* text, char* out, size_t size) {
 static bool run_in(const char* engine, const pdModel* m, bool aligned, trace* tr) {
   tr->n = 0;
   if (strncmp(engine, "soft", 4) == 0) {
-    pdState* s = pd_state_create(m);
-    if (strcmp(engine, "soft-pair") == 0) s->onsets = pd_onsetsPair;
+    pdStateOptions o = pd_state_options_default();
+    if (strcmp(engine, "soft-pair") == 0) o.onsets = pd_onsetsPair;
+    pdState* s = pd_state_create(m, &o);
     assert_true(pd_advance(m, s, m->settings.tend, observe, tr));
     pd_state_free(s);
     return true;
