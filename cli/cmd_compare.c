@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "compare_files.h"
 #include "polydyn/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/output.h"
@@ -54,9 +55,12 @@ typedef struct compareRun {
   const char* engine;
   const char* variant;
   bool isReference;
+  bool isChaos;  // the reference repeated at a perturbed tolerance: the scene's own divergence
   const char* status;  // ok, failed, refused, not built
   char message[512];
   pdTrajectory* trajectory;
+  pdContactLog* contacts;  // the soft engine's contacts per sample
+  pdDivergence divergence;
   double wallSeconds;
   long steps;
   pdCompareMetrics metrics;  // when status is ok
@@ -66,12 +70,13 @@ typedef struct compareRun {
 typedef struct softObserver {
   pdRunWriter* writer;
   pdTrajectory* trajectory;
+  pdContactLog* contacts;
 } softObserver;
 
 static bool observe_soft(const pdModel* model, const pdState* state, void* user) {
   softObserver* o = user;
   return pd_run_observe(model, state, o->writer) && pd_trajectory_observe(model, state, o->trajectory) &&
-         !pd_cli_interrupted;
+         pd_contact_log_observe(model, state, o->contacts) && !pd_cli_interrupted;
 }
 
 static bool observe_reference(const pdModel* model, const pdState* state, void* user) {
@@ -117,7 +122,8 @@ static void run_soft(const char* scene, const pdCliOverrides* overrides, const c
   }
   pdState* state = pd_state_create(model);
   r->trajectory = pd_trajectory_create(model);
-  softObserver o = {writer, r->trajectory};
+  r->contacts = pd_contact_log_create(model);
+  softObserver o = {writer, r->trajectory, r->contacts};
   double e0 = pd_state_energy(model, state), t0 = pd_cli_wall_seconds();
   bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
   pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
@@ -189,7 +195,7 @@ static void write_metric_rows(FILE* out, const char* scene, const pdModel* model
   double simulated = model->settings.tend;
   for (int i = 0; i < count; ++i) {
     const compareRun* r = &runs[i];
-    if (strcmp(r->status, "ok") != 0) continue;
+    if (strcmp(r->status, "ok") != 0 || r->isChaos) continue;
     const pdCompareMetrics m = r->metrics;
     fprintf(out, "\"%s\",%s,%s,%s,", scene, r->engine, r->variant, r->isReference ? "self" : refName);
     const double values[] = {m.posErrFinal, m.posErrRms, m.rotErrFinal, m.rotErrRms, m.energyDriftRel,
@@ -234,10 +240,17 @@ static bool write_results(const char* dir, const char* scene, const pdModel* mod
   return fclose(out) == 0 && ok;
 }
 
+// A column of the terminal table: the number, or "—" where it does not apply (printf pads bytes, and the
+// dash is three of them).
+static void table_cell(FILE* out, int width, double v, const char* format) {
+  if (isfinite(v)) fprintf(out, format, width, v);
+  else fprintf(out, " %*s—", width - 1, "");
+}
+
 // The table a person reads first (stdout).
 static void write_table(FILE* out, const pdModel* model, const compareRun* runs, int count) {
-  fprintf(out, "%-16s %-8s %12s %12s %12s %14s\n", "run", "status", "pos err end", "rot err end", "energy drift",
-          "wall/sim s");
+  fprintf(out, "%-16s %-8s %12s %12s %12s %14s %12s %12s\n", "run", "status", "pos err end", "rot err end", "energy drift",
+          "wall/sim s", "diverges s", "beyond chaos");
   for (int i = 0; i < count; ++i) {
     const compareRun* r = &runs[i];
     if (strcmp(r->status, "ok") != 0) {
@@ -245,8 +258,15 @@ static void write_table(FILE* out, const pdModel* model, const compareRun* runs,
       continue;
     }
     const pdCompareMetrics m = r->metrics;
-    fprintf(out, "%-16s %-8s %12.3g %12.3g %12.3g %14.3g\n", r->name, r->status, m.posErrFinal, m.rotErrFinal,
-            m.energyDriftRel, r->wallSeconds / model->settings.tend);
+    const pdDivergence d = r->divergence;
+    fprintf(out, "%-16s %-8s", r->name, r->status);
+    table_cell(out, 12, m.posErrFinal, " %*.3g");
+    table_cell(out, 12, m.rotErrFinal, " %*.3g");
+    table_cell(out, 12, m.energyDriftRel, " %*.3g");
+    table_cell(out, 14, r->wallSeconds / model->settings.tend, " %*.3g");
+    table_cell(out, 12, d.diverged ? d.t : NAN, " %*.3g");
+    table_cell(out, 12, !r->isChaos && d.diverged ? d.beyondChaos : NAN, " %*.3g");
+    fputc('\n', out);
   }
 }
 
@@ -277,7 +297,7 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
     pd_batch_append(result, &h, sizeof h);
     return;
   }
-  compareRun runs[8];
+  compareRun runs[8];  // the reference, the chaos run, soft, ODE and Bullet in two variants each
   int count = 0;
   pdCliOverrides tighter = c->overrides;
   tighter.tolScale = COMPARE_REFERENCE_TOL_SCALE;
@@ -285,6 +305,11 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
   // the reference first: every other run is measured against it
   runs[count] = (compareRun){.engine = "soft", .variant = "reference", .isReference = true, .status = "failed"};
   snprintf(runs[count].name, sizeof runs[count].name, "soft-reference");
+  ++count;
+  pdCliOverrides perturbed = tighter;
+  perturbed.tolScale = COMPARE_REFERENCE_TOL_SCALE * PD_COMPARE_CHAOS_TOL_SCALE;
+  runs[count] = (compareRun){.engine = "soft", .variant = "chaos", .isChaos = true, .status = "failed"};
+  snprintf(runs[count].name, sizeof runs[count].name, "soft-chaos");
   ++count;
   if (pd_cli_list_has(c->engines, "soft")) {
     runs[count] = (compareRun){.engine = "soft", .variant = "implicit", .status = "failed"};
@@ -307,7 +332,7 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
     snprintf(runDir, sizeof runDir, "%s/%s", runsDir, r->name);
     if (c->progress) fprintf(stderr, "\rpolydyn compare: %s %s (%d/%d)\033[K", scene, r->name, i + 1, count);
     if (strcmp(r->engine, "soft") == 0) {
-      run_soft(scene, r->isReference ? &tighter : &c->overrides, runDir, r);
+      run_soft(scene, r->isReference ? &tighter : r->isChaos ? &perturbed : &c->overrides, runDir, r);
       continue;
     }
     const pdRefAdapter* adapter = pd_ref_adapter(r->engine);
@@ -337,13 +362,27 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
                                            reference && reference != &runs[i] ? reference->trajectory : NULL);
   char refName[64];
   snprintf(refName, sizeof refName, "soft tol=%g", tolReference);
+  bool detailsWritten = true;
+  if (reference) {  // series, impacts, friction and divergence: against the reference, the chaos run beside it
+    pdCompareRunData data[8];
+    pdDivergence divergences[8];
+    int index[8], n = 0, chaos = -1;
+    for (int i = 0; i < count; ++i) {
+      if (strcmp(runs[i].status, "ok") != 0) continue;
+      if (runs[i].isChaos) chaos = n;
+      index[n] = i;
+      data[n++] = (pdCompareRunData){runs[i].engine, runs[i].variant, runs[i].trajectory, runs[i].contacts};
+    }
+    detailsWritten = pd_compare_write_details(dir, scene, model, data, n, chaos, divergences);
+    for (int i = 0; i < n; ++i) runs[index[i]].divergence = divergences[i];
+  }
   char* rows = NULL;
   char* table = NULL;
   size_t rowsSize = 0, tableSize = 0;
   FILE* rowsOut = open_memstream(&rows, &rowsSize);
   FILE* tableOut = open_memstream(&table, &tableSize);
   if (!rowsOut || !tableOut) abort();
-  if (write_results(dir, scene, model, runs, count, refName)) {
+  if (detailsWritten && write_results(dir, scene, model, runs, count, refName)) {
     write_metric_rows(rowsOut, scene, model, runs, count, refName);
     write_table(tableOut, model, runs, count);
   } else {
@@ -359,7 +398,10 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
   pd_batch_append(result, table, tableSize);
   free(rows);
   free(table);
-  for (int i = 0; i < count; ++i) pd_trajectory_free(runs[i].trajectory);
+  for (int i = 0; i < count; ++i) {
+    pd_trajectory_free(runs[i].trajectory);
+    pd_contact_log_free(runs[i].contacts);
+  }
 }
 
 // The scenes of one command: one file, or every NAME.scene of a directory (in byte order of the names).
