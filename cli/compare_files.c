@@ -119,7 +119,7 @@ static const char* verdict(const pdDivergence* d, bool isChaos) {
 static void write_divergence_row(FILE* out, const char* scene, const pdModel* model, const pdCompareRunData* run,
                                  const pdDivergence* d, double horizon, bool isChaos, bool chaosKnown) {
   pd_csv_text(out, scene);
-  fprintf(out, ",%s,%s,%g,", run->engine, run->variant, PD_COMPARE_DIVERGENCE_THRESHOLD);
+  fprintf(out, ",%s,%s,%g,%g,", run->engine, run->variant, PD_COMPARE_DIVERGENCE_THRESHOLD, PD_COMPARE_CHAOS_FACTOR);
   if (d->diverged) {
     fprintf(out, "%.9g,", d->t);
     pd_csv_text(out, body_name(model, d->body));
@@ -175,7 +175,7 @@ bool pd_compare_write_details(const char* dir, const char* scene, const pdModel*
   if (!close_checked(out, ok)) return false;
 
   if (!(out = open_in(dir, "divergence.csv"))) return false;
-  fputs("scene,engine,variant,threshold,first_t,first_body,first_kind,first_error,chaos_horizon,beyond_chaos_from,"
+  fputs("scene,engine,variant,threshold,chaos_factor,first_t,first_body,first_kind,first_error,chaos_horizon,beyond_chaos_from,"
         "verdict\n", out);
   for (int i = 1; i < count; ++i)
     write_divergence_row(out, scene, model, &runs[i], &divergences[i], horizon, i == chaos, chaos > 0);

@@ -101,13 +101,6 @@ static double speed_change(const pdModel* model, const pdTrajectory* run, long s
   return pd_v3_norm(pd_v3_sub(dv, pd_v3_scale(model->settings.gravity, dt)));
 }
 
-// Velocity of body (model index) at sample s (a fixed body: zero), and its acceleration in free flight.
-static pdVec3 velocity_of(const pdModel* model, const pdTrajectory* run, long s, int body, pdVec3* accel) {
-  const pdBody* b = &model->bodies[body];
-  *accel = b->fixed ? (pdVec3){0, 0, 0} : model->settings.gravity;
-  return b->fixed ? (pdVec3){0, 0, 0} : pd_trajectory_sample(run, s, b->stateIndex)->v;
-}
-
 // The smallest τ >= 0 with gap + speed τ + accel τ²/2 = 0, at most `longest`; `longest` when there is none
 // in between.
 static double time_to_close(double gap, double speed, double accel, double longest) {
@@ -126,12 +119,43 @@ static double time_to_close(double gap, double speed, double accel, double longe
   return fmin(tau, longest);
 }
 
-// Relative velocity of bodyA to bodyB at sample s moved in free flight by `dt` (s, either sign), and the gap
-// between them along n (m) at s.
-static pdVec3 relative_velocity(const pdModel* model, const pdTrajectory* run, long s, int bodyA, int bodyB,
+// Where the pair touches at sample s: the centroid of the smaller body's vertices within
+// PD_IMPACT_FEATURE_SPAN of its size of its support towards the other (the vertex, edge or face that lands).
+static pdVec3 touch_point(const pdModel* model, const pdTrajectory* run, long s, int bodyA, int bodyB, pdVec3 n) {
+  bool smallerA = model->bodies[bodyA].size <= model->bodies[bodyB].size;
+  int body = smallerA ? bodyA : bodyB;
+  pdVec3 towards = smallerA ? pd_v3_scale(n, -1.0) : n;  // n points from B into A
+  const pdBody* b = &model->bodies[body];
+  pdMat3 R;
+  pdVec3 x = pd_trajectory_body_position(model, run, s, body, &R);
+  double most = -INFINITY;
+  for (int i = 0; i < b->shape.vertexCount; ++i)
+    most = fmax(most, pd_v3_dot(pd_mat3_mulv(&R, b->shape.vertices[i]), towards));
+  pdVec3 sum = {0, 0, 0};
+  int count = 0;
+  for (int i = 0; i < b->shape.vertexCount; ++i) {
+    pdVec3 r = pd_mat3_mulv(&R, b->shape.vertices[i]);
+    if (pd_v3_dot(r, towards) >= most - PD_IMPACT_FEATURE_SPAN * b->size) sum = pd_v3_add(sum, r), ++count;
+  }
+  return pd_v3_add(x, pd_v3_scale(sum, 1.0 / count));
+}
+
+// Velocity of body (model index)'s material point at p, sample s (a fixed body: zero), and its acceleration in
+// free flight.
+static pdVec3 velocity_of(const pdModel* model, const pdTrajectory* run, long s, int body, pdVec3 p, pdVec3* accel) {
+  const pdBody* b = &model->bodies[body];
+  *accel = b->fixed ? (pdVec3){0, 0, 0} : model->settings.gravity;
+  if (b->fixed) return (pdVec3){0, 0, 0};
+  const pdBodyState* st = pd_trajectory_sample(run, s, b->stateIndex);
+  return pd_v3_add(st->v, pd_v3_cross(st->w, pd_v3_sub(p, st->x)));
+}
+
+// Relative velocity of bodyA to bodyB at their touching point at sample s, and their relative acceleration in
+// free flight.
+static pdVec3 relative_velocity(const pdModel* model, const pdTrajectory* run, long s, int bodyA, int bodyB, pdVec3 n,
                                 pdVec3* accel) {
-  pdVec3 ga, gb;
-  pdVec3 v = pd_v3_sub(velocity_of(model, run, s, bodyA, &ga), velocity_of(model, run, s, bodyB, &gb));
+  pdVec3 p = touch_point(model, run, s, bodyA, bodyB, n), ga, gb;
+  pdVec3 v = pd_v3_sub(velocity_of(model, run, s, bodyA, p, &ga), velocity_of(model, run, s, bodyB, p, &gb));
   *accel = pd_v3_sub(ga, gb);
   return v;
 }
@@ -174,12 +198,12 @@ static void add_impact(const pdModel* model, const pdTrajectory* run, int k, lon
   pdVec3 n = body == bodyA ? pd_v3_scale(axis, -1.0) : axis;
   // free flight up to the contact and from the separation: the speeds the impact met and left behind
   pdVec3 accel;
-  pdVec3 v0 = relative_velocity(model, run, first, bodyA, bodyB, &accel);
-  pdVec3 v1 = relative_velocity(model, run, last + 1, bodyA, bodyB, &accel);
+  pdVec3 v0 = relative_velocity(model, run, first, bodyA, bodyB, n, &accel);
+  pdVec3 v1 = relative_velocity(model, run, last + 1, bodyA, bodyB, n, &accel);
   double an = pd_v3_dot(accel, n), span = run->t[last + 1] - run->t[first];
   double toContact = time_to_close(gap_at(model, run, first, bodyA, bodyB), pd_v3_dot(v0, n), an, span);
-  double sinceSeparation = time_to_close(gap_at(model, run, last + 1, bodyA, bodyB), -pd_v3_dot(v1, n), an,
-                                         span - toContact);
+  double gapAfter = gap_at(model, run, last + 1, bodyA, bodyB);
+  double sinceSeparation = time_to_close(gapAfter, -pd_v3_dot(v1, n), an, span - toContact);
   pdVec3 before = pd_v3_add(v0, pd_v3_scale(accel, toContact));
   pdVec3 after = pd_v3_sub(v1, pd_v3_scale(accel, sinceSeparation));
   double t = run->t[first] + toContact;
@@ -194,7 +218,9 @@ static void add_impact(const pdModel* model, const pdTrajectory* run, int k, lon
                                .bodyB = bodyB,
                                .vnBefore = vnBefore,
                                .vnAfter = vnAfter,
-                               .restitution = vnBefore < 0.0 ? -vnAfter / vnBefore : NAN,
+                               .restitution = -vnBefore > PD_IMPACT_MIN_APPROACH_SHARE * pd_v3_norm(change)
+                                                  ? -vnAfter / vnBefore
+                                                  : NAN,
                                .restitutionRequested = pd_model_pair_contact(model, bodyA, bodyB).restitution,
                                .tangentialChange = pd_v3_norm(tangential),
                                .match = -1});

@@ -14,9 +14,11 @@
 //   least PD_IMPACT_MIN_SPEED_CHANGE), consecutive such intervals one impact; its partner the body
 //   deepest into it (or nearest) by the separating-axis test at the interval of the largest change, the
 //   normal that test's axis, from body_b into body_a (body_a < body_b in scene order). Normal and
-//   tangential speeds are those of the centres of mass relative to each other (exact for bodies that do
-//   not spin), before at the first sample of the impact and after at the first sample past it, each moved
-//   by gravity to the impact's time (the middle of its largest change).
+//   tangential speeds are those of the bodies' material points at the touching point (the centroid of the
+//   smaller body's vertices that lead towards the other), before at the first sample of the impact and
+//   after at the first sample past it, each moved
+//   back or on in free flight to the moment of contact and of separation (from the gap the separating-axis
+//   test gives at those samples).
 // - Contact tallies come from a run's contact reports (the soft engine's pd_state_contact): per moving body
 //   and sample, the contacts it takes part in, the sum of their normal forces (N) and the largest slip speed
 //   of its sliding contacts (m/s; NAN when none slides). Slip speed: |tangential part of the contact
@@ -42,6 +44,12 @@
 // (μ ≤ 1): twice |g| dt is an impact. In a scene without gravity a speed change of 1 mm/s is.
 #define PD_IMPACT_SPEED_CHANGE_OVER_G 2.0
 #define PD_IMPACT_MIN_SPEED_CHANGE 1e-3
+// A restitution is given only where the bodies approached at least at this share of the impact's change of
+// relative velocity ((1 + e) times the approach for a collision of the two): a smaller approach means another
+// body changed the speed (a pile's neighbours), and −v_after/v_before would be noise over a tiny number.
+#define PD_IMPACT_MIN_APPROACH_SHARE 0.1
+// The vertices of the feature that lands lie this close (a share of the body's size) to its support plane.
+#define PD_IMPACT_FEATURE_SPAN 1e-3
 // Impacts of two runs are the same impact when their bodies agree and their times lie this close, s:
 // a few samples at the usual rates, well below the time between a bouncing body's impacts.
 #define PD_IMPACT_MATCH_WINDOW 0.05
@@ -80,7 +88,7 @@ typedef struct pdImpact {
   double t;                       // s
   int bodyA, bodyB;               // model indices, bodyA < bodyB
   double vnBefore, vnAfter;       // m/s, relative normal speed (< 0 approaching)
-  double restitution;             // −vnAfter / vnBefore; NAN when the bodies did not approach
+  double restitution;             // −vnAfter / vnBefore; NAN when they hardly approached (see above)
   double restitutionRequested;    // the pair's e (pd_model_pair_contact)
   double tangentialChange;        // m/s, |change of the relative tangential velocity|
   int match;                      // index of the same impact in the reference's list, −1 when none
