@@ -183,15 +183,23 @@ static void push_impact(impactList* list, pdImpact impact) {
 static void add_impact(const pdModel* model, const pdTrajectory* run, int k, long first, long last, long peak,
                        impactList* list) {
   int body = model->movingBodies[k];
-  int partner = -1;
-  double deepest = -INFINITY;
-  pdVec3 axis = {0, 0, 1};
+  // the partner: of the bodies touching it, the one that came at it fastest (a domino resting on the floor is
+  // hit by its neighbour, not by the floor); the deepest when none approached
+  int partner = -1, fastest = -1;
+  double deepest = -INFINITY, fastestSpeed = 0.0;
+  pdVec3 axis = {0, 0, 1}, fastestAxis = axis;
   for (int j = 0; j < model->bodyCount; ++j) {
     if (j == body) continue;
     pdVec3 a;
     double p = pd_pair_penetration(model, run, peak + 1, body, j, &a);
     if (p > deepest) deepest = p, partner = j, axis = a;
+    if (p < -PD_IMPACT_TOUCH) continue;
+    int lo = body < j ? body : j, hi = body < j ? j : body;
+    pdVec3 n = body == lo ? pd_v3_scale(a, -1.0) : a, accel;
+    double approach = -pd_v3_dot(relative_velocity(model, run, first, lo, hi, n, &accel), n);
+    if (approach > fastestSpeed) fastestSpeed = approach, fastest = j, fastestAxis = a;
   }
+  if (fastest >= 0) partner = fastest, axis = fastestAxis;
   if (partner < 0) return;  // a body alone: nothing to hit (an applied force changed its speed)
   int bodyA = body < partner ? body : partner, bodyB = body < partner ? partner : body;
   // the axis runs from `body` to `partner`; the normal from bodyB into bodyA

@@ -11,9 +11,9 @@
 //   e(t) > max(threshold, PD_COMPARE_CHAOS_FACTOR · c(t)).
 // - Impacts are found in trajectories alone (every engine alike): a moving body whose velocity changes
 //   over one sample interval by more than gravity can explain (PD_IMPACT_SPEED_CHANGE_OVER_G · |g| dt, at
-//   least PD_IMPACT_MIN_SPEED_CHANGE), consecutive such intervals one impact; its partner the body
-//   deepest into it (or nearest) by the separating-axis test at the interval of the largest change, the
-//   normal that test's axis, from body_b into body_a (body_a < body_b in scene order). Normal and
+//   least PD_IMPACT_MIN_SPEED_CHANGE), consecutive such intervals one impact; its partner, of the bodies
+//   within PD_IMPACT_TOUCH of touching it just after its largest change (separating-axis test), the one
+//   that came at it fastest, or the deepest when none approached; the normal that test's axis, from body_b into body_a (body_a < body_b in scene order). Normal and
 //   tangential speeds are those of the bodies' material points at the touching point (the centroid of the
 //   smaller body's vertices that lead towards the other), before at the first sample of the impact and
 //   after at the first sample past it, each moved
@@ -48,6 +48,9 @@
 // relative velocity ((1 + e) times the approach for a collision of the two): a smaller approach means another
 // body changed the speed (a pile's neighbours), and −v_after/v_before would be noise over a tiny number.
 #define PD_IMPACT_MIN_APPROACH_SHARE 0.1
+// Bodies this close (over the smaller size) or overlapping touch, for the choice of an impact's partner: a
+// contact's deflection is at most a hundredth of the size (the scene's deflection setting).
+#define PD_IMPACT_TOUCH 0.01
 // The vertices of the feature that lands lie this close (a share of the body's size) to its support plane.
 #define PD_IMPACT_FEATURE_SPAN 1e-3
 // Impacts of two runs are the same impact when their bodies agree and their times lie this close, s:
