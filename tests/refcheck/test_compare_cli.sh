@@ -78,5 +78,42 @@ mkdir "$SCRATCH/empty"
 "$PD" compare "$SCRATCH/empty" --out "$SCRATCH/none" >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "a directory without scenes: exit 2, says so" '[ $rc -eq 2 ] && grep -q "no NAME.scene" "$SCRATCH/err" && [ ! -e "$SCRATCH/none" ]'
 
+# where, when and why (docs/compare-report.md): a cube dropped 0.5 m flat onto a floor (e = 0.5), named with a
+# quote and a comma; soft runs only (the reference, its chaos run and the default tolerance)
+BOUNCE=$SCRATCH/bounce.scene
+printf 'tend 0.7\nsample 100\ncube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nrestitution 0.5\ncube b"ox,1 red 0.2 0.2 0.2\nloc 0 0 0.6\nrestitution 0.5\n' >"$BOUNCE"
+"$PD" compare "$BOUNCE" --out "$SCRATCH/bounce" --engines soft >"$SCRATCH/stdout" 2>"$SCRATCH/err"; rc=$?
+check "bounce: exit 0, the four files beside metrics.csv" '[ $rc -eq 0 ] && for f in series impacts friction divergence; do [ -f "$SCRATCH/bounce/$f.csv" ] || exit 1; done'
+check "the terminal table prints — where a value does not apply (the reference's own error)" \
+  'grep -q "^soft-reference *ok *— *—" "$SCRATCH/stdout"'
+python3 - "$SCRATCH/bounce" <<'PY'; rc=$?
+import csv, json, math, sys
+d = sys.argv[1]
+mass = [b["mass"] for b in json.load(open(f"{d}/runs/soft-reference/summary.json"))["bodies"] if b["name"] == 'b"ox,1'][0]
+rows = lambda name: list(csv.DictReader(open(f"{d}/{name}.csv", newline="")))
+imp = rows("impacts")
+assert list(imp[0].keys()) == "scene,engine,variant,impact,body_a,body_b,t,vn_before,vn_after,restitution,restitution_requested,tangential_speed_change,reference_impact".split(","), imp[0].keys()
+# the quoted name reads back whole (RFC 4180)
+assert all(r["body_a"] == "floor" and r["body_b"] == 'b"ox,1' for r in imp), imp[0]
+first = {r["variant"]: r for r in imp if r["impact"] == "0"}
+# free fall of 0.5 m: |v_n| = sqrt(2 g h) at contact (the reference within 1e-3 m/s)
+assert abs(float(first["reference"]["vn_before"]) + math.sqrt(2 * 9.81 * 0.5)) < 1e-3, first["reference"]
+# the soft model's restitution is the requested one (eq. 15: within 1e-2 at this sample rate), matched to the reference's impact
+for v in ("reference", "implicit"):
+    assert abs(float(first[v]["restitution"]) - 0.5) < 1e-2 and first[v]["restitution_requested"] == "0.5" and first[v]["reference_impact"] == "0", first[v]
+# every impact of the soft run found in the reference: bounces alike to 1e-2 s
+assert all(r["reference_impact"] != "" for r in imp), [r for r in imp if r["reference_impact"] == ""]
+div = {r["variant"]: r for r in rows("divergence")}
+assert div["chaos"]["verdict"] == "own_divergence" and div["implicit"]["verdict"] == "agrees" and div["implicit"]["first_t"] == "", div
+ser = rows("series")
+# every run, every sample (0.7 s at 100 /s: 71), the one moving body; the soft runs report contacts
+for v in ("reference", "chaos", "implicit"):
+    mine = [r for r in ser if r["variant"] == v]
+    assert len(mine) == 71 and all(r["body"] == 'b"ox,1' for r in mine), (v, len(mine))
+    assert max(int(r["contacts"]) for r in mine) >= 4, v  # a flat landing: the four bottom corners
+    assert max(float(r["normal_force"]) for r in mine) > 2 * mass * 9.81, v  # an impact pushes harder than the weight
+PY
+check "impacts.csv, divergence.csv and series.csv: documented header, quoted name, e = 0.5 ± 0.01 matched, verdicts" '[ $rc -eq 0 ]'
+
 echo "test_compare_cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
