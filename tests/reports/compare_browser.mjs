@@ -73,12 +73,13 @@ try {
     const svg = el.querySelector('svg');
     return { id: el.id, marks: svg ? svg.querySelectorAll('path, text').length : 0 };
   }));
-  check(charts.length >= 8 && charts.every((c) => c.marks >= 10), `every chart drew (${charts.length}; blank: ${charts.filter((c) => c.marks < 10).map((c) => c.id).join(', ') || 'none'})`);
+  check(charts.length >= 6 && charts.every((c) => c.marks >= 10), `every chart drew (${charts.length}; blank: ${charts.filter((c) => c.marks < 10).map((c) => c.id).join(', ') || 'none'})`);
 
   // the body select switches the per-body charts to that body's data
   const switched = await page.evaluate(() => {
     const select = document.querySelector('select.pd-alt');
-    if (!select || select.options.length < 2) return null;
+    if (!select) return null;
+    if (select.options.length < 2) return { single: true };
     const id = select.dataset.charts.split(' ')[0];
     const chart = window.polydynReport.specs.find((s) => s.id === id).chart;
     const data = () => JSON.stringify(chart.getOption().series.map((s) => s.data));
@@ -89,7 +90,8 @@ try {
     const spec = window.polydynReport.specs.find((s) => s.id === id);
     return { changed: before !== after, matches: after === JSON.stringify(spec.alternatives[1].series.map((s) => s.data)) };
   });
-  check(switched && switched.changed && switched.matches, 'choosing another body redraws the per-body charts with its data');
+  if (switched && switched.single) console.log('# one moving body: no other body to choose');
+  else check(switched && switched.changed && switched.matches, 'choosing another body redraws the per-body charts with its data');
 
   // a first-divergence link opens the replay at that time, with that body selected, and the view draws
   const link = await page.evaluate(() => {

@@ -30,19 +30,22 @@ export function bodyOrder(d, engines) {
 }
 
 // What the impacts of `ev` say against the reference's: matched count, median restitution of both over the
-// matched ones that approached, requested e.
+// matched bounces, requested e.
 function impactClause(d, ev) {
   const ref = d.impacts.filter((r) => r.ev === REFERENCE);
   if (!ref.length) return null;
   const mine = d.impacts.filter((r) => r.ev === ev);
   const matched = mine.filter((r) => r.reference_impact !== null);
+  // bounces: the impacts whose restitution in the reference lies in [0, 1] (a domino pushing the next one
+  // along, or a pile's impacts that overlap, give numbers outside it that are no restitution)
+  const bounce = (x) => x.restitution !== null && x.restitution >= 0 && x.restitution <= 1;
   const pairs = matched.map((r) => [r, ref.find((x) => x.impact === r.reference_impact)])
-    .filter(([a, b]) => b && a.restitution !== null && b.restitution !== null);
+    .filter(([a, b]) => b && a.restitution !== null && bounce(b));
   const e = median(pairs.map(([a]) => a.restitution)), eRef = median(pairs.map(([, b]) => b.restitution));
   const req = median(pairs.map(([, b]) => b.restitution_requested).filter((x) => x !== null));
   let text = `${matched.length} of the reference’s ${ref.length} impacts found again`;
   if (mine.length > matched.length) text += ` (${mine.length - matched.length} more of its own)`;
-  if (e !== null) text += `, median restitution ${num(e)} where the reference has ${num(eRef)}${req !== null ? ` (requested ${num(req)})` : ''}`;
+  if (e !== null) text += `; on the ${pairs.length} bounce${pairs.length === 1 ? '' : 's'} of both, median restitution ${num(e)} where the reference has ${num(eRef)}${req !== null ? ` (requested ${num(req)})` : ''}`;
   return text;
 }
 

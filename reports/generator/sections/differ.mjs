@@ -146,9 +146,14 @@ export default {
     const bodies = bodyOrder(d, s.engines).slice(0, MAX_BODIES);
     if (bodies.length) {
       const options = bodies.map((b) => bodyCharts(ctx, d, b.body, runs));
-      const ids = [];
+      const ids = [], empty = [];
       let grid = '';
       for (let q = 0; q < options[0].length; ++q) {
+        // a quantity no run reports for any body (no sliding contact, say) gets a word instead of a blank chart
+        if (options.every((o) => !o[q].series.some((x) => x.data.some((p) => p[1] !== null)))) {
+          empty.push(options[0][q].yAxis.name);
+          continue;
+        }
         const div = ctx.chart(options[0][q], { height: 260, alternatives: options.map((o) => o[q]) });
         ids.push(/id="([^"]+)"/.exec(div)[1]);
         grid += div;
@@ -158,14 +163,15 @@ export default {
         `</select> — the worst first${bodies.length < s.bodyCount ? ` (the ${bodies.length} worst of ${s.bodyCount}; every body is in series.csv)` : ''}. ` +
         'Click a run in a legend to hide it. Dashed grey: the chaos run, the scene’s own divergence. Contacts, forces and slip speeds are those ' +
         'the engine reports (polydyn’s soft engine; ODE and Bullet report none to polydyn).</p>' +
-        `<div class="charts multi">${grid}</div>`;
+        `<div class="charts multi">${grid}</div>` +
+        (empty.length ? `<p class="muted">Not plotted, no run has any: ${esc(empty.join('; '))}.</p>` : '');
     }
 
     // impacts
     html += '<h3>Impacts</h3>' + impactsTable(d, s.engines);
 
     // friction cone
-    if (d.friction.length) {
+    if (d.friction.some((r) => r.ft > 1e-9 * r.fn)) {  // a flat bounce without friction has nothing to show
       const mus = pairMus(ctx);
       html += '<h3>Friction cone</h3><p>Every contact with a normal force (at most 4 000 per run, evenly taken): |F<sub>t</sub>|/F<sub>n</sub> ' +
         `against the slip speed of its point${mus.length ? `, the pairs’ μ dashed (${mus.join(', ')})` : ''}. A Coulomb cone puts sliding contacts ` +
