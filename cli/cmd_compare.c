@@ -159,8 +159,12 @@ static void run_reference_engine(const pdModel* model, const pdRefAdapter* adapt
     return;
   }
   r->trajectory = pd_trajectory_create(model);
+  r->contacts = pd_contact_log_create(model);
+  pdRefOptions o = *options;
+  o.contactObserver = pd_contact_log_add;
+  o.contactUser = r->contacts;
   pdRefRunStats stats;
-  bool ok = pd_ref_run(model, adapter, options, writer, observe_reference, r->trajectory, &stats, &err);
+  bool ok = pd_ref_run(model, adapter, &o, writer, observe_reference, r->trajectory, &stats, &err);
   r->wallSeconds = stats.wallSeconds;
   r->steps = stats.steps;
   if (!ok) {

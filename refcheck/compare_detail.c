@@ -8,6 +8,7 @@
 
 #include "compare_internal.h"
 #include "polydyn/error.h"
+#include "polydyn/refcheck.h"
 
 pdBodySample* pd_compare_body_samples(const pdModel* model, const pdTrajectory* run, const pdTrajectory* reference,
                                       const long* sampleIndex, long count) {
@@ -328,14 +329,8 @@ void pd_contact_log_free(pdContactLog* log) {
   free(log);
 }
 
-// Velocity of the material point at p of body (model index) at the state's time.
-static pdVec3 point_velocity(const pdModel* model, const pdState* state, int body, pdVec3 p) {
-  pdBodyState b = pd_state_body(model, state, body);
-  return pd_v3_add(b.v, pd_v3_cross(b.w, pd_v3_sub(p, b.x)));
-}
-
-bool pd_contact_log_observe(const pdModel* model, const pdState* state, void* user) {
-  pdContactLog* log = user;
+// The tallies of the next sample, zeroed.
+static pdContactTally* next_row(pdContactLog* log) {
   size_t m = (size_t)(log->movingCount > 0 ? log->movingCount : 1);
   if (log->samples == log->capacity) {
     log->capacity = log->capacity ? 2 * log->capacity : 256;
@@ -344,28 +339,47 @@ bool pd_contact_log_observe(const pdModel* model, const pdState* state, void* us
   }
   pdContactTally* row = &log->tallies[(size_t)log->samples * m];
   for (size_t k = 0; k < m; ++k) row[k] = (pdContactTally){0, 0.0, NAN};
+  return row;
+}
+
+static void add_contact(pdContactLog* log, pdContactTally* row, const pdModel* model, const pdState* state,
+                        const pdContactReport* c) {
+  pdVec3 rel = pd_v3_sub(pd_ref_point_velocity(model, state, c->bodyA, c->point),
+                         pd_ref_point_velocity(model, state, c->bodyB, c->point));
+  double slip = pd_v3_norm(pd_v3_sub(rel, pd_v3_scale(c->normal, pd_v3_dot(rel, c->normal))));
+  const int ends[2] = {c->bodyA, c->bodyB};
+  for (int e = 0; e < 2; ++e) {
+    int k = model->bodies[ends[e]].stateIndex;
+    if (k < 0) continue;
+    row[k].contacts += 1;
+    row[k].normalForce += c->fn;
+    if (c->slip) row[k].slipSpeed = isnan(row[k].slipSpeed) ? slip : fmax(row[k].slipSpeed, slip);
+  }
+  if (!(c->fn > 0.0)) return;
+  if (log->points == log->pointCapacity) {
+    log->pointCapacity = log->pointCapacity ? 2 * log->pointCapacity : 1024;
+    log->friction = realloc(log->friction, (size_t)log->pointCapacity * sizeof *log->friction);
+    if (!log->friction) abort();
+  }
+  log->friction[log->points++] = (pdFrictionPoint){state->t, c->bodyA, c->bodyB, c->fn, pd_v3_norm(c->ft), slip, c->slip};
+}
+
+bool pd_contact_log_observe(const pdModel* model, const pdState* state, void* user) {
+  pdContactLog* log = user;
+  pdContactTally* row = next_row(log);
   int count = pd_state_contact_count(state);
   for (int i = 0; i < count; ++i) {
     pdContactReport c = pd_state_contact(state, i);
-    pdVec3 rel = pd_v3_sub(point_velocity(model, state, c.bodyA, c.point), point_velocity(model, state, c.bodyB, c.point));
-    pdVec3 slipVelocity = pd_v3_sub(rel, pd_v3_scale(c.normal, pd_v3_dot(rel, c.normal)));
-    double slip = pd_v3_norm(slipVelocity);
-    const int ends[2] = {c.bodyA, c.bodyB};
-    for (int e = 0; e < 2; ++e) {
-      int k = model->bodies[ends[e]].stateIndex;
-      if (k < 0) continue;
-      row[k].contacts += 1;
-      row[k].normalForce += c.fn;
-      if (c.slip) row[k].slipSpeed = isnan(row[k].slipSpeed) ? slip : fmax(row[k].slipSpeed, slip);
-    }
-    if (!(c.fn > 0.0)) continue;
-    if (log->points == log->pointCapacity) {
-      log->pointCapacity = log->pointCapacity ? 2 * log->pointCapacity : 1024;
-      log->friction = realloc(log->friction, (size_t)log->pointCapacity * sizeof *log->friction);
-      if (!log->friction) abort();
-    }
-    log->friction[log->points++] = (pdFrictionPoint){state->t, c.bodyA, c.bodyB, c.fn, pd_v3_norm(c.ft), slip, c.slip};
+    add_contact(log, row, model, state, &c);
   }
   ++log->samples;
   return true;
+}
+
+void pd_contact_log_add(const pdModel* model, const pdState* state, const pdContactReport* contacts, int count,
+                        void* user) {
+  pdContactLog* log = user;
+  pdContactTally* row = next_row(log);
+  for (int i = 0; i < count; ++i) add_contact(log, row, model, state, &contacts[i]);
+  ++log->samples;
 }

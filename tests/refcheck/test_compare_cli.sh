@@ -115,5 +115,30 @@ for v in ("reference", "chaos", "implicit"):
 PY
 check "impacts.csv, divergence.csv and series.csv: documented header, quoted name, e = 0.5 ± 0.01 matched, verdicts" '[ $rc -eq 0 ]'
 
+# every engine's contacts (the soft engine's own, ODE's joint feedback, Bullet's impulses over the step): the
+# sliding block's friction is mu times its normal force, and that force its weight, in sum over its contacts
+"$PD" compare "$SCENE" --out "$SCRATCH/slide" --tend 0.4 >/dev/null 2>"$SCRATCH/err"; rc=$?
+python3 - "$SCRATCH/slide" <<'PY'; rc2=$?
+import csv, json, sys
+d = sys.argv[1]
+mass = [b["mass"] for b in json.load(open(f"{d}/runs/soft-reference/summary.json"))["bodies"] if b["name"] == "block"][0]
+runs = {(r["engine"], r["variant"]) for r in csv.DictReader(open(f"{d}/series.csv", newline=""))}
+fr = list(csv.DictReader(open(f"{d}/friction.csv", newline="")))
+bad = []
+for run in sorted(runs):
+    for t in ("0.1", "0.2", "0.3"):
+        mine = [r for r in fr if (r["engine"], r["variant"]) == run and r["t"] == t]
+        fn, ft = sum(float(r["fn"]) for r in mine), sum(float(r["ft"]) for r in mine)
+        # friction within 1 % of mu = 0.4 times the normal force (every point slides at 2 - 0.4 g t m/s); the
+        # weight within 1 % (Bullet's impulses chatter from step to step: 0.4, 1 and 1.6 times it at these samples)
+        weight = run[0] == "bullet" or abs(fn - mass * 9.81) < 0.01 * mass * 9.81
+        if not (weight and fn > 0 and abs(ft - 0.4 * fn) < 0.01 * fn and all(r["mode"] == "slip" for r in mine)):
+            bad.append((run, t, fn, ft))
+if bad or len(runs) < 3:
+    print("runs:", sorted(runs), "off:", bad)
+    sys.exit(1)
+PY
+check "every engine's contacts: friction mu times the normal force of a sliding block, which carries its weight" '[ $rc -eq 0 ] && [ $rc2 -eq 0 ]'
+
 echo "test_compare_cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

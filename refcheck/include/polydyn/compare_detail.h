@@ -19,7 +19,8 @@
 //   after at the first sample past it, each moved
 //   back or on in free flight to the moment of contact and of separation (from the gap the separating-axis
 //   test gives at those samples).
-// - Contact tallies come from a run's contact reports (the soft engine's pd_state_contact): per moving body
+// - Contact tallies come from a run's contact reports (the soft engine's pd_state_contact, ODE's and Bullet's
+//   through their adapters: refcheck.h): per moving body
 //   and sample, the contacts it takes part in, the sum of their normal forces (N) and the largest slip speed
 //   of its sliding contacts (m/s; NAN when none slides). Slip speed: |tangential part of the contact
 //   point's relative velocity| (body_a's point minus body_b's).
@@ -129,3 +130,6 @@ pdContactLog* pd_contact_log_create(const pdModel* model);
 void pd_contact_log_free(pdContactLog* log);
 // Observer (pdObserverFcn) appending the state's contacts; `user` is the pdContactLog.
 bool pd_contact_log_observe(const pdModel* model, const pdState* state, void* user);
+// The same for a reference engine's contacts at a sample (pdRefOptions.contactObserver).
+void pd_contact_log_add(const pdModel* model, const pdState* state, const pdContactReport* contacts, int count,
+                        void* user);

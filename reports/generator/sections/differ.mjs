@@ -162,7 +162,7 @@ export default {
         bodies.map((b, i) => `<option value="${i}">${esc(b.body)} (largest error ${num(b.worst)})</option>`).join('') +
         `</select> — the worst first${bodies.length < s.bodyCount ? ` (the ${bodies.length} worst of ${s.bodyCount}; every body is in series.csv)` : ''}. ` +
         'Click a run in a legend to hide it. Dashed grey: the chaos run, the scene’s own divergence. Contacts, forces and slip speeds are those ' +
-        'the engine reports (polydyn’s soft engine; ODE and Bullet report none to polydyn).</p>' +
+        'each engine reports at the sample (ODE and Bullet: the contacts of their step that ends there, the force their impulse over it).</p>' +
         `<div class="charts multi">${grid}</div>` +
         (empty.length ? `<p class="muted">Not plotted, no run has any: ${esc(empty.join('; '))}.</p>` : '');
     }
@@ -175,7 +175,8 @@ export default {
       const mus = pairMus(ctx);
       html += '<h3>Friction cone</h3><p>Every contact with a normal force (at most 4 000 per run, evenly taken): |F<sub>t</sub>|/F<sub>n</sub> ' +
         `against the slip speed of its point${mus.length ? `, the pairs’ μ dashed (${mus.join(', ')})` : ''}. A Coulomb cone puts sliding contacts ` +
-        'on μ and sticking ones below it at zero slip; a stick that creeps shows slip speed with the ratio below μ.</p>' + frictionChart(ctx, d, mus);
+        'on μ and sticking ones below it at zero slip; a stick that creeps shows slip speed with the ratio below μ. polydyn’s soft engine reports ' +
+        'each contact’s mode; ODE’s and Bullet’s contacts count as sliding above 1 mm/s.</p>' + frictionChart(ctx, d, mus);
     }
     return { html, data: { sentences: s.sentences.map((x) => x.text), divergence: d.divergence }, csv: [] };
   },
