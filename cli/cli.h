@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
@@ -35,9 +36,12 @@ extern bool pd_cli_parse_only;
 // every rank sees the same arguments); returns 2.
 int pd_cli_usage_error(const char* subcommand, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 
-// Output directories (cli/out_dir.c): mkdir -p of the directories above `path`; out/NAME for scene path
-// .../NAME.ext (free with free()); rm -r of a directory this command made.
-void pd_cli_make_parents(const char* path);
+// Terminal tables (cli/table.c): one right-aligned cell of `width` columns, a space included, `format`
+// (one double, e.g. "%.3g") for a finite value and "—" for a value that does not apply (NaN, ±inf).
+void pd_cli_table_number(FILE* out, int width, const char* format, double value);
+
+// Output directories (cli/out_dir.c; parents: pdu_make_parents, util/): out/NAME for scene path .../NAME.ext
+// (free with free()); rm -r of a directory this command made (rank 0 only).
 char* pd_cli_default_out_dir(const char* scene);
 void pd_cli_remove_tree(const char* path);
 // A whole output directory is written as OUT.partial-PID (tmp) and renamed to OUT when complete.

@@ -13,6 +13,8 @@
 
 #include "cli.h"
 #include "compare_files.h"
+#include "pdutil/csv.h"
+#include "pdutil/json.h"
 #include "polydyn/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/output.h"
@@ -179,20 +181,6 @@ static void run_reference_engine(const pdModel* model, const pdRefAdapter* adapt
   }
 }
 
-static void write_number(FILE* out, double v) {
-  if (isfinite(v)) fprintf(out, "%.6g", v);
-}
-
-static void write_json_text(FILE* out, const char* s) {
-  fputc('"', out);
-  for (; *s; ++s) {
-    if (*s == '"' || *s == '\\') fputc('\\', out);
-    if ((unsigned char)*s < 0x20) fprintf(out, "\\u%04x", *s);
-    else fputc(*s, out);
-  }
-  fputc('"', out);
-}
-
 static const char* const metricsHeader =
     "scene,engine,variant,reference,pos_err_final,pos_err_rms,rot_err_final_rad,rot_err_rms_rad,"
     "energy_drift_rel,momentum_drift_rel,max_penetration_over_size,wall_per_sim_second,steps,"
@@ -206,16 +194,30 @@ static void write_metric_rows(FILE* out, const char* scene, const pdModel* model
     const compareRun* r = &runs[i];
     if (strcmp(r->status, "ok") != 0 || r->isChaos) continue;
     const pdCompareMetrics m = r->metrics;
-    fprintf(out, "\"%s\",%s,%s,%s,", scene, r->engine, r->variant, r->isReference ? "self" : refName);
+    pdu_csv_quoted(out, scene);  // quoted in every row, as it always was
+    const char* const texts[] = {r->engine, r->variant, r->isReference ? "self" : refName};
+    for (size_t k = 0; k < sizeof texts / sizeof texts[0]; ++k) {
+      fputc(',', out);
+      pdu_csv_text(out, texts[k]);
+    }
+    fputc(',', out);
     const double values[] = {m.posErrFinal, m.posErrRms, m.rotErrFinal, m.rotErrRms, m.energyDriftRel,
                              m.momentumDriftRel, m.maxPenetrationOverSize, r->wallSeconds / simulated};
     for (size_t k = 0; k < sizeof values / sizeof values[0]; ++k) {
-      write_number(out, values[k]);
+      pdu_csv_number(out, values[k], 6);
       fputc(',', out);
     }
     fprintf(out, "%ld,", r->steps);
+    // "NAME:e;NAME:e": one field, quoted as a whole when a body's name needs it
+    char* impacts = NULL;
+    size_t impactsSize = 0;
+    FILE* text = open_memstream(&impacts, &impactsSize);
+    if (!text) abort();
     for (int k = 0; k < m.impacts && k < 16; ++k)
-      fprintf(out, "%s%s:%.4f", k ? ";" : "", model->bodies[m.impactBody[k]].name, m.restitution[k]);
+      fprintf(text, "%s%s:%.4f", k ? ";" : "", model->bodies[m.impactBody[k]].name, m.restitution[k]);
+    if (fclose(text) != 0) abort();
+    pdu_csv_text(out, impacts);
+    free(impacts);
     fputc('\n', out);
   }
 }
@@ -235,25 +237,25 @@ static bool write_results(const char* dir, const char* scene, const pdModel* mod
   out = fopen(path, "w");
   if (!out) return false;
   fputs("{\n  \"scene\": ", out);
-  write_json_text(out, scene);
-  fprintf(out, ",\n  \"reference\": \"%s\",\n  \"runs\": [\n", refName);
+  pdu_json_string(out, scene);
+  fputs(",\n  \"reference\": ", out);
+  pdu_json_string(out, refName);
+  fputs(",\n  \"runs\": [\n", out);
   for (int i = 0; i < count; ++i) {
     const compareRun* r = &runs[i];
-    fprintf(out, "    {\"engine\": \"%s\", \"variant\": \"%s\", \"status\": \"%s\", \"run_dir\": \"runs/%s\", \"message\": ",
-            r->engine, r->variant, r->status, r->name);
-    write_json_text(out, r->message);
+    const char* const keys[] = {"engine", "variant", "status"};
+    const char* const values[] = {r->engine, r->variant, r->status};
+    for (int k = 0; k < 3; ++k) {
+      fprintf(out, "%s\"%s\": ", k ? ", " : "    {", keys[k]);
+      pdu_json_string(out, values[k]);
+    }
+    fprintf(out, ", \"run_dir\": \"runs/%s\", \"message\": ", r->name);
+    pdu_json_string(out, r->message);
     fprintf(out, "}%s\n", i + 1 < count ? "," : "");
   }
   fputs("  ]\n}\n", out);
   ok = !ferror(out) && ok;
   return fclose(out) == 0 && ok;
-}
-
-// A column of the terminal table: the number, or "—" where it does not apply (printf pads bytes, and the
-// dash is three of them).
-static void table_cell(FILE* out, int width, double v, const char* format) {
-  if (isfinite(v)) fprintf(out, format, width, v);
-  else fprintf(out, " %*s—", width - 1, "");
 }
 
 // The table a person reads first (stdout).
@@ -269,12 +271,12 @@ static void write_table(FILE* out, const pdModel* model, const compareRun* runs,
     const pdCompareMetrics m = r->metrics;
     const pdDivergence d = r->divergence;
     fprintf(out, "%-16s %-8s", r->name, r->status);
-    table_cell(out, 12, m.posErrFinal, " %*.3g");
-    table_cell(out, 12, m.rotErrFinal, " %*.3g");
-    table_cell(out, 12, m.energyDriftRel, " %*.3g");
-    table_cell(out, 14, r->wallSeconds / model->settings.tend, " %*.3g");
-    table_cell(out, 12, d.diverged ? d.t : NAN, " %*.3g");
-    table_cell(out, 12, !r->isChaos && d.diverged ? d.beyondChaos : NAN, " %*.3g");
+    pd_cli_table_number(out, 13, "%.3g", m.posErrFinal);  // the reference row has no error: "—"
+    pd_cli_table_number(out, 13, "%.3g", m.rotErrFinal);
+    pd_cli_table_number(out, 13, "%.3g", m.energyDriftRel);
+    pd_cli_table_number(out, 15, "%.3g", r->wallSeconds / model->settings.tend);
+    pd_cli_table_number(out, 13, "%.3g", d.diverged ? d.t : NAN);  // never diverged: "—"
+    pd_cli_table_number(out, 13, "%.3g", !r->isChaos && d.diverged ? d.beyondChaos : NAN);
     fputc('\n', out);
   }
 }

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "pdutil/csv.h"
 #include "polydyn/batch.h"
 #include "polydyn/cubetoss.h"
 #include "polydyn/output.h"
@@ -335,10 +336,6 @@ static bool show_progress(int done, int total, void* user) {
   return !interrupted;
 }
 
-static void write_number(FILE* out, double v) {
-  if (isfinite(v)) fprintf(out, "%.9g", v);
-}
-
 static void per_toss_header(FILE* out) {
   fputs("toss,split,engine,variant,params,status,samples,duration_s,pos_err_end,pos_err_rms,rot_err_end_rad,"
         "rot_err_rms_rad,wall_seconds,cpu_seconds,steps,run_dir,message\n",
@@ -347,11 +344,17 @@ static void per_toss_header(FILE* out) {
 
 static void per_toss_row(FILE* out, const pdToss* toss, int index, const engineSpec* s, const char* label,
                          const pdTossResult* r, bool runs) {
-  fprintf(out, "%ld,%s,%s,%s,%s,%s,%d,%.9g,", toss->id, pd_toss_split_name(pd_toss_split(index)), s->name, s->variant,
-          label, pd_toss_status_name(r->status), r->samples, (double)(toss->sampleCount - 1) / PD_TOSS_RATE);
+  fprintf(out, "%ld", toss->id);
+  const char* const texts[] = {pd_toss_split_name(pd_toss_split(index)), s->name, s->variant, label,
+                               pd_toss_status_name(r->status)};
+  for (int k = 0; k < 5; ++k) {
+    fputc(',', out);
+    pdu_csv_text(out, texts[k]);
+  }
+  fprintf(out, ",%d,%.9g,", r->samples, (double)(toss->sampleCount - 1) / PD_TOSS_RATE);
   const double values[] = {r->posErrEnd, r->posErrRms, r->rotErrEnd, r->rotErrRms};
   for (int k = 0; k < 4; ++k) {
-    write_number(out, values[k]);
+    pdu_csv_number(out, values[k], 9);
     fputc(',', out);
   }
   if (r->status == pd_tossOk || r->status == pd_tossFailed) {
@@ -361,7 +364,7 @@ static void per_toss_row(FILE* out, const pdToss* toss, int index, const engineS
   }
   if (runs && r->runWritten) fprintf(out, "runs/%ld/%s", toss->id, s->label);
   fputc(',', out);
-  pd_write_csv_text(out, r->message);
+  pdu_csv_text(out, r->message);
   fputc('\n', out);
 }
 
@@ -420,13 +423,21 @@ static void summary_rows(FILE* out, const engineSpec* spec, const char* label, c
     splitStats s = split_stats(results, indices, count, splits[k]);
     if (s.tosses == 0) continue;
     for (int q = 0; q < QUANTITIES; ++q) {
-      fprintf(out, "%s,%s,%s,%s,%s,%d,%d,%s,%s,", spec->name, spec->variant, label, splits[k], summary_status(spec, &s),
-              s.tosses, s.completed, quantityNames[q], quantityUnits[q]);
-      write_number(out, s.q[q].mean);
+      const char* const texts[] = {spec->name, spec->variant, label, splits[k], summary_status(spec, &s)};
+      for (int t = 0; t < 5; ++t) {
+        pdu_csv_text(out, texts[t]);
+        fputc(',', out);
+      }
+      fprintf(out, "%d,%d,", s.tosses, s.completed);
+      pdu_csv_text(out, quantityNames[q]);
       fputc(',', out);
-      write_number(out, s.q[q].median);
+      pdu_csv_text(out, quantityUnits[q]);
       fputc(',', out);
-      write_number(out, s.q[q].p90);
+      pdu_csv_number(out, s.q[q].mean, 9);
+      fputc(',', out);
+      pdu_csv_number(out, s.q[q].median, 9);
+      fputc(',', out);
+      pdu_csv_number(out, s.q[q].p90, 9);
       fputc('\n', out);
     }
   }

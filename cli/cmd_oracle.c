@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "pdutil/files.h"
 #include "polydyn/oracle.h"
 #include "polydyn/state.h"
 
@@ -77,7 +78,7 @@ static bool csv_open(csvOut* c, const char* path) {
   c->partial = malloc(n);
   if (!c->path || !c->partial) abort();
   snprintf(c->partial, n, "%s.partial-XXXXXX", path);
-  pd_cli_make_parents(path);
+  pdu_make_parents(path);
   int fd = mkstemp(c->partial);
   if (fd < 0 || !(c->f = fdopen(fd, "w"))) {
     fprintf(stderr, "polydyn oracle: %s: cannot write: %s\n", path, strerror(errno));
@@ -202,7 +203,7 @@ static int run_timing(long n, unsigned long long seed, int repeats, const char* 
   pd_oracle_timing_print(&t, stdout);
   printf("time: CPU %.2f s (shapes, placement, an untimed pass and the timed repeats)\n", cpu_now() - c0);
   if (out) {
-    pd_cli_make_parents(out);
+    pdu_make_parents(out);
     FILE* f = fopen(out, "w");
     if (!f) {
       fprintf(stderr, "polydyn oracle: %s: cannot write: %s\n", out, strerror(errno));
@@ -320,34 +321,6 @@ done:
 // ---------------------------------------------------------------- --replay
 
 // Reads the whole file (so that a bad row is refused before anything is checked or written).
-static char* read_file(const char* path, size_t* size) {
-  FILE* f = fopen(path, "rb");
-  if (!f) {
-    fprintf(stderr, "%s: cannot open: %s\n", path, strerror(errno));
-    return NULL;
-  }
-  char* data = NULL;
-  size_t n = 0, capacity = 0;
-  for (;;) {
-    if (n == capacity) {
-      capacity = capacity ? 2 * capacity : 64 * 1024;
-      if (!(data = realloc(data, capacity))) abort();
-    }
-    size_t got = fread(data + n, 1, capacity - n, f);
-    n += got;
-    if (got == 0) break;
-  }
-  bool ok = !ferror(f);
-  if (!ok) fprintf(stderr, "%s: cannot read: %s\n", path, strerror(errno));
-  fclose(f);
-  if (!ok) {
-    free(data);
-    return NULL;
-  }
-  *size = n;
-  return data;
-}
-
 typedef struct replayRun {
   pdOracleStats* stats;
   csvOut* csv;
@@ -378,8 +351,11 @@ static bool replay_row(const pdOracleRow* listed, const pdOracleShape* sa, const
 
 static int run_replay(const char* path, const char* out) {
   size_t size = 0;
-  char* data = read_file(path, &size);
-  if (!data) return PD_EXIT_BAD_INPUT;
+  char* data = pdu_read_file(path, &size);
+  if (!data) {
+    fprintf(stderr, "%s: cannot read: %s\n", path, strerror(errno));
+    return PD_EXIT_BAD_INPUT;
+  }
   pdOracleStats stats;
   pd_oracle_stats_init(&stats);
   csvOut csv = {0};

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "pdutil/files.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
 #include "polydyn/state.h"
@@ -194,7 +195,7 @@ int pd_cmd_run(int argc, char** argv) {
     defaultOut = pd_cli_default_out_dir(scene);
     out = defaultOut;
   }
-  pd_cli_make_parents(out);
+  pdu_make_parents(out);
   // from here on an interrupt must remove the partial directory, so catch it before making one
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);

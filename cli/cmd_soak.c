@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "pdutil/csv.h"
+#include "pdutil/files.h"
 #include "polydyn/batch.h"
 #include "polydyn/soak.h"
 
@@ -74,21 +76,12 @@ static bool keep_going(int task, int done, int total, void* user) {
   return !interrupted;
 }
 
-static void csv_text(FILE* out, const char* s) {
-  fputc('"', out);
-  for (; *s; ++s) {
-    if (*s == '"') fputc('"', out);
-    fputc(*s, out);
-  }
-  fputc('"', out);
-}
-
 // The scene file of a run that did not pass: the scene, headed by what happened.
 static bool write_scene_file(const char* dir, const char* sub, long index, const char* engine, pdOnsets onsets,
                              const pdSoakScene* scene, const pdSoakResult* r) {
   char path[8192];
   snprintf(path, sizeof path, "%s/%s", dir, sub);
-  if (mkdir(path, 0777) != 0 && errno != EEXIST) return false;
+  if (!pdu_make_dir(path)) return false;
   snprintf(path, sizeof path, "%s/%s/%06ld-%s.scene", dir, sub, index, engine);
   FILE* f = fopen(path, "w");
   if (!f) return false;
@@ -214,7 +207,7 @@ int pd_cmd_soak(int argc, char** argv) {
         fprintf(csv, "%lu,%ld,%s,%d,%d,%s,%s,%.4g,%.6g,%ld,%.4g,%.4g,%.4g,", job.seed, index, pdSoakKindNames[scene.kind],
                 scene.objects, scene.dissipative, job.engines[e], pdSoakStatusNames[r.status], r.wallSeconds,
                 r.simulated, r.steps, r.penetration, r.energyGain, r.momentumError);
-        csv_text(csv, r.message);
+        pdu_csv_quoted(csv, r.message);  // quoted in every row, as it always was
         fputc('\n', csv);
         if (r.status == pd_soakFailed)
           ok = write_scene_file(tmp, "failures", index, job.engines[e], job.onsets, &scene, &r);

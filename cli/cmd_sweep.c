@@ -20,6 +20,8 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "pdutil/csv.h"
+#include "pdutil/json.h"
 #include "polydyn/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/refcheck.h"
@@ -527,14 +529,24 @@ int pd_cmd_sweep(int argc, char** argv) {
         const point* p = &points[i];
         char selfName[128];
         self_reference_name(kept, p, selfName, sizeof selfName);
-        fprintf(f, "\"%s\",%s,%s,%s,%.6g,", scene, p->engine, p->variant, p->setting, p->value);
+        pdu_csv_quoted(f, scene);  // quoted in every row, as it always was
+        const char* const texts[] = {p->engine, p->variant, p->setting};
+        for (int k = 0; k < 3; ++k) {
+          fputc(',', f);
+          pdu_csv_text(f, texts[k]);
+        }
+        fprintf(f, ",%.6g,", p->value);
         if (p->completed) fprintf(f, "%.6g", p->error);
         fprintf(f, ",rms_pose,");
         if (p->completed) fprintf(f, "%.6g,%.6g", p->wall, p->wall / tend);
         else fputc(',', f);
-        fprintf(f, ",%ld,%ld,%s,", p->steps, repeats, refName);
+        fprintf(f, ",%ld,%ld,", p->steps, repeats);
+        pdu_csv_text(f, refName);
+        fputc(',', f);
         if (p->completed && !isnan(p->selfError)) fprintf(f, "%.6g", p->selfError);
-        fprintf(f, ",%s,", selfName);
+        fputc(',', f);
+        pdu_csv_text(f, selfName);
+        fputc(',', f);
         if (p->completed && !isnan(p->horizon)) fprintf(f, "%.6g", p->horizon);
         fputc(',', f);
         if (p->completed && p->derivatives >= 0) fprintf(f, "%ld", p->derivatives);
@@ -548,12 +560,14 @@ int pd_cmd_sweep(int argc, char** argv) {
     if (f) {
       char horizonText[32] = "null";
       if (!isnan(refHorizon)) snprintf(horizonText, sizeof horizonText, "%.6g", refHorizon);
+      fputs("{\"scene\": ", f);
+      pdu_json_string(f, scene);
       fprintf(f,
-              "{\"scene\": \"%s\", \"engine\": \"soft\", \"tol\": %g, \"steps\": %ld, \"wall_seconds\": %.6g,\n"
+              ", \"engine\": \"soft\", \"tol\": %g, \"steps\": %ld, \"wall_seconds\": %.6g,\n"
               " \"check_tol\": %g, \"error_against_check\": %.6g,\n"
               " \"error_kind\": \"rms over samples and moving bodies of max(|x - x_ref| / size, rotation angle rad)"
               "\",\n \"horizon_threshold\": %g, \"horizon_against_check_seconds\": %s}\n",
-              scene, SWEEP_REFERENCE_TOL, refSteps, refWall, SWEEP_REFERENCE_CHECK_TOL, refError,
+              SWEEP_REFERENCE_TOL, refSteps, refWall, SWEEP_REFERENCE_CHECK_TOL, refError,
               SWEEP_HORIZON_THRESHOLD, horizonText);
       ok = !ferror(f);
       ok = fclose(f) == 0 && ok;

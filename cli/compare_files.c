@@ -5,23 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-void pd_csv_text(FILE* out, const char* text) {
-  if (!strpbrk(text, ",\"\r\n")) {
-    fputs(text, out);
-    return;
-  }
-  fputc('"', out);
-  for (const char* c = text; *c; ++c) {
-    if (*c == '"') fputc('"', out);
-    fputc(*c, out);
-  }
-  fputc('"', out);
-}
-
-// A number, or nothing where it does not apply (NAN).
-static void csv_number(FILE* out, double v) {
-  if (isfinite(v)) fprintf(out, "%.9g", v);
-}
+#include "pdutil/csv.h"
 
 static const char* body_name(const pdModel* model, int movingIndex) {
   return model->bodies[model->movingBodies[movingIndex]].name;
@@ -54,19 +38,19 @@ static void write_series(FILE* out, const pdModel* model, const pdCompareRunData
     for (long i = 0; i < count; ++i) {
       const pdBodySample* b = &samples[(size_t)i * (size_t)m + (size_t)k];
       fprintf(out, "%s,%s,", run->engine, run->variant);
-      pd_csv_text(out, body_name(model, k));
+      pdu_csv_text(out, body_name(model, k));
       fprintf(out, ",%.9g,", tr->t[index[i]]);
       const double values[] = {b->posErr, b->rotErr, b->energy, b->penetration};
       for (size_t v = 0; v < sizeof values / sizeof values[0]; ++v) {
-        csv_number(out, values[v]);
+        pdu_csv_number(out, values[v], 9);
         fputc(',', out);
       }
       if (tallied) {
         const pdContactTally* c = &run->contacts->tallies[(size_t)index[i] * (size_t)m + (size_t)k];
         fprintf(out, "%d,", c->contacts);
-        csv_number(out, c->normalForce);
+        pdu_csv_number(out, c->normalForce, 9);
         fputc(',', out);
-        csv_number(out, c->slipSpeed);
+        pdu_csv_number(out, c->slipSpeed, 9);
       } else {
         fputs(",,", out);
       }
@@ -80,15 +64,15 @@ static void write_impact_rows(FILE* out, const char* scene, const pdModel* model
                               const pdImpact* impacts, int count) {
   for (int i = 0; i < count; ++i) {
     const pdImpact* p = &impacts[i];
-    pd_csv_text(out, scene);
+    pdu_csv_text(out, scene);
     fprintf(out, ",%s,%s,%d,", run->engine, run->variant, i);
-    pd_csv_text(out, model->bodies[p->bodyA].name);
+    pdu_csv_text(out, model->bodies[p->bodyA].name);
     fputc(',', out);
-    pd_csv_text(out, model->bodies[p->bodyB].name);
+    pdu_csv_text(out, model->bodies[p->bodyB].name);
     const double values[] = {p->t, p->vnBefore, p->vnAfter, p->restitution, p->restitutionRequested, p->tangentialChange};
     for (size_t v = 0; v < sizeof values / sizeof values[0]; ++v) {
       fputc(',', out);
-      csv_number(out, values[v]);
+      pdu_csv_number(out, values[v], 9);
     }
     fputc(',', out);
     if (p->match >= 0) fprintf(out, "%d", p->match);
@@ -103,9 +87,9 @@ static void write_friction(FILE* out, const pdModel* model, const pdCompareRunDa
   for (long i = 0; i < log->points; i += stride) {
     const pdFrictionPoint* p = &log->friction[i];
     fprintf(out, "%s,%s,%.9g,", run->engine, run->variant, p->t);
-    pd_csv_text(out, model->bodies[p->bodyA].name);
+    pdu_csv_text(out, model->bodies[p->bodyA].name);
     fputc(',', out);
-    pd_csv_text(out, model->bodies[p->bodyB].name);
+    pdu_csv_text(out, model->bodies[p->bodyB].name);
     fprintf(out, ",%.9g,%.9g,%.9g,%s\n", p->fn, p->ft, p->slipSpeed, p->slip ? "slip" : "stick");
   }
 }
@@ -118,18 +102,18 @@ static const char* verdict(const pdDivergence* d, bool isChaos) {
 
 static void write_divergence_row(FILE* out, const char* scene, const pdModel* model, const pdCompareRunData* run,
                                  const pdDivergence* d, double horizon, bool isChaos, bool chaosKnown) {
-  pd_csv_text(out, scene);
+  pdu_csv_text(out, scene);
   fprintf(out, ",%s,%s,%g,%g,", run->engine, run->variant, PD_COMPARE_DIVERGENCE_THRESHOLD, PD_COMPARE_CHAOS_FACTOR);
   if (d->diverged) {
     fprintf(out, "%.9g,", d->t);
-    pd_csv_text(out, body_name(model, d->body));
+    pdu_csv_text(out, body_name(model, d->body));
     fprintf(out, ",%s,%.9g,", d->rotation ? "rotation" : "position", d->error);
   } else {
     fputs(",,,,", out);
   }
-  csv_number(out, horizon);
+  pdu_csv_number(out, horizon, 9);
   fputc(',', out);
-  if (!isChaos) csv_number(out, d->beyondChaos);
+  if (!isChaos) pdu_csv_number(out, d->beyondChaos, 9);
   // without a chaos run nothing tells chaos from model
   fprintf(out, ",%s\n", chaosKnown || !d->diverged || isChaos ? verdict(d, isChaos) : "unknown");
 }

@@ -25,6 +25,3 @@ typedef struct pdCompareRunData {
 // False on an I/O error (errno set).
 bool pd_compare_write_details(const char* dir, const char* scene, const pdModel* model, const pdCompareRunData* runs,
                               int count, int chaos, pdDivergence* divergences);
-
-// One CSV field as RFC 4180 has it: quoted (quotes doubled) when it holds a comma, a quote or a line break.
-void pd_csv_text(FILE* out, const char* text);

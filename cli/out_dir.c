@@ -1,7 +1,6 @@
 // polydyn CLI — output directories: default names, parents, and the write-then-rename of a whole
 // directory (DIR.partial-PID, renamed to DIR when complete; a previous DIR replaced only when it is ours).
 #include <errno.h>
-#include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,19 +8,8 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "pdutil/files.h"
 #include "polydyn/batch.h"
-
-// mkdir -p of the directories above `path`; a real failure shows when the run directory is made
-void pd_cli_make_parents(const char* path) {
-  char* p = strdup(path);
-  if (!p) abort();
-  for (char* slash = strchr(p + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
-    *slash = '\0';
-    mkdir(p, 0777);
-    *slash = '/';
-  }
-  free(p);
-}
 
 // out/NAME for scene path .../NAME.ext
 char* pd_cli_default_out_dir(const char* scene) {
@@ -36,14 +24,9 @@ char* pd_cli_default_out_dir(const char* scene) {
   return dir;
 }
 
-static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw) {
-  (void)st, (void)flag, (void)ftw;
-  return remove(path);
-}
-
 // Only rank 0 removes: the directories are rank 0's (pd_cli_out_open)
 void pd_cli_remove_tree(const char* path) {
-  if (pd_batch_is_root()) nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+  if (pd_batch_is_root()) pdu_remove_tree(path);
 }
 
 static bool out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize);
@@ -64,7 +47,7 @@ static bool out_open(const char* cmd, const char* out, const char* marker, char*
     return false;
   }
   snprintf(tmp, tmpSize, "%s.partial-%ld", out, (long)getpid());
-  if (mkdir(tmp, 0777) != 0) {
+  if (mkdir(tmp, 0777) != 0) {  // a fresh directory, not an existing one
     fprintf(stderr, "polydyn %s: cannot create %s: %s\n", cmd, tmp, strerror(errno));
     return false;
   }

@@ -172,7 +172,3 @@ double gk_wall_seconds(void) {
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
-
-void gk_csv_number(FILE* out, double x) {
-  if (isfinite(x)) fprintf(out, "%.17g", x);
-}

@@ -83,8 +83,6 @@ double gk_effective_mass(const pdModel* model, int body, pdVec3 p, pdVec3 n);
 // Monotonic wall clock, s (for the measured wall times).
 double gk_wall_seconds(void);
 
-// A CSV number with %.17g, or nothing when it is not finite (no NaN is ever written).
-void gk_csv_number(FILE* out, double x);
 
 // ---------------------------------------------------------------------------------------------------------
 // The suite's cases, shared with the work-precision runs (precision.c)

@@ -17,6 +17,7 @@
 #include "polydyn/refcheck.h"
 #include "polydyn/scene.h"
 #include "polydyn/stats.h"
+#include "pdutil/csv.h"
 
 // The knobs, loosest first (the header lists them; README "Work-precision per experiment").
 static const double softTolerances[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
@@ -290,30 +291,29 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
     const gkPoint* p = &s->points[i];
     const gkCase* c = p->c;
     const pdGkExperiment* e = c->experiment;
-    pd_write_csv_text(out, e->name);
+    pdu_csv_text(out, e->name);
     fprintf(out, ",%s,%s,%s,%s,", pdGkKindNames[e->kind], pdGkEngineNames[p->engine], p->variant, p->setting);
     if (isfinite(p->value)) fprintf(out, "%.6g", p->value);  // the setting as it is named (1/60 s: 0.0166667)
     fputc(',', out);
-    pd_write_csv_text(out, c->label);
+    const char* const texts[] = {c->label, e->quantity, e->unit};
+    for (int k = 0; k < 3; ++k) {
+      pdu_csv_text(out, texts[k]);
+      fputc(',', out);
+    }
+    pdu_csv_number(out, p->measured, 17);
     fputc(',', out);
-    pd_write_csv_text(out, e->quantity);
+    pdu_csv_number(out, c->expected.value, 17);
     fputc(',', out);
-    pd_write_csv_text(out, e->unit);
-    fputc(',', out);
-    gk_csv_number(out, p->measured);
-    fputc(',', out);
-    gk_csv_number(out, c->expected.value);
-    fputc(',', out);
-    gk_csv_number(out, p->error);
+    pdu_csv_number(out, p->error, 17);
     fprintf(out, ",%s,", e->relative ? "true" : "false");
-    gk_csv_number(out, c->expected.tolerance);
+    pdu_csv_number(out, c->expected.tolerance, 17);
     bool judged = pd_gk_applies(e, p->engine, strcmp(p->variant, "matched") == 0);
     fprintf(out, ",%s,%s,", judged ? "true" : "false", pointStatusNames[p->status]);
-    gk_csv_number(out, p->wall);
+    pdu_csv_number(out, p->wall, 17);
     fputc(',', out);
-    gk_csv_number(out, p->wall / c->model->settings.tend);
+    pdu_csv_number(out, p->wall / c->model->settings.tend, 17);
     fprintf(out, ",%ld,%d,", p->steps, s->options->repeats);
-    pd_write_csv_text(out, p->note);
+    pdu_csv_text(out, p->note);
     fputc('\n', out);
   }
   bool ok = !ferror(out);

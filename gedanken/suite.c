@@ -7,7 +7,6 @@
 // run directory and returns its row and series text, which land in task order, so the files are the same
 // bytes whatever the number of processes, except wall times.
 #include <errno.h>
-#include <ftw.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -17,6 +16,9 @@
 #include "polydyn/batch.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
+#include "pdutil/csv.h"
+#include "pdutil/files.h"
+#include "pdutil/json.h"
 
 const char* const pdGkEngineNames[pd_gkEngineCount] = {"soft", "ode", "bullet"};
 const char* const pdGkStatusNames[] = {"PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR", "NOT_APPLICABLE"};
@@ -40,43 +42,16 @@ enum { SERIES_MAX_ROWS = 500 };  // per run (RESULT_SCHEMAS.md: "at most ~500 ro
 // ---------------------------------------------------------------------------------------------------------
 // files
 
-static int remove_entry(const char* path, const struct stat* sb, int flag, struct FTW* ftw) {
-  (void)sb, (void)flag, (void)ftw;
-  return remove(path);
-}
-
-static void remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
-
-static char* path_join(const char* a, const char* b) {
-  size_t n = strlen(a) + strlen(b) + 2;
-  char* s = malloc(n);
-  PD_ASSERT(s != NULL);
-  snprintf(s, n, "%s/%s", a, b);
-  return s;
-}
-
 static bool make_dir(const char* path, pdError* err) {
-  if (mkdir(path, 0777) == 0 || errno == EEXIST) return true;
+  if (pdu_make_dir(path)) return true;
   pd_error_set(err, path, 0, 0, "cannot create the directory: %s", strerror(errno));
   return false;
-}
-
-// mkdir -p of the directories above `path` (a real failure shows when the directory itself is made)
-static void make_parents(const char* path) {
-  char* p = strdup(path);
-  PD_ASSERT(p != NULL);
-  for (char* slash = strchr(p + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
-    *slash = '\0';
-    mkdir(p, 0777);
-    *slash = '/';
-  }
-  free(p);
 }
 
 bool pd_gk_out_replaceable(const char* out, pdError* err) {
   struct stat st;
   if (stat(out, &st) != 0) return true;
-  char* results = path_join(out, "results.csv");
+  char* results = pdu_path_join(out, "results.csv");
   bool ours = S_ISDIR(st.st_mode) && access(results, F_OK) == 0;
   free(results);
   if (!ours) pd_error_set(err, out, 0, 0, "exists and is not a gedanken directory (no results.csv); not replacing it");
@@ -192,7 +167,7 @@ static void write_series(gkJob* job, const pdGkRecord* rec) {
 
 // Writes the generated scene beside the run's files, so `polydyn run DIR/scene.scene` repeats the run.
 static bool write_scene_copy(const char* dir, const char* text) {
-  char* path = path_join(dir, "scene.scene");
+  char* path = pdu_path_join(dir, "scene.scene");
   FILE* f = fopen(path, "w");
   free(path);
   if (!f) return false;
@@ -217,7 +192,7 @@ static void run_job(gkSuite* s, gkJob* job) {
   snprintf(name, sizeof name, "%s-%s%s%s", pdGkEngineNames[job->engine], variant_name(job), c->label[0] ? "-" : "",
            c->label);
   snprintf(job->runDir, sizeof job->runDir, "runs/%s/%s", c->experiment->name, name);
-  char* dir = path_join(s->root, job->runDir);
+  char* dir = pdu_path_join(s->root, job->runDir);
   pdError err = {0};
   pdRunWriter* writer = pd_run_open(dir, &err);
   if (!writer) {
@@ -340,7 +315,7 @@ static bool task_progress(int task, int done, int total, void* user) {
 // the output files
 
 static bool write_results(const gkSuite* s, pdError* err) {
-  char* path = path_join(s->root, "results.csv");
+  char* path = pdu_path_join(s->root, "results.csv");
   FILE* out = fopen(path, "w");
   free(path);
   if (!out) {
@@ -355,29 +330,29 @@ static bool write_results(const gkSuite* s, pdError* err) {
     const pdGkExperiment* e = job->c->experiment;
     bool judged = job->status == pd_gkPass || job->status == pd_gkFail || job->status == pd_gkNotApplicable;
     bool quantitative = isfinite(job->c->expected.value);
-    pd_write_csv_text(out, e->name);
+    pdu_csv_text(out, e->name);
     fprintf(out, ",%c,", e->group);
-    pd_write_csv_text(out, e->title);
+    pdu_csv_text(out, e->title);
     fprintf(out, ",%s,%s,", pdGkEngineNames[job->engine], variant_name(job));
-    pd_write_csv_text(out, e->quantity);
+    pdu_csv_text(out, e->quantity);
     fputc(',', out);
-    pd_write_csv_text(out, e->unit);
+    pdu_csv_text(out, e->unit);
     fputc(',', out);
-    pd_write_csv_text(out, job->c->label);
+    pdu_csv_text(out, job->c->label);
     fputc(',', out);
-    if (judged) gk_csv_number(out, job->measured);
+    if (judged) pdu_csv_number(out, job->measured, 17);
     fputc(',', out);
-    if (quantitative) gk_csv_number(out, job->c->expected.value);
+    if (quantitative) pdu_csv_number(out, job->c->expected.value, 17);
     fputc(',', out);
-    if (judged && quantitative) gk_csv_number(out, job->error);
+    if (judged && quantitative) pdu_csv_number(out, job->error, 17);
     fputc(',', out);
-    if (quantitative) gk_csv_number(out, job->c->expected.tolerance);
+    if (quantitative) pdu_csv_number(out, job->c->expected.tolerance, 17);
     fprintf(out, ",%s,", pdGkStatusNames[job->status]);
-    gk_csv_number(out, job->wallSeconds);
+    pdu_csv_number(out, job->wallSeconds, 17);
     fputc(',', out);
-    pd_write_csv_text(out, job->runDir);
+    pdu_csv_text(out, job->runDir);
     fputc(',', out);
-    pd_write_csv_text(out, job->note);
+    pdu_csv_text(out, job->note);
     fputc('\n', out);
   }
   bool ok = !ferror(out);
@@ -387,7 +362,7 @@ static bool write_results(const gkSuite* s, pdError* err) {
 }
 
 static bool write_experiments(const gkSuite* s, pdError* err) {
-  char* path = path_join(s->root, "experiments.json");
+  char* path = pdu_path_join(s->root, "experiments.json");
   FILE* out = fopen(path, "w");
   free(path);
   if (!out) {
@@ -410,7 +385,7 @@ static bool write_experiments(const gkSuite* s, pdError* err) {
     fputc('{', out);
     for (size_t f = 0; f < sizeof fields / sizeof fields[0]; ++f) {
       fprintf(out, "%s\"%s\": ", f ? ", " : "", fields[f].key);
-      pd_write_json_string(out, fields[f].value);
+      pdu_json_string(out, fields[f].value);
     }
     fprintf(out, ", \"qualitative\": %s, \"kind\": \"%s\", \"applies_to\": [", e->qualitative ? "true" : "false",
             pdGkKindNames[e->kind]);
@@ -420,9 +395,9 @@ static bool write_experiments(const gkSuite* s, pdError* err) {
           fprintf(out, "%s\"%s-%s\"", n++ ? ", " : "", pdGkEngineNames[engine], variant_of((pdGkEngine)engine, v));
     fputs("], \"not_applicable_reason\": ", out);
     if (e->kind == pd_gkLaw) fputs("null", out);
-    else pd_write_json_string(out, e->notApplicableReason);
+    else pdu_json_string(out, e->notApplicableReason);
     fputs(", \"scene\": \"generated\", \"series_label\": ", out);
-    pd_write_json_string(out, e->seriesLabel);
+    pdu_json_string(out, e->seriesLabel);
     fputc('}', out);
   }
   fputs("\n]\n", out);
@@ -433,13 +408,13 @@ static bool write_experiments(const gkSuite* s, pdError* err) {
 }
 
 static bool write_series_files(const gkSuite* s, pdError* err) {
-  char* dir = path_join(s->root, "series");
+  char* dir = pdu_path_join(s->root, "series");
   bool ok = make_dir(dir, err);
   for (int i = 0; ok && i < s->jobCount;) {
     const pdGkExperiment* e = s->jobs[i].c->experiment;
     char file[160];
     snprintf(file, sizeof file, "%s.csv", e->name);
-    char* path = path_join(dir, file);
+    char* path = pdu_path_join(dir, file);
     FILE* out = fopen(path, "w");
     free(path);
     if (!out) {
@@ -475,7 +450,7 @@ static bool install(const gkSuite* s, pdError* err) {
   ok = ok && rename(s->root, out) == 0;
   if (!ok) pd_error_set(err, out, 0, 0, "cannot move the results into place: %s", strerror(errno));
   if (old) {
-    if (ok) remove_tree(old);
+    if (ok) pdu_remove_tree(old);
     free(old);
   }
   return ok;
@@ -532,7 +507,7 @@ static void free_suite(gkSuite* s) {
   free(s->cases);
   free(s->jobs);
   if (s->root) {
-    if (pd_batch_is_root()) remove_tree(s->root);  // nothing when it was installed (renamed away)
+    if (pd_batch_is_root()) pdu_remove_tree(s->root);  // nothing when it was installed (renamed away)
     free(s->root);
   }
 }
@@ -580,7 +555,7 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
   char root[ROOT_MAX] = "";
   if (ok && pd_batch_is_root() && strlen(options->out) + 24 < ROOT_MAX) {
     snprintf(root, sizeof root, "%s.partial-XXXXXX", options->out);
-    make_parents(options->out);
+    pdu_make_parents(options->out);  // a real failure shows when the directory is made
     if (!mkdtemp(root)) {
       pd_error_set(err, options->out, 0, 0, "cannot create the output directory: %s", strerror(errno));
       root[0] = '\0';
@@ -590,11 +565,11 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
       chmod(root, 0777 & ~mask);
       s.root = strdup(root);
       PD_ASSERT(s.root != NULL);
-      char* runs = path_join(s.root, "runs");
+      char* runs = pdu_path_join(s.root, "runs");
       bool made = make_dir(runs, err);
       for (int i = 0; made && i < s.caseCount; ++i) {
         if (i > 0 && s.cases[i].experiment == s.cases[i - 1].experiment) continue;
-        char* dir = path_join(runs, s.cases[i].experiment->name);
+        char* dir = pdu_path_join(runs, s.cases[i].experiment->name);
         made = make_dir(dir, err);
         free(dir);
       }

@@ -17,6 +17,7 @@
 
 #include "bullet_shim.h"
 #include "polydyn/refcheck.h"
+#include "pdutil/json.h"
 
 #define PI 3.14159265358979323846
 
@@ -256,15 +257,6 @@ static int bullet_contacts(const pdRefWorld* w, pdContactReport* out, int capaci
   return count;
 }
 
-static void json_string(FILE* out, const char* s) {
-  fputc('"', out);
-  for (; *s; ++s) {
-    if (*s == '"' || *s == '\\') fputc('\\', out);
-    fputc(*s, out);
-  }
-  fputc('"', out);
-}
-
 // Every pair that can touch (not both fixed), with the values its contacts get.
 static void write_pairs(const pdRefWorld* w, FILE* out) {
   const pdModel* m = w->model;
@@ -276,9 +268,9 @@ static void write_pairs(const pdRefWorld* w, FILE* out) {
       if (total++ >= LISTED_PAIRS_MAX) continue;
       pdPairContact p = pd_model_pair_contact(m, a, b);
       fputs(total > 1 ? ", {\"a\": " : "{\"a\": ", out);
-      json_string(out, m->bodies[a].name);
+      pdu_json_string(out, m->bodies[a].name);
       fputs(", \"b\": ", out);
-      json_string(out, m->bodies[b].name);
+      pdu_json_string(out, m->bodies[b].name);
       fprintf(out, ", \"mu\": %.17g", p.mu);
       if (w->variant == pd_refMatched)
         fprintf(out, ", \"stiffness\": %.17g, \"damping\": %.17g}", p.kn, p.cn);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pdutil/csv.h"
 #include "polydyn/cubetoss.h"
 
 #define TOSS_HEADER "toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz"
@@ -22,25 +23,6 @@ void pd_toss_set_free(pdTossSet* set) {
   free(set->tosses);
   free(set->path);
   free(set);
-}
-
-// Splits `line` at commas into at most TOSS_FIELDS fields (in place); returns the number of fields and
-// each field's 1-based column.
-static int split_fields(char* line, char** fields, int* cols) {
-  int n = 0;
-  char* p = line;
-  for (;;) {
-    if (n < TOSS_FIELDS) {
-      fields[n] = p;
-      cols[n] = (int)(p - line) + 1;
-    }
-    ++n;
-    char* comma = strchr(p, ',');
-    if (!comma) break;
-    *comma = '\0';
-    p = comma + 1;
-  }
-  return n;
 }
 
 static bool parse_number(const char* text, double* v) {
@@ -110,9 +92,17 @@ static pdTossSet* parse(const char* path, lineSource* src, pdError* err) {
       continue;
     }
     if (len == 0) continue;  // a blank line (e.g. at the end) carries nothing
-    char* fields[TOSS_FIELDS];
-    int cols[TOSS_FIELDS];
-    int n = split_fields(line, fields, cols);
+    // one line, one record (RFC 4180, pdutil/csv.h); room to count a few fields too many
+    char* fields[4 * TOSS_FIELDS];
+    int cols[4 * TOSS_FIELDS];
+    pduCsvCursor cursor = pdu_csv_cursor(line);
+    pduCsvError bad;
+    int n = pdu_csv_next(&cursor, fields, cols, 4 * TOSS_FIELDS, NULL, &bad);
+    if (n < 0) {
+      pd_error_set(err, path, (int)lineNo, bad.col, "%s", bad.message);
+      ok = false;
+      break;
+    }
     if (n != TOSS_FIELDS) {
       pd_error_set(err, path, (int)lineNo, 1, "%d fields, expected %d (" TOSS_HEADER ")", n, TOSS_FIELDS);
       ok = false;

@@ -13,6 +13,7 @@
 #include "polydyn/output.h"
 #include "polydyn/scene.h"
 #include "polydyn/stats.h"
+#include "pdutil/json.h"
 #include "text_buffer.h"
 
 // Default stiffness of each side, N/m: eq. (11) for the cube, m vmax²/δ_max² with δ_max = 0.01 × side
@@ -269,16 +270,6 @@ void pd_toss_judge(const pdToss* toss, const pdTrajectory* run, pdTossResult* r)
 
 // ---------------------------------------------------------------- the record as a run directory
 
-static void write_json_text(FILE* out, const char* s) {
-  fputc('"', out);
-  for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
-    if (*p == '"' || *p == '\\') fputc('\\', out);
-    if (*p < 0x20) fprintf(out, "\\u%04x", *p);
-    else fputc(*p, out);
-  }
-  fputc('"', out);
-}
-
 bool pd_toss_write_record(const pdToss* toss, const pdTossParams* params, const char* dir, const char* dataPath,
                           pdError* err) {
   pdModel* model = pd_toss_model(toss, params, err);
@@ -306,7 +297,7 @@ bool pd_toss_write_record(const pdToss* toss, const pdTossParams* params, const 
   FILE* mem = open_memstream(&settings, &settingsSize);
   if (!mem) abort();
   fputs("{\"source\": ", mem);
-  write_json_text(mem, dataPath ? dataPath : "");
+  pdu_json_string(mem, dataPath ? dataPath : "");
   fprintf(mem, ", \"toss\": %ld, \"first_line\": %ld, \"rate_hz\": %.17g, \"quaternions\": \"normalised on reading\"}",
           toss->id, toss->line, PD_TOSS_RATE);
   fclose(mem);

@@ -44,6 +44,7 @@
 #include <ode/version.h>
 
 #include "polydyn/refcheck.h"
+#include "pdutil/json.h"
 
 // World constraint parameters of the native variant, stated rather than inherited: ODE's defaults.
 #define PD_ODE_WORLD_ERP 0.2
@@ -657,12 +658,12 @@ static void write_pairs(const pdRefWorld* w, FILE* out) {
   for (int k = 0; k < classCount; ++k) {
     const pdPairContact* p = &classes[k];
     fputs(k ? ", {\"example\": [" : "{\"example\": [", out);
-    pd_write_json_string(out, model->bodies[firstA[k]].name);
+    pdu_json_string(out, model->bodies[firstA[k]].name);
     fputs(", ", out);
-    pd_write_json_string(out, model->bodies[firstB[k]].name);
+    pdu_json_string(out, model->bodies[firstB[k]].name);
     fprintf(out, "], \"pair_count\": %ld, \"mu\": %.17g, \"restitution\": %.17g, \"restitution_source\": ", count[k],
             p->mu, p->restitution);
-    pd_write_json_string(out, p->restitutionSource);
+    pdu_json_string(out, p->restitutionSource);
     fprintf(out, ", \"kn\": %.17g, \"cn\": %.17g", p->kn, p->cn);
     if (w->options.variant == pd_refMatched)
       fprintf(out, ", \"soft_erp\": %.17g, \"soft_cfm\": %.17g", w->h * p->kn / (w->h * p->kn + p->cn),
@@ -682,7 +683,7 @@ static void write_fixed_bodies(const pdRefWorld* w, FILE* out) {
     if (!model->bodies[i].fixed) continue;
     fputs(first ? "{\"body\": " : ", {\"body\": ", out);
     first = false;
-    pd_write_json_string(out, model->bodies[i].name);
+    pdu_json_string(out, model->bodies[i].name);
     const odePlane* p = NULL;
     for (int k = 0; k < w->planeCount; ++k)
       if (w->planes[k].body == i) p = &w->planes[k];
@@ -699,7 +700,7 @@ static void write_fixed_bodies(const pdRefWorld* w, FILE* out) {
       fputs(", \"switched_to_convex_at\": null}", out);
     } else {
       fprintf(out, ", \"switched_to_convex_at\": %.17g, \"switched_by\": ", p->switchedAt);
-      pd_write_json_string(out, model->bodies[p->switchedBody].name);
+      pdu_json_string(out, model->bodies[p->switchedBody].name);
       fputc('}', out);
     }
   }
@@ -710,7 +711,7 @@ static void ode_settings_json(const pdRefWorld* w, FILE* out) {
   bool matched = w->options.variant == pd_refMatched;
   bool aligned = w->options.odeFriction == pd_odeFrictionAligned;
   fputs("{\"library\": \"ODE " dODE_VERSION " (Debian libode-dev, double)\", \"configuration\": ", out);
-  pd_write_json_string(out, dGetConfiguration());
+  pdu_json_string(out, dGetConfiguration());
   fputs(", \"step_method\": \"dWorldStep (Dantzig LCP, exact)\"", out);
   fprintf(out, ", \"world_erp\": %.17g, \"world_cfm\": %.17g, \"contact_surface_layer\": 0, "
                "\"contact_max_correcting_vel\": \"infinity\", \"damping\": 0, \"auto_disable\": false, "
@@ -754,7 +755,7 @@ static void ode_settings_json(const pdRefWorld* w, FILE* out) {
           w->zeroNormalDropped, w->nonFiniteDropped, w->odeMessages);
   if (w->odeMessages) {
     fputs(", \"first_ode_message\": ", out);
-    pd_write_json_string(out, w->firstMessage);
+    pdu_json_string(out, w->firstMessage);
   }
   fputc('}', out);
 }

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pdutil/csv.h"
 #include "polydyn/oracle.h"
 
 // A quaternion read back must be unit to this (|q| − 1): %.17g round-trips exactly, so only a
@@ -17,19 +18,6 @@ static const char* const header =
     "our_verdict,our_depth,gjk_verdict,mpr_verdict,epa_depth,mpr_depth,scale,size,epa_tol\n";
 
 void pd_oracle_csv_header(FILE* out) { fputs(header, out); }
-
-static void put_text(FILE* out, const char* s) {
-  if (!strpbrk(s, ",\"\n\r")) {
-    fputs(s, out);
-    return;
-  }
-  fputc('"', out);
-  for (const char* c = s; *c; ++c) {
-    if (*c == '"') fputc('"', out);
-    fputc(*c, out);
-  }
-  fputc('"', out);
-}
 
 static void put_number(FILE* out, double v) { fprintf(out, ",%.17g", v); }
 
@@ -45,11 +33,11 @@ static const char* verdict(bool overlap) { return overlap ? "overlap" : "separat
 
 void pd_oracle_csv_write(FILE* out, const pdOracleRow* row) {
   const pdOracleResult* r = &row->r;
-  put_text(out, row->source);
+  pdu_csv_text(out, row->source);
   fprintf(out, ",%ld,%.17g,%s,", row->index, row->t, pdOracleKindNames[r->kind]);
   const char* texts[4] = {row->nameA, row->nameB, row->specA, row->specB};
   for (int i = 0; i < 4; ++i) {
-    put_text(out, texts[i]);
+    pdu_csv_text(out, texts[i]);
     fputc(',', out);
   }
   const double pose[14] = {row->xa.x, row->xa.y, row->xa.z, row->qa.w, row->qa.x, row->qa.y, row->qa.z,
@@ -65,47 +53,6 @@ void pd_oracle_csv_write(FILE* out, const pdOracleRow* row) {
   put_number(out, r->size);
   put_optional(out, r->hasEpa, r->epaTol);
   fputc('\n', out);
-}
-
-// Splits buf into fields in place (quotes removed, "" unescaped); start[i] is field i's 1-based column.
-static int split(char* buf, char** fields, int* start, int max, int* badCol) {
-  int n = 0;
-  char* p = buf;
-  for (;;) {
-    if (n == max) {
-      *badCol = (int)(p - buf) + 1;
-      return -1;
-    }
-    start[n] = (int)(p - buf) + 1;
-    if (*p == '"') {
-      char *w = p, *r = p + 1;
-      fields[n] = w;
-      for (;; ++r) {
-        if (*r == '\0') {
-          *badCol = start[n];
-          return -1;  // unterminated quote
-        }
-        if (*r == '"') {
-          if (r[1] != '"') break;
-          ++r;
-        }
-        *w++ = *r;
-      }
-      ++r;
-      if (*r != ',' && *r != '\0') {
-        *badCol = (int)(r - buf) + 1;
-        return -1;
-      }
-      *w = '\0';
-      p = r;
-    } else {
-      fields[n] = p;
-      p += strcspn(p, ",");
-    }
-    ++n;
-    if (*p == '\0') return n;
-    *p++ = '\0';
-  }
 }
 
 static bool read_number(const char* s, double* v) {
@@ -132,9 +79,17 @@ bool pd_oracle_csv_read(char* buf, pdOracleRow* row, int* col, char* why, int wh
   memset(row, 0, sizeof *row);
   char* f[PD_ORACLE_CSV_FIELDS + 1];
   int at[PD_ORACLE_CSV_FIELDS + 1];
-  int n = split(buf, f, at, PD_ORACLE_CSV_FIELDS + 1, col);
+  pduCsvCursor cursor = pdu_csv_cursor(buf);
+  pduCsvError bad;
+  int n = pdu_csv_next(&cursor, f, at, PD_ORACLE_CSV_FIELDS + 1, NULL, &bad);
   if (n < 0) {
-    snprintf(why, (size_t)whySize, "malformed quoted field or too many fields");
+    *col = bad.col;
+    snprintf(why, (size_t)whySize, "%s", bad.message);
+    return false;
+  }
+  if (*cursor.p != '\0') {  // one line is one record: a line break inside a field does not belong here
+    *col = (int)(cursor.p - buf) + 1;
+    snprintf(why, (size_t)whySize, "a record must fit on one line");
     return false;
   }
   if (n != PD_ORACLE_CSV_FIELDS) {

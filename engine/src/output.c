@@ -15,7 +15,6 @@
 #include "polydyn/output.h"
 
 #include <errno.h>
-#include <ftw.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -26,6 +25,9 @@
 #include <unistd.h>
 
 #include "model_contact.h"
+#include "pdutil/csv.h"
+#include "pdutil/files.h"
+#include "pdutil/json.h"
 #include "number_format.h"
 
 // The ring: blocks of at least PD_OUTPUT_BLOCK_BYTES, as many as fit PD_OUTPUT_RING_BYTES with the first sample
@@ -65,29 +67,6 @@ struct pdRunWriter {
   pthread_cond_t filled;  // produced grew, or quit
   pthread_cond_t freed;   // consumed grew
 };
-
-static char* join(const char* a, const char* b) {
-  size_t n = strlen(a) + strlen(b) + 2;
-  char* s = malloc(n);
-  PD_ASSERT(s != NULL);
-  snprintf(s, n, "%s/%s", a, b);
-  return s;
-}
-
-static char* with_suffix(const char* a, const char* suffix) {
-  size_t n = strlen(a) + strlen(suffix) + 1;
-  char* s = malloc(n);
-  PD_ASSERT(s != NULL);
-  snprintf(s, n, "%s%s", a, suffix);
-  return s;
-}
-
-static int remove_entry(const char* path, const struct stat* sb, int flag, struct FTW* ftw) {
-  (void)sb, (void)flag, (void)ftw;
-  return remove(path);
-}
-
-static void remove_tree(const char* path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
 
 // Appends x to text at n (at most PD_G17_MAX − 1 characters); returns the new length. The engine never lets a
 // non-finite number reach an output; should one get here, it is written "null", so JSON stays valid.
@@ -164,22 +143,6 @@ static timeText time_text(double t) {
   return r;
 }
 
-// CSV field: quoted (RFC 4180) only when it holds a comma, a quote or a line break.
-static void write_csv_text(FILE* out, const char* s) {
-  if (!strpbrk(s, ",\"\r\n")) {
-    fputs(s, out);
-    return;
-  }
-  fputc('"', out);
-  for (; *s; ++s) {
-    if (*s == '"') fputc('"', out);
-    fputc(*s, out);
-  }
-  fputc('"', out);
-}
-
-void pd_write_csv_text(FILE* out, const char* s) { write_csv_text(out, s); }
-
 void pd_write_contacts_header(FILE* out) {
   fputs("t,body_a,body_b,kind,feat_a,feat_b,px,py,pz,nx,ny,nz,fn,ftx,fty,ftz,mode\n", out);
 }
@@ -203,9 +166,9 @@ static void write_contact_row(FILE* out, numberCache* cache, const pdModel* mode
                               const contactRecord* c) {
   fwrite(t->text, 1, t->length, out);
   fputc(',', out);
-  write_csv_text(out, model->bodies[c->bodyA].name);
+  pdu_csv_text(out, model->bodies[c->bodyA].name);
   fputc(',', out);
-  write_csv_text(out, model->bodies[c->bodyB].name);
+  pdu_csv_text(out, model->bodies[c->bodyB].name);
   // the rest of the row in one fwrite: ",EE,3,7" (kind, features), 10 numbers, ",slip\n"
   char text[32 + 10 * (PD_G17_MAX + 1)];
   PD_ASSERT(c->featureA >= 0 && c->featureB >= 0);
@@ -242,7 +205,7 @@ static void write_trajectory_row(FILE* out, numberCache* cache, const pdModel* m
                                  const double row[13]) {
   fwrite(t->text, 1, t->length, out);
   fputc(',', out);
-  write_csv_text(out, model->bodies[i].name);
+  pdu_csv_text(out, model->bodies[i].name);
   char text[13 * (PD_G17_MAX + 1) + 1];
   size_t n = append_numbers(cache, text, 0, row, 13);
   text[n++] = '\n';
@@ -383,7 +346,7 @@ static void writer_stop(pdRunWriter* run, bool discard) {
 pdRunWriter* pd_run_open(const char* dir, pdError* err) {
   struct stat st;
   if (stat(dir, &st) == 0) {
-    char* summary = join(dir, "summary.json");
+    char* summary = pdu_path_join(dir, "summary.json");
     bool isRun = S_ISDIR(st.st_mode) && access(summary, F_OK) == 0;
     free(summary);
     if (!isRun) {
@@ -393,8 +356,8 @@ pdRunWriter* pd_run_open(const char* dir, pdError* err) {
   }
   pdRunWriter* run = calloc(1, sizeof *run);
   PD_ASSERT(run != NULL);
-  run->dir = with_suffix(dir, "");
-  run->tmp = with_suffix(dir, ".partial-XXXXXX");
+  run->dir = pdu_path_suffix(dir, "");
+  run->tmp = pdu_path_suffix(dir, ".partial-XXXXXX");
   if (mkdtemp(run->tmp)) {
     // mkdtemp makes the directory private; a finished run directory gets the usual permissions
     mode_t mask = umask(0);
@@ -407,10 +370,10 @@ pdRunWriter* pd_run_open(const char* dir, pdError* err) {
     free(run);
     return NULL;
   }
-  char* path = join(run->tmp, "trajectory.csv");
+  char* path = pdu_path_join(run->tmp, "trajectory.csv");
   run->trajectory = fopen(path, "w");
   free(path);
-  path = join(run->tmp, "contacts.csv");
+  path = pdu_path_join(run->tmp, "contacts.csv");
   run->contacts = fopen(path, "w");
   free(path);
   if (!run->trajectory || !run->contacts) {
@@ -460,20 +423,6 @@ bool pd_run_observe(const pdModel* model, const pdState* state, void* user) {
   return true;
 }
 
-static void write_json_string(FILE* out, const char* s) {
-  fputc('"', out);
-  for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
-    if (*p == '"' || *p == '\\')
-      fprintf(out, "\\%c", *p);
-    else if (*p < 0x20)
-      fprintf(out, "\\u%04x", *p);
-    else
-      fputc(*p, out);
-  }
-  fputc('"', out);
-}
-
-void pd_write_json_string(FILE* out, const char* s) { write_json_string(out, s); }
 
 static void write_vec(FILE* out, pdVec3 v) {
   fputc('[', out);
@@ -544,11 +493,11 @@ static void write_contact_pairs(FILE* out, const pdModel* model) {
   for (int i = 0; i < listed; ++i) {
     pdPairContact p = pd_model_pair_contact(model, a[i], b[i]);
     fputs(i ? ",\n    {\"bodies\": [" : "\n    {\"bodies\": [", out);
-    write_json_string(out, model->bodies[a[i]].name);
+    pdu_json_string(out, model->bodies[a[i]].name);
     fputs(", ", out);
-    write_json_string(out, model->bodies[b[i]].name);
+    pdu_json_string(out, model->bodies[b[i]].name);
     fputs("], \"restitution_source\": ", out);
-    write_json_string(out, p.restitutionSource);
+    pdu_json_string(out, p.restitutionSource);
     fprintf(out, ", \"damping\": {\"n\": \"%s\", \"t\": \"%s\"}", p.modalN ? "modal" : "explicit",
             p.modalT ? "modal" : "explicit");
     const struct {
@@ -582,9 +531,9 @@ static void write_body(FILE* out, const pdModel* model, int index) {
   const pdBody* b = &model->bodies[index];
   pdBodyContactInfo info = pd_model_body_contact_info(model, index);
   fputs("    {\"name\": ", out);
-  write_json_string(out, b->name);
+  pdu_json_string(out, b->name);
   fputs(", \"color\": ", out);
-  write_json_string(out, b->color);
+  pdu_json_string(out, b->color);
   fprintf(out, ", \"primitive\": \"%s\", \"fixed\": %s,\n", primitive_name(b->kind), b->fixed ? "true" : "false");
   fputs("     \"mass\": ", out);
   write_number(out, b->mass);
@@ -648,16 +597,16 @@ static void write_body(FILE* out, const pdModel* model, int index) {
 void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state, const pdRunInfo* info) {
   const pdSettings* s = &model->settings;
   fputs("{\n  \"engine\": ", out);
-  write_json_string(out, info->engine);
+  pdu_json_string(out, info->engine);
   fputs(",\n  \"version\": \"" PD_VERSION "\",\n  \"scene\": ", out);
-  write_json_string(out, model->scenePath);
+  pdu_json_string(out, model->scenePath);
   fputs(",\n  \"stepper\": ", out);
-  write_json_string(out, info->stepper ? info->stepper : pd_stepper_name(state->stepper));
+  pdu_json_string(out, info->stepper ? info->stepper : pd_stepper_name(state->stepper));
   if (!info->stepper) {  // the soft engine's own state: how contacts that begin inside a step join
     fputs(",\n  \"onsets\": ", out);
-    write_json_string(out, pd_onsets_name(state->onsets));
+    pdu_json_string(out, pd_onsets_name(state->onsets));
     fputs(",\n  \"islands\": ", out);
-    write_json_string(out, pd_islands_name(state->islands));
+    pdu_json_string(out, pd_islands_name(state->islands));
   }
   fputs(",\n", out);
   if (info->engineSettingsJson) fprintf(out, "  \"engine_settings\": %s,\n", info->engineSettingsJson);
@@ -689,7 +638,7 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   for (int i = 0, count = pd_model_adjustment_count(model); i < count; ++i) {
     pd_model_adjustment_describe(model, i, line, sizeof line);
     fputs(i ? ",\n    " : "\n    ", out);
-    write_json_string(out, line);
+    pdu_json_string(out, line);
   }
   fprintf(out, "%s],\n  \"adjustments_dropped\": %d,\n", pd_model_adjustment_count(model) ? "\n  " : "",
           pd_model_adjustments_dropped(model));
@@ -744,7 +693,7 @@ bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state,
   ok = (fclose(run->contacts) == 0) && ok;
   run->trajectory = NULL;
   run->contacts = NULL;
-  char* path = join(run->tmp, "summary.json");
+  char* path = pdu_path_join(run->tmp, "summary.json");
   FILE* out = ok ? fopen(path, "w") : NULL;
   free(path);
   if (out) {
@@ -759,12 +708,12 @@ bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state,
     struct stat st;
     char* old = NULL;
     if (stat(run->dir, &st) == 0) {
-      old = with_suffix(run->dir, ".old-XXXXXX");
+      old = pdu_path_suffix(run->dir, ".old-XXXXXX");
       ok = mkdtemp(old) != NULL && rename(run->dir, old) == 0;
     }
     ok = ok && rename(run->tmp, run->dir) == 0;
     if (old) {
-      if (ok) remove_tree(old);
+      if (ok) pdu_remove_tree(old);
       free(old);
     }
   }
@@ -784,7 +733,7 @@ void pd_run_abort(pdRunWriter* run) {
   writer_stop(run, true);
   if (run->trajectory) fclose(run->trajectory);
   if (run->contacts) fclose(run->contacts);
-  remove_tree(run->tmp);
+  pdu_remove_tree(run->tmp);
   free(run->dir);
   free(run->tmp);
   free(run);

@@ -31,6 +31,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "pdutil/utf8.h"
 #include "polydyn/scene.h"
 
 enum {
@@ -409,9 +410,20 @@ static bool check_name(Parser* ps, const Token* t) {
   return true;
 }
 
+// A name or a colour is any word (docs/names-and-files.md) that is valid UTF-8: every file that carries it
+// (CSV, JSON, the replay page) then shows it as written. The error points at the first bad byte.
+static bool check_utf8(Parser* ps, const Token* t, const char* what) {
+  size_t valid = pdu_utf8_valid_length(t->text, t->len);
+  if (valid == t->len) return true;
+  pdSourceLoc at = t->loc;
+  at.col += (int)valid;
+  return fail(ps, at, "%s is not valid UTF-8 (byte 0x%02X)", what, (unsigned char)t->text[valid]);
+}
+
 // Appends a new object with its name and colour (checked unique) and the language's defaults.
 static pdSceneObject* add_object(Parser* ps, pdSourceLoc at, const Token* name, const Token* color) {
   pdScene* sc = ps->scene;
+  if (!check_utf8(ps, name, "the name") || !check_utf8(ps, color, "the colour")) return NULL;
   if (sc->objectCount == MAX_OBJECTS) {
     fail(ps, at, "too many objects (at most %d)", MAX_OBJECTS);
     return NULL;

@@ -643,6 +643,26 @@ static void test_error_duplicate_name_reports_the_first_definition(void** state)
   expect_error("cube a red 1 1 1\nhull a w 0 0 0 1 0 0 0 1 0 0 0 1\n", 2, 6, "duplicate name 'a'");
 }
 
+// The rule for names (docs/names-and-files.md): any word of valid UTF-8. A word may hold what CSV and JSON
+// must quote or escape; a name or colour that is not UTF-8 is refused at its first bad byte.
+static void test_names_are_any_word_of_valid_utf8(void** state) {
+  (void)state;
+  pdScene* sc = parse_text("cube <img/src=x/onerror=document.title=\"PWNED\"> red 1 1 1\n"
+                           "cube a,b;c:d'e t\xc3\xaate 1 1 1\n"
+                           "hull \xe7\xae\xb1\xf0\x9f\x98\x80 \xe2\x80\x94 0 0 0 1 0 0 0 1 0 0 0 1\n");
+  assert_int_equal(sc->objectCount, 3);
+  assert_string_equal(sc->objects[0].name, "<img/src=x/onerror=document.title=\"PWNED\">");
+  assert_string_equal(sc->objects[1].name, "a,b;c:d'e");
+  assert_string_equal(sc->objects[1].color, "t\xc3\xaate");
+  assert_string_equal(sc->objects[2].name, "\xe7\xae\xb1\xf0\x9f\x98\x80");
+  pd_scene_free(sc);
+  expect_error("cube ab\xff red 1 1 1\n", 1, 8, "the name is not valid UTF-8 (byte 0xFF)");
+  expect_error("cube ok red 1 1 1\nsphere \xc3( red 1 1 1 1\n", 2, 8, "the name is not valid UTF-8 (byte 0xC3)");
+  expect_error("cube a \xed\xa0\x80 1 1 1\n", 1, 8, "the colour is not valid UTF-8 (byte 0xED)");  // a surrogate
+  expect_error("cube a r\xc0\xaf 1 1 1\n", 1, 9, "the colour is not valid UTF-8 (byte 0xC0)");    // overlong '/'
+  expect_error("hull \xf4\x90\x80\x80 w 0 0 0 1 0 0 0 1 0 0 0 1\n", 1, 6, "the name is not valid UTF-8");
+}
+
 static void test_error_hull_with_3_points(void** state) {
   (void)state;
   expect_error("cube a red 1 1 1\nhull h w 0 0 0 \\\n 1 0 0 0 1 0\n", 2, 1, "hull needs at least 4 points, got 3");
@@ -871,6 +891,7 @@ int main(void) {
       cmocka_unit_test(test_10mb_comments_only_file_parses_fast),
       cmocka_unit_test(test_force_with_ramp_and_point_in_either_order),
       cmocka_unit_test(test_error_force_arity_keywords_values_and_fixed_bodies),
+      cmocka_unit_test(test_names_are_any_word_of_valid_utf8),
       cmocka_unit_test(test_error_print_formats_with_and_without_line),
       cmocka_unit_test(test_error_set_truncates_long_message_and_file_name),
   };

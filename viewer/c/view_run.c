@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pdutil/csv.h"
+#include "pdutil/files.h"
 #include "view_internal.h"
 
 static const char* const trajectoryHeader = "t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz";
@@ -28,80 +30,52 @@ static char* xstrdup(const char* s) {
   return memcpy(xmalloc(n), s, n);
 }
 
-static char* join(const char* dir, const char* name) {
-  size_t n = strlen(dir) + strlen(name) + 2;
-  char* s = xmalloc(n);
-  snprintf(s, n, "%s/%s", dir, name);
-  return s;
-}
-
 // ---------------------------------------------------------------- CSV
 
-// A CSV file read line by line, with the line number and the column (1-based byte) of each field.
+// A CSV file read line by line (a record of trajectory.csv or contacts.csv never spans lines: body names
+// hold no line break, docs/names-and-files.md), each line split by the shared RFC 4180 reader (pdutil/csv.h).
+enum { CSV_FIELDS_MAX = 18 };  // contacts.csv's 17, and one to tell "more"
 typedef struct csvReader {
   FILE* in;
   const char* path;
-  char* line;        // current line, without its line break
+  char* line;        // current line, without its line break, split in place
   size_t lineCap;
+  size_t lineLength;
   int lineNo;
-  char* pos;         // next field's start within line (NULL at the end of the line)
+  char* fields[CSV_FIELDS_MAX];
+  int cols[CSV_FIELDS_MAX];
+  int count;         // fields of the current line
+  int next;          // index of the next field csv_field returns
   int col;           // column of the field last returned
-  char* unquoted;    // buffer for a quoted field
-  size_t unquotedCap;
 } csvReader;
 
-// Reads the next line; false at the end of the file.
-static bool csv_next_line(csvReader* r) {
+// Reads and splits the next line: 1, 0 at the end of the file, -1 (err filled) for a malformed line.
+static int csv_next_line(csvReader* r, pdError* err) {
   ssize_t n = getline(&r->line, &r->lineCap, r->in);
-  if (n < 0) return false;
+  if (n < 0) return 0;
   while (n > 0 && (r->line[n - 1] == '\n' || r->line[n - 1] == '\r')) r->line[--n] = '\0';
+  r->lineLength = (size_t)n;
   r->lineNo++;
-  r->pos = r->line;
-  return true;
+  pduCsvCursor cursor = pdu_csv_cursor(r->line);
+  pduCsvError bad;
+  r->count = n == 0 ? 0 : pdu_csv_next(&cursor, r->fields, r->cols, CSV_FIELDS_MAX, NULL, &bad);
+  r->next = 0;
+  if (r->count < 0) {
+    pd_error_set(err, r->path, r->lineNo, bad.col, "%s", bad.message);
+    return -1;
+  }
+  return 1;
 }
 
-// Next field of the line (RFC 4180 quoting within one line); NULL when the line has no more fields.
+// Next field of the line; NULL when the line has no more fields.
 static const char* csv_field(csvReader* r) {
-  if (!r->pos) return NULL;
-  char* s = r->pos;
-  r->col = (int)(s - r->line) + 1;
-  if (*s != '"') {
-    char* comma = strchr(s, ',');
-    if (comma) {
-      *comma = '\0';
-      r->pos = comma + 1;
-    } else {
-      r->pos = NULL;
-    }
-    return s;
-  }
-  size_t need = strlen(s) + 1;
-  if (need > r->unquotedCap) {
-    r->unquotedCap = need;
-    r->unquoted = xrealloc(r->unquoted, need);
-  }
-  char* o = r->unquoted;
-  ++s;
-  for (;;) {
-    if (*s == '\0') return NULL;  // unterminated quote: reported by the caller as a missing field
-    if (*s == '"') {
-      if (s[1] == '"') {
-        *o++ = '"';
-        s += 2;
-        continue;
-      }
-      ++s;
-      break;
-    }
-    *o++ = *s++;
-  }
-  *o = '\0';
-  if (*s == ',')
-    r->pos = s + 1;
-  else
-    r->pos = NULL;  // anything after the closing quote other than a comma: the line ends here
-  return r->unquoted;
+  if (r->next >= r->count) return NULL;
+  r->col = r->cols[r->next];
+  return r->fields[r->next++];
 }
+
+// Whether the line has fields left.
+static bool csv_more(const csvReader* r) { return r->next < r->count; }
 
 static bool csv_number(csvReader* r, const char* field, double* value, pdError* err) {
   char* end = NULL;
@@ -120,7 +94,7 @@ static bool csv_numbers(csvReader* r, double* out, int count, int before, int to
   for (int c = 0; c < count; ++c) {
     const char* field = csv_field(r);
     if (!field) {
-      pd_error_set(err, r->path, r->lineNo, (int)strlen(r->line) + 1, "expected %d fields, found %d", total, before + c);
+      pd_error_set(err, r->path, r->lineNo, (int)r->lineLength + 1, "expected %d fields, found %d", total, before + c);
       return false;
     }
     if (!csv_number(r, field, &out[c], err)) return false;
@@ -137,7 +111,19 @@ static bool csv_open(csvReader* r, const char* path, const char* header, pdError
     pd_error_set(err, path, 0, 0, "cannot read: %s", strerror(errno));
     return false;
   }
-  if (!csv_next_line(r) || strcmp(r->line, header) != 0) {
+  char* expected = strdup(header);
+  if (!expected) abort();
+  bool same = csv_next_line(r, err) > 0;
+  // the header's names, field by field
+  for (char *name = expected, *end = NULL; same && name; name = end ? end + 1 : NULL) {
+    end = strchr(name, ',');
+    if (end) *end = '\0';
+    const char* field = csv_field(r);
+    same = field && strcmp(field, name) == 0;
+  }
+  same = same && !csv_more(r);
+  free(expected);
+  if (!same) {
     pd_error_set(err, path, 1, 1, "expected the header '%s'", header);
     return false;
   }
@@ -147,7 +133,6 @@ static bool csv_open(csvReader* r, const char* path, const char* header, pdError
 static void csv_close(csvReader* r) {
   if (r->in) fclose(r->in);
   free(r->line);
-  free(r->unquoted);
 }
 
 // ---------------------------------------------------------------- summary.json
@@ -245,34 +230,11 @@ static bool read_body(const cJSON* b, int index, const char* path, cJSON* bodies
   return true;
 }
 
-static char* read_file(const char* path, pdError* err) {
-  FILE* in = fopen(path, "rb");
-  if (!in) {
-    pd_error_set(err, path, 0, 0, "cannot read: %s", strerror(errno));
-    return NULL;
-  }
-  size_t cap = 1 << 16, len = 0;
-  char* text = xmalloc(cap);
-  size_t n;
-  while ((n = fread(text + len, 1, cap - len - 1, in)) > 0) {
-    len += n;
-    if (cap - len - 1 == 0) text = xrealloc(text, cap *= 2);
-  }
-  bool bad = ferror(in);
-  fclose(in);
-  if (bad) {
-    free(text);
-    pd_error_set(err, path, 0, 0, "cannot read: I/O error");
-    return NULL;
-  }
-  text[len] = '\0';
-  return text;
-}
-
 // Reads summary.json: fills names, fixed, the moving order, and the page's JSON (without the layout).
 static cJSON* read_summary(pdViewRun* run, pdError* err) {
-  char* path = join(run->dir, "summary.json");
-  char* text = read_file(path, err);
+  char* path = pdu_path_join(run->dir, "summary.json");
+  char* text = pdu_read_file(path, NULL);
+  if (!text) pd_error_set(err, path, 0, 0, "cannot read: %s", strerror(errno));
   cJSON* summary = text ? cJSON_ParseWithOpts(text, NULL, true) : NULL;
   cJSON* meta = NULL;
   if (text && !summary) {
@@ -339,13 +301,14 @@ done:
 // ---------------------------------------------------------------- trajectory.csv
 
 static bool read_trajectory(pdViewRun* run, pdError* err) {
-  char* path = join(run->dir, "trajectory.csv");
+  char* path = pdu_path_join(run->dir, "trajectory.csv");
   csvReader r;
   bool ok = csv_open(&r, path, trajectoryHeader, err);
   int m = run->movingCount;
   size_t cap = 0;
   int row = 0;  // row within the current sample
-  while (ok && csv_next_line(&r)) {
+  int got = 0;
+  while (ok && (got = csv_next_line(&r, err)) > 0) {
     double t;
     const char* field = csv_field(&r);
     if (!field || !csv_number(&r, field, &t, err)) {
@@ -383,8 +346,8 @@ static bool read_trajectory(pdViewRun* run, pdError* err) {
     size_t base = (size_t)(run->sampleCount - 1) * (size_t)m + (size_t)row;
     double values[13];
     ok = csv_numbers(&r, values, 13, 2, 15, err);
-    if (ok && r.pos) {
-      pd_error_set(err, path, r.lineNo, (int)(r.pos - r.line), "more than 15 fields");
+    if (ok && csv_more(&r)) {
+      pd_error_set(err, path, r.lineNo, r.cols[r.next], "more than 15 fields");
       ok = false;
     }
     if (!ok) break;
@@ -392,6 +355,7 @@ static bool read_trajectory(pdViewRun* run, pdError* err) {
     for (int c = 0; c < PD_VIEW_VEL; ++c) run->vel[base * PD_VIEW_VEL + (size_t)c] = (float)values[PD_VIEW_POSE + c];
     row = (row + 1) % m;
   }
+  if (got < 0) ok = false;
   if (ok && ferror(r.in)) {
     pd_error_set(err, path, r.lineNo, 0, "read error");
     ok = false;
@@ -423,7 +387,7 @@ static int compare_names(const void* a, const void* b) {
 static bool body_field(csvReader* r, const nameIndex* sorted, int count, int* index, pdError* err) {
   const char* field = csv_field(r);
   if (!field) {
-    pd_error_set(err, r->path, r->lineNo, (int)strlen(r->line) + 1, "expected 17 fields");
+    pd_error_set(err, r->path, r->lineNo, (int)r->lineLength + 1, "expected 17 fields");
     return false;
   }
   nameIndex key = {field, 0};
@@ -439,7 +403,7 @@ static bool body_field(csvReader* r, const nameIndex* sorted, int count, int* in
 static bool read_contacts(pdViewRun* run, pdError* err) {
   run->contactStart = calloc((size_t)run->sampleCount + 1, sizeof *run->contactStart);
   PD_ASSERT(run->contactStart != NULL);
-  char* path = join(run->dir, "contacts.csv");
+  char* path = pdu_path_join(run->dir, "contacts.csv");
   FILE* probe = fopen(path, "r");
   if (!probe && errno == ENOENT) {  // reference engines may write none
     free(path);
@@ -455,7 +419,8 @@ static bool read_contacts(pdViewRun* run, pdError* err) {
   bool ok = csv_open(&r, path, contactsHeader, err);
   size_t cap = 0;
   int sample = 0;
-  while (ok && csv_next_line(&r)) {
+  int got = 0;
+  while (ok && (got = csv_next_line(&r, err)) > 0) {
     double t;
     const char* field = csv_field(&r);
     if (!field) {
@@ -515,6 +480,7 @@ static bool read_contacts(pdViewRun* run, pdError* err) {
     ci[2] = flags;
     run->contactCount++;
   }
+  if (got < 0) ok = false;
   while (ok && sample < run->sampleCount) run->contactStart[++sample] = (uint32_t)run->contactCount;
   csv_close(&r);
   free(sorted);

@@ -2,6 +2,7 @@
 // block per run (layout in viewer/c/view_internal.h: float64 times and poses, float32 velocities and
 // contacts), or a run directory's files as the report hands them over (readRunFiles: the same arrays,
 // read from summary.json, trajectory.csv and contacts.csv as viewer/c/view_run.c reads them).
+import { parseCsvRecords } from './csv.js';
 
 function decodeBase64(text) {
   if (typeof Uint8Array.fromBase64 === 'function') return Uint8Array.fromBase64(text.trim());
@@ -149,42 +150,12 @@ function readSummary(summary, dir) {
   };
 }
 
-// Lines of a CSV text after its header, which must equal `header`; fields split at commas (polydyn
-// writes no quoted fields in these files; a quoted field is unquoted as in view_run.c's csv_field).
+// The records of a CSV text after its header, which must equal `header`, as [line, fields] (src/csv.js).
 function* csvRows(text, header, where) {
-  const lines = text.split('\n');
-  if (lines[0].replace(/\r$/, '') !== header) throw new Error(`${where}:1: expected the header '${header}'`);
-  for (let i = 1; i < lines.length; ++i) {
-    const line = lines[i].replace(/\r$/, '');
-    if (line === '' && i === lines.length - 1) break;
-    yield [i + 1, line.includes('"') ? splitQuoted(line) : line.split(',')];
-  }
-}
-
-function splitQuoted(line) {
-  const out = [];
-  let i = 0;
-  for (;;) {
-    if (line[i] !== '"') {
-      const comma = line.indexOf(',', i);
-      out.push(line.slice(i, comma < 0 ? undefined : comma));
-      if (comma < 0) return out;
-      i = comma + 1;
-      continue;
-    }
-    let s = '';
-    for (++i; i < line.length; ++i) {
-      if (line[i] === '"') {
-        if (line[i + 1] === '"') { s += '"'; ++i; continue; }
-        break;
-      }
-      s += line[i];
-    }
-    if (i >= line.length) return out;  // unterminated quote: a missing field
-    out.push(s);
-    if (line[i + 1] !== ',') return out;
-    i += 2;
-  }
+  const records = parseCsvRecords(text, (line, message) => { throw new Error(`${where}:${line}: ${message}`); });
+  if (records.length === 0 || records[0].fields.join(',') !== header)
+    throw new Error(`${where}:1: expected the header '${header}'`);
+  for (let i = 1; i < records.length; ++i) yield [records[i].line, records[i].fields];
 }
 
 function number(field, where) {

@@ -43,8 +43,6 @@ PD_API void pd_write_trajectory_header(FILE* out);
 // mode stick or slip.
 PD_API void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state);
 PD_API void pd_write_contacts_header(FILE* out);
-// Writes `s` as one CSV field: as it is, or quoted (RFC 4180) when it holds a comma, a quote or a line break.
-PD_API void pd_write_csv_text(FILE* out, const char* s);
 
 typedef struct pdRunInfo {
   const char* engine;     // e.g. "polydyn-soft"
@@ -63,9 +61,6 @@ PD_API bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState*
 
 // Removes the temporary directory and frees the writer (an interrupted or failed run); NULL is allowed.
 PD_API void pd_run_abort(pdRunWriter* run);
-
-// Writes `s` (UTF-8) as a JSON string: quoted, with the quote, the backslash and control characters escaped.
-PD_API void pd_write_json_string(FILE* out, const char* s);
 
 // Writes the summary JSON object to `out` (also used by `polydyn check --json` later).
 PD_API void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state, const pdRunInfo* info);
