@@ -74,12 +74,17 @@ function impactsTable(d, engines) {
     table(['t (s)', 'bodies', 'e requested', 'reference', ...engines.map(esc)], rows, 'impacts');
 }
 
+// The ratio's axis ends at twice the largest μ: a contact whose normal force vanishes has any ratio.
 function frictionChart(ctx, d, mus) {
   const evs = [...new Set(d.friction.map((r) => r.ev))].filter((ev) => ev !== CHAOS);
+  const top = mus.length ? 2 * Math.max(...mus) : 2;
   const series = [];
+  let above = 0;
   for (const ev of evs)
     for (const mode of ['slip', 'stick']) {
-      const pts = d.friction.filter((r) => r.ev === ev && r.mode === mode && r.fn > 0).map((r) => [r.slip_speed, r.ft / r.fn, `${r.body_a}–${r.body_b} ${mode} t=${r.t}`]);
+      const all = d.friction.filter((r) => r.ev === ev && r.mode === mode && r.fn > 0);
+      const pts = all.filter((r) => r.ft / r.fn <= top).map((r) => [r.slip_speed, r.ft / r.fn, `${r.body_a}–${r.body_b} ${mode} t=${r.t}`]);
+      above += all.length - pts.length;
       if (!pts.length) continue;
       const color = ev === REFERENCE ? REFERENCE_COLOR : ctx.color(ev);
       series.push({ name: `${runLabel(ev)} ${mode}`, type: 'scatter', symbol: mode === 'slip' ? 'circle' : 'triangle', symbolSize: 5,
@@ -88,13 +93,13 @@ function frictionChart(ctx, d, mus) {
   if (series.length && mus.length)
     series[0].markLine = { silent: true, symbol: 'none', lineStyle: { color: '#555', type: 'dashed' },
       label: { formatter: '{b}', position: 'insideEndTop' }, data: mus.map((mu) => ({ yAxis: mu, name: `μ ${mu}` })) };
-  return ctx.chart({
+  return { above, top, html: ctx.chart({
     tooltip: { trigger: 'item', formatter: 'point3' }, legend: { top: 0, type: 'scroll' },
     grid: { left: 64, right: 24, top: 40, bottom: 44 },
     xAxis: { type: 'value', name: 'slip speed (m/s)', nameLocation: 'middle', nameGap: 26, axisLabel: { formatter: 'num' } },
-    yAxis: { type: 'value', name: '|F_t| / F_n', nameLocation: 'middle', nameGap: 44, axisLabel: { formatter: 'num' } },
+    yAxis: { type: 'value', min: 0, max: top, name: '|F_t| / F_n', nameLocation: 'middle', nameGap: 44, axisLabel: { formatter: 'num' } },
     series,
-  }, { height: 340 });
+  }, { height: 340 }) };
 }
 
 // μ of every pair of material classes the reference used.
@@ -176,7 +181,10 @@ export default {
       html += '<h3>Friction cone</h3><p>Every contact with a normal force (at most 4 000 per run, evenly taken): |F<sub>t</sub>|/F<sub>n</sub> ' +
         `against the slip speed of its point${mus.length ? `, the pairs’ μ dashed (${mus.join(', ')})` : ''}. A Coulomb cone puts sliding contacts ` +
         'on μ and sticking ones below it at zero slip; a stick that creeps shows slip speed with the ratio below μ. polydyn’s soft engine reports ' +
-        'each contact’s mode; ODE’s and Bullet’s contacts count as sliding above 1 mm/s.</p>' + frictionChart(ctx, d, mus);
+        'each contact’s mode; ODE’s and Bullet’s contacts count as sliding above 1 mm/s.</p>';
+      const cone = frictionChart(ctx, d, mus);
+      html += cone.html + (cone.above ? `<p class="muted">${cone.above} contacts with a ratio above ${num(cone.top)} (a normal force near zero) are not drawn; ` +
+        'they are in friction.csv.</p>' : '');
     }
     return { html, data: { sentences: s.sentences.map((x) => x.text), divergence: d.divergence }, csv: [] };
   },
