@@ -46,6 +46,10 @@ plus the numbers it shows as JSON and CSV beside it. Sections appear when their 
   precision.csv                   work-precision of each experiment against its closed form, the cost to
                                   reach its tolerance, and the summary's fronts (gedanken --precision)
   metrics.csv                     comparison metrics
+  divergence.csv, impacts.csv,    where, when and why the engines differ (polydyn compare SCENE): a sentence
+  series.csv, friction.csv        per engine, the first divergence linked into the replay, each body over
+                                  time, the impacts matched across engines, the friction cone
+  NAME/divergence.csv             polydyn compare SCENE_DIR: a row per scene, and NAME/report.html for each
   cubetoss/summary.csv            cube tosses against reality (per_toss.csv, fit.csv, replay/TOSS/ or
                                   runs/TOSS/ beside it); DIR may also be a polydyn cubetoss directory
 
