@@ -6,22 +6,18 @@
 // body selected, and the replay's view is drawn (pixels other than the clear colour).
 // usage: node compare_browser.mjs REPORT.html [--screenshot PNG] [--full PNG]
 //   --screenshot: the first screen (1360 × 900); --full: the whole page with the replay open at the link
-import fs from 'node:fs';
-import os from 'node:os';
 import path from 'node:path';
-import { createRequire } from 'node:module';
 import { fileURLToPath, pathToFileURL } from 'node:url';
 
+// Debian's Chromium with software WebGL, and the replay view's pixel statistics: the viewer's browser helpers
 const HERE = path.dirname(fileURLToPath(import.meta.url));
-const require = createRequire(path.join(HERE, '..', '..', 'reports', 'generator', 'package.json'));
-const { chromium } = require('playwright-core');
+const { launch, haveChromium, chromiumPath, viewStats } = await import(path.join(HERE, '..', '..', 'viewer', 'scripts', 'browser.mjs'));
 
 const args = process.argv.slice(2);
 const opt = (name) => { const k = args.indexOf(name); return k >= 0 ? args[k + 1] : null; };
 const file = args[0];
-const CHROMIUM = process.env.PD_CHROMIUM || '/usr/bin/chromium';
-if (!fs.existsSync(CHROMIUM)) {
-  console.log(`SKIP: no Chromium at ${CHROMIUM}`);
+if (!haveChromium()) {
+  console.log(`SKIP: no Chromium at ${chromiumPath}`);
   process.exit(77);
 }
 
@@ -31,15 +27,10 @@ function check(ok, what) {
   if (!ok) failures++;
 }
 
-const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'pd-compare-chromium-'));
-const context = await chromium.launchPersistentContext(userDataDir, {
-  executablePath: CHROMIUM, headless: true,
-  args: ['--headless', '--no-sandbox', '--disable-quic', '--no-first-run', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  viewport: { width: 1360, height: 900 },
-});
+const browser = await launch();
 try {
-  const page = await context.newPage();
+  const page = await browser.context.newPage();
+  await page.setViewportSize({ width: 1360, height: 900 });
   const problems = [], requests = [];
   page.on('console', (m) => {
     // software WebGL's performance notes are not errors of the page
@@ -115,28 +106,14 @@ try {
     check(state && state.runs >= 3, `the reference and the engines overlaid (${state ? state.runs : 0} runs)`);
     const canvas = page.locator('#pd-differ-replay canvas').first();
     await canvas.scrollIntoViewIfNeeded();
-    const png = await canvas.screenshot();
-    const drawn = await page.evaluate(async (b64) => {
-      const img = new Image();
-      img.src = `data:image/png;base64,${b64}`;
-      await img.decode();
-      const c = document.createElement('canvas');
-      c.width = img.width; c.height = img.height;
-      const g = c.getContext('2d');
-      g.drawImage(img, 0, 0);
-      const px = g.getImageData(0, 0, c.width, c.height).data;
-      let n = 0;
-      for (let i = 0; i < px.length; i += 4) if (Math.abs(px[i] - 0x20) + Math.abs(px[i + 1] - 0x24) + Math.abs(px[i + 2] - 0x2b) > 12) n++;
-      return n / (px.length / 4);
-    }, png.toString('base64'));
+    const { drawn } = await viewStats(page, canvas);
     check(drawn > 0.02, `the replay's view is drawn (${(100 * drawn).toFixed(1)} % of its pixels)`);
     if (opt('--full')) await page.screenshot({ path: opt('--full'), fullPage: true });
   }
   check(problems.length === 0, `no console errors or warnings${problems.length ? ': ' + problems.join(' | ') : ''}`);
   check(requests.length === 0, `no network request${requests.length ? ': ' + requests.join(', ') : ''}`);
 } finally {
-  await context.close();
-  fs.rmSync(userDataDir, { recursive: true, force: true });
+  await browser.close();
 }
 console.log(failures === 0 ? 'all checks passed' : `${failures} check(s) failed`);
 process.exitCode = failures ? 1 : 0;
