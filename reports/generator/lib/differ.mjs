@@ -49,7 +49,24 @@ function impactClause(d, ev) {
   return text;
 }
 
-export function summarize(d, metricsRows) {
+// Whether `ev`'s sliding contacts leave Coulomb's cone |F_t| <= μ F_n (one μ in the scene): the 90th percentile
+// of their ratio, when it exceeds μ by more than 5 %; contacts under 1 % of the largest normal force (a corner
+// brushing by) left out. A ratio below μ while sliding is not told: ODE's and Bullet's mode is read from the
+// contact point's speed, which a pivoting edge's reported point has too.
+function frictionClause(d, ev, mus) {
+  if (mus.length !== 1) return null;
+  const mu = mus[0];
+  const mine = d.friction.filter((r) => r.ev === ev && r.mode === 'slip');
+  if (!mine.length) return null;
+  const big = Math.max(...mine.map((r) => r.fn));
+  const ratios = mine.filter((r) => r.fn > 0.01 * big).map((r) => r.ft / r.fn).sort((a, b) => a - b);
+  if (ratios.length < 5) return null;
+  const hi = ratios[Math.ceil(0.9 * (ratios.length - 1))];
+  if (hi <= 1.05 * mu) return null;
+  return `its sliding contacts leave the friction cone: |F_t|/F_n up to ${num(hi)} (90th percentile) where μ is ${num(mu)}`;
+}
+
+export function summarize(d, metricsRows, mus = []) {
   const threshold = d.divergence.length ? d.divergence[0].threshold : null;
   const chaosFactor = d.divergence.length ? d.divergence[0].chaos_factor : null;
   const chaos = d.divergence.find((r) => r.ev === CHAOS) || null;
@@ -80,8 +97,8 @@ export function summarize(d, metricsRows) {
         what += `, after the scene’s own divergence (${num(horizon, 4)} s) and never ${chaosFactor}× beyond it: chaos explains it`;
       else what += ' (no chaos run to tell model from chaos)';
     }
-    const imp = impactClause(d, r.ev);
-    const text = `${r.ev} ${what}${imp ? `; ${imp}` : ''}.`;
+    const imp = impactClause(d, r.ev), fric = frictionClause(d, r.ev, mus);
+    const text = `${r.ev} ${what}${imp ? `; ${imp}` : ''}${fric ? `; ${fric}` : ''}.`;
     sentences.push({ text, html: `<b>${esc(r.ev)}</b> ${esc(text.slice(r.ev.length + 1))}` });
   }
   return { scene, threshold, chaosFactor, engines, sentences, bodyCount, verdictWords: VERDICT_WORDS };

@@ -116,7 +116,7 @@ export default {
   build(ctx) {
     const d = ctx.compareDetail;
     if (!d) return null;
-    const s = summarize(d, ctx.metrics ? ctx.metrics.rows : []);
+    const s = summarize(d, ctx.metrics ? ctx.metrics.rows : [], pairMus(ctx));
     const runs = [REFERENCE, CHAOS, ...s.engines].filter((ev) => d.series.some((r) => r.ev === ev));
     let html = `<ul class="verdict">${s.sentences.map((x) => `<li>${x.html}</li>`).join('')}</ul>`;
 
