@@ -36,6 +36,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "grow.h"
 #include "polydyn/error.h"
 
 // Insertion-sort budget per endpoint and axis before a full sort (qsort) takes over. Coherent motion moves
@@ -522,6 +523,18 @@ int pd_broad_phase_pairs(pdBroadPhase* bp, pdPair* out, int capacity) {
   }
   int written = count < capacity ? count : capacity;
   for (int i = 0; i < written; ++i) out[i] = (pdPair){(int)(bp->sorted[i] >> 32), (int)(uint32_t)bp->sorted[i]};
+  return count;
+}
+
+int pd_broad_phase_pairs_grown(pdBroadPhase* bp, const pdAabb* boxes, pdPair** pairs, int* capacity) {
+  bool updated = pd_broad_phase_update(bp, boxes);
+  PD_ASSERT(updated);  // false only when memory runs out
+  int count = pd_broad_phase_pairs(bp, *pairs, *capacity);
+  if (count > *capacity) {
+    *capacity = 2 * count;
+    *pairs = pd_grow(*pairs, (size_t)*capacity, sizeof **pairs);
+    pd_broad_phase_pairs(bp, *pairs, *capacity);
+  }
   return count;
 }
 

@@ -94,6 +94,12 @@ bool pd_broad_phase_update(pdBroadPhase* bp, const pdAabb* boxes);
 // (the result depends only on the last update). No allocation. out may be NULL when capacity is 0.
 int pd_broad_phase_pairs(pdBroadPhase* bp, pdPair* out, int capacity);
 
+// pd_broad_phase_update with these boxes, then pd_broad_phase_pairs into *pairs (capacity *capacity), which is grown
+// to twice the count and filled again when the pairs do not fit: the caller grows its own per-pair arrays when
+// *capacity changed. For the callers that run it between steps (the contact search, the islands' partition): it
+// allocates, and memory that is not there is fatal (PD_ASSERT), like every other allocation of the engine's loop.
+int pd_broad_phase_pairs_grown(pdBroadPhase* bp, const pdAabb* boxes, pdPair** pairs, int* capacity);
+
 pdBroadPhaseStats pd_broad_phase_stats(const pdBroadPhase* bp);
 
 // The exact box of a polyhedron (body frame) at pose (x, R): world = x + R·p for every vertex p,

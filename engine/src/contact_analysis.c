@@ -701,56 +701,9 @@ bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const 
   return false;
 }
 
-// Smallest root of a t² + b t + c = 0 in [0, 1], or -1.
-static double first_root_in_unit(double a, double b, double c) {
-  double roots[2];
-  int count = 0;
-  if (fabs(a) <= 1e-12 * (fabs(b) + fabs(c))) {
-    if (b != 0.0) roots[count++] = -c / b;
-  } else {
-    double disc = b * b - 4.0 * a * c;
-    if (disc >= 0.0) {
-      // numerically stable pair
-      double qr = -0.5 * (b + copysign(sqrt(disc), b));
-      roots[count++] = qr / a;
-      if (qr != 0.0) roots[count++] = c / qr;
-    }
-  }
-  double best = -1.0;
-  for (int i = 0; i < count; ++i)
-    if (roots[i] >= 0.0 && roots[i] <= 1.0 && (best < 0.0 || roots[i] < best)) best = roots[i];
-  return best;
-}
-
-double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPose* body1Start,
-                        const pdPose* body1End, const pdPose* body2Start, const pdPose* body2End) {
-  if (id->kind == pd_contactVF) {
-    const pdPolyhedron* s1 = &model->bodies[id->body1].shape;
-    const pdPolyhedron* s2 = &model->bodies[id->body2].shape;
-    // App. C (23)–(25): vertex v, a point u of the face and its normal n move linearly over the step
-    pdVec3 v1 = to_world(body1Start, s1->vertices[id->feat1]), v2 = to_world(body1End, s1->vertices[id->feat1]);
-    pdVec3 faceLocal = s2->vertices[s2->faceVertices[s2->faces[id->feat2].first]];
-    pdVec3 u1 = to_world(body2Start, faceLocal), u2 = to_world(body2End, faceLocal);
-    pdVec3 n1 = pd_mat3_mulv(&body2Start->R, s2->faces[id->feat2].normal);
-    pdVec3 n2 = pd_mat3_mulv(&body2End->R, s2->faces[id->feat2].normal);
-    pdVec3 dn = pd_v3_sub(n2, n1), rel = pd_v3_sub(pd_v3_sub(v2, v1), pd_v3_sub(u2, u1)), w1 = pd_v3_sub(v1, u1);
-    double a = pd_v3_dot(dn, rel), b = pd_v3_dot(dn, w1) + pd_v3_dot(n1, rel), c = pd_v3_dot(n1, w1);
-    if (c <= 0.0) return 0.0;  // already on or behind the face plane at the start: virtual contact
-    double t = first_root_in_unit(a, b, c);
-    if (t >= 0.0) return t;
-    // the linear model has no crossing (large rotation over the step): interpolate the distances
-    double c2 = pd_v3_dot(n2, pd_v3_sub(v2, u2));
-    return c2 < 0.0 ? c / (c - c2) : 1.0;
-  }
-  // App. C (26): the signed distance between the two edge lines at the start and at the end of the
-  // step, each measured in the bodies' relative pose (the same as holding body 2 fixed)
-  pdContactGeom end, start;
-  if (!edge_contact(model, id, body1End, body2End, NULL, false, &end) ||
-      !edge_contact(model, id, body1Start, body2Start, NULL, false, &start))
-    return 0.0;  // parallel at one end of the step: no interpolation possible, take the contact as it is
-  double d1 = -start.depth, d2 = -end.depth;  // separations
-  if (d1 <= 0.0) return 0.0;
-  return d2 < 0.0 ? d1 / (d1 - d2) : 1.0;
+bool pd_contact_edge_lines(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                           pdContactGeom* out) {
+  return edge_contact(model, id, p1, p2, NULL, false, out);
 }
 
 // ---------------------------------------------------------------- search certificates

@@ -102,10 +102,7 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
 // The motion of the pair from the certificate's poses to pa, pb, m: |Δoff| + ‖Δrel‖_F reach, which bounds how far
 // any point of B moves in A's frame and any point of A in B's frame, and (over reach) how far B's directions turn.
 double pd_search_motion(const pdSearchCertificate* cert, const pdPose* pa, const pdPose* pb);
-// Onset of a contact found at the end of a step (App. C): the fraction δ ∈ [0, 1] of the step at
-// which the features first touched, given the poses of body 1 and body 2 at the start and the end
-// of the step. VF by the quadratic (24)–(25) with linearly interpolated vertex, face point and normal;
-// EE by the linear interpolation (26) of the edge-line distances in body 2's frame. Returns 0 when
-// the features were already touching at the start (a virtual contact, §4.4.3).
-double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPose* body1Start,
-                        const pdPose* body1End, const pdPose* body2Start, const pdPose* body2End);
+// Where the edge lines of EE contact id are closest at poses p1, p2 (its normal and the lines' signed distance as
+// depth), whether or not the closest points lie inside the edges; false when the lines are parallel (out unset).
+bool pd_contact_edge_lines(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
+                           pdContactGeom* out);

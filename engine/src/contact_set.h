@@ -70,17 +70,14 @@ void pd_contact_events_commit(const pdModel* model, pdState* state, const double
 
 // min(h, fraction × the largest step the adaptive stepper may take with the committed contact list), that
 // step satisfying (step/2) ω_max ≤ 2.5 for the fastest contact mode, ω_max bounded by the smaller of two
-// Gershgorin bounds (contact_set.c, stability_prepare; INFINITY without contacts): fraction 1 for step doubling
-// (its half steps are the ones kept), ½ for a single RK4 step. The tight bound is formed only when the cheap one
+// Gershgorin bounds (stability_bound.c; INFINITY without contacts): fraction 1 for step doubling (its half steps
+// are the ones kept), ½ for a single RK4 step. The tight bound is formed only when the cheap one
 // does not let h through; *tightNeeded says whether it was needed.
 double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction, bool* tightNeeded);
 
 // How many times the tight stability bound was formed for this set (work counter for the tests: at most once per
 // contact list whose step the cheap bound does not settle).
 long pd_contact_set_tight_formed(const pdContactSet* set);
-
-// Grows the state's y, weight and work to hold `contacts` contacts (between steps only).
-void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contacts);
 
 // ---------------------------------------------------------------- islands (islands.c)
 // An island's state runs over a model of some of the scene's bodies (its moving bodies and every fixed body,

@@ -1,6 +1,8 @@
-// polydyn — the integration loop (paper §2 and Fig. 8, DESIGN §3.5).
+// polydyn — the steppers and the loop that runs one system through them (paper §2 and Fig. 8; docs/DESIGN.md §5).
+// pd_advance (advance.c) runs it for the whole scene with islands off; islands.c runs it for each island. It calls
+// neither of them.
 //
-// Design note. pd_advance walks from state->t to tEnd in steps of classic fourth-order Runge–Kutta.
+// Design note. pd_step_until walks from state->t to tEnd in steps of classic fourth-order Runge–Kutta.
 // The adaptive stepper estimates the local error by step doubling: one step of h and two of h/2
 // from the same start; their difference is 15/16 of the full step's error, so
 //   err_i = (y_half,i − y_full,i) / 15
@@ -22,11 +24,12 @@
 // with no stability bound (trial_implicit; its matrices in implicit.c), until step doubling could take about its
 // steps again: one system (island) at a time, decided from its own numbers.
 //
-// Output samples fall exactly on t = k / sampleRate, but they do not cut the error-controlled steppers' steps, nor
-// does pd_advance's tEnd: the step that passes such a time keeps its interpolant (dense_output.h), the state is
+// Output samples fall exactly on t = k / sampleRate (samples.h), but they do not cut the error-controlled steppers'
+// steps, nor does tEnd: the step that passes such a time keeps its interpolant (dense_output.h), the state is
 // presented there for the observer, and at tEnd it is left presented while the integration's own state waits at its
 // step's end for the next call. So the samples and the call's slices do not change the steps. The fixed stepper
-// (a reference for the work-precision sweeps) still cuts its step to end on each sample and on tEnd.
+// (a reference for the work-precision sweeps) still cuts its step to end on each sample and on tEnd. An island (no
+// observer) keeps its own samples too: they are where its steps aim while it lags behind the scene.
 //
 // Numerical trouble: a trial step that produces a non-finite number is rejected and retried four
 // times smaller (warning counted). At dtmin the run stops with state->failed set; the state keeps
@@ -43,8 +46,9 @@
 #include "dynamics.h"
 #include "help_desk.h"
 #include "implicit.h"
-#include "islands.h"
+#include "integrator.h"
 #include "polydyn/state.h"
+#include "samples.h"
 #include "state_layout.h"
 
 // Reading the clock costs about 25 ns on the machines measured (clock_gettime through the vDSO): the three reads
@@ -478,22 +482,6 @@ static double fixed_step(const pdModel* model, pdState* s, double hMax) {
   return h;
 }
 
-static double sample_time(const pdModel* model, long k) { return (double)k / model->settings.sampleRate; }
-
-static void observe(const pdModel* model, pdState* s, pdObserverFcn* observer, void* user) {
-  double t0 = pd_clock_seconds();
-  if (observer && !observer(model, s, user)) s->stopped = true;
-  ++s->count.samples;
-  ++s->nextSample;
-  s->stageSeconds[pd_stageObserve] += pd_clock_seconds() - t0;
-}
-
-bool pd_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
-  PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
-  if (s->islands == pd_islandsOn) return pd_islands_advance(model, s, tEnd, observer, user);
-  return pd_advance_hooked(model, s, tEnd, false, observer, user, NULL, NULL);
-}
-
 // One step of the state's stepper from state->t; `target` the next time the state must be at or presented at. The
 // fixed stepper ends on it, and so does any stepper when `land`; else the error-controlled ones do not cut their
 // steps for it (dense output). Returns the step taken (0 on failure).
@@ -513,14 +501,14 @@ static double one_step(const pdModel* model, pdState* s, double target, bool lan
   }
 }
 
-bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, bool landOnEnd, pdObserverFcn* observer,
-                       void* user, pdStepHookFcn* hook, void* hookUser) {
+bool pd_step_until(const pdModel* model, pdState* s, double tEnd, bool landOnEnd, pdObserverFcn* observer, void* user,
+                   pdStepHookFcn* hook, void* hookUser) {
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
   if (s->failed) return false;
   s->stopped = false;
   // skip samples already behind us (a state advanced without an observer, then with one)
-  while (sample_time(model, s->nextSample) < s->t) ++s->nextSample;
-  if (sample_time(model, s->nextSample) == s->t) observe(model, s, observer, user);
+  while (pd_sample_time(model, s->nextSample) < s->t) ++s->nextSample;
+  if (pd_sample_time(model, s->nextSample) == s->t) pd_observe(model, s, observer, user);
   if (s->stopped) return false;
   // a state presented at the last call's end goes on from the integration's own, later, state; that step's end was
   // never shown to the hook (it lay beyond that call's end)
@@ -528,14 +516,14 @@ bool pd_advance_hooked(const pdModel* model, pdState* s, double tEnd, bool landO
   for (;;) {
     // the samples up to the integration's time: the last step's end itself, or presented inside that step (a stop
     // leaves the state at that sample, presented)
-    for (double tSample; (tSample = sample_time(model, s->nextSample)) <= s->t && tSample <= tEnd;) {
+    for (double tSample; (tSample = pd_sample_time(model, s->nextSample)) <= s->t && tSample <= tEnd;) {
       if (tSample < s->t && observer) pd_dense_present(model, s, tSample);
-      observe(model, s, observer, user);
+      pd_observe(model, s, observer, user);
       if (s->stopped) return false;
       pd_dense_resume(s);
     }
     if (s->t >= tEnd) break;
-    double tSample = sample_time(model, s->nextSample);
+    double tSample = pd_sample_time(model, s->nextSample);
     double target = fmin(tEnd, tSample);
     double taken = 0.0;
     if (s->n == 0) {

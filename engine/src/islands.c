@@ -73,7 +73,6 @@
 #include "islands.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -82,9 +81,11 @@
 #include "clock.h"
 #include "contact_set.h"
 #include "grow.h"
-#include "help_desk.h"
+#include "integrator.h"
 #include "interference.h"
 #include "model_contact.h"
+#include "pool.h"
+#include "samples.h"
 #include "state_layout.h"
 
 // Slack of the travel bound, in the body's design deflections δ_max (deflection × size), plus a fraction of
@@ -181,26 +182,15 @@ struct pdIslandSet {
   double retiredStages[pd_stageCount];
   double observeSeconds;  // the scene's observer calls
   long formed, largest, intervals, redos;
-  // the pool (design note, "Threads"): the caller and threadCount - 1 workers
-  int threadCount;
-  pthread_t* workers;  // (threadCount - 1)
-  pthread_mutex_t lock;
-  pthread_cond_t wake;  // a new batch (generation) or quit
-  pthread_cond_t done;  // pending reached 0
-  long generation;      // batches handed out so far
-  int pending;          // workers still running the batch
-  bool quit;
+  pdPool pool;  // the caller and pdState.threads − 1 workers (design note, "Threads"; pool.h)
   // the batch: jobCount islands, all to jobTime
   int jobCount;
   double jobTime;
-  bool jobLand;            // cut the islands' last steps to end on jobTime (a sync time inside a sample interval)
-  island** jobs;           // (islandCapacity)
-  bool* jobCoarse;         // (islandCapacity) a free body's island (island_advance's coarse)
-  bool* jobOk;             // (islandCapacity) written by the job's thread
-  struct jobOrder* order;  // (islandCapacity) the jobs by weight, heaviest first: the order they are taken in
-  atomic_int nextJob;      // the next entry of `order` to take
-  atomic_int jobsLeft;     // jobs of the batch not finished yet
-  pdHelpDesk desk;         // where a running island posts half loops for a thread without an island (help_desk.h)
+  bool jobLand;          // cut the islands' last steps to end on jobTime (a sync time inside a sample interval)
+  island** jobs;         // (islandCapacity)
+  bool* jobCoarse;       // (islandCapacity) a free body's island (island_advance's coarse)
+  bool* jobOk;           // (islandCapacity) written by the job's thread
+  pdPoolOrder* order;    // (islandCapacity) the jobs by weight: the order the pool takes them in
 };
 
 // ---------------------------------------------------------------- one island
@@ -251,7 +241,7 @@ static island* island_create(const pdModel* model, struct pdIslandSet* set, cons
   }
   sub->materials = pd_material_table_view(model->materials, is->toScene, n);
   is->state = pd_state_create(sub);
-  pd_contact_set_help(is->state->contacts, &set->desk);
+  pd_contact_set_help(is->state->contacts, &set->pool.desk);
   return is;
 }
 
@@ -278,7 +268,7 @@ static void island_load(const pdModel* model, const pdState* s, struct pdIslandS
   for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = -1;
 }
 
-// The step hook of an island's pd_advance_hooked: each body's travel since T (centre displacement plus
+// The step hook of an island's pd_step_until: each body's travel since T (centre displacement plus
 // radius × rotation angle), the largest so far kept.
 typedef struct travelProbe {
   const island* is;
@@ -315,80 +305,15 @@ static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bo
   travelProbe probe = coarse ? (travelProbe){is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel}
                              : (travelProbe){is, set->t0, set->x0, set->v0, set->q0, set->travel};
   is->advanced = true;
-  return pd_advance_hooked(&is->model, is->state, tNext, land, NULL, NULL, measure_travel, &probe);
+  return pd_step_until(&is->model, is->state, tNext, land, NULL, NULL, measure_travel, &probe);
 }
 
-// ---------------------------------------------------------------- the pool
+// ---------------------------------------------------------------- the pool's jobs
 
-typedef struct jobOrder {
-  long weight;
-  int job;
-} jobOrder;
-
-// Heaviest first; equal weights in job order (a total order: the split does not depend on qsort).
-static int compare_jobs(const void* a, const void* b) {
-  const jobOrder *x = a, *y = b;
-  if (x->weight != y->weight) return x->weight > y->weight ? -1 : 1;
-  return (x->job > y->job) - (x->job < y->job);
-}
-
-// Takes the batch's jobs in `order`, one at a time, until none is left; then, with other threads, serves the
-// help desk until every job is finished (the islands still running post half their loops there).
-static void run_jobs(struct pdIslandSet* set) {
-  for (int n; (n = atomic_fetch_add(&set->nextJob, 1)) < set->jobCount;) {
-    int i = set->order[n].job;
-    set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobLand, set->jobCoarse[i]);
-    if (atomic_fetch_sub(&set->jobsLeft, 1) == 1 && set->threadCount > 1) pd_help_wake_all(&set->desk);
-  }
-  if (set->threadCount > 1) pd_help_serve(&set->desk, &set->jobsLeft);
-}
-
-static void* worker_main(void* user) {
-  struct pdIslandSet* set = user;
-  long seen = 0;
-  pthread_mutex_lock(&set->lock);
-  for (;;) {
-    while (!set->quit && set->generation == seen) pthread_cond_wait(&set->wake, &set->lock);
-    if (set->quit) break;
-    seen = set->generation;
-    pthread_mutex_unlock(&set->lock);
-    run_jobs(set);
-    pthread_mutex_lock(&set->lock);
-    if (--set->pending == 0) pthread_cond_signal(&set->done);
-  }
-  pthread_mutex_unlock(&set->lock);
-  return NULL;
-}
-
-static void pool_stop(struct pdIslandSet* set) {
-  if (set->threadCount > 1) {
-    pthread_mutex_lock(&set->lock);
-    set->quit = true;
-    pthread_cond_broadcast(&set->wake);
-    pthread_mutex_unlock(&set->lock);
-    for (int w = 0; w < set->threadCount - 1; ++w) pthread_join(set->workers[w], NULL);
-    pthread_cond_destroy(&set->wake);
-    pthread_cond_destroy(&set->done);
-    pthread_mutex_destroy(&set->lock);
-  }
-  free(set->workers);
-  set->workers = NULL;
-  set->threadCount = 0;
-}
-
-// `threads` threads in all (the caller and threads - 1 workers, waiting for batches).
-static void pool_start(struct pdIslandSet* set, int threads) {
-  set->threadCount = threads;
-  set->quit = false;
-  set->generation = 0;
-  set->pending = 0;
-  if (threads == 1) return;
-  set->workers = pd_grow(NULL, (size_t)threads - 1, sizeof *set->workers);
-  PD_ASSERT(pthread_mutex_init(&set->lock, NULL) == 0 && pthread_cond_init(&set->wake, NULL) == 0 &&
-            pthread_cond_init(&set->done, NULL) == 0);
-  for (int w = 0; w < threads - 1; ++w) {
-    PD_ASSERT(pthread_create(&set->workers[w], NULL, worker_main, set) == 0);
-  }
+// Runs job i of the batch (pdPoolJobFcn).
+static void run_job(void* ctx, int i) {
+  struct pdIslandSet* set = ctx;
+  set->jobOk[i] = island_advance(set, set->jobs[i], set->jobTime, set->jobLand, set->jobCoarse[i]);
 }
 
 // Adds island `is` (to the batch's time) to the batch.
@@ -407,27 +332,9 @@ static bool run_batch(struct pdIslandSet* set, double tNext, bool land) {
   set->jobLand = land;
   for (int i = 0; i < set->jobCount; ++i) {
     const island* is = set->jobs[i];
-    set->order[i] = (jobOrder){is->bodyCount + PD_ISLAND_CONTACT_WEIGHT * (long)pd_state_contact_count(is->state), i};
+    set->order[i] = (pdPoolOrder){is->bodyCount + PD_ISLAND_CONTACT_WEIGHT * (long)pd_state_contact_count(is->state), i};
   }
-  if (set->threadCount > 1) qsort(set->order, (size_t)set->jobCount, sizeof *set->order, compare_jobs);
-  atomic_store(&set->nextJob, 0);
-  atomic_store(&set->jobsLeft, set->jobCount);
-  // one island alone gets the other threads' help when it has contacts enough to split
-  bool parallel = set->threadCount > 1 &&
-                  (set->jobCount > 1 || (set->jobCount == 1 && set->order[0].weight >= PD_ISLAND_HELP_WEIGHT));
-  if (parallel) {
-    pthread_mutex_lock(&set->lock);
-    set->pending = set->threadCount - 1;
-    ++set->generation;
-    pthread_cond_broadcast(&set->wake);
-    pthread_mutex_unlock(&set->lock);
-  }
-  run_jobs(set);
-  if (parallel) {
-    pthread_mutex_lock(&set->lock);
-    while (set->pending > 0) pthread_cond_wait(&set->done, &set->lock);
-    pthread_mutex_unlock(&set->lock);
-  }
+  pd_pool_run(&set->pool, set->order, set->jobCount, PD_ISLAND_HELP_WEIGHT, run_job, set);
   bool ok = true;
   for (int i = 0; i < set->jobCount; ++i) ok = ok && set->jobOk[i];
   set->jobCount = 0;
@@ -487,12 +394,13 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
 
 int pd_island_count(const pdState* s) { return s->islandSet ? s->islandSet->islandCount : 0; }
 
-long pd_island_help_served(const pdState* s) { return s->islandSet ? atomic_load(&s->islandSet->desk.served) : 0; }
+long pd_island_help_served(const pdState* s) {
+  return s->islandSet ? atomic_load(&s->islandSet->pool.desk.served) : 0;
+}
 
 void pd_island_set_free(struct pdIslandSet* set) {
   if (!set) return;
-  pool_stop(set);
-  pd_help_desk_destroy(&set->desk);
+  pd_pool_destroy(&set->pool);
   free(set->jobs);
   free(set->jobCoarse);
   free(set->jobOk);
@@ -606,8 +514,7 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->jobCoarse = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobCoarse);
   set->jobOk = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobOk);
   set->order = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->order);
-  pd_help_desk_init(&set->desk);
-  pool_start(set, s->threads);
+  pd_pool_init(&set->pool, s->threads);
   return set;
 }
 
@@ -744,15 +651,11 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
   for (int k = 1; k < m && joined; ++k) joined = find(set->root, k) == find(set->root, 0);
   int pairCount = 0;
   if (!joined) {
-    bool updated = pd_broad_phase_update(set->broad, set->boxes);
-    PD_ASSERT(updated);  // false only when memory runs out
-    pairCount = pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
-    if (pairCount > set->pairCapacity) {
-      set->pairCapacity = 2 * pairCount;
-      set->pairs = pd_grow(set->pairs, (size_t)set->pairCapacity, sizeof *set->pairs);
+    int capacity = set->pairCapacity;
+    pairCount = pd_broad_phase_pairs_grown(set->broad, set->boxes, &set->pairs, &set->pairCapacity);
+    if (set->pairCapacity != capacity) {
       set->sat = pd_grow(set->sat, (size_t)set->pairCapacity, sizeof *set->sat);
       set->satNext = pd_grow(set->satNext, (size_t)set->pairCapacity, sizeof *set->satNext);
-      pd_broad_phase_pairs(set->broad, set->pairs, set->pairCapacity);
     }
   }
   int cached = 0, tested = 0;
@@ -999,16 +902,8 @@ static int sync_parts(const pdModel* model, const struct pdIslandSet* set, doubl
   return parts <= 1.0 ? 1 : (int)fmin(PD_ISLAND_SYNC_PARTS_MAX, parts);
 }
 
-static double sample_time(const pdModel* model, long k) { return (double)k / model->settings.sampleRate; }
-
 static void observe(const pdModel* model, pdState* s, struct pdIslandSet* set, pdObserverFcn* observer, void* user) {
-  double t0 = pd_clock_seconds();
-  if (observer && !observer(model, s, user)) s->stopped = true;
-  ++s->count.samples;
-  ++s->nextSample;
-  double seconds = pd_clock_seconds() - t0;
-  set->observeSeconds += seconds;
-  s->stageSeconds[pd_stageObserve] += seconds;
+  set->observeSeconds += pd_observe(model, s, observer, user);
 }
 
 bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
@@ -1018,14 +913,11 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
   PD_ASSERT(s->threads >= 1 && s->threads <= PD_THREADS_MAX);
   if (!s->islandSet) s->islandSet = set_create(model, s);
   struct pdIslandSet* set = s->islandSet;
-  if (set->threadCount != s->threads) {
-    pool_stop(set);
-    pool_start(set, s->threads);
-  }
-  while (sample_time(model, s->nextSample) < s->t) ++s->nextSample;
-  if (sample_time(model, s->nextSample) == s->t) observe(model, s, set, observer, user);
+  pd_pool_resize(&set->pool, s->threads);
+  while (pd_sample_time(model, s->nextSample) < s->t) ++s->nextSample;
+  if (pd_sample_time(model, s->nextSample) == s->t) observe(model, s, set, observer, user);
   while (s->t < tEnd && !s->stopped) {
-    double tSample = sample_time(model, s->nextSample);
+    double tSample = pd_sample_time(model, s->nextSample);
     double target = fmin(tEnd, tSample);
     // the sync times: the interval to the sample cut into equal parts short enough for the fastest body
     double t0 = s->t;

@@ -6,18 +6,8 @@
 
 #include "polydyn/state.h"
 
-// Called by pd_advance_hooked after every step it takes (accepted or a jump to the next sample), with the
-// state at its new time.
-typedef void pdStepHookFcn(const pdModel* model, const pdState* state, void* user);
-
-// pd_advance without the islands' dispatch, calling `hook` (nullable) with `hookUser` after each step that ends by
-// tEnd, and once more with the state presented at tEnd when the last step passed it (integrator.c). With landOnEnd the
-// last step is cut to end on tEnd unless the state is already past it (dense output, dense_output.h). pd_advance is
-// pd_advance_hooked with no hook, landOnEnd false, when islands are off.
-bool pd_advance_hooked(const pdModel* model, pdState* state, double tEnd, bool landOnEnd, pdObserverFcn* observer,
-                       void* user, pdStepHookFcn* hook, void* hookUser);
-
-// pd_advance with state->islands == pd_islandsOn (contract of pd_advance, state.h).
+// pd_advance with state->islands == pd_islandsOn (contract of pd_advance, state.h): each island stepped by
+// pd_step_until (integrator.h).
 bool pd_islands_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
 
 // The number of islands of the state's last interval (0 before the first, or with islands off).

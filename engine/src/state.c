@@ -1,10 +1,11 @@
-// polydyn — the mutable state: creation, reset, read-out.
+// polydyn — the mutable state: creation, reset, growth, read-out (bodies, contacts, energy).
 #include "polydyn/state.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-#include "contact_set.h"
+#include "contact_set_internal.h"
+#include "grow.h"
 #include "dense_output.h"
 #include "implicit.h"
 #include "islands.h"
@@ -75,6 +76,42 @@ void pd_state_free(pdState* s) {
   free(s);
 }
 
+void pd_state_reserve_contacts(const pdModel* model, pdState* s, int contacts) {
+  pd_contact_set_reserve_list(s->contacts, contacts);
+  int needed = spring_base(model) + PD_CONTACT_STATE_SIZE * contacts;
+  if (needed <= s->capacity) return;
+  int c = s->capacity > 0 ? s->capacity : 1;
+  while (c < needed) c *= 2;
+  s->y = pd_grow(s->y, c, sizeof *s->y);
+  s->weight = pd_grow(s->weight, c, sizeof *s->weight);
+  // the stepper's vectors hold no data between steps: reallocate rather than copy
+  free(s->work);
+  s->work = calloc((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
+  PD_ASSERT(s->work != NULL);
+  s->capacity = c;
+}
+
+int pd_state_contact_count(const pdState* s) { return s->contacts ? s->contacts->count : 0; }
+
+pdContactReport pd_state_contact(const pdState* s, int i) {
+  PD_ASSERT(s->contacts != NULL && i >= 0 && i < s->contacts->count);
+  const contactSlot* c = &s->contacts->items[i];
+  pdContactReport r;
+  r.bodyA = c->id.body1;
+  r.bodyB = c->id.body2;
+  r.edgeEdge = c->id.kind == pd_contactEE;
+  r.featureA = c->id.feat1;
+  r.featureB = c->id.feat2;
+  r.point = c->point;
+  r.normal = c->normal;
+  r.depth = c->depth;
+  bool pulls = pd_contact_force_pulls(&c->force);
+  r.fn = pulls ? 0.0 : c->force.fn;
+  r.ft = pulls ? (pdVec3){0, 0, 0} : c->force.ft;
+  r.slip = c->force.slip;
+  return r;
+}
+
 pdBodyState pd_state_body(const pdModel* model, const pdState* s, int bodyIndex) {
   PD_ASSERT(bodyIndex >= 0 && bodyIndex < model->bodyCount);
   const pdBody* b = &model->bodies[bodyIndex];
@@ -110,11 +147,6 @@ const char* pd_stepper_name(pdStepper stepper) {
 
 const char* pd_onsets_name(pdOnsets onsets) {
   return onsets == pd_onsetsExact ? "exact" : onsets == pd_onsetsPair ? "pair" : "auto";
-}
-
-pdOnsets pd_onsets_effective(pdOnsets onsets, int movingBodies) {
-  if (onsets != pd_onsetsAuto) return onsets;
-  return movingBodies > PD_ONSETS_CROWD_BODIES ? pd_onsetsPair : pd_onsetsExact;
 }
 
 const char* pd_islands_name(pdIslands islands) { return islands == pd_islandsOn ? "on" : "off"; }

@@ -1,6 +1,7 @@
 // polydyn (internal) — where each body's 13 numbers sit in the state vector, and scratch sizes.
 #pragma once
 
+#include "polydyn/state.h"
 #include "polydyn/vecmath.h"
 
 enum {
@@ -25,3 +26,7 @@ static inline void pd_layout_store(double* y, pdVec3 v, pdVec3 w, pdVec3 x, pdQu
   y[PD_Y_X] = x.x, y[PD_Y_X + 1] = x.y, y[PD_Y_X + 2] = x.z;
   y[PD_Y_Q] = q.w, y[PD_Y_Q + 1] = q.x, y[PD_Y_Q + 2] = q.y, y[PD_Y_Q + 3] = q.z;
 }
+
+// Grows the state's y, weight and work, and its contact list, to hold `contacts` contacts (between steps only: the
+// stepper's scratch in work is dropped, not copied). state.c.
+void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contacts);

@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "contact_analysis.h"
+#include "onsets.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
 #include "scene_run.h"

@@ -1,0 +1,373 @@
+// polydyn — the contacts' modal dampers and the stability bound of the explicit steppers (paper §3.3–§3.4: the
+// contacts' time constants set the step an explicit method can take).
+//
+// Modal dampers: a pair's dampers are sized for the mass its contacts move together (material.h, "modal"), set when
+// the pair's contacts change and held until they change again. The stability bound: a Gershgorin bound on the
+// contacts' fastest undamped mode ω_max, in two parts — a cheap one formed for every new list, a tight one only when
+// the step the stepper wants exceeds the cheap one's (pd_contact_set_limit_step) — and the step (h/2) ω_max ≤
+// PD_STABLE_STEP_OMEGA that follows from it.
+#ifdef PD_SELF_CHECKS
+#include <gsl/gsl_eigen.h>
+#endif
+
+#include <math.h>
+#include <string.h>
+
+#include "contact_set_internal.h"
+#include "material.h"
+
+// Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can
+// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (pd_stability_prepare). Classic
+// RK4 is stable to |hλ| ≈ 2.8 along both the negative real and the imaginary axis; 2.5 leaves a margin
+// for what the bound does not see (contacts coupled through a fixed body's neighbours count none). Without
+// the bound the error control walks the step up to the stability edge, where round-off grows until a
+// step is rejected: a block at rest then jitters at the tolerance (µm/s) instead of round-off.
+#define PD_STABLE_STEP_OMEGA 2.5
+// Relative margin on the stability bounds (pd_stability_prepare, stability_tight) against the rounding of their
+// sums (~1e-15 relative): where a Gershgorin bound is exact (a single contact), rounding must not take it below
+// ω_max².
+#define PD_STABLE_MARGIN 1e-9
+
+// ---------------------------------------------------------------- modal dampers
+
+// Mass per contact of one body pair's joint motion (material.h, "modal"): the pair's contacts i = 1 … n at
+// points p_i with normals n_i (from b into a) pushed with equal unit forces. The relative acceleration of
+// the contacts along their normals, summed, is 1ᵀA1 = |N|² (1/m_a + 1/m_b) + L_aᵀ J_a⁻¹ L_a + L_bᵀ J_b⁻¹ L_b
+// with N = Σ n_i, L = Σ (p_i − x) × n_i (world inverse inertia J⁻¹ = R I⁻¹ Rᵀ), so the common mode carries
+// m_c = n/1ᵀA1 per contact: m_eff for one contact, m/4 for a cube landing flat, m/2 on an edge. In P_t the
+// same with one tangent t for all: n² (1/m_a + 1/m_b) + tᵀ [Σr]ₓᵀ J⁻¹ [Σr]ₓ t, averaged over two tangents.
+typedef struct modalSums {
+  pdVec3 normal, moment, arm;  // N, L, Σ r about one body's centre of mass
+} modalSums;
+
+static pdMat3 cross_matrix(pdVec3 r) { return (pdMat3){{{0, -r.z, r.y}, {r.z, 0, -r.x}, {-r.y, r.x, 0}}}; }
+
+// a [r]ₓ: pd_mat3_mul with cross_matrix(r), its products with the zeros left out (the other terms added in the same
+// order, so the same numbers up to the sign of a zero sum; the stability bound takes absolute values). a [r]ₓᵀ is
+// a [−r]ₓ.
+static pdMat3 mul_cross(const pdMat3* a, pdVec3 r) {
+  pdMat3 m;
+  for (int i = 0; i < 3; ++i) {
+    const double* ai = a->m[i];
+    m.m[i][0] = ai[1] * r.z + ai[2] * -r.y;
+    m.m[i][1] = ai[0] * -r.z + ai[2] * r.x;
+    m.m[i][2] = ai[0] * r.y + ai[1] * -r.x;
+  }
+  return m;
+}
+
+// invWorld: the body's R I⁻¹ Rᵀ (set->invInertiaWorld).
+static void add_body_terms(const pdBody* b, const pdMat3* invWorld, const modalSums* s, double* qn, pdMat3* mt) {
+  if (b->fixed) return;
+  *qn += pd_v3_dot(s->normal, s->normal) * b->invMass + pd_v3_dot(s->moment, pd_mat3_mulv(invWorld, s->moment));
+  const pdMat3 rx = cross_matrix(s->arm);
+  pdMat3 rxT = pd_mat3_transpose(&rx);
+  pdMat3 a = pd_mat3_mul(invWorld, &rx);
+  pdMat3 m = pd_mat3_mul(&rxT, &a);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) mt->m[i][j] += m.m[i][j];
+}
+
+// The dampers of a pair are set when its contacts change (one made or broken: a new slot has modalCount 0, a
+// survivor of a break a count that no longer matches) and then held until they change again, not re-derived
+// from the pose after every step: a damper that followed the pose step by step was a staircase in time, whose
+// steps made impacts converge only as ~tol^0.24 (the exit velocity of cases/sweep/eccentric_impact.scene's first
+// impact 1.1e-5 m/s from tol 1e-12's at tol 1e-8); held, the force is smooth between contact events (1.4e-7).
+void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+  for (int first = 0, last; first < set->count; first = last) {
+    contactSlot* c0 = &set->items[first];
+    int a = c0->id.body1 < c0->id.body2 ? c0->id.body1 : c0->id.body2;
+    int b = c0->id.body1 < c0->id.body2 ? c0->id.body2 : c0->id.body1;
+    last = first + 1;
+    while (last < set->count && compare_to_pair(&set->items[last].id, a, b) == 0) ++last;
+    if (!c0->params.modalN && !c0->params.modalT) continue;
+    bool unchanged = true;
+    for (int i = first; i < last && unchanged; ++i) unchanged = set->items[i].modalCount == last - first;
+    if (unchanged) continue;
+    modalSums sa = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, sb = sa;
+    for (int i = first; i < last; ++i) {
+      const contactSlot* c = &set->items[i];
+      pdVec3 n = c->id.body1 == a ? c->normal : pd_v3_scale(c->normal, -1.0);
+      pdVec3 ra = pd_v3_sub(c->point, poses[a].x), rb = pd_v3_sub(c->point, poses[b].x);
+      sa.normal = sb.normal = pd_v3_add(sa.normal, n);
+      sa.moment = pd_v3_add(sa.moment, pd_v3_cross(ra, n));
+      sb.moment = pd_v3_add(sb.moment, pd_v3_cross(rb, n));
+      sa.arm = pd_v3_add(sa.arm, ra);
+      sb.arm = pd_v3_add(sb.arm, rb);
+    }
+    const pdBody *A = &model->bodies[a], *B = &model->bodies[b];
+    double count = (double)(last - first), qn = 0.0;
+    pdMat3 mt = {{{0}}};
+    add_body_terms(A, &set->invInertiaWorld[a], &sa, &qn, &mt);
+    add_body_terms(B, &set->invInertiaWorld[b], &sb, &qn, &mt);
+    // tangent-plane average: (trace − N̂ᵀ M N̂)/2 plus the translational n²(1/m_a + 1/m_b)
+    double nn = pd_v3_norm(sa.normal);
+    pdVec3 axis = nn > 0.0 ? pd_v3_scale(sa.normal, 1.0 / nn) : c0->normal;
+    double trace = mt.m[0][0] + mt.m[1][1] + mt.m[2][2];
+    double qt = count * count * (A->invMass + B->invMass) + 0.5 * (trace - pd_v3_dot(axis, pd_mat3_mulv(&mt, axis)));
+    // a degenerate sum (normals cancelling) leaves 1ᵀA1 ~ 0: the clamp to the reduced mass takes over
+    double massN = qn > 0.0 ? count / qn : INFINITY, massT = qt > 0.0 ? count / qt : INFINITY;
+    for (int i = first; i < last; ++i) {
+      pd_contact_modal_damping(&set->items[i].params, massN, massT);
+      set->items[i].modalMass = fmin(massN, set->items[i].params.massPair);
+      set->items[i].modalCount = last - first;
+    }
+  }
+}
+
+// ---------------------------------------------------------------- stability bound
+
+static double row_abs_sum(const pdMat3* m, int row) {
+  return fabs(m->m[row][0]) + fabs(m->m[row][1]) + fabs(m->m[row][2]);
+}
+
+static double overdamp_factor(double zeta) { return zeta > 1.0 ? zeta + sqrt(zeta * zeta - 1.0) : 1.0; }
+
+// The absolute row sums of m.
+static pdVec3 row_abs_sums(const pdMat3* m) {
+  return (pdVec3){row_abs_sum(m, 0), row_abs_sum(m, 1), row_abs_sum(m, 2)};
+}
+
+// rows[r] += scale Σ_p |a_rp| w_p: bounds row r's absolute sum of a·b summed over all b whose rows sum to w.
+static void add_weighted_rows(const pdMat3* a, pdVec3 w, double scale, double rows[3]) {
+  for (int r = 0; r < 3; ++r)
+    rows[r] += scale * (fabs(a->m[r][0]) * w.x + fabs(a->m[r][1]) * w.y + fabs(a->m[r][2]) * w.z);
+}
+
+static double step_of(double omega2, double overdamp) {
+  double omega = sqrt(omega2) * overdamp;
+  // the stepper keeps the result of two half steps (integrator.c): they are the ones that must be stable
+  return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
+}
+
+// The stability bound in two parts, both Gershgorin bounds on ω_max² (never below it; README, Integration).
+// pd_stability_prepare (after every new list, O(contacts)) forms each contact's terms and a cheap bound of the
+// contact-space matrix M above: by |Σ_j (A B_j)_rq| ≤ Σ_p |A_rp| |(B_j)_pq|, row r of contact i's Gershgorin sum
+// is at most Σ over its moving ends B of Σ_p |(K_i^½)_rp| w_p / m_B + Σ_p |(K_i^½ [r_i]ₓᵀ)_rp| u_p, where w_p
+// and u_p are the row-p absolute sums of K_j^½ and of W_B [r_j]ₓ K_j^½ summed over B's contacts j. Only when the
+// step the stepper wants exceeds the cheap bound's (pd_contact_set_limit_step) is the tight one formed
+// (stability_tight): the Gershgorin bound of the body-space matrix S, also O(contacts), and the bound is the
+// smaller of the two. On a stack of boxes S's rows are far tighter than M's (a box's 16 contacts couple with each
+// other in M, its 6 coordinates in S): on cases/bench/stack_20.scene ω_max² came out at 0.55–0.71 of M's exact
+// Gershgorin bound (which was O(contacts × contacts per body); the true ω_max² 0.46–0.62 of it), so its steps
+// are 1.2–1.35× longer. S's bound alone can be looser than M's (a box on an edge or a corner, its rows summing
+// translation and rotation: up to 1.75× M's exact bound on cases/sweep/pile_10.scene), hence the minimum.
+
+// Accumulates Gᵀ H into out (6 × 6) for G, H = [T | R] (3 × 6 each, given as their two 3 × 3 halves).
+static void add_gram(const pdMat3* gT, const pdMat3* gR, const pdMat3* hT, const pdMat3* hR, double out[6][6]) {
+  // G and H as 3 × 6 rows first: the loop over b then runs along contiguous rows, which the compiler vectorises
+  // (each entry the same sum in the same order)
+  double g[3][6], h[3][6];
+  for (int k = 0; k < 3; ++k)
+    for (int c = 0; c < 3; ++c) {
+      g[k][c] = gT->m[k][c], g[k][c + 3] = gR->m[k][c];
+      h[k][c] = hT->m[k][c], h[k][c + 3] = hR->m[k][c];
+    }
+  for (int a = 0; a < 6; ++a)
+    for (int b = 0; b < 6; ++b) out[a][b] += g[0][a] * h[0][b] + g[1][a] * h[1][b] + g[2][a] * h[2][b];
+}
+
+// Contact i's G = K^½ J_iB 𝕄_B^-½ on its end e (body B): T = σ K^½ / √m_B, R = −σ K^½ [r]ₓ W_B^½.
+static void contact_gram_factor(const stabilityTerms* t, int e, const bodySpaceBlock* b, pdMat3* T, pdMat3* R) {
+  double sigma = e == 0 ? 1.0 : -1.0;
+  pdMat3 krx = mul_cross(&t->k, t->arm[e]);
+  pdMat3 krxw = pd_mat3_mul(&krx, &b->invSqrtInertia);
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) {
+      T->m[r][q] = sigma * b->invSqrtMass * t->k.m[r][q];
+      R->m[r][q] = -sigma * krxw.m[r][q];
+    }
+}
+
+// Does moving body k have contacts in the list (a block of S)?
+static bool has_block(const pdModel* model, const pdContactSet* set, int k) {
+  return !model->bodies[k].fixed && set->bodyFirst[k] < set->bodyFirst[k + 1];
+}
+
+// Each block's 𝕄^-½ at `poses`, its sums cleared.
+static void body_space_scales(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+  for (int k = 0; k < model->bodyCount; ++k) {
+    if (!has_block(model, set, k)) continue;
+    const pdBody* body = &model->bodies[k];
+    bodySpaceBlock* b = &set->bodyBlocks[k];
+    b->invSqrtMass = sqrt(body->invMass);
+    pdMat3 q = pd_mat3_mul(&poses[k].R, &body->principalAxes);  // principal axes in the world
+    pdMat3 qd = q;
+    for (int c = 0; c < 3; ++c) {
+      double s = 1.0 / sqrt(body->principal[c]);
+      for (int r = 0; r < 3; ++r) qd.m[r][c] *= s;
+    }
+    pdMat3 qt = pd_mat3_transpose(&q);
+    b->invSqrtInertia = pd_mat3_mul(&qd, &qt);
+    memset(b->diagonal, 0, sizeof b->diagonal);
+    memset(b->rows, 0, sizeof b->rows);
+  }
+}
+
+// The tight bound: the largest absolute row sum of S, over the blocks of every moving body with contacts and of
+// every touching pair (the list is sorted by pair, so a pair's contacts are one run). ω_max², no margin.
+static double stability_tight(const pdModel* model, pdContactSet* set) {
+  body_space_scales(model, set, set->stablePoses);
+  for (int first = 0, last; first < set->count; first = last) {
+    const pdContactId* id0 = &set->items[first].id;
+    int lo = id0->body1 < id0->body2 ? id0->body1 : id0->body2, hi = id0->body1 < id0->body2 ? id0->body2 : id0->body1;
+    last = first + 1;
+    while (last < set->count && compare_to_pair(&set->items[last].id, lo, hi) == 0) ++last;
+    bool both = !model->bodies[lo].fixed && !model->bodies[hi].fixed;
+    double pair[6][6] = {{0}};  // S_lo,hi
+    for (int i = first; i < last; ++i) {
+      const stabilityTerms* t = &set->stability[i];
+      const pdContactId* id = &set->items[i].id;
+      pdMat3 T[2], R[2];
+      int ends[2] = {id->body1, id->body2};
+      for (int e = 0; e < 2; ++e) {
+        if (model->bodies[ends[e]].fixed) continue;
+        bodySpaceBlock* b = &set->bodyBlocks[ends[e]];
+        contact_gram_factor(t, e, b, &T[e], &R[e]);
+        add_gram(&T[e], &R[e], &T[e], &R[e], b->diagonal);
+      }
+      if (both) {
+        int eLo = id->body1 == lo ? 0 : 1;
+        add_gram(&T[eLo], &R[eLo], &T[1 - eLo], &R[1 - eLo], pair);
+      }
+    }
+    if (!both) continue;
+    // S_hi,lo = S_lo,hiᵀ: lo's rows take the pair block's row sums, hi's its column sums
+    bodySpaceBlock *bLo = &set->bodyBlocks[lo], *bHi = &set->bodyBlocks[hi];
+    for (int a = 0; a < 6; ++a)
+      for (int q = 0; q < 6; ++q) {
+        bLo->rows[a] += fabs(pair[a][q]);
+        bHi->rows[q] += fabs(pair[a][q]);
+      }
+  }
+  double omega2 = 0.0;
+  for (int k = 0; k < model->bodyCount; ++k) {
+    if (!has_block(model, set, k)) continue;
+    const bodySpaceBlock* b = &set->bodyBlocks[k];
+    for (int a = 0; a < 6; ++a) {
+      double row = b->rows[a];
+      for (int q = 0; q < 6; ++q) row += fabs(b->diagonal[a][q]);
+      omega2 = fmax(omega2, row);
+    }
+  }
+  return omega2;
+}
+
+#ifdef PD_SELF_CHECKS
+// Lists of at most this many contacts are checked (a dense eigenproblem of 3 × this size per list).
+#define PD_STABILITY_CHECK_CONTACTS_MAX 32
+// The self-check of the sanitizer and Debug builds: both bounds against ω_max², the largest eigenvalue (GSL) of
+// the contact-space matrix M assembled from its own formula (the terms left and right), not from S.
+static void stability_self_check(const pdModel* model, pdContactSet* set) {
+  int c = set->count, n = 3 * c;
+  if (c > PD_STABILITY_CHECK_CONTACTS_MAX) return;
+  gsl_matrix* m = gsl_matrix_calloc((size_t)n, (size_t)n);
+  PD_ASSERT(m != NULL);
+  for (int i = 0; i < c; ++i)
+    for (int j = 0; j < c; ++j) {
+      const pdContactId *a = &set->items[i].id, *b = &set->items[j].id;
+      const stabilityTerms *ti = &set->stability[i], *tj = &set->stability[j];
+      int endsA[2] = {a->body1, a->body2}, endsB[2] = {b->body1, b->body2};
+      for (int ea = 0; ea < 2; ++ea)
+        for (int eb = 0; eb < 2; ++eb) {
+          const pdBody* body = &model->bodies[endsA[ea]];
+          if (endsA[ea] != endsB[eb] || body->fixed) continue;
+          double sign = (ea == eb) ? 1.0 : -1.0;
+          pdMat3 kk = pd_mat3_mul(&ti->k, &tj->k), rot = pd_mat3_mul(&ti->left[ea], &tj->right[eb]);
+          for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q) {
+              double v = sign * (kk.m[r][q] * body->invMass + rot.m[r][q]);
+              *gsl_matrix_ptr(m, (size_t)(3 * i + r), (size_t)(3 * j + q)) += 0.5 * v;
+              *gsl_matrix_ptr(m, (size_t)(3 * j + q), (size_t)(3 * i + r)) += 0.5 * v;
+            }
+        }
+    }
+  gsl_vector* eigenvalues = gsl_vector_alloc((size_t)n);
+  gsl_eigen_symm_workspace* w = gsl_eigen_symm_alloc((size_t)n);
+  PD_ASSERT(eigenvalues != NULL && w != NULL);
+  gsl_eigen_symm(m, eigenvalues, w);
+  double omega2 = gsl_vector_max(eigenvalues);
+  gsl_eigen_symm_free(w);
+  gsl_vector_free(eigenvalues);
+  gsl_matrix_free(m);
+  // the eigenvalue is exact to ~1e-15 of the largest entry; the bounds carry PD_STABLE_MARGIN
+  double tight2 = stability_tight(model, set) * (1.0 + PD_STABLE_MARGIN);
+  PD_ASSERT(set->cheapOmega2 >= omega2 * (1.0 - 1e-12));
+  PD_ASSERT(tight2 >= omega2 * (1.0 - 1e-12));
+}
+#endif
+
+void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+  set->stableKnown = false;
+  if (set->count == 0) {
+    set->stableStep = set->stableCheap = INFINITY;
+    set->cheapOmega2 = 0.0;
+    set->stableKnown = true;
+    return;
+  }
+  pd_contact_set_list_bodies(model, set);
+  set->stablePoses = poses;
+  int bodies = model->bodyCount;
+  for (int k = 0; k < bodies; ++k) set->bodyRowsK[k] = set->bodyRowsRight[k] = (pdVec3){0, 0, 0};
+  for (int i = 0; i < set->count; ++i) {
+    const contactSlot* c = &set->items[i];
+    const pdContactParams* p = &c->params;
+    stabilityTerms* t = &set->stability[i];
+    // a sliding contact's tangential spring is held at the friction limit: no tangential mode
+    bool sticks = p->mu > 0.0 && !c->force.slip;
+    double sn = sqrt(pd_series(p->k1n, p->k2n)), st = sticks ? sqrt(pd_series(p->k1t, p->k2t)) : 0.0;
+    pdVec3 n = c->normal;
+    double nv[3] = {n.x, n.y, n.z};
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 3; ++q) t->k.m[r][q] = (r == q ? st : 0.0) + (sn - st) * nv[r] * nv[q];
+    double zn = isfinite(p->zetaN) ? p->zetaN : 0.0, zt = p->mu > 0.0 && isfinite(p->zetaT) ? p->zetaT : 0.0;
+    t->overdamp = fmax(overdamp_factor(zn), overdamp_factor(zt));
+    int ends[2] = {c->id.body1, c->id.body2};
+    for (int e = 0; e < 2; ++e) {
+      const pdBody* b = &model->bodies[ends[e]];
+      if (b->fixed) continue;
+      t->arm[e] = pd_v3_sub(c->point, poses[ends[e]].x);
+      t->left[e] = mul_cross(&t->k, pd_v3_scale(t->arm[e], -1.0));
+      pdMat3 wrx = mul_cross(&set->invInertiaWorld[ends[e]], t->arm[e]);
+      t->right[e] = pd_mat3_mul(&wrx, &t->k);
+      set->bodyRowsK[ends[e]] = pd_v3_add(set->bodyRowsK[ends[e]], row_abs_sums(&t->k));
+      set->bodyRowsRight[ends[e]] = pd_v3_add(set->bodyRowsRight[ends[e]], row_abs_sums(&t->right[e]));
+    }
+  }
+  // the cheap bound
+  double cheap2 = 0.0;
+  set->overdamp = 1.0;
+  for (int i = 0; i < set->count; ++i) {
+    const stabilityTerms* ti = &set->stability[i];
+    set->overdamp = fmax(set->overdamp, ti->overdamp);
+    double rows[3] = {0, 0, 0};
+    int ends[2] = {set->items[i].id.body1, set->items[i].id.body2};
+    for (int e = 0; e < 2; ++e) {
+      const pdBody* b = &model->bodies[ends[e]];
+      if (b->fixed) continue;
+      add_weighted_rows(&ti->k, set->bodyRowsK[ends[e]], b->invMass, rows);
+      add_weighted_rows(&ti->left[e], set->bodyRowsRight[ends[e]], 1.0, rows);
+    }
+    cheap2 = fmax(cheap2, fmax(rows[0], fmax(rows[1], rows[2])));
+  }
+  set->cheapOmega2 = cheap2 * (1.0 + PD_STABLE_MARGIN);
+  set->stableCheap = step_of(set->cheapOmega2, set->overdamp);
+#ifdef PD_SELF_CHECKS
+  stability_self_check(model, set);
+#endif
+}
+
+long pd_contact_set_tight_formed(const pdContactSet* set) { return set->tightFormed; }
+
+double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction,
+                                 bool* tightNeeded) {
+  *tightNeeded = fraction * set->stableCheap < h;
+  if (!*tightNeeded) return h;  // the bound, never below the cheap one's step, cannot bind
+  if (!set->stableKnown) {
+    ++set->tightFormed;
+    double tight2 = stability_tight(model, set) * (1.0 + PD_STABLE_MARGIN);
+    set->stableStep = step_of(fmin(set->cheapOmega2, tight2), set->overdamp);
+    set->stableKnown = true;
+  }
+  return fmin(h, fraction * set->stableStep);
+}
