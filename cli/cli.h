@@ -88,6 +88,7 @@ typedef struct pdCliOverrides {
   double tolScale;  // > 0: multiplies the scene's tol (compare's tighter reference run)
   double tol;       // > 0: replaces the scene's tol (sweeps)
   double dt;        // > 0: replaces the scene's dt, the fixed stepper's step (sweeps)
+  int sleep;        // > 0: sleep on, < 0: sleep off, 0: the scene's setting
 } pdCliOverrides;
 
 // Parses and compiles a scene, applying the overrides. On bad input prints `FILE:LINE:COL: message`

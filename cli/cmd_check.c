@@ -59,6 +59,8 @@ static void print_settings(const pdModel* m, const pdSceneSettings* s) {
     printf("  (estimated: initial speeds and a fall through the scene's height)\n");
   else
     print_origin(s, PD_SET_VMAX);
+  printf("  %-11s %s", "sleep", set->sleep ? "on" : "off");
+  print_origin(s, PD_SET_SLEEP);
 }
 
 // Material as the scene asked for it: only what the file set (mu always has a value).

@@ -16,8 +16,8 @@
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
     "                         [--stepper implicit|adaptive|fixed|embedded] [--variant native|matched]\n"
-    "                         [--onsets pair|exact|auto] [--islands on|off] [--threads N] [--step H]\n"
-    "                         [--ode-friction pyramid|aligned]\n"
+    "                         [--onsets pair|exact|auto] [--islands on|off] [--sleep on|off] [--threads N]\n"
+    "                         [--step H] [--ode-friction pyramid|aligned]\n"
     "\n"
     "Simulates SCENE and writes DIR/trajectory.csv and DIR/summary.json. DIR is written under a\n"
     "temporary name and renamed when complete; an existing run directory DIR is replaced.\n"
@@ -42,6 +42,10 @@ static const char* const help =
     "                   (bodies in contact or whose boxes may meet before the next sample), each with its\n"
     "                   own steps and contact events; off advances all bodies with one step size\n"
     "                   (README \"Islands\")\n"
+    "  --sleep on|off   soft engine with islands on: on (the scene's `sleep`, default on) stops integrating\n"
+    "                   an island whose bodies stayed at rest for a few periods of its slowest contact\n"
+    "                   until a moving body may reach it or an applied force changes; off integrates every\n"
+    "                   island to the end (docs/sleeping.md)\n"
     "  --threads N      soft engine with islands on: advance the islands on N threads, 1..64 (default 1),\n"
     "                   a thread without an island helping a big one with its loops over contacts;\n"
     "                   every contact's numbers are the same on any thread, so the outputs are\n"
@@ -108,7 +112,7 @@ int pd_cmd_run(int argc, char** argv) {
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--engine") == 0 || strcmp(a, "--tend") == 0 ||
                strcmp(a, "--sample") == 0 || strcmp(a, "--stepper") == 0 || strcmp(a, "--variant") == 0 ||
                strcmp(a, "--step") == 0 || strcmp(a, "--ode-friction") == 0 || strcmp(a, "--onsets") == 0 ||
-               strcmp(a, "--islands") == 0 || strcmp(a, "--threads") == 0) {
+               strcmp(a, "--islands") == 0 || strcmp(a, "--sleep") == 0 || strcmp(a, "--threads") == 0) {
       if (!hasValue) return pd_cli_usage_error("run", "%s needs a value", a);
       const char* v = argv[++i];
       if (strcmp(a, "--out") == 0) {
@@ -135,6 +139,14 @@ int pd_cmd_run(int argc, char** argv) {
           islands = pd_islandsOff;
         else
           return pd_cli_usage_error("run", "--islands must be on or off, not '%s'", v);
+      } else if (strcmp(a, "--sleep") == 0) {
+        softOptionGiven = true;
+        if (strcmp(v, "on") == 0)
+          overrides.sleep = 1;
+        else if (strcmp(v, "off") == 0)
+          overrides.sleep = -1;
+        else
+          return pd_cli_usage_error("run", "--sleep must be on or off, not '%s'", v);
       } else if (strcmp(a, "--threads") == 0) {
         softOptionGiven = true;
         if (!pd_cli_jobs(v, &threads) || threads > PD_THREADS_MAX)
@@ -180,7 +192,7 @@ int pd_cmd_run(int argc, char** argv) {
   if (soft && refOptionGiven)
     return pd_cli_usage_error("run", "--variant, --step and --ode-friction are for --engine ode or bullet");
   if (!soft && softOptionGiven)
-    return pd_cli_usage_error("run", "--stepper, --onsets, --islands and --threads are for the soft engine");
+    return pd_cli_usage_error("run", "--stepper, --onsets, --islands, --sleep and --threads are for the soft engine");
   // islands off is one system on one thread: more threads would be silently idle
   if (threads > 1 && islands != pd_islandsOn) return pd_cli_usage_error("run", "--threads N > 1 needs --islands on");
   if (strcmp(engine, "bullet") == 0 && ref.odeFriction != pd_odeFrictionPyramid)

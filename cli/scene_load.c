@@ -16,6 +16,7 @@ pdModel* pd_cli_load_model(const char* path, const pdCliOverrides* overrides, pd
   if (overrides && overrides->tolScale > 0.0) scene->settings.tol *= overrides->tolScale;
   // dtmin is left alone: it sizes the §3.3 material adjustments, and a sweep must compare one model
   if (overrides && overrides->dt > 0.0) scene->settings.dt = overrides->dt;
+  if (overrides && overrides->sleep != 0) scene->settings.sleep = overrides->sleep > 0;
   if (scene->settings.tend * scene->settings.sample > 1e8) {
     pd_error_set(&err, path, 0, 0, "too many output samples (tend × sample > 1e8)");
     pd_error_print(&err, stderr);

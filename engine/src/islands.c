@@ -67,6 +67,15 @@
 //   half there. A batch of one island wakes the workers only from PD_ISLAND_HELP_WEIGHT on. Each index is
 //   computed alike on either thread and combined in index order by the island's own, so this too leaves every
 //   result the same bit for bit.
+// - Sleeping (settings.sleep; sleep.h, docs/sleeping.md): at the end of an interval an island whose bodies all touch
+//   something and stayed below the speed and acceleration thresholds for its settle time falls asleep: it is kept
+//   with its state as it is and never advanced, so the gather hands the scene the same frozen numbers at every
+//   sample. Its bodies take part in every partition with their boxes where they lie (not swept, bound 0) and stay
+//   one island (join_sleepers); a sleeping island that the partition joins with a moving body or another sleeping
+//   island wakes (wake_reached) and the partition is formed again, as for a free body activated; so does one whose
+//   applied force changed (wake_pushed). A woken island is freed and its bodies set up anew from the scene's
+//   numbers, which are the frozen ones. Every decision is taken on the calling thread from numbers no thread count
+//   changes.
 //
 // Memory: islands are set up, grown and freed only at sync times; a step allocates nothing. The pool's
 // threads are created with the set (or when pdState.threads changes) and joined when it is freed.
@@ -86,6 +95,7 @@
 #include "model_contact.h"
 #include "pool.h"
 #include "samples.h"
+#include "sleep.h"
 #include "state_layout.h"
 
 // Slack of the travel bound, in the body's design deflections δ_max (deflection × size), plus a fraction of
@@ -126,6 +136,7 @@ typedef struct island {
   int* toScene;    // (model.bodyCount) scene body index of each of its bodies
   pdState* state;  // at T, or at T' once advanced
   bool advanced;   // advanced over the interval under way
+  bool asleep;     // frozen (sleeping, below): never advanced; its state kept as it was when it fell asleep
 } island;
 
 struct pdIslandSet {
@@ -191,6 +202,7 @@ struct pdIslandSet {
   bool* jobCoarse;       // (islandCapacity) a free body's island (island_advance's coarse)
   bool* jobOk;           // (islandCapacity) written by the job's thread
   pdPoolOrder* order;    // (islandCapacity) the jobs by weight: the order the pool takes them in
+  pdSleepSet* sleep;     // the bodies' sleep records (NULL when settings.sleep is off)
 };
 
 // ---------------------------------------------------------------- one island
@@ -276,6 +288,7 @@ typedef struct travelProbe {
   const pdVec3 *x0, *v0;  // (movingCount) centre of mass and velocity at t0
   const pdQuat* q0;       // (movingCount) orientation at t0
   double* travel;         // (movingCount) the largest distance from the path so far, m
+  pdSleepSet* sleep;      // nullable: the bodies' speed peaks (sleep.h)
 } travelProbe;
 
 static void measure_travel(const pdModel* sub, const pdState* state, void* user) {
@@ -294,6 +307,7 @@ static void measure_travel(const pdModel* sub, const pdState* state, void* user)
         probe->x0[k], pd_v3_add(pd_v3_scale(probe->v0[k], tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
     double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
     probe->travel[k] = fmax(probe->travel[k], moved);
+    if (probe->sleep) pd_sleep_step_end(probe->sleep, b, k, y);
   }
 }
 
@@ -301,9 +315,14 @@ static void measure_travel(const pdModel* sub, const pdState* state, void* user)
 // over the whole sample interval, and keeps what it measured since T0.
 static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool land, bool coarse) {
   if (!coarse)
-    for (int j = 0; j < is->bodyCount; ++j) set->travel[is->bodies[j]] = 0.0;
-  travelProbe probe = coarse ? (travelProbe){is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel}
-                             : (travelProbe){is, set->t0, set->x0, set->v0, set->q0, set->travel};
+    for (int j = 0; j < is->bodyCount; ++j) {
+      set->travel[is->bodies[j]] = 0.0;
+      if (set->sleep)
+        pd_sleep_interval_start(set->sleep, &is->model.bodies[is->model.movingBodies[j]], is->bodies[j],
+                                is->state->y + PD_BODY_STATE_SIZE * j);
+    }
+  travelProbe probe = coarse ? (travelProbe){is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel, NULL}
+                             : (travelProbe){is, set->t0, set->x0, set->v0, set->q0, set->travel, set->sleep};
   is->advanced = true;
   return pd_step_until(&is->model, is->state, tNext, land, NULL, NULL, measure_travel, &probe);
 }
@@ -388,6 +407,11 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
   s->count.islandIntervals = set->intervals;
   s->count.islandRedos = set->redos;
   s->count.islandStrays = set->strays;
+  if (set->sleep) {
+    s->count.islandsSlept = set->sleep->sleeps;
+    s->count.islandsWoken = set->sleep->wakes;
+    s->count.bodySecondsAsleep = set->sleep->bodySeconds;
+  }
 }
 
 // ---------------------------------------------------------------- the set
@@ -401,6 +425,7 @@ long pd_island_help_served(const pdState* s) {
 void pd_island_set_free(struct pdIslandSet* set) {
   if (!set) return;
   pd_pool_destroy(&set->pool);
+  pd_sleep_free(set->sleep);
   free(set->jobs);
   free(set->jobCoarse);
   free(set->jobOk);
@@ -514,6 +539,7 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   set->jobCoarse = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobCoarse);
   set->jobOk = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->jobOk);
   set->order = pd_grow(NULL, (size_t)set->islandCapacity, sizeof *set->order);
+  if (model->settings.sleep) set->sleep = pd_sleep_create(model);
   pd_pool_init(&set->pool, s->threads);
   return set;
 }
@@ -620,6 +646,17 @@ static void group_by(const int* group, int n, int groups, int* first, int* out) 
   first[0] = 0;
 }
 
+// The bodies of each sleeping island stay one island: frozen, they move together (not at all), and a part of one
+// woken alone would leave the rest frozen against moving bodies.
+static void join_sleepers(struct pdIslandSet* set) {
+  if (!set->sleep) return;
+  for (int j = 0; j < set->islandCount; ++j) {
+    const island* is = set->islands[j];
+    if (!is || !is->asleep) continue;
+    for (int m = 1; m < is->bodyCount; ++m) join(set->root, is->bodies[0], is->bodies[m]);
+  }
+}
+
 static int partition(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt, bool fine) {
   int m = set->movingCount, activations = 0;
   for (int k = 0; k < m; ++k) {
@@ -644,6 +681,7 @@ static int partition(const pdModel* model, const pdState* s, struct pdIslandSet*
     const pdBody *a = &model->bodies[b1], *b = &model->bodies[b2];
     if (!a->fixed && !b->fixed) join(set->root, a->stateIndex, b->stateIndex);
   }
+  join_sleepers(set);
   // every moving body in one island by its contacts alone (a stack, a wall): every pair below would be skipped as
   // joined, with no free body to activate (a free body touches nothing), so the broad phase is not asked (its pairs
   // come sorted whatever its history: broad_phase.h)
@@ -750,8 +788,14 @@ static void set_start(const pdModel* model, const pdState* s, struct pdIslandSet
   set->q0[k] = pd_layout_q(yb);
   set->r0[k] = pd_quat_to_mat3(pd_quat_normalize(set->q0[k]));
   set->box0[k] = pd_aabb_of(&b->shape, set->x0[k], &set->r0[k]);
-  set->bound[k] = travel_bound(model, set, k, yb, &set->box0[k], &set->touching[k], s->t, dt);
   set->travel[k] = 0.0;
+  if (set->sleep && set->sleep->asleep[k]) {
+    // frozen: its box stays where it is, whatever its (frozen) velocity says
+    set->v0[k] = (pdVec3){0.0, 0.0, 0.0};
+    set->bound[k] = 0.0;
+    return;
+  }
+  set->bound[k] = travel_bound(model, set, k, yb, &set->box0[k], &set->touching[k], s->t, dt);
 }
 
 // Marks in set->touching the moving bodies of the scene's contacts.
@@ -762,6 +806,116 @@ static void mark_touching(const pdModel* model, const pdState* s, struct pdIslan
     pd_contact_set_bodies(s->contacts, c, &b1, &b2);
     if (!model->bodies[b1].fixed) set->touching[model->bodies[b1].stateIndex] = true;
     if (!model->bodies[b2].fixed) set->touching[model->bodies[b2].stateIndex] = true;
+  }
+}
+
+// ---------------------------------------------------------------- sleeping (sleep.h)
+
+// Sleeping island j wakes at T (the scene's state s): its state is freed, and its bodies, moving again, are set up
+// in a new island from the scene's numbers at T, which are the frozen ones (its contacts' springs included).
+static void wake_island(const pdModel* model, const pdState* s, struct pdIslandSet* set, int j, double dt) {
+  island* is = set->islands[j];
+  for (int m = 0; m < is->bodyCount; ++m) {
+    int k = is->bodies[m];
+    set->sleep->asleep[k] = false;
+    set->sleep->quietSince[k] = NAN;
+    set->islandOld[k] = -1;
+    set_start(model, s, set, k, dt);
+  }
+  ++set->sleep->wakes;
+  retire(set, is);
+  set->islands[j] = NULL;
+}
+
+// Sleeping islands on one of whose bodies the applied force changed since it fell asleep wake at T.
+static void wake_pushed(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt) {
+  for (int j = 0; j < set->islandCount; ++j) {
+    const island* is = set->islands[j];
+    if (!is || !is->asleep) continue;
+    bool pushed = false;
+    for (int m = 0; m < is->bodyCount && !pushed; ++m) {
+      int k = is->bodies[m];
+      pushed = pd_sleep_force_changed(set->sleep, &model->bodies[model->movingBodies[k]], k, s->t);
+    }
+    if (pushed) wake_island(model, s, set, j, dt);
+  }
+}
+
+// After a partition: a sleeping island that shares an island of the partition with a moving body (its box, grown by
+// all it can move, and the sleeping body's may meet: the broad phase, then the separating-axis test) or with
+// another sleeping island wakes. True if one woke (the partition must be formed again).
+static bool wake_reached(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt) {
+  bool woke = false;
+  for (int p = 0; p < set->partCount; ++p) {
+    bool mixed = false;
+    int owner0 = 0;
+    for (int i = set->first[p]; i < set->first[p + 1]; ++i) {
+      int k = set->members[i];
+      int owner = set->sleep->asleep[k] ? set->islandOld[k] : -1;
+      if (i == set->first[p])
+        owner0 = owner;
+      else if (owner != owner0)
+        mixed = true;
+    }
+    if (!mixed) continue;
+    for (int i = set->first[p]; i < set->first[p + 1]; ++i) {
+      int k = set->members[i];
+      if (set->sleep->asleep[k]) {
+        wake_island(model, s, set, set->islandOld[k], dt);
+        woke = true;
+      }
+    }
+  }
+  return woke;
+}
+
+// At the end of the interval [T, tNext], the scene's state gathered: the body-seconds asleep over it, and the
+// islands quiet for their settle time fall asleep (sleep.h). A sleeping island keeps its state as it is: the
+// scene's numbers at tNext are its own, presented there, and stay so at every later sample until it wakes.
+static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandSet* set, double tNext) {
+  pdSleepSet* sleep = set->sleep;
+  long asleep = 0;
+  for (int k = 0; k < set->movingCount; ++k) asleep += sleep->asleep[k];
+  sleep->bodySeconds += (double)asleep * (tNext - set->t0);
+  for (int j = 0; j < set->islandCount; ++j) {
+    island* is = set->islands[j];
+    if (is->asleep || set->free[is->bodies[0]]) continue;  // a free body touches nothing: never at rest
+    // the cheap test first: one body above the speed threshold keeps the island awake, and the quiet time of every
+    // body in it starts again (an island comes to rest as a whole)
+    bool slow = true;
+    for (int m = 0; m < is->bodyCount && slow; ++m) {
+      int k = is->bodies[m];
+      slow = pd_sleep_slow(sleep, &model->bodies[model->movingBodies[k]], k, s->y + PD_BODY_STATE_SIZE * k);
+    }
+    if (!slow) {
+      for (int m = 0; m < is->bodyCount; ++m) sleep->quietSince[is->bodies[m]] = NAN;
+      continue;
+    }
+    double settle = pd_sleep_settle_time(&is->model, is->state);
+    for (int m = 0; m < is->bodyCount; ++m) sleep->inContact[is->bodies[m]] = false;
+    for (int c = 0; c < pd_state_contact_count(is->state); ++c) {
+      int b[2];
+      pd_contact_set_bodies(is->state->contacts, c, &b[0], &b[1]);
+      for (int e = 0; e < 2; ++e)
+        if (!is->model.bodies[b[e]].fixed) sleep->inContact[is->bodies[is->model.bodies[b[e]].stateIndex]] = true;
+    }
+    bool quiet = true;
+    double since = -INFINITY;
+    for (int m = 0; m < is->bodyCount; ++m) {
+      int k = is->bodies[m];
+      const pdBody* b = &model->bodies[model->movingBodies[k]];
+      bool bodyQuiet = pd_sleep_quiet(sleep, b, k, s->y + PD_BODY_STATE_SIZE * k, set->t0, tNext, settle);
+      if (!bodyQuiet || !sleep->inContact[k]) {
+        sleep->quietSince[k] = NAN;
+        quiet = false;
+      } else {
+        since = fmax(since, sleep->quietSince[k]);
+      }
+    }
+    if (!quiet || tNext - since < settle) continue;
+    is->asleep = true;
+    ++sleep->sleeps;
+    for (int m = 0; m < is->bodyCount; ++m) pd_sleep_fall_asleep(sleep, is->bodies[m], tNext, settle);
   }
 }
 
@@ -789,20 +943,24 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
   for (int k = 0; k < set->movingCount; ++k)
     if (!set->free[k]) set_start(model, s, set, k, dt);
   for (int j = 0; j < set->islandCount; ++j) set->islands[j]->advanced = false;
+  if (set->sleep) wake_pushed(model, s, set, dt);
   for (int round = 0;; ++round) {
-    // a free body another body may reach joins the others from here: it is brought to T first
-    for (int activations; (activations = partition(model, s, set, dt, true)) > 0;)
-      for (int i = 0; i < activations; ++i) {
-        int k = set->activate[i];
-        if (s->t > set->ct0 && !free_advance(s, set, k, s->t, true)) return false;
-        set->free[k] = false;
-        set_start(model, s, set, k, dt);
-      }
+    // a free body another body may reach joins the others from here: it is brought to T first; a sleeping island
+    // another body may reach wakes here, and the partition is formed again with its bodies moving
+    do {
+      for (int activations; (activations = partition(model, s, set, dt, true)) > 0;)
+        for (int i = 0; i < activations; ++i) {
+          int k = set->activate[i];
+          if (s->t > set->ct0 && !free_advance(s, set, k, s->t, true)) return false;
+          set->free[k] = false;
+          set_start(model, s, set, k, dt);
+        }
+    } while (set->sleep && wake_reached(model, s, set, dt));
     int built = rebuild(model, s, set);
     if (round > 0) set->redos += built;
     for (int j = 0; j < set->islandCount; ++j) {
       island* is = set->islands[j];
-      if (is->advanced || set->free[is->bodies[0]]) continue;
+      if (is->advanced || is->asleep || set->free[is->bodies[0]]) continue;
       ++set->intervals;
       add_job(set, is, false);
     }
@@ -847,6 +1005,7 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
     set->subMaps[j] = is->toScene;
   }
   pd_contact_set_gather(model, s, set->islandCount, set->subModels, set->subStates, set->subMaps);
+  if (set->sleep) fall_asleep(model, s, set, tNext);
   return true;
 }
 

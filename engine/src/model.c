@@ -273,6 +273,7 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
       .dtmax = s->dtmax,
       .sampleRate = s->sample,
       .deflection = s->deflection,
+      .sleep = s->sleep,
   };
   if (s->setMask & PD_SET_VMAX) {
     m->settings.vmax = s->vmax;

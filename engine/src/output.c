@@ -607,6 +607,9 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
     pdu_json_string(out, pd_onsets_name(state->onsets));
     fputs(",\n  \"islands\": ", out);
     pdu_json_string(out, pd_islands_name(state->islands));
+    // sleeping is a matter of the islands: with islands off there is one system, never at rest while any body moves
+    fputs(",\n  \"sleep\": ", out);
+    pdu_json_string(out, state->islands == pd_islandsOn && s->sleep ? "on" : "off");
   }
   fputs(",\n", out);
   if (info->engineSettingsJson) fprintf(out, "  \"engine_settings\": %s,\n", info->engineSettingsJson);
@@ -655,12 +658,16 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
           state->count.searchesSkipped, state->count.contactsMade, state->count.contactsVirtual,
           state->count.contactsTransferred, state->count.breaksForce, state->count.breaksGeometry,
           pd_state_contact_count(state));
-  if (!info->stepper && state->islands == pd_islandsOn)  // the soft engine's islands only
+  if (!info->stepper && state->islands == pd_islandsOn) {  // the soft engine's islands only
     fprintf(out,
             "  \"island_counts\": {\"islands_formed\": %ld, \"largest_island\": %ld, \"island_intervals\": %ld, "
-            "\"island_redos\": %ld, \"island_strays\": %ld},\n",
+            "\"island_redos\": %ld, \"island_strays\": %ld, \"islands_slept\": %ld, \"islands_woken\": %ld, "
+            "\"body_seconds_asleep\": ",
             state->count.islandsFormed, state->count.islandsLargest, state->count.islandIntervals,
-            state->count.islandRedos, state->count.islandStrays);
+            state->count.islandRedos, state->count.islandStrays, state->count.islandsSlept, state->count.islandsWoken);
+    write_number(out, state->count.bodySecondsAsleep);
+    fputs("},\n", out);
+  }
   fputs("  \"warnings\": {", out);
   for (int w = 0; w < pd_warnCount; ++w) fprintf(out, "%s\"%s\": %ld", w ? ", " : "", pdWarningNames[w], state->warnings[w]);
   fputs("},\n  \"t_reached\": ", out);

@@ -236,7 +236,7 @@ static TokenKind lex(Lexer* lx, Token* tok) {
 // commands
 
 typedef enum CommandId {
-  cmd_gravity, cmd_tend, cmd_tol, cmd_dt, cmd_dtmin, cmd_dtmax, cmd_sample, cmd_vmax, cmd_deflection,
+  cmd_gravity, cmd_tend, cmd_tol, cmd_dt, cmd_dtmin, cmd_dtmax, cmd_sample, cmd_vmax, cmd_deflection, cmd_sleep,
   cmd_cube, cmd_prism, cmd_tprism, cmd_sphere, cmd_hull,
   cmd_fixed, cmd_loc, cmd_vel, cmd_spgrav, cmd_mu, cmd_kn, cmd_kt, cmd_cn, cmd_ct, cmd_restitution, cmd_force,
 } CommandId;
@@ -261,6 +261,7 @@ static const Command commands[] = {
     {"sample", cmd_sample, class_setting, 1, 1, "HZ"},
     {"vmax", cmd_vmax, class_setting, 1, 1, "V"},
     {"deflection", cmd_deflection, class_setting, 1, 1, "F"},
+    {"sleep", cmd_sleep, class_setting, 1, 1, "on|off"},
     {"cube", cmd_cube, class_object, 5, 5, "NAME COLOR sx sy sz"},
     {"prism", cmd_prism, class_object, 6, 6, "NAME COLOR n sx sy sz"},
     {"tprism", cmd_tprism, class_object, 7, 7, "NAME COLOR n sx sy sz taper"},
@@ -355,6 +356,17 @@ static bool ranged(Parser* ps, const Token* t, const char* what, Range r, double
     return fail(ps, t->loc, "%s must be %s, got %s", what, need, shown(buf, t->text, t->len));
   }
   *out = v;
+  return true;
+}
+
+// A switch: the word `on` or `off`.
+static bool on_off(Parser* ps, const Token* t, const char* what, bool* out) {
+  bool on = strcmp(t->text, "on") == 0;
+  if (!on && strcmp(t->text, "off") != 0) {
+    char buf[SHOWN_BUF];
+    return fail(ps, t->loc, "%s must be on or off, got '%s'", what, shown(buf, t->text, t->len));
+  }
+  *out = on;
   return true;
 }
 
@@ -702,6 +714,7 @@ static bool setting_command(Parser* ps, const Command* cmd) {
     case cmd_sample: ok = ranged(ps, arg, "sample", range_pos, &s->sample); break;
     case cmd_vmax: ok = ranged(ps, arg, "vmax", range_pos, &s->vmax); break;
     case cmd_deflection: ok = ranged(ps, arg, "deflection", range_open01, &s->deflection); break;
+    case cmd_sleep: ok = on_off(ps, arg, "sleep", &s->sleep); break;
     default: break;
   }
   if (ok) {
@@ -833,6 +846,7 @@ static pdScene* parse(const char* name, FILE* file, const unsigned char* text, s
       .sample = PD_DEFAULT_SAMPLE,
       .vmax = 0,
       .deflection = PD_DEFAULT_DEFLECTION,
+      .sleep = PD_DEFAULT_SLEEP,
   };
   for (int i = 0; i < 16; ++i) names[i] = -1;
   ps->names = names;

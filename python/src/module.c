@@ -105,9 +105,10 @@ static PyObject* scene_from_string(PyObject* type, PyObject* args, PyObject* kwa
 }
 
 static PyObject* settings_dict(const pdSceneSettings* s) {
-  return Py_BuildValue("{s:(ddd),s:d,s:d,s:d,s:d,s:d,s:d,s:d,s:d}", "gravity", s->gravity[0], s->gravity[1],
+  return Py_BuildValue("{s:(ddd),s:d,s:d,s:d,s:d,s:d,s:d,s:d,s:d,s:O}", "gravity", s->gravity[0], s->gravity[1],
                        s->gravity[2], "tend", s->tend, "tol", s->tol, "dt", s->dt, "dtmin", s->dtmin, "dtmax",
-                       s->dtmax, "sample", s->sample, "vmax", s->vmax, "deflection", s->deflection);
+                       s->dtmax, "sample", s->sample, "vmax", s->vmax, "deflection", s->deflection, "sleep",
+                       s->sleep ? Py_True : Py_False);
 }
 
 static PyObject* scene_get_path(pdPyScene* self, void* closure) {
@@ -269,10 +270,11 @@ static PyObject* model_get_moving(pdPyModel* self, void* closure) {
 static PyObject* model_get_settings(pdPyModel* self, void* closure) {
   (void)closure;
   const pdSettings* s = &self->model->settings;
-  return Py_BuildValue("{s:(ddd),s:d,s:d,s:d,s:d,s:d,s:d,s:d,s:O,s:d}", "gravity", s->gravity.x, s->gravity.y,
+  return Py_BuildValue("{s:(ddd),s:d,s:d,s:d,s:d,s:d,s:d,s:d,s:O,s:d,s:O}", "gravity", s->gravity.x, s->gravity.y,
                        s->gravity.z, "tend", s->tend, "tol", s->tol, "dt", s->dt, "dtmin", s->dtmin, "dtmax", s->dtmax,
                        "sample", s->sampleRate, "vmax", s->vmax, "vmax_estimated",
-                       s->vmaxEstimated ? Py_True : Py_False, "deflection", s->deflection);
+                       s->vmaxEstimated ? Py_True : Py_False, "deflection", s->deflection, "sleep",
+                       s->sleep ? Py_True : Py_False);
 }
 
 static PyObject* model_get_path(pdPyModel* self, void* closure) {

@@ -421,9 +421,10 @@ static PyObject* state_get_counters(pdPyState* self, void* closure) {
   (void)closure;
   if (!state_usable(self)) return NULL;
   const pdCounters* c = &self->state->count;
-  return Py_BuildValue("{s:l,s:l,s:l,s:l,s:l,s:l,s:l}", "accepted", c->accepted, "rejected", c->rejected,
+  return Py_BuildValue("{s:l,s:l,s:l,s:l,s:l,s:l,s:l,s:d}", "accepted", c->accepted, "rejected", c->rejected,
                        "derivatives", c->derivatives, "samples", c->samples, "contacts_made", c->contactsMade,
-                       "breaks_force", c->breaksForce, "breaks_geometry", c->breaksGeometry);
+                       "breaks_force", c->breaksForce, "breaks_geometry", c->breaksGeometry, "body_seconds_asleep",
+                       c->bodySecondsAsleep);
 }
 
 static PyObject* state_get_model(pdPyState* self, void* closure) {

@@ -177,8 +177,8 @@ def test_state_stepping_matches_one_run():
 
 
 def test_gil_released_while_c_runs():
-    # a Python thread keeps counting while a run is in C
-    scene = polydyn.Scene.from_string(CUBE_SCENE)
+    # a Python thread keeps counting while a run is in C (sleep off: a cube at rest asleep would cost next to nothing)
+    scene = polydyn.Scene.from_string("sleep off\n" + CUBE_SCENE)
     count = [0]
     done = threading.Event()
 

@@ -145,13 +145,23 @@ sample_times() { tail -n +2 "$1" | cut -d, -f1 | uniq | tr "\n" " "; }
 check "samples at 0, 0.1, ..., 0.5" '[ "$(sample_times "$RUN3/trajectory.csv")" = "$TIMES" ]'
 for bad in "--tend abc" "--tend -1" "--tend nan" "--sample 0" "--tend" "--islands maybe" "--islands" \
   "--engine ode --islands on" "--islands on --threads 0" "--islands on --threads 65" "--islands on --threads 2x" \
-  "--islands on --threads" "--islands off --threads 2" "--engine ode --threads 1"; do
+  "--islands on --threads" "--islands off --threads 2" "--engine ode --threads 1" "--sleep maybe" "--sleep" \
+  "--engine bullet --sleep off"; do
   dir=$SCRATCH/out_badopt
   # shellcheck disable=SC2086
   run_pd "$OUT" "$ERR" run "$DEMO" --out "$dir" $bad
   check "run $bad exits 2" '[ $rc -eq 2 ]'
   check "run $bad writes nothing" '[ ! -e "$dir" ] && no_partial "$dir"'
 done
+
+# --sleep overrides the scene's `sleep` setting; summary.json says which was in force
+RUN_SLEEP=$SCRATCH/run_sleep
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN_SLEEP" --tend 0.2 --sleep off
+check "--sleep off exits 0" '[ $rc -eq 0 ]'
+check "--sleep off: summary.json says sleep off, no body-seconds asleep" \
+  'grep -q "\"sleep\": \"off\"" "$RUN_SLEEP/summary.json" && grep -q "\"body_seconds_asleep\": 0}" "$RUN_SLEEP/summary.json"'
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN_SLEEP" --tend 0.2
+check "default: summary.json says sleep on" '[ $rc -eq 0 ] && grep -q "\"sleep\": \"on\"" "$RUN_SLEEP/summary.json"'
 
 # --- output directory rules ----------------------------------------------------------------------
 KEEP=$SCRATCH/not_a_run

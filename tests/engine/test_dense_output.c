@@ -55,7 +55,8 @@ static bool keep(const pdModel* model, const pdState* state, void* user) {
 
 static trace* run_sampled(const char* body, double sampleRate, pdStepper stepper, pdIslands islands, long* steps) {
   char text[1024];
-  snprintf(text, sizeof text, "tend 0.6\nsample %g\n%s", sampleRate, body);
+  // sleep off: an island falls asleep at a sync time, and the samples are sync times (docs/sleeping.md)
+  snprintf(text, sizeof text, "tend 0.6\nsample %g\nsleep off\n%s", sampleRate, body);
   pdModel* m = compile_text(text);
   pdState* s = pd_state_create(m);
   s->stepper = stepper;

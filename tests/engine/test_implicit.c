@@ -40,7 +40,7 @@ static pdModel* two_boxes_on_a_ramp(double tend) {
   const double low = 0.05 + gap, high = 0.15 + 2.0 * gap;                  // the centres' heights along it
   char text[1024];
   snprintf(text, sizeof text,
-           "tend %g\nsample 100\n"
+           "tend %g\nsample 100\nsleep off\n"  // the steps at rest are what is measured: sleeping would skip them
            "cube ramp grey 2 2 0.2\nfixed\nloc 0 %.17g %.17g  10 1 0 0\nmu 0.5\n"
            "cube low red 0.2 0.2 0.1\nloc 0 %.17g %.17g  10 1 0 0\nmu 0.5\n"
            "cube high blue 0.1 0.1 0.1\nloc 0 %.17g %.17g  10 1 0 0\nmu 0.5\n",

@@ -170,7 +170,10 @@ static void test_far_groups_compute_as_if_alone(void** state) {
 // ---------------------------------------------------------------- one island = islands off
 
 static void expect_islands_off_bits(const char* text, const char* what) {
-  pdModel* m = compile_text(text);
+  // with islands off nothing sleeps (docs/sleeping.md): sleep off here too, for the same steps
+  char scene[2048];
+  snprintf(scene, sizeof scene, "sleep off\n%s", text);
+  pdModel* m = compile_text(scene);
   trace* on = run_islands(m, pd_islandsOn, NULL);
   trace* off = run_islands(m, pd_islandsOff, NULL);
   assert_int_equal(on->count, off->count);

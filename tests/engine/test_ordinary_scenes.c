@@ -277,7 +277,7 @@ static void test_block_slides_down_a_ramp_at_the_coulomb_rate_on_its_line(void**
 static void twist_counts(const char* tend, pdState** s, record** r) {
   char text[512];
   snprintf(text, sizeof text,
-           "tend %s\nsample 1000\n"
+           "tend %s\nsample 1000\nsleep off\n"  // the steps at rest are what is measured: sleeping would skip them
            "cube floor grey 3 3 0.2\nfixed\nloc 0 0 -0.1\nmu 0.5\n"
            "cube box red 0.2 0.15 0.1\nloc 0 0 0.05\nvel 0.05 0 0  30 0 0 1\nmu 0.5\n",
            tend);

@@ -115,8 +115,9 @@ static void check_default_settings(const pdSceneSettings* s) {
   assert_true(s->sample == PD_DEFAULT_SAMPLE);
   assert_true(s->vmax == 0);
   assert_true(s->deflection == PD_DEFAULT_DEFLECTION);
+  assert_true(s->sleep == PD_DEFAULT_SLEEP);
   assert_int_equal(s->setMask, 0);
-  for (int i = 0; i < 9; ++i) assert_int_equal(s->where[i].line, 0);
+  for (int i = 0; i < 10; ++i) assert_int_equal(s->where[i].line, 0);
 }
 
 static void test_empty_scene_is_valid_with_default_settings(void** state) {
@@ -156,7 +157,8 @@ static void test_settings_are_parsed_with_mask_and_location(void** state) {
       "dtmax 1e-3\n"
       "sample 1000\n"
       "vmax 5\n"
-      "  deflection 0.02\n");
+      "  deflection 0.02\n"
+      "sleep off\n");
   const pdSceneSettings* s = &sc->settings;
   assert_true(s->gravity[0] == 1 && s->gravity[1] == -2 && s->gravity[2] == 3.5);
   assert_true(s->tend == 2.5);
@@ -167,9 +169,10 @@ static void test_settings_are_parsed_with_mask_and_location(void** state) {
   assert_true(s->sample == 1000);
   assert_true(s->vmax == 5);
   assert_true(s->deflection == 0.02);
+  assert_false(s->sleep);
   assert_int_equal(s->setMask, PD_SET_GRAVITY | PD_SET_TEND | PD_SET_TOL | PD_SET_DT | PD_SET_DTMIN | PD_SET_DTMAX |
-                                   PD_SET_SAMPLE | PD_SET_VMAX | PD_SET_DEFLECTION);
-  for (int i = 0; i < 9; ++i) assert_int_equal(s->where[i].line, i + 1);
+                                   PD_SET_SAMPLE | PD_SET_VMAX | PD_SET_DEFLECTION | PD_SET_SLEEP);
+  for (int i = 0; i < 10; ++i) assert_int_equal(s->where[i].line, i + 1);
   assert_int_equal(s->where[8].col, 3);
   assert_int_equal(sc->objectCount, 0);
   pd_scene_free(sc);
@@ -622,6 +625,8 @@ static void test_error_setting_ranges(void** state) {
   expect_error("sample 0\n", 1, 8, "sample must be > 0");
   expect_error("vmax 0\n", 1, 6, "vmax must be > 0");
   expect_error("deflection 1\n", 1, 12, "deflection must be in (0, 1), got 1");
+  expect_error("sleep 0\n", 1, 7, "sleep must be on or off, got '0'");
+  expect_error("sleep on off\n", 1, 10, "too many arguments: 'sleep' expects 1 (on|off)");
 }
 
 static void test_error_zero_rotation_axis_with_nonzero_angle(void** state) {

@@ -77,6 +77,7 @@ typedef struct pdSettings {
   double vmax;           // m/s: characteristic speed (requested, or estimated: see velocityScaleSource)
   bool vmaxEstimated;    // true when vmax was estimated from the scene
   double deflection;     // δ_max as a fraction of a body's average dimension
+  bool sleep;            // islands at rest stop being integrated until reached (pd_islandsOn; docs/sleeping.md)
 } pdSettings;
 
 typedef struct pdModel {

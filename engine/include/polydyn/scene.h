@@ -53,6 +53,7 @@ enum {
   PD_SET_SAMPLE = 1u << 6,
   PD_SET_VMAX = 1u << 7,
   PD_SET_DEFLECTION = 1u << 8,
+  PD_SET_SLEEP = 1u << 9,
 };
 
 // Where a command stood in its file (1-based line and column of its first character).
@@ -101,6 +102,7 @@ typedef struct pdSceneObject {
 #define PD_DEFAULT_DTMAX 1e-2         // s
 #define PD_DEFAULT_SAMPLE 100.0       // output samples per second
 #define PD_DEFAULT_DEFLECTION 0.01    // δ_max as a fraction of a body's average dimension
+#define PD_DEFAULT_SLEEP true         // islands at rest stop being integrated (docs/sleeping.md)
 #define PD_DEFAULT_MU 0.5             // base friction coefficient
 #define PD_DEFAULT_SPGRAV 1.0         // water
 
@@ -114,8 +116,9 @@ typedef struct pdSceneSettings {
   double sample;       // Hz, > 0
   double vmax;         // m/s, > 0 when PD_SET_VMAX, else 0 (estimated from the scene)
   double deflection;   // (0, 1)
+  bool sleep;          // `sleep on|off`
   unsigned setMask;    // PD_SET_* setting bits
-  pdSourceLoc where[9];  // where each setting was last given, indexed by bit number (line 0 = default)
+  pdSourceLoc where[10];  // where each setting was last given, indexed by bit number (line 0 = default)
 } pdSceneSettings;
 
 typedef struct pdScene {

@@ -145,6 +145,10 @@ typedef struct pdCounters {
   long islandRedos;      // islands whose interval was redone because a body moved farther than its grown box
   long islandStrays;     // free bodies found outside their box over a sample interval (none expected: a free body
                          // has no contact to leave its ballistic path by; counted, not recovered)
+  // pd_islandsOn with settings.sleep (0 otherwise): islands at rest stop being integrated (docs/sleeping.md)
+  long islandsSlept;         // islands that fell asleep
+  long islandsWoken;         // sleeping islands woken (a body may reach them, or an applied force changed)
+  double bodySecondsAsleep;  // s: the sum over moving bodies of the time each spent asleep
 } pdCounters;
 
 typedef struct pdState {

@@ -1,0 +1,102 @@
+// polydyn — sleeping bodies' records and thresholds (sleep.h; the decisions are in islands.c).
+#include "sleep.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "contact_set.h"
+#include "grow.h"
+#include "model_contact.h"
+#include "polydyn/error.h"
+#include "state_layout.h"
+
+#define PI 3.14159265358979323846
+
+pdSleepSet* pd_sleep_create(const pdModel* model) {
+  pdSleepSet* set = calloc(1, sizeof *set);
+  PD_ASSERT(set != NULL);
+  int m = model->movingCount > 0 ? model->movingCount : 1;
+  set->movingCount = model->movingCount;
+  set->speedMax = PD_SLEEP_SPEED_TOL * model->settings.tol * model->settings.vmax;
+  set->speedPeak = pd_grow(NULL, (size_t)m, sizeof *set->speedPeak);
+  set->v0 = pd_grow(NULL, (size_t)m, sizeof *set->v0);
+  set->w0 = pd_grow(NULL, (size_t)m, sizeof *set->w0);
+  set->quietSince = pd_grow(NULL, (size_t)m, sizeof *set->quietSince);
+  set->asleep = pd_grow(NULL, (size_t)m, sizeof *set->asleep);
+  set->asleepSince = pd_grow(NULL, (size_t)m, sizeof *set->asleepSince);
+  set->settle = pd_grow(NULL, (size_t)m, sizeof *set->settle);
+  set->inContact = pd_grow(NULL, (size_t)m, sizeof *set->inContact);
+  for (int k = 0; k < model->movingCount; ++k) {
+    set->speedPeak[k] = 0.0;
+    set->quietSince[k] = NAN;
+    set->asleep[k] = false;
+  }
+  return set;
+}
+
+void pd_sleep_free(pdSleepSet* set) {
+  if (!set) return;
+  free(set->speedPeak);
+  free(set->v0);
+  free(set->w0);
+  free(set->quietSince);
+  free(set->asleep);
+  free(set->asleepSince);
+  free(set->settle);
+  free(set->inContact);
+  free(set);
+}
+
+double pd_sleep_speed(const pdBody* body, const double* yb) {
+  return pd_v3_norm(pd_layout_v(yb)) + pd_v3_norm(pd_layout_w(yb)) * body->radius;
+}
+
+void pd_sleep_interval_start(pdSleepSet* set, const pdBody* body, int k, const double* yb) {
+  set->speedPeak[k] = pd_sleep_speed(body, yb);
+  set->v0[k] = pd_layout_v(yb);
+  set->w0[k] = pd_layout_w(yb);
+}
+
+double pd_sleep_settle_time(const pdModel* sub, const pdState* state) {
+  double period = 0.0;
+  for (int c = 0; c < pd_state_contact_count(state); ++c) {
+    int b1, b2;
+    pd_contact_set_bodies(state->contacts, c, &b1, &b2);
+    pdContactParams p = pd_model_contact_params(sub, b1, b2);
+    double kn = p.k1n * p.k2n / (p.k1n + p.k2n), kt = p.k1t * p.k2t / (p.k1t + p.k2t);
+    double k = p.mu > 0.0 && kt > 0.0 ? fmin(kn, kt) : kn;
+    if (k > 0.0 && isfinite(p.massPair)) period = fmax(period, 2.0 * PI * sqrt(p.massPair / k));
+  }
+  return period > 0.0 ? PD_SLEEP_SETTLE_PERIODS * period : INFINITY;
+}
+
+bool pd_sleep_slow(const pdSleepSet* set, const pdBody* body, int k, const double* yb) {
+  return fmax(set->speedPeak[k], pd_sleep_speed(body, yb)) < set->speedMax;
+}
+
+bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb, double t0, double t1,
+                    double settle) {
+  double dt = t1 - t0;
+  pdVec3 dv = pd_v3_sub(pd_layout_v(yb), set->v0[k]), dw = pd_v3_sub(pd_layout_w(yb), set->w0[k]);
+  double accel = dt > 0.0 ? (pd_v3_norm(dv) + pd_v3_norm(dw) * body->radius) / dt : 0.0;
+  bool quiet = isfinite(settle) && pd_sleep_slow(set, body, k, yb) && accel * settle < set->speedMax;
+  if (!quiet)
+    set->quietSince[k] = NAN;
+  else if (isnan(set->quietSince[k]))
+    set->quietSince[k] = t0;
+  return quiet;
+}
+
+void pd_sleep_fall_asleep(pdSleepSet* set, int k, double t, double settle) {
+  set->asleep[k] = true;
+  set->asleepSince[k] = t;
+  set->settle[k] = settle;
+}
+
+bool pd_sleep_force_changed(const pdSleepSet* set, const pdBody* body, int k, double t) {
+  if (!body->hasForce) return false;
+  double change = pd_v3_norm(body->forceRate) * fabs(t - set->asleepSince[k]);
+  double surface = change * body->invMass;
+  if (body->principal[0] > 0.0) surface += change * pd_v3_norm(body->forcePoint) * body->radius / body->principal[0];
+  return surface * set->settle[k] >= set->speedMax;
+}
