@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "compare_files.h"
 #include "pdutil/csv.h"
 #include "pdutil/json.h"
 #include "polydyn/batch.h"
@@ -34,6 +35,11 @@ static const char* const help =
     "against the reference, final and RMS; energy and momentum drift; deepest penetration; restitution of\n"
     "each bounce; cost), DIR/compare.json (every run with its status) and DIR/runs/ENGINE-VARIANT/ (each\n"
     "run directory, for replay). DIR is written under a temporary name and renamed when complete.\n"
+    "Beside metrics.csv: series.csv (each body over time in every run: pose error, energy, penetration, contacts,\n"
+    "normal force, slip speed), impacts.csv (every impact, matched to the reference's), friction.csv (|F_t|/F_n\n"
+    "against slip speed) and divergence.csv (when and where each run first differs by more than 0.1, and whether\n"
+    "chaos explains it: the reference is repeated at twice its tolerance, runs/soft-chaos). `polydyn report DIR`\n"
+    "shows them (docs/compare-report.md).\n"
     "\n"
     "  --engines LIST   comma-separated: soft, ode, bullet (default: all three)\n"
     "  --variants LIST  of the reference engines: native, matched (default: both)\n"
@@ -56,9 +62,12 @@ typedef struct compareRun {
   const char* engine;
   const char* variant;
   bool isReference;
+  bool isChaos;  // the reference repeated at a perturbed tolerance: the scene's own divergence
   const char* status;  // ok, failed, refused, not built
   char message[512];
   pdTrajectory* trajectory;
+  pdContactLog* contacts;  // the soft engine's contacts per sample
+  pdDivergence divergence;
   double wallSeconds;
   long steps;
   pdCompareMetrics metrics;  // when status is ok
@@ -68,12 +77,13 @@ typedef struct compareRun {
 typedef struct softObserver {
   pdRunWriter* writer;
   pdTrajectory* trajectory;
+  pdContactLog* contacts;
 } softObserver;
 
 static bool observe_soft(const pdModel* model, const pdState* state, void* user) {
   softObserver* o = user;
   return pd_run_observe(model, state, o->writer) && pd_trajectory_observe(model, state, o->trajectory) &&
-         !pd_cli_interrupted;
+         pd_contact_log_observe(model, state, o->contacts) && !pd_cli_interrupted;
 }
 
 static bool observe_reference(const pdModel* model, const pdState* state, void* user) {
@@ -119,7 +129,8 @@ static void run_soft(const char* scene, const pdCliOverrides* overrides, const c
   }
   pdState* state = pd_state_create(model, NULL);
   r->trajectory = pd_trajectory_create(model);
-  softObserver o = {writer, r->trajectory};
+  r->contacts = pd_contact_log_create(model);
+  softObserver o = {writer, r->trajectory, r->contacts};
   double e0 = pd_state_energy(model, state), t0 = pd_cli_wall_seconds();
   bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
   pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
@@ -150,8 +161,12 @@ static void run_reference_engine(const pdModel* model, const pdRefAdapter* adapt
     return;
   }
   r->trajectory = pd_trajectory_create(model);
+  r->contacts = pd_contact_log_create(model);
+  pdRefOptions o = *options;
+  o.contactObserver = pd_contact_log_add;
+  o.contactUser = r->contacts;
   pdRefRunStats stats;
-  bool ok = pd_ref_run(model, adapter, options, writer, observe_reference, r->trajectory, &stats, &err);
+  bool ok = pd_ref_run(model, adapter, &o, writer, observe_reference, r->trajectory, &stats, &err);
   r->wallSeconds = stats.wallSeconds;
   r->steps = stats.steps;
   if (!ok) {
@@ -177,7 +192,7 @@ static void write_metric_rows(FILE* out, const char* scene, const pdModel* model
   double simulated = model->settings.tend;
   for (int i = 0; i < count; ++i) {
     const compareRun* r = &runs[i];
-    if (strcmp(r->status, "ok") != 0) continue;
+    if (strcmp(r->status, "ok") != 0 || r->isChaos) continue;
     const pdCompareMetrics m = r->metrics;
     pdu_csv_quoted(out, scene);  // quoted in every row, as it always was
     const char* const texts[] = {r->engine, r->variant, r->isReference ? "self" : refName};
@@ -245,8 +260,8 @@ static bool write_results(const char* dir, const char* scene, const pdModel* mod
 
 // The table a person reads first (stdout).
 static void write_table(FILE* out, const pdModel* model, const compareRun* runs, int count) {
-  fprintf(out, "%-16s %-8s %12s %12s %12s %14s\n", "run", "status", "pos err end", "rot err end", "energy drift",
-          "wall/sim s");
+  fprintf(out, "%-16s %-8s %12s %12s %12s %14s %12s %12s\n", "run", "status", "pos err end", "rot err end", "energy drift",
+          "wall/sim s", "diverges s", "beyond chaos");
   for (int i = 0; i < count; ++i) {
     const compareRun* r = &runs[i];
     if (strcmp(r->status, "ok") != 0) {
@@ -254,11 +269,14 @@ static void write_table(FILE* out, const pdModel* model, const compareRun* runs,
       continue;
     }
     const pdCompareMetrics m = r->metrics;
+    const pdDivergence d = r->divergence;
     fprintf(out, "%-16s %-8s", r->name, r->status);
     pd_cli_table_number(out, 13, "%.3g", m.posErrFinal);  // the reference row has no error: "—"
     pd_cli_table_number(out, 13, "%.3g", m.rotErrFinal);
     pd_cli_table_number(out, 13, "%.3g", m.energyDriftRel);
     pd_cli_table_number(out, 15, "%.3g", r->wallSeconds / model->settings.tend);
+    pd_cli_table_number(out, 13, "%.3g", d.diverged ? d.t : NAN);  // never diverged: "—"
+    pd_cli_table_number(out, 13, "%.3g", !r->isChaos && d.diverged ? d.beyondChaos : NAN);
     fputc('\n', out);
   }
 }
@@ -290,7 +308,7 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
     pd_batch_append(result, &h, sizeof h);
     return;
   }
-  compareRun runs[8];
+  compareRun runs[8];  // the reference, the chaos run, soft, ODE and Bullet in two variants each
   int count = 0;
   pdCliOverrides tighter = c->overrides;
   tighter.tolScale = COMPARE_REFERENCE_TOL_SCALE;
@@ -298,6 +316,11 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
   // the reference first: every other run is measured against it
   runs[count] = (compareRun){.engine = "soft", .variant = "reference", .isReference = true, .status = "failed"};
   snprintf(runs[count].name, sizeof runs[count].name, "soft-reference");
+  ++count;
+  pdCliOverrides perturbed = tighter;
+  perturbed.tolScale = COMPARE_REFERENCE_TOL_SCALE * PD_COMPARE_CHAOS_TOL_SCALE;
+  runs[count] = (compareRun){.engine = "soft", .variant = "chaos", .isChaos = true, .status = "failed"};
+  snprintf(runs[count].name, sizeof runs[count].name, "soft-chaos");
   ++count;
   if (pd_cli_list_has(c->engines, "soft")) {
     runs[count] = (compareRun){.engine = "soft", .variant = "implicit", .status = "failed"};
@@ -320,7 +343,7 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
     snprintf(runDir, sizeof runDir, "%s/%s", runsDir, r->name);
     if (c->progress) fprintf(stderr, "\rpolydyn compare: %s %s (%d/%d)\033[K", scene, r->name, i + 1, count);
     if (strcmp(r->engine, "soft") == 0) {
-      run_soft(scene, r->isReference ? &tighter : &c->overrides, runDir, r);
+      run_soft(scene, r->isReference ? &tighter : r->isChaos ? &perturbed : &c->overrides, runDir, r);
       continue;
     }
     const pdRefAdapter* adapter = pd_ref_adapter(r->engine);
@@ -350,13 +373,27 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
                                            reference && reference != &runs[i] ? reference->trajectory : NULL);
   char refName[64];
   snprintf(refName, sizeof refName, "soft tol=%g", tolReference);
+  bool detailsWritten = true;
+  if (reference) {  // series, impacts, friction and divergence: against the reference, the chaos run beside it
+    pdCompareRunData data[8];
+    pdDivergence divergences[8];
+    int index[8], n = 0, chaos = -1;
+    for (int i = 0; i < count; ++i) {
+      if (strcmp(runs[i].status, "ok") != 0) continue;
+      if (runs[i].isChaos) chaos = n;
+      index[n] = i;
+      data[n++] = (pdCompareRunData){runs[i].engine, runs[i].variant, runs[i].trajectory, runs[i].contacts};
+    }
+    detailsWritten = pd_compare_write_details(dir, scene, model, data, n, chaos, divergences);
+    for (int i = 0; i < n; ++i) runs[index[i]].divergence = divergences[i];
+  }
   char* rows = NULL;
   char* table = NULL;
   size_t rowsSize = 0, tableSize = 0;
   FILE* rowsOut = open_memstream(&rows, &rowsSize);
   FILE* tableOut = open_memstream(&table, &tableSize);
   if (!rowsOut || !tableOut) abort();
-  if (write_results(dir, scene, model, runs, count, refName)) {
+  if (detailsWritten && write_results(dir, scene, model, runs, count, refName)) {
     write_metric_rows(rowsOut, scene, model, runs, count, refName);
     write_table(tableOut, model, runs, count);
   } else {
@@ -372,7 +409,10 @@ static void compare_scene(const char* scene, const pdModel* model, const compare
   pd_batch_append(result, table, tableSize);
   free(rows);
   free(table);
-  for (int i = 0; i < count; ++i) pd_trajectory_free(runs[i].trajectory);
+  for (int i = 0; i < count; ++i) {
+    pd_trajectory_free(runs[i].trajectory);
+    pd_contact_log_free(runs[i].contacts);
+  }
 }
 
 // The scenes of one command: one file, or every NAME.scene of a directory (in byte order of the names).

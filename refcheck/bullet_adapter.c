@@ -75,6 +75,7 @@ struct pdRefWorld {
   long steps;               // steps taken: the step starts at t = steps·h
   int bodiesAdded;          // Bullet's index of the next body added
   int planarBodies;         // bodies held in the x–z plane (bts_hold_in_xz_plane)
+  double lastStep;          // s, of the last step: the contacts' impulses over it are their forces
 };
 
 static void pair_material(void* user, int a, int b, btsContactMaterial* out) {
@@ -219,6 +220,7 @@ static void apply_forces(pdRefWorld* w, double h) {
 
 static bool bullet_step(pdRefWorld* w, double h) {
   apply_forces(w, h);
+  w->lastStep = h;
   bts_step(w->bullet, h);
   ++w->steps;
   for (int i = 0; i < w->model->movingCount; ++i) {
@@ -246,6 +248,21 @@ static pdBodyState bullet_body(const pdRefWorld* w, int movingIndex) {
 }
 
 static int bullet_contact_count(const pdRefWorld* w) { return bts_contact_count(w->bullet); }
+
+static int bullet_contacts(const pdRefWorld* w, pdContactReport* out, int capacity) {
+  btsContact* points = capacity > 0 ? calloc((size_t)capacity, sizeof *points) : NULL;
+  if (capacity > 0 && !points) abort();
+  int count = bts_contacts(w->bullet, w->lastStep, points, capacity);
+  for (int i = 0; i < count && i < capacity; ++i) {
+    const btsContact* c = &points[i];
+    pdVec3 n = {c->normal[0], c->normal[1], c->normal[2]}, ft = {c->ft[0], c->ft[1], c->ft[2]};
+    out[i] = (pdContactReport){.bodyA = c->a, .bodyB = c->b, .featureA = -1, .featureB = -1,
+                               .point = {c->point[0], c->point[1], c->point[2]}, .normal = n, .fn = c->fn,
+                               .ft = pd_v3_sub(ft, pd_v3_scale(n, pd_v3_dot(ft, n)))};
+  }
+  free(points);
+  return count;
+}
 
 // Every pair that can touch (not both fixed), with the values its contacts get.
 static void write_pairs(const pdRefWorld* w, FILE* out) {
@@ -337,6 +354,7 @@ const pdRefAdapter pd_bullet_adapter = {
     .step = bullet_step,
     .body = bullet_body,
     .contact_count = bullet_contact_count,
+    .contacts = bullet_contacts,
     .settings_json = bullet_settings_json,
     .destroy = bullet_destroy,
 };

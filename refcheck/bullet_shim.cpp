@@ -160,6 +160,33 @@ extern "C" void bts_body_state(const btsWorld* w, int index, double position[3],
   quaternion[0] = q.w(), quaternion[1] = q.x(), quaternion[2] = q.y(), quaternion[3] = q.z();
 }
 
+extern "C" int bts_contacts(const btsWorld* w, double h, btsContact* out, int capacity) {
+  int count = 0;
+  for (int m = 0; m < w->dispatcher.getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = w->dispatcher.getManifoldByIndexInternal(m);
+    for (int p = 0; p < manifold->getNumContacts(); ++p) {
+      const btManifoldPoint& pt = manifold->getContactPoint(p);
+      if (pt.getDistance() > manifold->getContactProcessingThreshold()) continue;
+      if (count < capacity) {
+        btsContact& c = out[count];
+        c.a = manifold->getBody0()->getUserIndex();
+        c.b = manifold->getBody1()->getUserIndex();
+        btVector3 mid = 0.5 * (pt.getPositionWorldOnA() + pt.getPositionWorldOnB());
+        btVector3 ft = (pt.m_appliedImpulseLateral1 * pt.m_lateralFrictionDir1 +
+                        pt.m_appliedImpulseLateral2 * pt.m_lateralFrictionDir2) / h;
+        for (int k = 0; k < 3; ++k) {
+          c.point[k] = mid[k];
+          c.normal[k] = pt.m_normalWorldOnB[k];  // Bullet's normal on B points towards A
+          c.ft[k] = ft[k];
+        }
+        c.fn = pt.getAppliedImpulse() / h;
+      }
+      ++count;
+    }
+  }
+  return count;
+}
+
 extern "C" int bts_contact_count(const btsWorld* w) {
   int count = 0;
   for (int m = 0; m < w->dispatcher.getNumManifolds(); ++m) {

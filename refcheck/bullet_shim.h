@@ -98,6 +98,18 @@ void bts_body_state(const btsWorld* world, int index, double position[3], double
 // Contact points the solver used in the last step (distance within the processing threshold).
 int bts_contact_count(const btsWorld* world);
 
+// One of them with the impulses the solver applied through it in the last step of h seconds, as a force.
+typedef struct btsContact {
+  int a, b;            // the caller's body ids (bts_add_hull's id) of the manifold's first and second body
+  double point[3];     // m, world: midway between the two bodies' witness points
+  double normal[3];    // unit, world, from b into a
+  double fn;           // N, normal force on a
+  double ft[3];        // N, friction force on a (both lateral directions)
+} btsContact;
+
+// Those contact points, the first min(count, capacity) in out; returns their count.
+int bts_contacts(const btsWorld* world, double h, btsContact* out, int capacity);
+
 void bts_world_destroy(btsWorld* world);
 
 // Bullet's version as its headers give it (BT_BULLET_VERSION, e.g. "324") and the precision built against

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "compare_internal.h"
 #include "interference.h"
 #include "polydyn/error.h"
 
@@ -39,7 +40,7 @@ bool pd_trajectory_observe(const pdModel* model, const pdState* state, void* use
   return true;
 }
 
-static const pdBodyState* sample_body(const pdTrajectory* tr, long s, int k) {
+const pdBodyState* pd_trajectory_sample(const pdTrajectory* tr, long s, int k) {
   return &tr->bodies[(size_t)s * (size_t)tr->movingCount + (size_t)k];
 }
 
@@ -59,38 +60,46 @@ static pdQuat slerp(pdQuat a, pdQuat b, double u) {
 
 pdBodyState pd_trajectory_at(const pdTrajectory* tr, int k, double t) {
   PD_ASSERT(tr->samples > 0 && k >= 0 && k < tr->movingCount);
-  if (t <= tr->t[0]) return *sample_body(tr, 0, k);
-  if (t >= tr->t[tr->samples - 1]) return *sample_body(tr, tr->samples - 1, k);
+  if (t <= tr->t[0]) return *pd_trajectory_sample(tr, 0, k);
+  if (t >= tr->t[tr->samples - 1]) return *pd_trajectory_sample(tr, tr->samples - 1, k);
   long lo = 0, hi = tr->samples - 1;  // t[lo] <= t < t[hi]
   while (hi - lo > 1) {
     long mid = (lo + hi) / 2;
     if (tr->t[mid] <= t) lo = mid;
     else hi = mid;
   }
-  const pdBodyState *a = sample_body(tr, lo, k), *b = sample_body(tr, hi, k);
+  const pdBodyState *a = pd_trajectory_sample(tr, lo, k), *b = pd_trajectory_sample(tr, hi, k);
   double u = (t - tr->t[lo]) / (tr->t[hi] - tr->t[lo]);
   if (u == 0.0) return *a;
   return (pdBodyState){lerp3(a->x, b->x, u), slerp(a->q, b->q, u), lerp3(a->v, b->v, u), lerp3(a->w, b->w, u)};
 }
 
-// Angle of q_ref⁻¹ q, rad in [0, π].
-static double rotation_angle(pdQuat q, pdQuat ref) {
+double pd_rotation_angle(pdQuat q, pdQuat ref) {
   double d = fabs(q.w * ref.w + q.x * ref.x + q.y * ref.y + q.z * ref.z);
   return 2.0 * acos(fmin(1.0, d));
 }
 
+double pd_trajectory_body_energy(const pdModel* model, const pdTrajectory* tr, long s, int k, double* kinetic) {
+  const pdBody* body = &model->bodies[model->movingBodies[k]];
+  const pdBodyState* b = pd_trajectory_sample(tr, s, k);
+  *kinetic = pd_body_kinetic_energy(body, b->v, b->w, b->q);
+  return *kinetic - body->mass * pd_v3_dot(model->settings.gravity, b->x);
+}
+
 static double energy_at(const pdModel* model, const pdTrajectory* tr, long s, double* kineticOut) {
   double e = 0.0, kinetic = 0.0;
-  pdVec3 g = model->settings.gravity;
   for (int k = 0; k < tr->movingCount; ++k) {
-    const pdBody* body = &model->bodies[model->movingBodies[k]];
-    const pdBodyState* b = sample_body(tr, s, k);
-    double ke = pd_body_kinetic_energy(body, b->v, b->w, b->q);
+    double ke;
+    e += pd_trajectory_body_energy(model, tr, s, k, &ke);
     kinetic += ke;
-    e += ke - body->mass * pd_v3_dot(g, b->x);
   }
   *kineticOut = kinetic;
   return e;
+}
+
+double pd_pose_error(const pdModel* model, int k, const pdBodyState* b, const pdBodyState* ref, double* rotation) {
+  *rotation = pd_rotation_angle(b->q, ref->q);
+  return pd_v3_norm(pd_v3_sub(b->x, ref->x)) / model->bodies[model->movingBodies[k]].size;
 }
 
 static void errors(const pdModel* model, const pdTrajectory* run, const pdTrajectory* ref, pdCompareMetrics* m) {
@@ -99,10 +108,8 @@ static void errors(const pdModel* model, const pdTrajectory* run, const pdTrajec
   for (long s = 0; s < run->samples; ++s) {
     double posMax = 0.0, rotMax = 0.0;
     for (int k = 0; k < run->movingCount; ++k) {
-      const pdBody* body = &model->bodies[model->movingBodies[k]];
-      const pdBodyState* b = sample_body(run, s, k);
       pdBodyState r = pd_trajectory_at(ref, k, run->t[s]);
-      double pe = pd_v3_norm(pd_v3_sub(b->x, r.x)) / body->size, re = rotation_angle(b->q, r.q);
+      double re, pe = pd_pose_error(model, k, pd_trajectory_sample(run, s, k), &r, &re);
       pos2 += pe * pe;
       rot2 += re * re;
       ++count;
@@ -126,7 +133,7 @@ static void drifts(const pdModel* model, const pdTrajectory* run, pdCompareMetri
   for (long s = 0; s < run->samples; ++s) {
     e1 = energy_at(model, run, s, &kinetic);
     kineticMax = fmax(kineticMax, kinetic);
-    for (int k = 0; k < run->movingCount; ++k) vmax = fmax(vmax, pd_v3_norm(sample_body(run, s, k)->v));
+    for (int k = 0; k < run->movingCount; ++k) vmax = fmax(vmax, pd_v3_norm(pd_trajectory_sample(run, s, k)->v));
   }
   double scale = kineticMax + fabs(e0);
   m->energyDriftRel = scale > 0.0 ? (e1 - e0) / scale : 0.0;
@@ -137,44 +144,49 @@ static void drifts(const pdModel* model, const pdTrajectory* run, pdCompareMetri
   for (int k = 0; k < run->movingCount; ++k) {
     const pdBody* body = &model->bodies[model->movingBodies[k]];
     mass += body->mass;
-    p0 = pd_v3_muladd(p0, body->mass, sample_body(run, 0, k)->v);
-    p1 = pd_v3_muladd(p1, body->mass, sample_body(run, run->samples - 1, k)->v);
+    p0 = pd_v3_muladd(p0, body->mass, pd_trajectory_sample(run, 0, k)->v);
+    p1 = pd_v3_muladd(p1, body->mass, pd_trajectory_sample(run, run->samples - 1, k)->v);
   }
   double elapsed = run->t[run->samples - 1] - run->t[0];
   pdVec3 lost = pd_v3_sub(pd_v3_sub(p1, p0), pd_v3_scale(model->settings.gravity, mass * elapsed));
   m->momentumDriftRel = vmax > 0.0 ? pd_v3_norm(lost) / (mass * vmax) : 0.0;
 }
 
-static pdVec3 body_position(const pdModel* model, const pdTrajectory* run, long s, int body, pdMat3* R) {
+pdVec3 pd_trajectory_body_position(const pdModel* model, const pdTrajectory* run, long s, int body, pdMat3* R) {
   const pdBody* b = &model->bodies[body];
   if (b->fixed) {
     *R = pd_quat_to_mat3(b->q0);
     return b->x0;
   }
-  const pdBodyState* st = sample_body(run, s, b->stateIndex);
+  const pdBodyState* st = pd_trajectory_sample(run, s, b->stateIndex);
   *R = pd_quat_to_mat3(st->q);
   return st->x;
+}
+
+double pd_pair_penetration(const pdModel* model, const pdTrajectory* run, long s, int i, int j, pdVec3* axis) {
+  const pdBody *a = &model->bodies[i], *b = &model->bodies[j];
+  pdMat3 Ra, Rb;
+  pdVec3 xa = pd_trajectory_body_position(model, run, s, i, &Ra), xb = pd_trajectory_body_position(model, run, s, j, &Rb);
+  double distance = pd_v3_norm(pd_v3_sub(xb, xa));
+  double gap = distance - a->radius - b->radius;
+  double size = fmin(a->size, b->size);
+  if (gap > 0.0) {  // bounding spheres apart: the SAT would say separated by at least this
+    if (axis) *axis = pd_v3_scale(pd_v3_sub(xb, xa), 1.0 / distance);
+    return -gap / size;
+  }
+  pdSatResult r;
+  pd_interference(&a->shape, xa, &Ra, &b->shape, xb, &Rb, PD_SAT_MIN_DEPTH, NULL, &r);
+  if (axis) *axis = r.axis;
+  return r.depth / size;
 }
 
 static void penetration(const pdModel* model, const pdTrajectory* run, pdCompareMetrics* m) {
   double deepest = -INFINITY;
   for (long s = 0; s < run->samples; ++s)
     for (int i = 0; i < model->bodyCount; ++i)
-      for (int j = i + 1; j < model->bodyCount; ++j) {
-        const pdBody *a = &model->bodies[i], *b = &model->bodies[j];
-        if (a->fixed && b->fixed) continue;
-        pdMat3 Ra, Rb;
-        pdVec3 xa = body_position(model, run, s, i, &Ra), xb = body_position(model, run, s, j, &Rb);
-        double gap = pd_v3_norm(pd_v3_sub(xa, xb)) - a->radius - b->radius;
-        double size = fmin(a->size, b->size);
-        if (gap > 0.0) {  // bounding spheres apart: the SAT would say separated by at least this
-          deepest = fmax(deepest, -gap / size);
-          continue;
-        }
-        pdSatResult r;
-        pd_interference(&a->shape, xa, &Ra, &b->shape, xb, &Rb, PD_SAT_MIN_DEPTH, NULL, &r);
-        deepest = fmax(deepest, r.depth / size);
-      }
+      for (int j = i + 1; j < model->bodyCount; ++j)
+        if (!model->bodies[i].fixed || !model->bodies[j].fixed)
+          deepest = fmax(deepest, pd_pair_penetration(model, run, s, i, j, NULL));
   m->maxPenetrationOverSize = isfinite(deepest) ? deepest : 0.0;
 }
 
@@ -194,10 +206,10 @@ static void bounces(const pdModel* model, const pdTrajectory* run, pdCompareMetr
     int body = model->movingBodies[k];
     double minRise = PD_COMPARE_BOUNCE_MIN_RISE * model->bodies[body].size;
     // walk the height: apex (local max) → contact (local min) → apex
-    double apex = pd_v3_dot(up, sample_body(run, 0, k)->x), low = apex, lowT = run->t[0];
-    bool falling = pd_v3_dot(up, sample_body(run, 0, k)->v) <= 0.0;
+    double apex = pd_v3_dot(up, pd_trajectory_sample(run, 0, k)->x), low = apex, lowT = run->t[0];
+    bool falling = pd_v3_dot(up, pd_trajectory_sample(run, 0, k)->v) <= 0.0;
     for (long s = 1; s < run->samples; ++s) {
-      double z = pd_v3_dot(up, sample_body(run, s, k)->x);
+      double z = pd_v3_dot(up, pd_trajectory_sample(run, s, k)->x);
       if (falling) {
         if (z <= low) {
           low = z;
@@ -206,8 +218,8 @@ static void bounces(const pdModel* model, const pdTrajectory* run, pdCompareMetr
           // follow the rise to its apex
           double next = z;
           long r = s;
-          while (r + 1 < run->samples && pd_v3_dot(up, sample_body(run, r + 1, k)->x) >= next)
-            next = pd_v3_dot(up, sample_body(run, ++r, k)->x);
+          while (r + 1 < run->samples && pd_v3_dot(up, pd_trajectory_sample(run, r + 1, k)->x) >= next)
+            next = pd_v3_dot(up, pd_trajectory_sample(run, ++r, k)->x);
           if (apex - low > minRise && count < 64)
             found[count++] = (bounce){lowT, sqrt((next - low) / (apex - low)), body};
           apex = next;

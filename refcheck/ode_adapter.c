@@ -96,6 +96,13 @@ typedef struct odeConvexData {
   unsigned* polygons;    // per face: vertex count, then the indices, CCW seen from outside
 } odeConvexData;
 
+// A contact joint of the last step with the force ODE applied through it (dJointFeedback).
+typedef struct odeContactForce {
+  dJointFeedback feedback;
+  int bodyA, bodyB;  // model indices of the joint's first and second geom
+  pdVec3 point, normal;
+} odeContactForce;
+
 struct pdRefWorld {
   const pdModel* model;
   pdRefOptions options;
@@ -114,6 +121,8 @@ struct pdRefWorld {
   double h;                  // step of the current / last step, s
   long steps;
   int contactCount;          // contact joints of the last step
+  odeContactForce* forces;   // (forceCapacity) the first contacts of the last step, their joints' feedback
+  int forceCapacity;         // grown after a step that had more contacts: never during one (ODE keeps pointers)
   long zeroNormalDropped;    // libccd zero-normal contacts dropped
   long nonFiniteDropped;     // contacts with a non-finite normal or depth dropped
   long alignedContacts;      // aligned friction: contacts with fdir1 along the slip
@@ -382,6 +391,14 @@ static void near_callback(void* data, dGeomID g1, dGeomID g2) {
     }
     dJointID j = dJointCreateContact(w->world, w->contactGroup, c);
     dJointAttach(j, b1, b2);
+    if (w->contactCount < w->forceCapacity) {
+      odeContactForce* f = &w->forces[w->contactCount];
+      dJointSetFeedback(j, &f->feedback);
+      f->bodyA = o1->body;
+      f->bodyB = o2->body;
+      f->point = (pdVec3){c->geom.pos[0], c->geom.pos[1], c->geom.pos[2]};
+      f->normal = (pdVec3){nn[0], nn[1], nn[2]};
+    }
     ++w->contactCount;
   }
 }
@@ -412,6 +429,7 @@ static void ode_destroy(pdRefWorld* w) {
   free(w->bodies);
   free(w->fixedConvex);
   free(w->contactBuffer);
+  free(w->forces);
   free(w);
 }
 
@@ -486,7 +504,9 @@ static pdRefWorld* ode_create(const pdModel* model, const pdRefOptions* options,
   w->maxContacts = maxVertices < PD_ODE_MIN_CONTACTS ? PD_ODE_MIN_CONTACTS : maxVertices;
   if (w->maxContacts > PD_ODE_MAX_CONTACTS) w->maxContacts = PD_ODE_MAX_CONTACTS;
   w->contactBuffer = calloc((size_t)w->maxContacts, sizeof *w->contactBuffer);
-  if (!w->contactBuffer) abort();
+  w->forceCapacity = 8 * model->bodyCount;  // a box resting on a face: 4 to 8 contacts; grown after a step with more
+  w->forces = calloc((size_t)w->forceCapacity, sizeof *w->forces);
+  if (!w->contactBuffer || !w->forces) abort();
 
   for (int m = 0; m < model->movingCount; ++m) {
     int i = model->movingBodies[m];
@@ -573,6 +593,11 @@ static bool ode_step(pdRefWorld* w, double h) {
   add_applied_forces(w, h);
   int ok = dWorldStep(w->world, h);
   dJointGroupEmpty(w->contactGroup);
+  if (w->contactCount > w->forceCapacity) {  // room for the next step's: the feedback must not move during one
+    w->forceCapacity = 2 * w->contactCount;
+    w->forces = realloc(w->forces, (size_t)w->forceCapacity * sizeof *w->forces);
+    if (!w->forces) abort();
+  }
   ++w->steps;
   currentWorld = previous;
   if (!ok) return false;
@@ -600,6 +625,26 @@ static pdBodyState ode_body(const pdRefWorld* w, int movingIndex) {
 }
 
 static int ode_contact_count(const pdRefWorld* w) { return w->contactCount; }
+
+// The last step's contacts with their forces; those past the feedback's room (a step with more contacts than any
+// before it) are not reported.
+static int ode_contacts(const pdRefWorld* w, pdContactReport* out, int capacity) {
+  int count = w->contactCount < w->forceCapacity ? w->contactCount : w->forceCapacity;
+  for (int i = 0; i < count && i < capacity; ++i) {
+    const odeContactForce* f = &w->forces[i];
+    // the force on the first geom's body; on a fixed first geom, minus the force on the second
+    bool firstMoves = !w->model->bodies[f->bodyA].fixed;
+    const dReal* F = firstMoves ? f->feedback.f1 : f->feedback.f2;
+    pdVec3 force = {F[0], F[1], F[2]};
+    if (!firstMoves) force = pd_v3_scale(force, -1.0);
+    // the normal from B into A: the way the contact pushes A
+    pdVec3 n = pd_v3_dot(force, f->normal) >= 0.0 ? f->normal : pd_v3_scale(f->normal, -1.0);
+    double fn = pd_v3_dot(force, n);
+    out[i] = (pdContactReport){.bodyA = f->bodyA, .bodyB = f->bodyB, .featureA = -1, .featureB = -1, .point = f->point,
+                               .normal = n, .fn = fn, .ft = pd_v3_sub(force, pd_v3_scale(n, fn))};
+  }
+  return count;
+}
 
 // ---------------------------------------------------------------- settings JSON
 
@@ -755,6 +800,7 @@ const pdRefAdapter pd_ode_adapter = {
     .step = ode_step,
     .body = ode_body,
     .contact_count = ode_contact_count,
+    .contacts = ode_contacts,
     .settings_json = ode_settings_json,
     .destroy = ode_destroy,
 };

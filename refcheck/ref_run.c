@@ -71,6 +71,35 @@ static sampling plan_sampling(double requestedStep, double sampleRate) {
   return s;
 }
 
+// The engine's contacts at a sample for options->contactObserver: their mode from the slip speed of the point.
+typedef struct contactBuffer {
+  pdContactReport* items;
+  int capacity;
+} contactBuffer;
+
+pdVec3 pd_ref_point_velocity(const pdModel* model, const pdState* state, int body, pdVec3 p) {
+  pdBodyState b = pd_state_body(model, state, body);
+  return pd_v3_add(b.v, pd_v3_cross(b.w, pd_v3_sub(p, b.x)));
+}
+
+static void report_contacts(const pdModel* model, const pdRefAdapter* adapter, const pdRefWorld* world,
+                            const pdRefOptions* options, const pdState* state, contactBuffer* buffer) {
+  int count = adapter->contacts(world, buffer->items, buffer->capacity);
+  if (count > buffer->capacity) {  // grown to the most contacts seen: a sample's work, not a step's
+    buffer->capacity = 2 * count;
+    buffer->items = realloc(buffer->items, (size_t)buffer->capacity * sizeof *buffer->items);
+    if (!buffer->items) abort();
+    count = adapter->contacts(world, buffer->items, buffer->capacity);
+  }
+  for (int i = 0; i < count; ++i) {
+    pdContactReport* c = &buffer->items[i];
+    pdVec3 rel = pd_v3_sub(pd_ref_point_velocity(model, state, c->bodyA, c->point),
+                           pd_ref_point_velocity(model, state, c->bodyB, c->point));
+    c->slip = pd_v3_norm(pd_v3_sub(rel, pd_v3_scale(c->normal, pd_v3_dot(rel, c->normal)))) > PD_REF_SLIP_SPEED;
+  }
+  options->contactObserver(model, state, buffer->items, count, options->contactUser);
+}
+
 bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOptions* options,
                 pdRunWriter* writer, pdObserverFcn* observer, void* user, pdRefRunStats* stats, pdError* err) {
   PD_ASSERT(model && adapter && options && stats && options->step > 0.0);
@@ -88,6 +117,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
   double tend = model->settings.tend;
   long sampleCount = (long)floor(tend / plan.sampleInterval * (1.0 + 1e-12));
   bool ok = true, stopped = false;
+  contactBuffer contacts = {0};
   for (long k = 0; k <= sampleCount && ok && !stopped; ++k) {
     if (k > 0) {
       for (long j = 0; j < plan.stepsPerSample; ++j) {
@@ -110,7 +140,9 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
     ++state->count.samples;
     if (writer && !pd_run_observe(model, state, writer)) stopped = true;
     if (observer && !observer(model, state, user)) stopped = true;
+    if (options->contactObserver && adapter->contacts) report_contacts(model, adapter, world, options, state, &contacts);
   }
+  free(contacts.items);
   if (writer) pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
   stats->wallSeconds = wall_seconds() - wall0;
   stats->completed = ok && !stopped;

@@ -17,7 +17,8 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { InputError, UsageError, SetupError, WriteError } from './lib/errors.mjs';
-import { readResults, readExperiments, readSeries, readSweep, readPrecision, readMetrics, readSummary, readCubetoss } from './lib/inputs.mjs';
+import { readResults, readExperiments, readSeries, readSweep, readPrecision, readMetrics, readSummary, readCubetoss, readCompareDetail,
+  listCompareScenes } from './lib/inputs.mjs';
 import { precision as derivePrecision } from './lib/precision.mjs';
 import { loadTypical } from './lib/cubetoss.mjs';
 import { compactTrajectory, compactContacts } from './lib/replay.mjs';
@@ -45,6 +46,10 @@ plus the numbers it shows as JSON and CSV beside it. Sections appear when their 
   precision.csv                   work-precision of each experiment against its closed form, the cost to
                                   reach its tolerance, and the summary's fronts (gedanken --precision)
   metrics.csv                     comparison metrics
+  divergence.csv, impacts.csv,    where, when and why the engines differ (polydyn compare SCENE): a sentence
+  series.csv, friction.csv        per engine, the first divergence linked into the replay, each body over
+                                  time, the impacts matched across engines, the friction cone
+  NAME/divergence.csv             polydyn compare SCENE_DIR: a row per scene, and NAME/report.html for each
   cubetoss/summary.csv            cube tosses against reality (per_toss.csv, fit.csv, replay/TOSS/ or
                                   runs/TOSS/ beside it); DIR may also be a polydyn cubetoss directory
   planar-drops/summary.csv        planar drops against reality (the same files)
@@ -99,6 +104,20 @@ export function loadInputs(dir) {
       'cubetoss/summary.csv is there');
   inputs.cubetossTypical = inputs.cubetoss ? loadTypical(dir, inputs.cubetoss) : null;
   inputs.planarDropsTypical = inputs.planarDrops ? loadTypical(dir, inputs.planarDrops) : null;
+  // polydyn compare SCENE: the runs' details; polydyn compare SCENE_DIR: each scene's, for the overview
+  inputs.compareDetail = inputs.metrics ? readCompareDetail(dir) : null;
+  inputs.compareRuns = [];
+  inputs.compareSummary = null;
+  if (inputs.compareDetail && inputs.compareDetail.compare && Array.isArray(inputs.compareDetail.compare.runs)) {
+    for (const r of inputs.compareDetail.compare.runs)
+      if (r.status === 'ok' && typeof r.run_dir === 'string' && !r.run_dir.includes('..'))
+        inputs.compareRuns.push({ ev: `${r.engine} ${r.variant}`, run_dir: r.run_dir });
+    const ref = inputs.compareRuns.find((r) => r.ev === 'soft reference');
+    const s = ref ? readSummary(dir, ref.run_dir) : null;
+    inputs.compareSummary = s ? s.summary : null;
+  }
+  inputs.compareScenes = inputs.metrics ? listCompareScenes(dir).map((name) => ({ name, detail: readCompareDetail(path.join(dir, name)),
+    metrics: readMetrics(path.join(dir, name)) })) : [];
   // run directories named in results.csv, each once
   inputs.runs = [];
   if (inputs.results) {
@@ -169,6 +188,10 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
     cubetossTypical: inputs.cubetossTypical,
     planarDrops: inputs.planarDrops,
     planarDropsTypical: inputs.planarDropsTypical,
+    compareDetail: inputs.compareDetail,
+    compareRuns: inputs.compareRuns,
+    compareSummary: inputs.compareSummary,
+    compareScenes: inputs.compareScenes,
     runs: inputs.runs,
     viewer: viewerSource,
     evOrder,
@@ -183,9 +206,10 @@ export function generate(dir, inputs, { viewerSource = null, echartsSource = rea
     get precision() { return prec(); },
     get cost() { return matrix() || wp() ? derive.cost(matrix(), wp()) : null; },
     color: (ev) => colorOf(ev, evOrder),
-    chart(option, { height = 320, width = null } = {}) {
+    // alternatives: options the page switches between (a select of class pd-alt naming the chart), option the first
+    chart(option, { height = 320, width = null, alternatives = null } = {}) {
       const id = `chart-${charts.length + 1}`;
-      charts.push({ id, option });
+      charts.push(alternatives ? { id, option: null, alternatives } : { id, option });
       return `<div class="chart" id="${id}" style="height:${height}px${width ? `;max-width:${width}px` : ''}"></div>`;
     },
     runData(runDir) {
@@ -358,14 +382,27 @@ export function main(argv) {
   if (viewerPath) {
     try { viewerSource = fs.readFileSync(viewerPath, 'utf8'); } catch (e) { throw new InputError(viewerPath, 0, `cannot read the viewer bundle: ${e.code || e.message}`); }
   }
-  const replayFolder = outputPaths(dir, opts.out).replays;
-  const { html, json, csvs, replays } = generate(dir, inputs, { viewerSource, replayFolder: path.basename(replayFolder) });
-  const out = outputPaths(dir, opts.out, csvs.map((c) => c.name));
-  writeAll([[out.json, json], ...csvs.map((c) => [out.csv[c.name], c.text]), [out.page, html]], out.replays, replays.length ? replays : null);
+  // the page of DIR, and with a directory of compared scenes the page of each (DIR/NAME/report.html): all built
+  // before any is written
+  const pages = [{ dir, out: opts.out, inputs }];
+  for (const { name } of inputs.compareScenes) {
+    const sub = path.join(dir, name);
+    pages.push({ dir: sub, out: null, inputs: loadInputs(sub) });
+  }
+  const built = pages.map((p) => {
+    const replayFolder = outputPaths(p.dir, p.out).replays;
+    const g = generate(p.dir, p.inputs, { viewerSource, replayFolder: path.basename(replayFolder) });
+    return { ...g, out: outputPaths(p.dir, p.out, g.csvs.map((c) => c.name)) };
+  });
+  for (const b of built.slice(1).concat(built.slice(0, 1)))
+    writeAll([[b.out.json, b.json], ...b.csvs.map((c) => [b.out.csv[c.name], c.text]), [b.out.page, b.html]], b.out.replays,
+      b.replays.length ? b.replays : null);
+  const { html, csvs, replays, out } = built[0];
   written = true;
   const mb = (n) => `${(n / 1e6).toFixed(1)} MB`;
   process.stderr.write(`polydyn report: wrote ${out.page} (${mb(html.length)}), ${path.basename(out.json)}, ${csvs.length} CSV table${csvs.length === 1 ? '' : 's'}` +
-    `${replays.length ? ` and ${replays.length} replays in ${path.basename(out.replays)}/ (${mb(replays.reduce((n, [, t]) => n + t.length, 0))})` : ''}\n`);
+    `${replays.length ? ` and ${replays.length} replays in ${path.basename(out.replays)}/ (${mb(replays.reduce((n, [, t]) => n + t.length, 0))})` : ''}` +
+    `${built.length > 1 ? `, and the page of each of the ${built.length - 1} scenes (NAME/report.html)` : ''}\n`);
   return 0;
 }
 

@@ -1,5 +1,6 @@
 // Tests of the comparison metrics (refcheck/compare.c): each metric on a trajectory whose answer is known
-// in closed form, and the soft engine's own bounce measured by the apex method.
+// in closed form, and the soft engine's own bounce measured by the apex method; the first divergence, the
+// chaos verdict, impacts and their matching (refcheck/compare_detail.c) on trajectories built to have them.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -11,6 +12,7 @@
 #include <cmocka.h>
 
 #include "polydyn/compare.h"
+#include "polydyn/compare_detail.h"
 #include "polydyn/scene.h"
 
 static pdModel* compile_text(const char* text) {
@@ -160,6 +162,77 @@ static void test_soft_cube_bounce_is_found_and_below_the_single_contact_value(vo
   pd_model_free(model);
 }
 
+// A run that drifts 0.009 m (0.045 of the size) per 0.1 s from the reference: past 0.1 of the size after 0.222 s.
+static void test_first_divergence_and_chaos(void** state) {
+  (void)state;
+  pdModel* model = compile_text(freeCube);
+  pdTrajectory *run = pd_trajectory_create(model), *ref = pd_trajectory_create(model);
+  pdTrajectory *calm = pd_trajectory_create(model), *wild = pd_trajectory_create(model);
+  for (int k = 0; k <= 100; ++k) {
+    double t = 0.01 * k;
+    push(ref, t, flight(1.0, 0.0, t, 0.0));
+    push(run, t, flight(1.0 + 0.09 * t, 0.0, t, 0.0));
+    push(calm, t, flight(1.0 + 1e-9 * t, 0.0, t, 0.0));  // the scene's own divergence: tiny
+    push(wild, t, flight(1.0 + 0.5 * t, 0.0, t, 0.0));   // 5.6 times the run's: chaos explains the run
+  }
+  pdDivergence d = pd_compare_divergence(model, run, ref, calm, PD_COMPARE_DIVERGENCE_THRESHOLD);
+  // first sample with 0.09 t / 0.2 > 0.1: t = 0.23, error 0.1035
+  assert_true(d.diverged && fabs(d.t - 0.23) < 1e-9 && d.body == 0 && !d.rotation);
+  assert_true(fabs(d.error - 0.1035) < 1e-9);
+  assert_true(fabs(d.beyondChaos - 0.23) < 1e-9);  // the chaos run is 1e-8 of it: beyond at once
+  d = pd_compare_divergence(model, run, ref, wild, PD_COMPARE_DIVERGENCE_THRESHOLD);
+  assert_true(d.diverged && fabs(d.t - 0.23) < 1e-9 && isnan(d.beyondChaos));  // never 10x the chaos run
+  d = pd_compare_divergence(model, calm, ref, NULL, PD_COMPARE_DIVERGENCE_THRESHOLD);
+  assert_false(d.diverged);
+  pd_trajectory_free(run);
+  pd_trajectory_free(ref);
+  pd_trajectory_free(calm);
+  pd_trajectory_free(wild);
+  pd_model_free(model);
+}
+
+// Impacts of the same bodies are matched nearest first within the window, each reference impact once.
+static void test_impacts_matched_nearest_first(void** state) {
+  (void)state;
+  pdImpact ref[3] = {{.t = 0.30, .bodyA = 0, .bodyB = 1}, {.t = 0.34, .bodyA = 0, .bodyB = 1}, {.t = 0.50, .bodyA = 1, .bodyB = 2}};
+  pdImpact run[4] = {{.t = 0.33, .bodyA = 0, .bodyB = 1},   // nearer 0.34 (0.01) than 0.30 (0.03)
+                     {.t = 0.31, .bodyA = 0, .bodyB = 1},   // then 0.30
+                     {.t = 0.50, .bodyA = 0, .bodyB = 2},   // other bodies: none
+                     {.t = 0.56, .bodyA = 1, .bodyB = 2}};  // 0.06 s away: outside the window
+  pd_compare_match_impacts(run, 4, ref, 3);
+  assert_int_equal(run[0].match, 1);
+  assert_int_equal(run[1].match, 0);
+  assert_int_equal(run[2].match, -1);
+  assert_int_equal(run[3].match, -1);
+}
+
+// A cube dropped 0.2 m onto a floor leaving with half its speed between two samples: one impact with the floor,
+// the contact speed sqrt(2 g h) and e = 0.5, wherever in the interval the contact falls.
+static void test_impact_found_from_samples(void** state) {
+  (void)state;
+  pdModel* model = compile_text("tend 1\nsample 100\ncube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\n"
+                                "cube c red 0.2 0.2 0.2\nloc 0 0 0.3\n");
+  pdTrajectory* run = pd_trajectory_create(model);
+  const double g = 9.81, h = 0.2, tc = sqrt(2.0 * h / g), vc = sqrt(2.0 * g * h);  // contact at z = 0.1
+  for (int k = 0; k <= 40; ++k) {
+    double t = 0.01 * k;
+    if (t <= tc) push(run, t, flight(0.3, 0.0, t, 0.0));
+    else push(run, t, flight(0.1, 0.5 * vc, t - tc, 0.0));  // an instant bounce with e = 0.5
+  }
+  pdImpact* impacts = NULL;
+  int n = pd_compare_impacts(model, run, &impacts);
+  assert_int_equal(n, 1);
+  assert_int_equal(impacts[0].bodyA, 0);  // the floor, scene order
+  assert_int_equal(impacts[0].bodyB, 1);
+  // relative speed of the floor to the cube along the normal into the floor: approaching at vc, leaving at vc/2
+  assert_true(fabs(impacts[0].vnBefore + vc) < 1e-9 && fabs(impacts[0].vnAfter - 0.5 * vc) < 1e-9);
+  assert_true(fabs(impacts[0].restitution - 0.5) < 1e-9 && fabs(impacts[0].t - tc) < 1e-9);
+  assert_true(impacts[0].tangentialChange < 1e-12);
+  free(impacts);
+  pd_trajectory_free(run);
+  pd_model_free(model);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_identical_runs_have_zero_error_and_free_flight_conserves_energy),
@@ -167,6 +240,9 @@ int main(void) {
       cmocka_unit_test(test_reference_sampled_elsewhere_is_interpolated),
       cmocka_unit_test(test_bounce_restitution_from_apex_heights),
       cmocka_unit_test(test_soft_cube_bounce_is_found_and_below_the_single_contact_value),
+      cmocka_unit_test(test_first_divergence_and_chaos),
+      cmocka_unit_test(test_impacts_matched_nearest_first),
+      cmocka_unit_test(test_impact_found_from_samples),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

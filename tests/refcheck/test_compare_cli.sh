@@ -78,5 +78,67 @@ mkdir "$SCRATCH/empty"
 "$PD" compare "$SCRATCH/empty" --out "$SCRATCH/none" >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "a directory without scenes: exit 2, says so" '[ $rc -eq 2 ] && grep -q "no NAME.scene" "$SCRATCH/err" && [ ! -e "$SCRATCH/none" ]'
 
+# where, when and why (docs/compare-report.md): a cube dropped 0.5 m flat onto a floor (e = 0.5), named with a
+# quote and a comma; soft runs only (the reference, its chaos run and the default tolerance)
+BOUNCE=$SCRATCH/bounce.scene
+printf 'tend 0.7\nsample 100\ncube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nrestitution 0.5\ncube b"ox,1 red 0.2 0.2 0.2\nloc 0 0 0.6\nrestitution 0.5\n' >"$BOUNCE"
+"$PD" compare "$BOUNCE" --out "$SCRATCH/bounce" --engines soft >"$SCRATCH/stdout" 2>"$SCRATCH/err"; rc=$?
+check "bounce: exit 0, the four files beside metrics.csv" '[ $rc -eq 0 ] && for f in series impacts friction divergence; do [ -f "$SCRATCH/bounce/$f.csv" ] || exit 1; done'
+check "the terminal table prints — where a value does not apply (the reference's own error)" \
+  'grep -q "^soft-reference *ok *— *—" "$SCRATCH/stdout"'
+python3 - "$SCRATCH/bounce" <<'PY'; rc=$?
+import csv, json, math, sys
+d = sys.argv[1]
+mass = [b["mass"] for b in json.load(open(f"{d}/runs/soft-reference/summary.json"))["bodies"] if b["name"] == 'b"ox,1'][0]
+rows = lambda name: list(csv.DictReader(open(f"{d}/{name}.csv", newline="")))
+imp = rows("impacts")
+assert list(imp[0].keys()) == "scene,engine,variant,impact,body_a,body_b,t,vn_before,vn_after,restitution,restitution_requested,tangential_speed_change,reference_impact".split(","), imp[0].keys()
+# the quoted name reads back whole (RFC 4180)
+assert all(r["body_a"] == "floor" and r["body_b"] == 'b"ox,1' for r in imp), imp[0]
+first = {r["variant"]: r for r in imp if r["impact"] == "0"}
+# free fall of 0.5 m: |v_n| = sqrt(2 g h) at contact (the reference within 1e-3 m/s)
+assert abs(float(first["reference"]["vn_before"]) + math.sqrt(2 * 9.81 * 0.5)) < 1e-3, first["reference"]
+# the soft model's restitution is the requested one (eq. 15: within 1e-2 at this sample rate), matched to the reference's impact
+for v in ("reference", "implicit"):
+    assert abs(float(first[v]["restitution"]) - 0.5) < 1e-2 and first[v]["restitution_requested"] == "0.5" and first[v]["reference_impact"] == "0", first[v]
+# every impact of the soft run found in the reference: bounces alike to 1e-2 s
+assert all(r["reference_impact"] != "" for r in imp), [r for r in imp if r["reference_impact"] == ""]
+div = {r["variant"]: r for r in rows("divergence")}
+assert div["chaos"]["verdict"] == "own_divergence" and div["implicit"]["verdict"] == "agrees" and div["implicit"]["first_t"] == "", div
+ser = rows("series")
+# every run, every sample (0.7 s at 100 /s: 71), the one moving body; the soft runs report contacts
+for v in ("reference", "chaos", "implicit"):
+    mine = [r for r in ser if r["variant"] == v]
+    assert len(mine) == 71 and all(r["body"] == 'b"ox,1' for r in mine), (v, len(mine))
+    assert max(int(r["contacts"]) for r in mine) >= 4, v  # a flat landing: the four bottom corners
+    assert max(float(r["normal_force"]) for r in mine) > 2 * mass * 9.81, v  # an impact pushes harder than the weight
+PY
+check "impacts.csv, divergence.csv and series.csv: documented header, quoted name, e = 0.5 ± 0.01 matched, verdicts" '[ $rc -eq 0 ]'
+
+# every engine's contacts (the soft engine's own, ODE's joint feedback, Bullet's impulses over the step): the
+# sliding block's friction is mu times its normal force, and that force its weight, in sum over its contacts
+"$PD" compare "$SCENE" --out "$SCRATCH/slide" --tend 0.4 >/dev/null 2>"$SCRATCH/err"; rc=$?
+python3 - "$SCRATCH/slide" <<'PY'; rc2=$?
+import csv, json, sys
+d = sys.argv[1]
+mass = [b["mass"] for b in json.load(open(f"{d}/runs/soft-reference/summary.json"))["bodies"] if b["name"] == "block"][0]
+runs = {(r["engine"], r["variant"]) for r in csv.DictReader(open(f"{d}/series.csv", newline=""))}
+fr = list(csv.DictReader(open(f"{d}/friction.csv", newline="")))
+bad = []
+for run in sorted(runs):
+    for t in ("0.1", "0.2", "0.3"):
+        mine = [r for r in fr if (r["engine"], r["variant"]) == run and r["t"] == t]
+        fn, ft = sum(float(r["fn"]) for r in mine), sum(float(r["ft"]) for r in mine)
+        # friction within 1 % of mu = 0.4 times the normal force (every point slides at 2 - 0.4 g t m/s); the
+        # weight within 1 % (Bullet's impulses chatter from step to step: 0.4, 1 and 1.6 times it at these samples)
+        weight = run[0] == "bullet" or abs(fn - mass * 9.81) < 0.01 * mass * 9.81
+        if not (weight and fn > 0 and abs(ft - 0.4 * fn) < 0.01 * fn and all(r["mode"] == "slip" for r in mine)):
+            bad.append((run, t, fn, ft))
+if bad or len(runs) < 3:
+    print("runs:", sorted(runs), "off:", bad)
+    sys.exit(1)
+PY
+check "every engine's contacts: friction mu times the normal force of a sliding block, which carries its weight" '[ $rc -eq 0 ] && [ $rc2 -eq 0 ]'
+
 echo "test_compare_cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

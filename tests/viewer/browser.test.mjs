@@ -16,7 +16,7 @@ if (!polydyn || !source) {
   console.error('usage: browser.test.mjs POLYDYN_BINARY PROJECT_SOURCE_DIR');
   process.exit(2);
 }
-const { launch, haveChromium, chromiumPath } = await import(join(source, 'viewer/scripts/browser.mjs'));
+const { launch, haveChromium, chromiumPath, viewStats } = await import(join(source, 'viewer/scripts/browser.mjs'));
 if (!haveChromium()) {
   console.log(`SKIP: no Chromium at ${chromiumPath}`);
   process.exit(77);
@@ -51,27 +51,7 @@ function poseRows({ x: p, q: [w, x, y, z] }) {
 function maxDiff(a, b) { return Math.max(...a.map((v, i) => Math.abs(v - b[i]))); }
 
 // Statistics of the 3-D view's pixels in a screenshot: share differing from the clear colour, colours.
-async function viewPixels() {
-  const box = await page.locator('.pdv-view canvas').boundingBox();
-  const png = await page.screenshot({ clip: box });
-  return page.evaluate(async (b64) => {
-    const img = new Image();
-    img.src = `data:image/png;base64,${b64}`;
-    await img.decode();
-    const c = document.createElement('canvas');
-    c.width = img.width; c.height = img.height;
-    const ctx = c.getContext('2d');
-    ctx.drawImage(img, 0, 0);
-    const d = ctx.getImageData(0, 0, c.width, c.height).data;
-    let drawn = 0;
-    const colours = new Set();
-    for (let i = 0; i < d.length; i += 4) {
-      if (Math.abs(d[i] - 0x20) + Math.abs(d[i + 1] - 0x24) + Math.abs(d[i + 2] - 0x2b) > 12) drawn++;
-      colours.add((d[i] >> 3) << 10 | (d[i + 1] >> 3) << 5 | (d[i + 2] >> 3));
-    }
-    return { drawn: drawn / (d.length / 4), colours: colours.size, data: Array.from(d.filter((_, i) => i % 64 === 0)) };
-  }, png.toString('base64'));
-}
+function viewPixels() { return viewStats(page, page.locator('.pdv-view canvas')); }
 
 // A new tab on the page `file`, after its main replay is ready; `errors` collects page errors and, with
 // consoleErrors, console errors.

@@ -1,5 +1,5 @@
 // Launches Debian's Chromium headless through playwright-core (never a downloaded browser).
-// Used by the movie script, the browser test and the scale measurement.
+// Used by the movie script, the browser tests (the viewer's, a compared scene's report) and the scale measurement.
 import { mkdtempSync, rmSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -42,4 +42,28 @@ export async function launch() {
       }
     },
   };
+}
+
+// Statistics of a replay's 3-D view (the element `locator` finds, e.g. its canvas) in a screenshot of it: the share
+// of its pixels that differ from the clear colour (0x20242b), how many colours (5 bits each) it has, and every
+// 16th pixel's bytes.
+export async function viewStats(page, locator) {
+  const png = await page.screenshot({ clip: await locator.boundingBox() });
+  return page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width; c.height = img.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(img, 0, 0);
+    const d = ctx.getImageData(0, 0, c.width, c.height).data;
+    let drawn = 0;
+    const colours = new Set();
+    for (let i = 0; i < d.length; i += 4) {
+      if (Math.abs(d[i] - 0x20) + Math.abs(d[i + 1] - 0x24) + Math.abs(d[i + 2] - 0x2b) > 12) drawn++;
+      colours.add((d[i] >> 3) << 10 | (d[i + 1] >> 3) << 5 | (d[i + 2] >> 3));
+    }
+    return { drawn: drawn / (d.length / 4), colours: colours.size, data: Array.from(d.filter((_, i) => i % 64 === 0)) };
+  }, png.toString('base64'));
 }

@@ -48,7 +48,19 @@ typedef struct pdRefOptions {
   pdOdeFriction odeFriction;  // ODE only
   int iterations;             // Bullet: sequential-impulse iterations per step, 0 for the adapter's (100); ODE's
                               // dWorldStep solves its LCP exactly and has none
+  // Nullable: called at every output sample with the contacts of the step that ended there (their forces that
+  // step's average, their mode from the slip speed: PD_REF_SLIP_SPEED), after pd_ref_run's observer.
+  void (*contactObserver)(const pdModel* model, const pdState* state, const pdContactReport* contacts, int count,
+                          void* user);
+  void* contactUser;
 } pdRefOptions;
+
+// A reference engine's contact slides when its points move apart along the surface faster than this, m/s
+// (neither engine reports a mode): a millimetre per second, far above a resting contact's creep at 1 ms steps.
+#define PD_REF_SLIP_SPEED 1e-3
+
+// Velocity of the material point at p (world, m) of body `body` (model index; a fixed body: zero), m/s.
+pdVec3 pd_ref_point_velocity(const pdModel* model, const pdState* state, int body, pdVec3 p);
 
 typedef struct pdRefWorld pdRefWorld;
 
@@ -66,6 +78,9 @@ typedef struct pdRefAdapter {
   pdBodyState (*body)(const pdRefWorld* world, int movingIndex);
   // Contacts the engine used in its last step (for the counts in the summary).
   int (*contact_count)(const pdRefWorld* world);
+  // Those contacts with their forces averaged over the step (bodies, point, unit normal from B into A, fn and ft
+  // on A; features and mode unset), the first min(count, capacity) in out; returns the count.
+  int (*contacts)(const pdRefWorld* world, pdContactReport* out, int capacity);
   // One JSON object (no trailing newline) of every setting that changes the answer.
   void (*settings_json)(const pdRefWorld* world, FILE* out);
   void (*destroy)(pdRefWorld* world);

@@ -478,3 +478,64 @@ export function readBodyTrajectory(dir, run, body) {
   }
   return { file: src.file, samples: out };
 }
+
+// What `polydyn compare SCENE` writes beside metrics.csv (reports/FORMATS.md): divergence.csv, impacts.csv,
+// series.csv, friction.csv and compare.json; null when divergence.csv is absent (an older compare directory).
+export const DIVERGENCE_HEADER = ['scene', 'engine', 'variant', 'threshold', 'chaos_factor', 'first_t', 'first_body', 'first_kind', 'first_error',
+  'chaos_horizon', 'beyond_chaos_from', 'verdict'];
+export const IMPACTS_HEADER = ['scene', 'engine', 'variant', 'impact', 'body_a', 'body_b', 't', 'vn_before', 'vn_after', 'restitution',
+  'restitution_requested', 'tangential_speed_change', 'reference_impact'];
+export const BODY_SERIES_HEADER = ['engine', 'variant', 'body', 't', 'pos_err', 'rot_err_rad', 'energy', 'max_penetration_over_size',
+  'contacts', 'normal_force', 'slip_speed'];
+export const FRICTION_HEADER = ['engine', 'variant', 't', 'body_a', 'body_b', 'fn', 'ft', 'slip_speed', 'mode'];
+const VERDICTS = ['agrees', 'chaos', 'model', 'own_divergence', 'unknown'];
+
+export function readCompareDetail(dir) {
+  const div = readText(dir, 'divergence.csv');
+  if (!div) return null;
+  const ev = (f, file, line) => ({ engine: word(f.engine, 'engine', file, line), variant: word(f.variant, 'variant', file, line),
+    ev: `${f.engine} ${f.variant}` });
+  const divergence = table(div, DIVERGENCE_HEADER).map(({ line, f }) => {
+    if (!VERDICTS.includes(f.verdict)) throw new InputError(div.file, line, `verdict: one of ${VERDICTS.join(', ')}, found '${f.verdict}'`);
+    if (!['', 'position', 'rotation'].includes(f.first_kind)) throw new InputError(div.file, line, `first_kind: position, rotation or empty, found '${f.first_kind}'`);
+    const r = { scene: f.scene, ...ev(f, div.file, line), first_body: f.first_body, first_kind: f.first_kind, verdict: f.verdict };
+    for (const h of ['threshold', 'chaos_factor', 'first_t', 'first_error', 'chaos_horizon', 'beyond_chaos_from']) r[h] = number(f[h], h, div.file, line);
+    return r;
+  });
+  const need = (name, header) => {
+    const src = readText(dir, name);
+    if (!src) throw new InputError(path.join(dir, name), 0, 'missing (divergence.csv is there: polydyn compare writes both)');
+    return { src, rows: table(src, header) };
+  };
+  const imp = need('impacts.csv', IMPACTS_HEADER);
+  const impacts = imp.rows.map(({ line, f }) => {
+    const r = { ...ev(f, imp.src.file, line), body_a: f.body_a, body_b: f.body_b };
+    for (const h of ['impact', 't', 'vn_before', 'vn_after', 'restitution', 'restitution_requested', 'tangential_speed_change', 'reference_impact'])
+      r[h] = number(f[h], h, imp.src.file, line, { integer: h === 'impact' || h === 'reference_impact' });
+    return r;
+  });
+  const ser = need('series.csv', BODY_SERIES_HEADER);
+  const series = ser.rows.map(({ line, f }) => {
+    const r = { ...ev(f, ser.src.file, line), body: f.body };
+    for (const h of BODY_SERIES_HEADER.slice(3)) r[h] = number(f[h], h, ser.src.file, line, { integer: h === 'contacts' });
+    return r;
+  });
+  const fr = need('friction.csv', FRICTION_HEADER);
+  const friction = fr.rows.map(({ line, f }) => {
+    if (f.mode !== 'slip' && f.mode !== 'stick') throw new InputError(fr.src.file, line, `mode: slip or stick, found '${f.mode}'`);
+    const r = { ...ev(f, fr.src.file, line), body_a: f.body_a, body_b: f.body_b, mode: f.mode };
+    for (const h of ['t', 'fn', 'ft', 'slip_speed']) r[h] = number(f[h], h, fr.src.file, line, { required: true });
+    return r;
+  });
+  const cj = readText(dir, 'compare.json');
+  const compare = cj ? parseJson(cj.text, cj.file) : null;
+  return { divergence, impacts, series, friction, compare };
+}
+
+// The scenes of `polydyn compare SCENE_DIR --out DIR`: every sub-directory NAME of DIR with a divergence.csv,
+// in byte order of the names.
+export function listCompareScenes(dir) {
+  let names;
+  try { names = fs.readdirSync(dir, { withFileTypes: true }).filter((e) => e.isDirectory()).map((e) => e.name); } catch { return []; }
+  return names.sort((a, b) => (a < b ? -1 : a > b ? 1 : 0)).filter((n) => fs.existsSync(path.join(dir, n, 'divergence.csv')));
+}

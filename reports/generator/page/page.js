@@ -50,16 +50,33 @@
   // about a second to draw at once); all of them before printing.
   var specs = JSON.parse(document.getElementById('pd-charts').textContent);
   var charts = [];
+  var specById = {};
+  specs.forEach(function (s) { specById[s.id] = s; });
+  // a chart with alternatives (e.g. one per body) shows the one its select chose (s.current)
+  function optionOf(s) {
+    var option = decorate(s.alternatives ? s.alternatives[s.current || 0] : s.option);
+    option.animation = false;
+    option.textStyle = { fontFamily: 'system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans", sans-serif' };
+    return option;
+  }
   function draw(s) {
     if (s.drawn) return;
     s.drawn = true;
     var chart = echarts.init(document.getElementById(s.id), null, { renderer: 'svg' });
-    var option = decorate(s.option);
-    option.animation = false;
-    option.textStyle = { fontFamily: 'system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans", sans-serif' };
-    chart.setOption(option);
+    chart.setOption(optionOf(s));
+    s.chart = chart;
     charts.push(chart);
   }
+  Array.prototype.forEach.call(document.querySelectorAll('select.pd-alt'), function (select) {
+    select.addEventListener('change', function () {
+      select.dataset.charts.split(' ').forEach(function (id) {
+        var s = specById[id];
+        if (!s) return;
+        s.current = Number(select.value);
+        if (s.chart) s.chart.setOption(optionOf(s), true);
+      });
+    });
+  });
   function drawAll() { specs.forEach(draw); }
   if (typeof IntersectionObserver === 'function') {
     var specOf = {};
@@ -79,7 +96,29 @@
   }
   window.addEventListener('beforeprint', drawAll);
   window.addEventListener('resize', function () { charts.forEach(function (c) { c.resize(); }); });
-  window.polydynReport = { charts: charts, drawAll: drawAll };
+  window.polydynReport = { charts: charts, drawAll: drawAll, specs: specs };
+
+  // a link of class pd-seek (data-t, data-body) into a block holding a replay: opens it, and once mounted
+  // shows time t with that body selected
+  function seek(d, at) {
+    d.pdSeek = at;
+    var replay = d.pdReplay;
+    if (!replay) return;
+    if (replay.playing && typeof replay.pause === 'function') replay.pause();
+    replay.setTime(at.t);
+    var bodies = replay.runs && replay.runs[0] ? replay.runs[0].bodies : [];
+    for (var i = 0; i < bodies.length; ++i) if (bodies[i].name === at.body) replay.selectBody(i);
+    if (typeof replay.renderNow === 'function') replay.renderNow();
+  }
+  document.addEventListener('click', function (e) {
+    var a = e.target.closest ? e.target.closest('a.pd-seek') : null;
+    if (!a) return;
+    var holder = document.querySelector(a.getAttribute('href'));
+    var d = holder && holder.querySelector('details.replay');
+    if (!d) return;
+    seek(d, { t: Number(a.dataset.t), body: a.dataset.body });
+    d.open = true;
+  });
 
   // replays: the inlined viewer bundle defines PolydynViewer.mount(element, files); each replay's
   // files are in a script of the folder beside the page (body's data-replays), which calls
@@ -108,7 +147,8 @@
       target.textContent = 'Loading the replay data from ' + src + ' …';
       waiting[name] = function (files) {
         target.textContent = '';
-        viewer.mount(target, files);
+        d.pdReplay = viewer.mount(target, files);
+        if (d.pdSeek) seek(d, d.pdSeek);
       };
       var script = document.createElement('script');
       script.src = encodeURIComponent(folder) + '/' + encodeURIComponent(name);

@@ -14,8 +14,10 @@ import frictionCone from './friction_cone.mjs';
 import workPrecision from './work_precision.mjs';
 import cost from './cost.mjs';
 import compare from './compare.mjs';
+import differ from './differ.mjs';
+import scenes from './scenes.mjs';
 import experiments from './experiments.mjs';
 import parameters from './parameters.mjs';
 import cubetoss, { planarDrops } from './cubetoss.mjs';
 
-export const sections = [summary, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, planarDrops, experiments, parameters];
+export const sections = [differ, scenes, summary, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, planarDrops, experiments, parameters];
