@@ -12,7 +12,9 @@ CHILD = r"""
 import os, sys, polydyn
 from conftest import CUBE_SCENE
 mode, out = sys.argv[1], sys.argv[2]
-long_scene = polydyn.Scene.from_string(CUBE_SCENE.replace("tend 3", "tend 100000"))
+# sleeping off: a cube at rest would otherwise sleep through 1e5 simulated seconds in about one second
+LONG = CUBE_SCENE.replace("tend 3", "tend 100000\nsleep off")
+long_scene = polydyn.Scene.from_string(LONG)
 print("started", flush=True)
 try:
     if mode == "run":
@@ -28,7 +30,7 @@ try:
     elif mode == "compare":
         path = os.path.join(os.path.dirname(out), "long.scene")
         with open(path, "w") as f:
-            f.write(CUBE_SCENE.replace("tend 3", "tend 100000"))
+            f.write(LONG)
         polydyn.compare(path, engines=["soft"])
     print("not interrupted", flush=True)
 except KeyboardInterrupt:
