@@ -398,7 +398,7 @@ static void observe_step(const pdModel* m, const pdState* s, bool start, void* u
   double depth = deepest_overlap(m, s, &pi, &pj);
   if (depth > o->penetration) {
     o->penetration = depth;
-    snprintf(w->deepest, sizeof w->deepest, "%.40s and %.40s at t = %.6g s (a step between samples)",
+    snprintf(w->deepest, sizeof w->deepest, "%.40s and %.40s at t = %.6g s (an accepted step)",
              m->bodies[pi].name, m->bodies[pj].name, s->t);
   }
 }

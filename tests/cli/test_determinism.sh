@@ -142,7 +142,7 @@ soak_twice() {
   check "$T: the same report on stdout" 'cmp -s "$SCRATCH/$T/first.out" "$SCRATCH/$T/second.out"'
 }
 soak_twice soak 0 --seed 4 --scenes $SOAK_SCENES --engines soft,ode,bullet
-soak_twice soak_failure 1 --seed 3 --first 370 --scenes 2
+soak_twice soak_failure 1 --generator 1 --seed 3 --first 370 --scenes 2
 check "soak_failure: the failing scene's replay file is there" '[ -s "$SCRATCH/soak_failure/first/failures/000371-soft.scene" ]'
 
 # --- cubetoss: synthetic tosses, --jobs 1 against --jobs 2 -------------------------------------------------
