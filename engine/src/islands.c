@@ -382,6 +382,9 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->transitionsUnlocated += c->transitionsUnlocated;
   to->transitionBoundMax = fmax(to->transitionBoundMax, c->transitionBoundMax);
   to->transitionBoundSum += c->transitionBoundSum;
+  to->releasesCorrected += c->releasesCorrected;
+  to->releaseBoundMax = fmax(to->releaseBoundMax, c->releaseBoundMax);
+  to->releaseBoundSum += c->releaseBoundSum;
   to->historyKept += c->historyKept;
 }
 

@@ -155,6 +155,9 @@ typedef struct pdCounters {
   long transitionsUnlocated;   // stick–slip changes left inside their step (bounded events), each with its bound:
   double transitionBoundMax;   // the largest
   double transitionBoundSum;   // and their sum, error-norm units as above
+  long releasesCorrected;      // normal forces that reached zero inside a step whose modes were held (docs/events.md):
+  double releaseBoundMax;      // the tension applied since taken out at the step's end, never located; each one's
+  double releaseBoundSum;      // error bound, largest and summed, error-norm units
   long historyKept;  // contacts that started on the features of one broken by force within the gap tolerance, with
                      // its tangential springs (engine/src/contact_history.h)
   // pd_islandsOn only (0 otherwise); the counts above are then summed over the islands
