@@ -32,6 +32,9 @@ int pd_contact_set_count(const pdContactSet* set);
 // there or located by a retry (pd_contact_events; docs/events.md, "Modes within a step"). Set by the stepper
 // before a step; off, the force law decides at every evaluation (the paper's loop).
 void pd_contact_set_hold_modes(pdContactSet* set, bool hold);
+// With `all`, every held mode's change is corrected whatever its bound, none located (tests measure the bound
+// against the located run's answer); off (the default), the bound decides.
+void pd_contact_set_correct_held(pdContactSet* set, bool all);
 
 // Inside the derivative: poses of every body from y (fixed bodies keep theirs), then for every contact
 // its force and moment on both bodies (summed per moving body, world: pd_contact_set_force/_torque) and

@@ -147,6 +147,7 @@ struct pdContactSet {
   int onsetRetries;        // onset retries of the step under way
   int modeRetries;         // trials of the step under way cut to a held mode's change (holdModes)
   bool holdModes;          // the derivative holds each contact's modes of the step's start (pd_contact_set_hold_modes)
+  bool correctHeld;        // every held change corrected, none located (pd_contact_set_correct_held)
   // stability bound (pd_stability_prepare, stability_tight), sized with the list
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])

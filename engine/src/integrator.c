@@ -317,8 +317,8 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
                             double stableFraction, const probationLimits* probation, stepOutcome* outcome) {
   const pdSettings* set = &model->settings;
   stepperWork w = work_of(s);
-  // bounded events hold each contact's modes over the step (contact_set.h); the paper's loop lets the law decide
-  pd_contact_set_hold_modes(s->contacts, pd_onsets_effective(s->onsets, model->movingCount) == pd_onsetsBounded);
+  // held events hold each contact's modes over the step (contact_set.h); the others let the law decide
+  pd_contact_set_hold_modes(s->contacts, s->onsets == pd_onsetsHeld);
   derivative(model, s, s->t, s->y, w.k1);
   bool eventCut = false;
   for (;;) {
