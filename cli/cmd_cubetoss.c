@@ -1,5 +1,5 @@
 // polydyn cubetoss — real cube tosses in every engine, and fitting each engine's free parameters to them
-// (docs/DESIGN.md §8.4; the library part is refcheck/include/polydyn/cubetoss.h).
+// (docs/DESIGN.md §8.4; the library part is validation/include/polydyn/cubetoss.h).
 #include <errno.h>
 #include <math.h>
 #include <signal.h>

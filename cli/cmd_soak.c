@@ -1,4 +1,4 @@
-// polydyn soak — the random-scene soak (refcheck/include/polydyn/soak.h; docs/reliability.md). Each scene
+// polydyn soak — the random-scene soak (validation/include/polydyn/soak.h; docs/reliability.md). Each scene
 // is one task of a batch (refcheck/include/polydyn/batch.h); its runs go through child processes.
 #include <errno.h>
 #include <signal.h>

@@ -1,4 +1,4 @@
-// polydyn refcheck — one cube toss: its scene, its run in an engine, its errors against the record, the
+// polydyn validation — one cube toss: its scene, its run in an engine, its errors against the record, the
 // record as a run directory, statistics and parameter fragments (conventions in cubetoss.h).
 #include <errno.h>
 #include <math.h>
