@@ -48,7 +48,7 @@ void pd_cli_remove_tree(const char* path);
 // pd_cli_out_open refuses (message, false) an existing OUT without `marker` in it — not a directory of
 // this command — and makes tmp. pd_cli_out_close moves tmp into place, replacing a previous OUT; on
 // failure it prints why, removes tmp and returns false.
-// Under MPI (refcheck/include/polydyn/batch.h) both are collective: rank 0 makes, moves and removes the
+// Under MPI (runner/include/pdrun/batch.h) both are collective: rank 0 makes, moves and removes the
 // directories, every rank gets tmp's name (or false), and the others' pd_cli_out_close does nothing.
 bool pd_cli_out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize);
 bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out);

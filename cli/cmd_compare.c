@@ -1,5 +1,5 @@
 // polydyn compare — one scene (or every scene of a directory) in every engine, metrics against a tighter
-// soft run (docs/DESIGN.md §8.1). Each scene is one task of a batch (refcheck/include/polydyn/batch.h).
+// soft run (docs/DESIGN.md §8.1). Each scene is one task of a batch (runner/include/pdrun/batch.h).
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
@@ -15,7 +15,7 @@
 #include "compare_files.h"
 #include "pdutil/csv.h"
 #include "pdutil/json.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"

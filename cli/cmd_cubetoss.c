@@ -12,7 +12,7 @@
 
 #include "cli.h"
 #include "pdutil/csv.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/cubetoss.h"
 #include "polydyn/output.h"
 

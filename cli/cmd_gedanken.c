@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "cli.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/gedanken.h"
 
 static const char* const help =

@@ -22,11 +22,11 @@
 #include "cli.h"
 #include "pdutil/csv.h"
 #include "pdutil/json.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/refcheck.h"
 #include "polydyn/state.h"
-#include "polydyn/stats.h"
+#include "pdrun/stats.h"
 
 // The reference tolerance and its check: the sweep's tightest point is 1e-10, the reference two decades
 // below it, and its own error is estimated against one a decade tighter still.

@@ -9,7 +9,7 @@
 #include <time.h>
 
 #include "cli.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 
 static const char* const usage =
     "usage: polydyn COMMAND [ARGS]\n"

@@ -3,7 +3,7 @@
 //
 // Order of work: the scenes are generated and compiled first (compiling touches GSL's global error
 // handler), one model per (experiment, input), shared read-only by that case's runs. Every run is then one
-// task of a batch (refcheck/include/polydyn/batch.h: `jobs` worker processes, or MPI ranks): it writes its
+// task of a batch (runner/include/pdrun/batch.h: `jobs` worker processes, or MPI ranks): it writes its
 // run directory and returns its row and series text, which land in task order, so the files are the same
 // bytes whatever the number of processes, except wall times.
 #include <errno.h>
@@ -13,7 +13,7 @@
 #include <unistd.h>
 
 #include "gedanken_internal.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
 #include "pdutil/csv.h"
