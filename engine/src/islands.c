@@ -127,7 +127,7 @@
 
 static void island_free(island* is) {
   if (!is) return;
-  pd_state_free(is->state);
+  pd_state_release(is->state);
   pd_material_table_free(is->model.materials);
   free(is->model.bodies);
   free(is->model.movingBodies);
