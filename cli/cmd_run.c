@@ -149,7 +149,7 @@ int pd_cmd_run(int argc, char** argv) {
   char threadsMessage[64];
   snprintf(threadsMessage, sizeof threadsMessage, "--threads needs a whole number 1..%d", PD_THREADS_MAX);
   const pdCliOption table[] = {
-      {.name = "--out", .kind = pd_optText, .target = &out, .message = "--out needs a directory name"},
+      {.name = "--out", .kind = pd_optText, .target = &out, .message = "--out needs a directory name", .min = 1},
       {.name = "--engine", .kind = pd_optAccept, .target = &engine, .accept = accept_engine},
       {.name = "--tend", .kind = pd_optPositive, .target = &overrides.tend, .message = "--tend needs a number > 0"},
       {.name = "--sample", .kind = pd_optPositive, .target = &overrides.sample,
@@ -175,7 +175,7 @@ int pd_cmd_run(int argc, char** argv) {
        .message = "--ode-friction must be pyramid or aligned", .words = frictionWords, .values = frictionValues,
        .given = &refOptionGiven},
   };
-  pdCliPositionals scenes = {&scene, 1, 0, "one scene at a time ('%s' and '%s')"};
+  pdCliPositionals scenes = {.values = &scene, .max = 1, .tooMany = "one scene at a time ('%s' and '%s')"};
   int parsed = pd_cli_parse_options("run", argc, argv, table, sizeof table / sizeof table[0], &scenes, help);
   if (parsed >= 0) return parsed;
   ref.variant = (pdRefVariant)variant;

@@ -378,7 +378,7 @@ int pd_cmd_sweep(int argc, char** argv) {
   snprintf(jobsMessage, sizeof jobsMessage, "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
   const pdCliOption table[] = {
       {.name = "--out", .kind = pd_optText, .target = &out, .message = "--out needs a directory name (< 3000 bytes)",
-       .max = 3000},
+       .min = 1, .max = 3000},
       {.name = "--repeats", .kind = pd_optWhole, .target = &repeats, .message = repeatsMessage, .min = 1,
        .max = SWEEP_MAX_REPEATS},
       {.name = "--engines", .kind = pd_optAccept, .target = &engines, .accept = accept_engines},
@@ -386,7 +386,7 @@ int pd_cmd_sweep(int argc, char** argv) {
       {.name = "--jobs", .kind = pd_optJobs, .target = &jobs, .message = jobsMessage},
       {.name = "--events", .kind = pd_optAccept, .target = &sweepOnsets, .accept = accept_events},
   };
-  pdCliPositionals scenes = {&scene, 1, 0, "one scene at a time ('%s' and '%s')"};
+  pdCliPositionals scenes = {.values = &scene, .max = 1, .tooMany = "one scene at a time ('%s' and '%s')"};
   int parsed = pd_cli_parse_options("sweep", argc, argv, table, sizeof table / sizeof table[0], &scenes, help);
   if (parsed >= 0) return parsed;
   if (!scene) return pd_cli_usage_error("sweep", "no scene given");

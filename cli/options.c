@@ -17,8 +17,10 @@ static int bad_value(const char* cmd, const pdCliOption* o, const char* value) {
 // Takes one option's value; returns -1 when taken, else the exit status.
 static int take(const char* cmd, const pdCliOption* o, const char* v) {
   switch (o->kind) {
+    case pd_optFlag:
+      return -1;  // taken by the caller
     case pd_optText:
-      if (v[0] == '\0' || (o->max > 0 && strlen(v) > (size_t)o->max)) return bad_value(cmd, o, v);
+      if (strlen(v) < (size_t)o->min || (o->max > 0 && strlen(v) > (size_t)o->max)) return bad_value(cmd, o, v);
       *(const char**)o->target = v;
       return -1;
     case pd_optPositive:
@@ -61,13 +63,22 @@ int pd_cli_parse_options(const char* cmd, int argc, char** argv, const pdCliOpti
     const pdCliOption* o = NULL;
     for (int k = 0; k < count && !o; ++k)
       if (strcmp(a, table[k].name) == 0) o = &table[k];
-    if (o) {
+    if (o && o->kind == pd_optFlag) {
+      if (o->refuse) return pd_cli_usage_error(cmd, o->refuse, a);
+      if (o->given) *o->given = true;
+      if (o->accept && !o->accept(cmd, NULL, o->target)) return PD_EXIT_BAD_INPUT;
+      if (!o->accept) *(bool*)o->target = true;
+    } else if (o) {
       if (i + 1 >= argc) return pd_cli_usage_error(cmd, "%s needs a value", a);
+      if (o->refuse) return pd_cli_usage_error(cmd, o->refuse, a);
       if (o->given) *o->given = true;
       int status = take(cmd, o, argv[++i]);
       if (status >= 0) return status;
-    } else if (a[0] == '-' && a[1] != '\0') {
-      return pd_cli_usage_error(cmd, "unknown option '%s'", a);
+    } else if (a[0] == '-' && (a[1] != '\0' || positionals->loneDashIsOption)) {
+      const char* unknown = positionals->unknownOption ? positionals->unknownOption : "unknown option '%s'";
+      return pd_cli_usage_error(cmd, unknown, a);
+    } else if (positionals->count == positionals->max && positionals->max == 0) {
+      return pd_cli_usage_error(cmd, positionals->tooMany, a);
     } else if (positionals->count == positionals->max) {
       return pd_cli_usage_error(cmd, positionals->tooMany, positionals->values[0], a);
     } else {
