@@ -1,12 +1,12 @@
 // polydyn for Python — the bench: the interference oracle (refcheck/include/polydyn/oracle.h), the Gedanken
 // suite (gedanken/include/polydyn/gedanken.h), and the batch commands whose orchestration belongs to the command
-// line (compare, cubetoss: cli/cli.h), run in this process with the command's own code.
+// line (compare, cubetoss: cli/include/pdcli/commands.h), run in this process with the command's own code.
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli.h"
+#include "pdcli/commands.h"
 #include "polydyn/gedanken.h"
 #include "polydyn/oracle.h"
 #include "pypolydyn.h"
