@@ -118,7 +118,7 @@
 // rough guess; the heaviest go first, so that the last ones taken are small).
 #define PD_ISLAND_CONTACT_WEIGHT 1
 // A batch of one island wakes the other threads to serve its help desk (help_desk.h) from this weight on (bodies +
-// contacts): below it the per-contact loops are too short to split (PD_HELP_MIN_CONTACTS in contact_set_internal.h).
+// contacts): below it the per-contact loops are too short to split (PD_HELP_MIN_CONTACTS in contact_list.h).
 #define PD_ISLAND_HELP_WEIGHT 128
 
 // the set and its islands: island_set.h

@@ -3,7 +3,7 @@
 #include "polydyn/state.h"
 
 #include "contact_force.h"
-#include "contact_set_internal.h"
+#include "contact_list.h"
 #include "state_layout.h"
 
 int pd_state_contact_room(const pdModel* model, const pdState* s) {
