@@ -24,7 +24,7 @@ int pd_cmd_gedanken(int argc, char** argv);
 int pd_cmd_oracle(int argc, char** argv);
 int pd_cmd_soak(int argc, char** argv);
 
-// `polydyn ARGS...`: argv[1] names the subcommand (cli/dispatch.c; main() calls it). Returns the exit status.
+// `polydyn ARGS...`: argv[1] names the subcommand (cli/commands.c; main() calls it). Returns the exit status.
 int pd_cli_dispatch(int argc, char** argv);
 
 // Set by an interrupt (SIGINT, SIGTERM) while a command that catches them runs: the command stops at its next
