@@ -118,9 +118,8 @@ static bool accept_engines(const char* cmd, const char* v, void* target) {
     return false;
   }
   for (int k = 0; k < count; ++k) {
-    int e = 0;
-    while (e < pd_gkEngineCount && strcmp(names[k], pdGkEngineNames[e]) != 0) ++e;
-    if (e == pd_gkEngineCount) {
+    pdGkEngine e;
+    if (!pd_gk_engine_named(names[k], &e)) {
       pd_cli_usage_error(cmd, "unknown engine '%s' (soft, ode or bullet)", names[k]);
       return false;
     }

@@ -7,6 +7,16 @@ const char* const pdGkEngineNames[pd_gkEngineCount] = {"soft", "ode", "bullet"};
 const char* const pdGkStatusNames[] = {"PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR", "NOT_APPLICABLE"};
 const char* const pdGkKindNames[] = {"law", "model_prediction"};
 
+bool pd_gk_engine_named(const char* name, pdGkEngine* engine) {
+  for (int e = 0; e < pd_gkEngineCount; ++e) {
+    if (strcmp(name, pdGkEngineNames[e]) == 0) {
+      *engine = (pdGkEngine)e;
+      return true;
+    }
+  }
+  return false;
+}
+
 unsigned pd_gk_variant_bit(pdGkEngine engine, bool matched) {
   switch (engine) {
     case pd_gkSoft: return PD_GK_SOFT;

@@ -246,9 +246,8 @@ static PyObject* gedanken(PyObject* module, PyObject* args, PyObject* kwargs) {
   const char** engineNames = string_array(engines, &engineCount);
   if (!engineNames) goto done;
   for (int i = 0; i < engineCount; ++i) {
-    int e = 0;
-    while (e < pd_gkEngineCount && strcmp(engineNames[i], pdGkEngineNames[e]) != 0) ++e;
-    if (e == pd_gkEngineCount) {
+    pdGkEngine e;
+    if (!pd_gk_engine_named(engineNames[i], &e)) {
       PyErr_Format(PyExc_ValueError, "engines must be among soft, ode, bullet, not '%s'", engineNames[i]);
       goto done;
     }
