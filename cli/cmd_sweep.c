@@ -43,7 +43,7 @@
 
 static const char* const help =
     "usage: polydyn sweep SCENE --out DIR [--repeats R] [--engines soft,ode,bullet] [--tend T] [--jobs N]\n"
-    "                     [--events bounded|exact]\n"
+    "                     [--events bounded|exact|held]\n"
     "\n"
     "Work-precision sweep of SCENE: polydyn's default stepper (implicit: step doubling switching to ROS34PW2\n"
     "where the contacts' stability bound holds it), adaptive RK4 (step doubling alone) and its embedded RK4(3)\n"
@@ -362,7 +362,7 @@ static bool accept_engines(const char* cmd, const char* v, void* target) {
 
 static bool accept_events(const char* cmd, const char* v, void* target) {
   if (pd_cli_events(v, target)) return true;
-  pd_cli_usage_error(cmd, "--events must be bounded or exact");
+  pd_cli_usage_error(cmd, "--events must be bounded, exact or held");
   return false;
 }
 
