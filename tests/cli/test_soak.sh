@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The random-scene soak (docs/reliability.md; cli/cmd_soak.c, refcheck/soak.c).
+# The random-scene soak (docs/reliability.md; cli/cmd_soak.c, validation/soak.c).
 # - CI's campaign: the latest generator (plates too), seed 1, scenes 0..SCENES-1 (40; 12 in the ASan + UBSan
 #   build, 10-40 times slower, whose runs get a budget of 300 s instead of 20), in the soft engine (checked at
 #   every accepted step), ODE and Bullet: every run ok, or refused where it must be (the overlap scenes), no
