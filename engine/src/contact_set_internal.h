@@ -33,6 +33,8 @@ typedef struct contactSlot {
   pdVec3 onsetImpulse;  // N·s, on body 1: pd_onsets_start_late' scratch
   double modalMass;     // kg: the mass per contact of its pair's joint motion along n (pd_modal_dampers; 0: none)
   int modalCount;       // contacts its pair had when pd_modal_dampers last set its dampers (0: not yet)
+  int modalBodyContacts[2];  // contacts of body1, body2 (moving) then: a neighbour's change re-sizes its dampers
+  double stackScale[2];      // ζ of its modal dampers at the pair's own mass over the requested (n, P_t; >= 1)
 } contactSlot;
 
 // A pair's search certificate (contact_analysis.h, "search certificates") and when to issue its next, kept beside
@@ -151,9 +153,11 @@ struct pdContactSet {
   bodySpaceBlock* bodyBlocks;  // (bodyCount) stability_tight's
   const pdPose* stablePoses;   // the poses of the list's pd_stability_prepare (unchanged until the step's limit)
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
+  double stackTau;         // s: the largest c/k along n of contacts whose dampers a stack sized (0: none; step_of)
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
+  struct pdStackScratch* stackScratch;  // the modal dampers' local mode analyses (stack_modes.h)
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation
   // the state record() formed every contact's force at (its slots' force, point and rates), while recordedValid:
   // a derivative at the very same numbers takes them from there (pd_contact_forces)
