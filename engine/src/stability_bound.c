@@ -74,12 +74,17 @@ static void add_body_terms(const pdBody* b, const pdMat3* invWorld, const modalS
 // from the pose after every step: a damper that followed the pose step by step was a staircase in time, whose
 // steps made impacts converge only as ~tol^0.24 (the exit velocity of cases/sweep/eccentric_impact.scene's first
 // impact 1.1e-5 m/s from tol 1e-12's at tol 1e-8); held, the force is smooth between contact events (1.4e-7).
+static bool own_contacts_unchanged(const pdContactSet* set, int first, int last) {
+  for (int i = first; i < last; ++i)
+    if (set->items[i].modalCount != last - first) return false;
+  return true;
+}
+
 // In a stack (stack_modes.c) a pair's dampers are also set anew when a contact of one of its moving bodies with another
 // body is made or broken (its count of contacts changed): that changes the modes its dampers are sized for.
-static bool pair_unchanged(const pdModel* model, const pdContactSet* set, int first, int last) {
+static bool neighbours_unchanged(const pdModel* model, const pdContactSet* set, int first, int last) {
   for (int i = first; i < last; ++i) {
     const contactSlot* c = &set->items[i];
-    if (c->modalCount != last - first) return false;
     int ends[2] = {c->id.body1, c->id.body2};
     for (int e = 0; e < 2; ++e)
       if (!model->bodies[ends[e]].fixed &&
@@ -87,6 +92,11 @@ static bool pair_unchanged(const pdModel* model, const pdContactSet* set, int fi
         return false;
   }
   return true;
+}
+
+static void note_body_contacts(contactSlot* c, const pdContactSet* set) {
+  c->modalBodyContacts[0] = set->bodyFirst[c->id.body1 + 1] - set->bodyFirst[c->id.body1];
+  c->modalBodyContacts[1] = set->bodyFirst[c->id.body2 + 1] - set->bodyFirst[c->id.body2];
 }
 
 void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses) {
@@ -98,7 +108,17 @@ void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* pos
     last = first + 1;
     while (last < set->count && compare_to_pair(&set->items[last].id, a, b) == 0) ++last;
     if (!c0->params.modalN && !c0->params.modalT) continue;
-    if (pair_unchanged(model, set, first, last)) continue;
+    bool own = own_contacts_unchanged(set, first, last);
+    if (own && neighbours_unchanged(model, set, first, last)) continue;
+    // in a stack, along n: a mass per contact of up to k_s/Ω², Ω the slow mode the pair takes part in
+    double stackN = 0.0, omegaN, weight;
+    bool stacked = c0->params.modalN &&
+                   pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omegaN, &weight);
+    if (stacked) stackN = weight * pd_series(c0->params.k1n, c0->params.k2n) / (omegaN * omegaN);
+    if (own && !stacked && c0->stackScale[0] == 1.0) {  // its own dampers, held: only a neighbour changed
+      for (int i = first; i < last; ++i) note_body_contacts(&set->items[i], set);
+      continue;
+    }
     modalSums sa = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, sb = sa;
     for (int i = first; i < last; ++i) {
       const contactSlot* c = &set->items[i];
@@ -122,17 +142,12 @@ void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* pos
     double qt = count * count * (A->invMass + B->invMass) + 0.5 * (trace - pd_v3_dot(axis, pd_mat3_mulv(&mt, axis)));
     // a degenerate sum (normals cancelling) leaves 1ᵀA1 ~ 0: the clamp to the reduced mass takes over
     double massN = qn > 0.0 ? count / qn : INFINITY, massT = qt > 0.0 ? count / qt : INFINITY;
-    // in a stack, along n: at least the mass per contact k_s/Ω² of the slow mode the pair takes part in
-    double stackN = 0.0, omegaN;
-    if (c0->params.modalN && pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omegaN))
-      stackN = pd_series(c0->params.k1n, c0->params.k2n) / (omegaN * omegaN);
     for (int i = first; i < last; ++i) {
       contactSlot* c = &set->items[i];
       pd_contact_modal_damping(&c->params, massN, massT, stackN, 0.0, c->stackScale);
       c->modalMass = fmin(massN, c->params.massPair);
       c->modalCount = last - first;
-      c->modalBodyContacts[0] = set->bodyFirst[c->id.body1 + 1] - set->bodyFirst[c->id.body1];
-      c->modalBodyContacts[1] = set->bodyFirst[c->id.body2 + 1] - set->bodyFirst[c->id.body2];
+      note_body_contacts(c, set);
     }
   }
 }
