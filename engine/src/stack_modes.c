@@ -4,7 +4,8 @@
 // to the mode whose frequency is ω = √(k_s/m_c). For two bodies alone that is their joint motion (m_c from the pair,
 // stability_bound.c). In a stack the slow mode is another one: an 80 kg block on a 0.2 kg pad on a floor bounces on
 // both interfaces in series at √(k/2/80), while each pair alone would size its dampers for the pad (ζ 0.01 left for
-// the block). Dampers proportional to the springs with one c/k = 2ζ/ω along a chain in series are one Kelvin–Voigt
+// the block). Only where the masses differ (PD_STACK_RATIO_FROM): among bodies of one mass the pair's own dampers
+// damp the stack's modes within a factor of ~2. Dampers proportional to the springs with one c/k = 2ζ/ω along a chain in series are one Kelvin–Voigt
 // element, so the chain's mode at ω gets exactly ζ; hence each pair's dampers are sized for the slowest mode of its
 // local system in which its springs hold a real share of the strain energy (min(1, s/PD_STACK_SHARE) weighs it: a
 // light body resting on a heavy one holds ~(m/M)² of the heavy one's bounce and keeps its own, faster mode). The
