@@ -99,6 +99,27 @@ static void note_body_contacts(contactSlot* c, const pdContactSet* set) {
   c->modalBodyContacts[1] = set->bodyFirst[c->id.body2 + 1] - set->bodyFirst[c->id.body2];
 }
 
+// A stack's mass per contact enters where its slow mode is far slower than the pair's own: from (ω_own/Ω)² =
+// PD_STACK_SLOW_FROM in proportion to the logarithm, fully from PD_STACK_SLOW_FULL. Among boxes of one mass
+// (ω_own/Ω)² is 5 in cases/hard/stack_10.scene and up to 8.5 in cases/hard/brick_bond.scene, and the heavier dampers
+// there only cost steps (1.4 and 1.7 times the derivative evaluations, the overdamped part of the stability bound);
+// a heavy body on a pad of a tenth of its mass gives 20 (√(M/m) slower, times the two interfaces in series), where
+// the pair's own dampers leave its bounce at ζ 0.08.
+#define PD_STACK_SLOW_FROM 10.0
+#define PD_STACK_SLOW_FULL 20.0
+
+// In a stack, along n: the mass per contact k_s/Ω² of the slow mode the pair takes part in (stack_modes.h), weighed
+// as above against the pair's own mass per contact `own`; 0: the pair's own dampers.
+static double stack_mass(const pdModel* model, pdContactSet* set, const pdPose* poses, int first, int last,
+                         double own) {
+  const pdContactParams* p = &set->items[first].params;
+  double omega;
+  if (!p->modalN || !pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omega)) return 0.0;
+  double mass = pd_series(p->k1n, p->k2n) / (omega * omega);
+  double weight = log(mass / own / PD_STACK_SLOW_FROM) / log(PD_STACK_SLOW_FULL / PD_STACK_SLOW_FROM);
+  return weight > 0.0 ? fmin(1.0, weight) * mass : 0.0;
+}
+
 void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses) {
   if (!set->bodyListValid) pd_contact_set_list_bodies(model, set);
   for (int first = 0, last; first < set->count; first = last) {
@@ -110,15 +131,6 @@ void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* pos
     if (!c0->params.modalN && !c0->params.modalT) continue;
     bool own = own_contacts_unchanged(set, first, last);
     if (own && neighbours_unchanged(model, set, first, last)) continue;
-    // in a stack, along n: a mass per contact of up to k_s/Ω², Ω the slow mode the pair takes part in
-    double stackN = 0.0, omegaN, weight;
-    bool stacked = c0->params.modalN &&
-                   pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omegaN, &weight);
-    if (stacked) stackN = weight * pd_series(c0->params.k1n, c0->params.k2n) / (omegaN * omegaN);
-    if (own && !stacked && c0->stackScale[0] == 1.0) {  // its own dampers, held: only a neighbour changed
-      for (int i = first; i < last; ++i) note_body_contacts(&set->items[i], set);
-      continue;
-    }
     modalSums sa = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, sb = sa;
     for (int i = first; i < last; ++i) {
       const contactSlot* c = &set->items[i];
@@ -142,6 +154,11 @@ void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* pos
     double qt = count * count * (A->invMass + B->invMass) + 0.5 * (trace - pd_v3_dot(axis, pd_mat3_mulv(&mt, axis)));
     // a degenerate sum (normals cancelling) leaves 1ᵀA1 ~ 0: the clamp to the reduced mass takes over
     double massN = qn > 0.0 ? count / qn : INFINITY, massT = qt > 0.0 ? count / qt : INFINITY;
+    double stackN = stack_mass(model, set, poses, first, last, fmin(massN, c0->params.massPair));
+    if (own && stackN == 0.0 && c0->stackScale[0] == 1.0) {  // its own dampers, held: only a neighbour changed
+      for (int i = first; i < last; ++i) note_body_contacts(&set->items[i], set);
+      continue;
+    }
     for (int i = first; i < last; ++i) {
       contactSlot* c = &set->items[i];
       pd_contact_modal_damping(&c->params, massN, massT, stackN, 0.0, c->stackScale);

@@ -4,8 +4,8 @@
 // to the mode whose frequency is ω = √(k_s/m_c). For two bodies alone that is their joint motion (m_c from the pair,
 // stability_bound.c). In a stack the slow mode is another one: an 80 kg block on a 0.2 kg pad on a floor bounces on
 // both interfaces in series at √(k/2/80), while each pair alone would size its dampers for the pad (ζ 0.01 left for
-// the block). Only where the masses differ (PD_STACK_RATIO_FROM): among bodies of one mass the pair's own dampers
-// damp the stack's modes within a factor of ~2. Dampers proportional to the springs with one c/k = 2ζ/ω along a chain in series are one Kelvin–Voigt
+// the block). Only where the masses differ (PD_STACK_MASS_RATIO) and the slow mode is far slower than the pair's own
+// (stability_bound.c, PD_STACK_SLOW_FROM): among bodies of one mass the pair's own dampers are kept. Dampers proportional to the springs with one c/k = 2ζ/ω along a chain in series are one Kelvin–Voigt
 // element, so the chain's mode at ω gets exactly ζ; hence each pair's dampers are sized for the slowest mode of its
 // local system in which its springs hold a real share of the strain energy (min(1, s/PD_STACK_SHARE) weighs it: a
 // light body resting on a heavy one holds ~(m/M)² of the heavy one's bounce and keeps its own, faster mode). The
@@ -29,15 +29,10 @@
 // also counts the slow modes of a ring of equal boxes fully: cases/hard/stack_10.scene then took 5 840 derivative
 // evaluations to its 0.3 s, with 1/2 3 530 (2 543 with each pair's own dampers).
 #define PD_STACK_SHARE 0.5
-// Stacks whose bodies' masses differ by at most PD_STACK_RATIO_FROM keep each pair's own dampers; from there the
-// stack's mass enters in proportion to log(ratio) and fully from PD_STACK_RATIO_FULL. Among bodies of one size a
-// pair's own mode and its local system's slow modes are within a factor of ~2 of each other, and the stack's
-// heavier dampers cost steps (the overdamped part of the stability bound): cases/hard/stack_10.scene took 1.4
-// times its derivative evaluations, cases/hard/brick_bond.scene 1.7 times, for no impact or mode that needed them.
-// Where a heavy body rides on a light one the slow mode is √(M/m) times slower and the pair's own dampers leave it
-// ringing: there the stack's mass is needed, fully at a ratio of 10 (the test's 1:10 stack).
-#define PD_STACK_RATIO_FROM 2.0
-#define PD_STACK_RATIO_FULL 8.0
+// A local system whose masses differ by at most this factor is not analysed: among bodies of one mass a pair's own
+// mode and the slow modes around it are within the factor of PD_STACK_SLOW_FROM (stability_bound.c), so the
+// analysis would change nothing.
+#define PD_STACK_MASS_RATIO 2.0
 // Modes below this fraction of the largest eigenvalue are the local system's free motions (a body sliding
 // without tangential springs): no strain, no damping to size.
 #define PD_STACK_FREE_MODE 1e-12
@@ -225,7 +220,7 @@ static double slow_period(const pdContactSet* set, int first, int last, pdStackS
 }
 
 bool pd_stack_pair_frequency(const pdModel* model, const pdContactSet* set, const pdPose* poses, int first, int last,
-                             pdStackScratch* scratch, double* omega, double* weight) {
+                             pdStackScratch* scratch, double* omega) {
   PD_ASSERT(set->bodyListValid);
   const pdContactId* id = &set->items[first].id;
   int a = id->body1 < id->body2 ? id->body1 : id->body2, b = id->body1 < id->body2 ? id->body2 : id->body1;
@@ -235,13 +230,19 @@ bool pd_stack_pair_frequency(const pdModel* model, const pdContactSet* set, cons
     lightest = fmin(lightest, model->bodies[scratch->members[m]].mass);
     heaviest = fmax(heaviest, model->bodies[scratch->members[m]].mass);
   }
-  *weight = fmin(1.0, log(heaviest / lightest / PD_STACK_RATIO_FROM) / log(PD_STACK_RATIO_FULL / PD_STACK_RATIO_FROM));
-  if (!(*weight > 0.0)) return false;
+  if (!(heaviest > PD_STACK_MASS_RATIO * lightest)) return false;
   for (int m = 0; m < scratch->memberCount; ++m)
     scratch->scale[m] = mass_scale(&model->bodies[scratch->members[m]], &poses[scratch->members[m]]);
   double period = slow_period(set, first, last, scratch);
   if (!(period > 0.0)) return false;
-  *omega = 1.0 / period;
+  // A mode slower than the whole local system's mass on the pair's springs, each in series with one spring per
+  // body, is a mechanism of the normal springs alone (a box rocking about a line of two contacts, which gravity and
+  // the tangential springs hold), not a bounce: Ω² >= count k_s / (members · Σ m).
+  const pdContactParams* p = &set->items[first].params;
+  double total = 0.0;
+  for (int m = 0; m < scratch->memberCount; ++m) total += model->bodies[scratch->members[m]].mass;
+  double slowest = (last - first) * pd_series(p->k1n, p->k2n) / (scratch->memberCount * total);
+  *omega = fmax(1.0 / period, sqrt(slowest));
   return true;
 }
 

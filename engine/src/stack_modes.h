@@ -19,10 +19,8 @@ void pd_stack_scratch_free(pdStackScratch* scratch);
 // The slow frequency Ω (rad/s) that pair [first, last) of the list takes part in along the normals, from the
 // undamped normal modes of its local system (the pair's moving bodies and their neighbours in contact, every contact
 // touching them; bodies outside it fixed): 1/Ω = max over modes j of min(1, s_j / PD_STACK_SHARE) / ω_j, s_j the
-// share of mode j's strain energy in the pair's springs, and *weight in (0, 1], how much of the stack's mass per
-// contact k_s/Ω² to use (PD_STACK_RATIO_FROM, _FULL: by the ratio of the local system's heaviest and lightest mass).
-// Returns false (both unset) for a pair whose bodies touch nothing else, whose local system's masses are within
-// PD_STACK_RATIO_FROM, or which has no normal stiffness: its dampers are the pair's own. The body lists (bodyFirst,
-// bodyList) must be current.
+// share of mode j's strain energy in the pair's springs. Returns false (*omega unset) for a pair whose bodies touch
+// nothing else, whose local system's masses are within PD_STACK_MASS_RATIO of each other, or which has no normal
+// stiffness: its dampers are the pair's own. The body lists (bodyFirst, bodyList) must be current.
 bool pd_stack_pair_frequency(const pdModel* model, const pdContactSet* set, const pdPose* poses, int first,
-                             int last, pdStackScratch* scratch, double* omega, double* weight);
+                             int last, pdStackScratch* scratch, double* omega);
