@@ -13,7 +13,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "contact_set_internal.h"
+#include "contact_list.h"
 #include "material.h"
 #include "stack_modes.h"
 

@@ -5,7 +5,7 @@
 
 #include <stdbool.h>
 
-#include "contact_set_internal.h"
+#include "contact_list.h"
 
 typedef struct pdStackScratch pdStackScratch;
 
