@@ -181,7 +181,7 @@ static double outside_by(const pdPolyhedron* s, pdVec3 q) {
 }
 
 // The face a vertex of sv outside sf (q in sf's frame) presses on beyond an acute edge (design note above), or -1:
-// the previous contact's face when it qualifies, else the shallowest that does. *penetration: the bodies'
+// the previous contact's face (while the vertex is below it and over it), else the shallowest that qualifies. *penetration: the bodies'
 // penetration depth, formed here when first needed (NAN until then).
 static int face_beyond_acute_edge(const pdModel* m, int iv, const pdPose* pv, int jf, const pdPose* pf, int i,
                                   pdVec3 q, const pdMat3* rel, int previous, double tol, double over,
@@ -191,18 +191,22 @@ static int face_beyond_acute_edge(const pdModel* m, int iv, const pdPose* pv, in
   double deltaMax = pd_model_pair_delta_max(m, iv, jf);
   double outside = outside_by(sf, q);
   if (outside > deltaMax) return -1;
+  // face continuity (§4.4.3), as for a vertex inside: a vertex in contact keeps its face, or is no new contact here
+  if (previous >= 0) {
+    double d = face_depth(sf, previous, q);
+    return d > tol && d >= outside && projects_inside(sf, previous, q, over) ? previous : -1;
+  }
   int face = -1;
   double best = INFINITY;
   for (int f = 0; f < sf->faceCount; ++f) {
     double d = face_depth(sf, f, q);
     if (!(d > tol) || !(d >= outside) || !projects_inside(sf, f, q, over)) continue;
-    if (f != previous && !(d < best)) continue;
+    if (!(d < best)) continue;
     if (d > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax) {
       if (isnan(*penetration)) *penetration = penetration_depth(sv, pv, sf, pf);
       if (d > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + *penetration) continue;
     }
     if (!support_along(sv, i, rel, q, sf->faces[f].normal)) continue;
-    if (f == previous) return f;
     best = d, face = f;
   }
   return face;
