@@ -264,6 +264,10 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
     }
     if (!(penetration > tol)) continue;
     int face = previous_face(previous, previousCount, iv, i, jf);
+    // face continuity holds while the vertex is over its face, as tracking keeps it (pd_contact_track); one that slid
+    // off it onto the next face is found there now, so that its contact hands over in this commit (a successor found
+    // only at the next commit leaves the vertex without a contact for a step)
+    if (face >= 0 && !projects_inside(sf, face, q, fmax(tol, flushTol))) face = -1;
     // a new contact: the face whose plane it crossed during the step. Depth alone misleads where the
     // vertex also lies just inside another plane (a brick's corner a roundoff inside the side plane of
     // the brick below, which it slides along, while it sinks into the top face).
@@ -877,7 +881,8 @@ bool pd_contact_edge_lines(const pdModel* model, const pdContactId* id, const pd
 // - VF, vertex v of one body in the other: not outside any face plane of the other by more than max(tol,
 //   flushTol) (a face it is farther outside of is never a shared plane, and outside it, it is rejected), or, when the
 //   other body has an acute edge, by more than δ_max (a vertex beyond an acute edge). Margin: how far v is outside
-//   its farthest face plane, less that tolerance.
+//   its farthest face plane, less that tolerance. A vertex in the exempt list keeps its face while it is over the
+//   face's polygon (find_vf's face continuity): margin, how far its projection is inside the polygon.
 // - EE, edges ea of A and eb of B: each edge's closest point within max(tol, δ_max) + P of inside the other body
 //   (the slack find_ee allows; P, the bodies' penetration depth, only for a pair deeper than 3 δ_max), so neither
 //   edge may lie wholly beyond one face plane of the other body by more. A motion m moves the edge by at most m
@@ -974,23 +979,47 @@ static double segment_distance2(pdVec3 p0, pdVec3 u, pdVec3 q0, pdVec3 v) {
   return pd_v3_dot(d, d);
 }
 
-static bool exempt_listed(const pdContactId* exempt, int count, pdContactKind kind, int body1, int feat1, int feat2) {
+// The exempt contact of this kind on body1's feature feat1 (and, for EE, feat2), or -1.
+static int exempt_index(const pdContactId* exempt, int count, pdContactKind kind, int body1, int feat1, int feat2) {
   for (int i = 0; i < count; ++i) {
     const pdContactId* c = &exempt[i];
     if (c->kind == kind && c->body1 == body1 && c->feat1 == feat1 && (kind == pd_contactVF || c->feat2 == feat2))
-      return true;
+      return i;
   }
-  return false;
+  return -1;
+}
+static bool exempt_listed(const pdContactId* exempt, int count, pdContactKind kind, int body1, int feat1, int feat2) {
+  return exempt_index(exempt, count, kind, body1, feat1, feat2) >= 0;
+}
+
+// How far q's projection onto face f's plane may move before it leaves the polygon by more than `over`, m.
+static double over_face_margin(const pdPolyhedron* s, int f, pdVec3 q, double over) {
+  const pdFace* face = &s->faces[f];
+  const int* idx = s->faceVertices + face->first;
+  double least = INFINITY;
+  for (int i = 0; i < face->count; ++i) {
+    pdVec3 a = s->vertices[idx[i]], b = s->vertices[idx[(i + 1) % face->count]];
+    pdVec3 e = pd_v3_sub(b, a);
+    double side = pd_v3_dot(pd_v3_cross(face->normal, e), pd_v3_sub(q, a)) / pd_v3_norm(e);
+    least = fmin(least, side + over);
+  }
+  return least;
 }
 
 // The least margin of the vertices of sv (given in sf's frame by rel, off) against sf, vertices listed as VF
 // contacts of body iv in `exempt` left out; stops at `bound` (no lower margin needed).
 static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf,
-                              double tolerance, const pdContactId* exempt, int exemptCount, double bound) {
+                              double tolerance, double over, const pdContactId* exempt, int exemptCount, double bound) {
   double least = bound;
   for (int i = 0; i < sv->vertexCount && least > 0.0; ++i) {
-    if (exempt_listed(exempt, exemptCount, pd_contactVF, iv, i, 0)) continue;
     pdVec3 q = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[i]));
+    int listed = exempt_index(exempt, exemptCount, pd_contactVF, iv, i, 0);
+    if (listed >= 0) {
+      // a vertex in contact keeps its face while it is over it (find_vf), and takes another once it is not
+      double margin = over_face_margin(sf, exempt[listed].feat2, q, over);
+      least = margin < least ? margin : least;
+      continue;
+    }
     double margin = outside_farthest(sf, q, least + tolerance) - tolerance;
     least = margin < least ? margin : least;
   }
@@ -1018,8 +1047,9 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   // outside it by up to δ_max may be a contact too (a vertex beyond an acute edge, find_vf)
   double onA = has_acute_edge(sa) ? fmax(deltaMax, tolA) : fmax(tolA, flushTol);
   double onB = has_acute_edge(sb) ? fmax(deltaMax, tolB) : fmax(tolB, flushTol);
-  double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, exempt, exemptCount, INFINITY);
-  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, exempt, exemptCount, least);
+  double overA = fmax(tolA, flushTol) - guard, overB = fmax(tolB, flushTol) - guard;  // find_vf's "over its face"
+  double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, exempt, exemptCount, INFINITY);
+  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, exempt, exemptCount, least);
   if (!(least > 0.0)) return cert;
   // EE: per edge, how far it lies beyond one face plane of the other body (then any pair with it is certified)
   enum { EDGES_MAX = 64 };
