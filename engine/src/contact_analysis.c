@@ -31,9 +31,6 @@
 // A vertex is its body's support point along a direction while no edge from it goes lower by more than this sine
 // (rounding of an edge lying in the plane, as a box's bottom edges on the face it rests on).
 #define ARC_TOUCH_TOL_VF 1e-9
-// An edge is acute when its faces' outward normals are more than 90° apart by more than this cosine (a box's
-// right angles, rounded, are not).
-#define ACUTE_EDGE_COS 1e-9
 
 static pdVec3 to_world(const pdPose* p, pdVec3 local) { return pd_v3_add(p->x, pd_mat3_mulv(&p->R, local)); }
 static pdVec3 to_local(const pdPose* p, pdVec3 world) { return pd_mat3_tmulv(&p->R, pd_v3_sub(world, p->x)); }
@@ -165,13 +162,6 @@ static bool support_along(const pdPolyhedron* sv, int i, const pdMat3* rel, pdVe
   return true;
 }
 
-// Does s have an edge whose faces meet at less than 90° (their outward normals more than 90° apart)?
-static bool has_acute_edge(const pdPolyhedron* s) {
-  for (int e = 0; e < s->edgeCount; ++e)
-    if (pd_v3_dot(s->faces[s->edges[e].f[0]].normal, s->faces[s->edges[e].f[1]].normal) < -ACUTE_EDGE_COS)
-      return true;
-  return false;
-}
 
 // How far q lies outside the farthest face plane of s, m (<= 0: inside all of them).
 static double outside_by(const pdPolyhedron* s, pdVec3 q) {
@@ -184,14 +174,16 @@ static double outside_by(const pdPolyhedron* s, pdVec3 q) {
 // the previous contact's face (while the vertex is below it and over it), else the shallowest that qualifies. *penetration: the bodies'
 // penetration depth, formed here when first needed (NAN until then).
 static int face_beyond_acute_edge(const pdModel* m, int iv, const pdPose* pv, int jf, const pdPose* pf, int i,
-                                  pdVec3 q, const pdMat3* rel, int previous, double tol, double over,
-                                  double* penetration) {
+                                                            pdVec3 q, const pdMat3* rel, const pdContactId* previousIds,
+                                                            int previousCount, double tol, double over,
+                                                            double* penetration) {
   const pdPolyhedron* sv = &m->bodies[iv].shape;
   const pdPolyhedron* sf = &m->bodies[jf].shape;
   double deltaMax = pd_model_pair_delta_max(m, iv, jf);
   double outside = outside_by(sf, q);
   if (outside > deltaMax) return -1;
   // face continuity (§4.4.3), as for a vertex inside: a vertex in contact keeps its face, or is no new contact here
+  int previous = previous_face(previousIds, previousCount, iv, i, jf);
   if (previous >= 0) {
     double d = face_depth(sf, previous, q);
     return d > tol && d >= outside && projects_inside(sf, previous, q, over) ? previous : -1;
@@ -212,17 +204,49 @@ static int face_beyond_acute_edge(const pdModel* m, int iv, const pdPose* pv, in
   return face;
 }
 
+// What find_vf learns of a pair only when a vertex outside the other body needs it.
+typedef struct beyondAcute {
+  bool acute;          // does the face body have an acute edge
+  double penetration;  // the bodies' penetration depth, m (NAN: not yet formed)
+} beyondAcute;
+
+// The VF contact of vertex i of body iv (at p, world; q in jf's frame), outside body jf (which has an acute edge), beyond
+// an acute edge, appended
+// to out (find_vf's), or nothing: n or n + 1. Out of find_vf's loop over the vertices, which it would slow for every
+// pair.
+__attribute__((noinline)) static int vf_beyond_acute_edge(const pdModel* m, int iv, const pdPose* pv, int jf,
+                                                          const pdPose* pf, int i, pdVec3 p, pdVec3 q,
+                                                          const pdContactId* previous, int previousCount,
+                                                          beyondAcute* b, pdContactGeom* out, int capacity, int n) {
+  const pdPolyhedron* sf = &m->bodies[jf].shape;
+  double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
+  double flushTol = FLUSH_TOL_DEFLECTIONS * pd_model_pair_delta_max(m, iv, jf);
+  pdMat3 rel;
+  pdVec3 off;
+  pose_in_frame_of(pf, pv, &rel, &off);
+  int face = face_beyond_acute_edge(m, iv, pv, jf, pf, i, q, &rel, previous, previousCount, tol, fmax(tol, flushTol),
+                                    &b->penetration);
+  if (face < 0) return n;
+  if (n < capacity)
+    out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, face}, p, pd_mat3_mulv(&pf->R, sf->faces[face].normal),
+                             face_depth(sf, face, q)};
+  return n + 1;
+}
+
 // VF contacts of the vertices of body iv inside body jf.
-static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0, int jf, const pdPose* pf,
-                   const pdPose* pf0, const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity,
-                   int n) {
+// (Formed twice, for a face body with an acute edge and for one without (find_vf): without, the loop is the paper's
+// alone, as fast as it was before vertices beyond acute edges were looked at.)
+__attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m, int iv, const pdPose* pv,
+                                                                const pdPose* pv0, int jf, const pdPose* pf,
+                                                                const pdPose* pf0, const pdContactId* previous,
+                                                                int previousCount, pdContactGeom* out, int capacity,
+                                                                int n, const bool acute) {
   const pdPolyhedron* sv = &m->bodies[iv].shape;
   const pdPolyhedron* sf = &m->bodies[jf].shape;
   double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
   double deltaMax = pd_model_pair_delta_max(m, iv, jf);
   double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
-  int acute = -1;                // does sf have an acute edge (formed when first needed)
-  double pairPenetration = NAN;  // the bodies' penetration depth, formed when first needed
+  beyondAcute beyond = {acute, NAN};
   pdMat3 rel;  // the vertex body in the face body's frame
   pdVec3 off;
   pose_in_frame_of(pf, pv, &rel, &off);
@@ -239,27 +263,16 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
     // A vertex within flushTol outside a shared plane is on it too: a flush stack's corner, rocked by
     // rounding (1e-11 rad moves it 1e-12 m on a 0.1 m box), must stay a VF contact; lost at the boundary
     // tolerance it left its corner to an edge-edge pair that came and went with the rounding's sign.
-    double outsideBy = 0.0;  // how far outside the first face plane found outside, m
     for (int f = 0; f < sf->faceCount && !outside; ++f) {
       double d = face_depth(sf, f, q);
       if (d <= flushTol && d >= -flushTol && !crosses_face_plane(sv, &rel, off, sf, f, flushTol)) continue;
       outside = d < -tol;
-      outsideBy = -d;
       if (d < penetration) penetration = d;  // fmin but inline (only compared with tol below)
     }
     if (outside) {
-      // a vertex beyond an acute edge, still pressed into a face (design note above): the vertices of bodies with
-      // such an edge, outside by at most δ_max, are looked at again
-      if (outsideBy > deltaMax) continue;
-      if (acute < 0) acute = has_acute_edge(sf);
-      if (!acute) continue;
-      int face = face_beyond_acute_edge(m, iv, pv, jf, pf, i, q, &rel, previous_face(previous, previousCount, iv, i, jf),
-                                        tol, fmax(tol, flushTol), &pairPenetration);
-      if (face < 0) continue;
-      if (n < capacity)
-        out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, face}, p, pd_mat3_mulv(&pf->R, sf->faces[face].normal),
-                                 face_depth(sf, face, q)};
-      ++n;
+      // a vertex beyond an acute edge, still pressed into a face (design note above): the vertices outside a body with
+      // such an edge are looked at again
+      if (acute) n = vf_beyond_acute_edge(m, iv, pv, jf, pf, i, p, q, previous, previousCount, &beyond, out, capacity, n);
       continue;
     }
     if (!(penetration > tol)) continue;
@@ -293,6 +306,14 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
     ++n;
   }
   return n;
+}
+
+static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0, int jf, const pdPose* pf,
+                   const pdPose* pf0, const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity,
+                   int n) {
+  if (pd_polyhedron_has_acute_edge(&m->bodies[jf].shape))
+    return find_vf_formed(m, iv, pv, pv0, jf, pf, pf0, previous, previousCount, out, capacity, n, true);
+  return find_vf_formed(m, iv, pv, pv0, jf, pf, pf0, previous, previousCount, out, capacity, n, false);
 }
 
 // Closest points of the lines P + s u and Q + t v; false when (nearly) parallel.
@@ -1045,8 +1066,8 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   double tolA = BOUNDARY_TOL_REL * sizeA, tolB = BOUNDARY_TOL_REL * sizeB;
   // VF: B's vertices against A (A's frame), A's against B (B's frame); against a body with an acute edge a vertex
   // outside it by up to δ_max may be a contact too (a vertex beyond an acute edge, find_vf)
-  double onA = has_acute_edge(sa) ? fmax(deltaMax, tolA) : fmax(tolA, flushTol);
-  double onB = has_acute_edge(sb) ? fmax(deltaMax, tolB) : fmax(tolB, flushTol);
+  double onA = pd_polyhedron_has_acute_edge(sa) ? fmax(deltaMax, tolA) : fmax(tolA, flushTol);
+  double onB = pd_polyhedron_has_acute_edge(sb) ? fmax(deltaMax, tolB) : fmax(tolB, flushTol);
   double overA = fmax(tolA, flushTol) - guard, overB = fmax(tolB, flushTol) - guard;  // find_vf's "over its face"
   double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, exempt, exemptCount, INFINITY);
   least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, exempt, exemptCount, least);
