@@ -66,13 +66,16 @@ static const hardCase hardCases[] = {
     {"stack_10.scene", NULL, NULL, 0.0},
     {"grazing.scene", NULL, NULL, 0.0},
     {"brick_bond.scene", NULL, NULL, 0.0},
-    // the contact classes the random-scene soak found (docs/reliability.md), each at 2 kHz
+    // the contact classes the random-scene soak found (docs/reliability.md), at 2 kHz, or at the soak's 100 Hz where
+    // the samples (the islands' sync times) are part of the trajectory it found
     {"corner_past_acute_edge.scene", NULL, NULL, 0.0},
     {"blade_over_corner.scene", NULL, NULL, 0.0},
     {"corner_past_acute_edge_free.scene", NULL, NULL, 0.0},
     {"edge_through_sliver.scene", NULL, NULL, 0.0},
     // pile-ups: pushed together by the bodies behind beyond what the springs are sized for (one impact at vmax), the
     // pair's contacts present throughout (its hand-overs carried): the bound is the load's, measured 4.4 and 3.7 δ_max
+    {"vertex_past_edge_frustum_sliver.scene", NULL, NULL, 0.0},
+    {"vertex_past_edge_plate.scene", NULL, NULL, 0.0},
     {"handover_pile_up.scene", NULL, NULL, 5.0},
     {"pile_up_box_frustum.scene", NULL, NULL, 5.0},
 };
