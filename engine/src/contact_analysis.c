@@ -685,6 +685,8 @@ static int feature_vertices(const pdModel* model, const pdContactId* id, int bod
 }
 
 bool pd_contact_continues(const pdModel* model, const pdContactId* a, const pdContactId* b) {
+  bool samePair = (a->body1 == b->body1 && a->body2 == b->body2) || (a->body1 == b->body2 && a->body2 == b->body1);
+  if (!samePair) return false;
   int bodies[2] = {a->body1, a->body2};
   for (int k = 0; k < 2; ++k) {
     int va[2], vb[2];
