@@ -263,16 +263,19 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
     // A vertex within flushTol outside a shared plane is on it too: a flush stack's corner, rocked by
     // rounding (1e-11 rad moves it 1e-12 m on a 0.1 m box), must stay a VF contact; lost at the boundary
     // tolerance it left its corner to an edge-edge pair that came and went with the rounding's sign.
+    double outsideBy = 0.0;  // m: how far outside the face plane that showed it outside (acute only)
     for (int f = 0; f < sf->faceCount && !outside; ++f) {
       double d = face_depth(sf, f, q);
       if (d <= flushTol && d >= -flushTol && !crosses_face_plane(sv, &rel, off, sf, f, flushTol)) continue;
       outside = d < -tol;
+      if (acute) outsideBy = -d;
       if (d < penetration) penetration = d;  // fmin but inline (only compared with tol below)
     }
     if (outside) {
       // a vertex beyond an acute edge, still pressed into a face (design note above): the vertices outside a body with
-      // such an edge are looked at again
-      if (acute) n = vf_beyond_acute_edge(m, iv, pv, jf, pf, i, p, q, previous, previousCount, &beyond, out, capacity, n);
+      // such an edge by at most δ_max are looked at again
+      if (acute && outsideBy <= deltaMax)
+        n = vf_beyond_acute_edge(m, iv, pv, jf, pf, i, p, q, previous, previousCount, &beyond, out, capacity, n);
       continue;
     }
     if (!(penetration > tol)) continue;
