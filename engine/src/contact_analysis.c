@@ -28,6 +28,9 @@
 // Edge pairs whose direction cross product is below this (sine of the angle) are parallel: their
 // closest points are not unique and the VF contacts at the edge ends carry the contact.
 #define PARALLEL_SINE_TOL 1e-9
+// A vertex is its body's support point along a direction while no edge from it goes lower by more than this sine
+// (rounding of an edge lying in the plane, as a box's bottom edges on the face it rests on).
+#define ARC_TOUCH_TOL_VF 1e-9
 
 static pdVec3 to_world(const pdPose* p, pdVec3 local) { return pd_v3_add(p->x, pd_mat3_mulv(&p->R, local)); }
 static pdVec3 to_local(const pdPose* p, pdVec3 world) { return pd_mat3_tmulv(&p->R, pd_v3_sub(world, p->x)); }
@@ -115,14 +118,135 @@ static int previous_face(const pdContactId* previous, int count, int vertexBody,
   return -1;
 }
 
-// VF contacts of the vertices of body iv inside body jf.
-static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0, int jf, const pdPose* pf,
-                   const pdPose* pf0, const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity,
-                   int n) {
+// Deepest a new EE contact may be beyond the bodies' own penetration, in the pair's δ_max: contacts are found as
+// they start (onsets are interpolated to 10⁻³ δ_max), so a deeper one is not where the bodies just met unless they
+// interpenetrate that deeply (find_ee: the pair's depth against their penetration depth).
+#define EE_NEW_DEPTH_MAX_DEFLECTIONS 3.0
+
+// The bodies' penetration depth at their poses (the separating-axis test's minimum overlap over the faces of their
+// Minkowski difference, 0 when apart), m.
+static double penetration_depth(const pdPolyhedron* sa, const pdPose* pa, const pdPolyhedron* sb, const pdPose* pb) {
+  pdSatCache cache = {PD_SAT_NONE, -1, -1, {0, 0, 0}};
+  pdSatResult r;
+  pd_interference(sa, pa->x, &pa->R, sb, pb->x, &pb->R, PD_SAT_MIN_DEPTH, &cache, &r);
+  return r.depth > 0.0 ? r.depth : 0.0;
+}
+
+// ---------------------------------------------------------------- a vertex beyond an acute edge
+//
+// Design note. The paper's VF contact is a vertex inside the other body. At an acute edge of the other body (faces
+// meeting at less than 90°: a wedge, a sliver's rim, a frustum's or a triangular prism's edge) a vertex pressed into
+// one face F lies outside the other face once it is within depth × cot(angle) of the edge: no longer inside the
+// body, yet still pressed into F, its projection still on F's polygon. No EE pair replaces it either: the edges at
+// the vertex cross the acute edge with their closest points at the vertex itself, not inside the edges. The
+// vertex and F then still span a face of the Minkowski difference (the vertex is its body's support point along
+// −n_F) and the overlap along n_F is exactly the vertex's depth below F: the separating-axis test's own measure of
+// that configuration. So such a vertex is a VF contact on F while it is over F's polygon, below F's plane, its
+// body's support point along −n_F, and outside the other body by no more than its depth and δ_max (and at most 3 δ_max
+// deep beyond the bodies' penetration P, as a new EE contact, find_ee); its depth and normal are
+// those of a VF contact on F, so they go on unchanged as the vertex crosses the other face's plane. At a right or
+// obtuse edge no such vertex exists (outside the other face, its projection is off F), so boxes and regular
+// prisms meet only the paper's contacts.
+
+// Is vertex i of sv (placed in sf's frame by rel, off; at q there) its body's support point along −n (sf's frame)
+// within the arcs' touch tolerance: none of its neighbours lies lower along n?
+static bool support_along(const pdPolyhedron* sv, int i, const pdMat3* rel, pdVec3 q, pdVec3 n) {
+  pdVec3 nv = pd_mat3_tmulv(rel, n);  // n in sv's frame
+  for (int e = 0; e < sv->edgeCount; ++e) {
+    const pdEdge* edge = &sv->edges[e];
+    if (edge->v[0] != i && edge->v[1] != i) continue;
+    pdVec3 w = pd_v3_sub(sv->vertices[edge->v[0] == i ? edge->v[1] : edge->v[0]], sv->vertices[i]);
+    if (pd_v3_dot(nv, w) < -ARC_TOUCH_TOL_VF * pd_v3_norm(w)) return false;
+  }
+  (void)q;
+  return true;
+}
+
+
+// How far q lies outside the farthest face plane of s, m (<= 0: inside all of them).
+static double outside_by(const pdPolyhedron* s, pdVec3 q) {
+  double most = -INFINITY;
+  for (int f = 0; f < s->faceCount; ++f) most = fmax(most, -face_depth(s, f, q));
+  return most;
+}
+
+// The face a vertex of sv outside sf (q in sf's frame) presses on beyond an acute edge (design note above), or -1:
+// the previous contact's face (while the vertex is below it and over it), else the shallowest that qualifies. *penetration: the bodies'
+// penetration depth, formed here when first needed (NAN until then).
+static int face_beyond_acute_edge(const pdModel* m, int iv, const pdPose* pv, int jf, const pdPose* pf, int i,
+                                                            pdVec3 q, const pdMat3* rel, const pdContactId* previousIds,
+                                                            int previousCount, double tol, double over,
+                                                            double* penetration) {
   const pdPolyhedron* sv = &m->bodies[iv].shape;
+  const pdPolyhedron* sf = &m->bodies[jf].shape;
+  double deltaMax = pd_model_pair_delta_max(m, iv, jf);
+  double outside = outside_by(sf, q);
+  if (outside > deltaMax) return -1;
+  // face continuity (§4.4.3), as for a vertex inside: a vertex in contact keeps its face, or is no new contact here
+  int previous = previous_face(previousIds, previousCount, iv, i, jf);
+  if (previous >= 0) {
+    double d = face_depth(sf, previous, q);
+    return d > tol && d >= outside && projects_inside(sf, previous, q, over) ? previous : -1;
+  }
+  int face = -1;
+  double best = INFINITY;
+  for (int f = 0; f < sf->faceCount; ++f) {
+    double d = face_depth(sf, f, q);
+    if (!(d > tol) || !(d >= outside) || !projects_inside(sf, f, q, over)) continue;
+    if (!(d < best)) continue;
+    if (d > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax) {
+      if (isnan(*penetration)) *penetration = penetration_depth(sv, pv, sf, pf);
+      if (d > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + *penetration) continue;
+    }
+    if (!support_along(sv, i, rel, q, sf->faces[f].normal)) continue;
+    best = d, face = f;
+  }
+  return face;
+}
+
+// What find_vf learns of a pair only when a vertex outside the other body needs it.
+typedef struct beyondAcute {
+  bool acute;          // does the face body have an acute edge
+  double penetration;  // the bodies' penetration depth, m (NAN: not yet formed)
+} beyondAcute;
+
+// The VF contact of vertex i of body iv (at p, world; q in jf's frame), outside body jf (which has an acute edge), beyond
+// an acute edge, appended
+// to out (find_vf's), or nothing: n or n + 1. Out of find_vf's loop over the vertices, which it would slow for every
+// pair.
+__attribute__((noinline)) static int vf_beyond_acute_edge(const pdModel* m, int iv, const pdPose* pv, int jf,
+                                                          const pdPose* pf, int i, pdVec3 p, pdVec3 q,
+                                                          const pdContactId* previous, int previousCount,
+                                                          beyondAcute* b, pdContactGeom* out, int capacity, int n) {
   const pdPolyhedron* sf = &m->bodies[jf].shape;
   double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
   double flushTol = FLUSH_TOL_DEFLECTIONS * pd_model_pair_delta_max(m, iv, jf);
+  pdMat3 rel;
+  pdVec3 off;
+  pose_in_frame_of(pf, pv, &rel, &off);
+  int face = face_beyond_acute_edge(m, iv, pv, jf, pf, i, q, &rel, previous, previousCount, tol, fmax(tol, flushTol),
+                                    &b->penetration);
+  if (face < 0) return n;
+  if (n < capacity)
+    out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, face}, p, pd_mat3_mulv(&pf->R, sf->faces[face].normal),
+                             face_depth(sf, face, q)};
+  return n + 1;
+}
+
+// VF contacts of the vertices of body iv inside body jf.
+// (Formed twice, for a face body with an acute edge and for one without (find_vf): without, the loop is the paper's
+// alone, as fast as it was before vertices beyond acute edges were looked at.)
+__attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m, int iv, const pdPose* pv,
+                                                                const pdPose* pv0, int jf, const pdPose* pf,
+                                                                const pdPose* pf0, const pdContactId* previous,
+                                                                int previousCount, pdContactGeom* out, int capacity,
+                                                                int n, const bool acute) {
+  const pdPolyhedron* sv = &m->bodies[iv].shape;
+  const pdPolyhedron* sf = &m->bodies[jf].shape;
+  double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
+  double deltaMax = pd_model_pair_delta_max(m, iv, jf);
+  double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
+  beyondAcute beyond = {acute, NAN};
   pdMat3 rel;  // the vertex body in the face body's frame
   pdVec3 off;
   pose_in_frame_of(pf, pv, &rel, &off);
@@ -139,14 +263,27 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
     // A vertex within flushTol outside a shared plane is on it too: a flush stack's corner, rocked by
     // rounding (1e-11 rad moves it 1e-12 m on a 0.1 m box), must stay a VF contact; lost at the boundary
     // tolerance it left its corner to an edge-edge pair that came and went with the rounding's sign.
+    double outsideBy = 0.0;  // m: how far outside the face plane that showed it outside (acute only)
     for (int f = 0; f < sf->faceCount && !outside; ++f) {
       double d = face_depth(sf, f, q);
       if (d <= flushTol && d >= -flushTol && !crosses_face_plane(sv, &rel, off, sf, f, flushTol)) continue;
       outside = d < -tol;
+      if (acute) outsideBy = -d;
       if (d < penetration) penetration = d;  // fmin but inline (only compared with tol below)
     }
-    if (outside || !(penetration > tol)) continue;
+    if (outside) {
+      // a vertex beyond an acute edge, still pressed into a face (design note above): the vertices outside a body with
+      // such an edge by at most δ_max are looked at again
+      if (acute && outsideBy <= deltaMax)
+        n = vf_beyond_acute_edge(m, iv, pv, jf, pf, i, p, q, previous, previousCount, &beyond, out, capacity, n);
+      continue;
+    }
+    if (!(penetration > tol)) continue;
     int face = previous_face(previous, previousCount, iv, i, jf);
+    // face continuity holds while the vertex is over its face, as tracking keeps it (pd_contact_track); one that slid
+    // off it onto the next face is found there now, so that its contact hands over in this commit (a successor found
+    // only at the next commit leaves the vertex without a contact for a step)
+    if (face >= 0 && !projects_inside(sf, face, q, fmax(tol, flushTol))) face = -1;
     // a new contact: the face whose plane it crossed during the step. Depth alone misleads where the
     // vertex also lies just inside another plane (a brick's corner a roundoff inside the side plane of
     // the brick below, which it slides along, while it sinks into the top face).
@@ -172,6 +309,14 @@ static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0
     ++n;
   }
   return n;
+}
+
+static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0, int jf, const pdPose* pf,
+                   const pdPose* pf0, const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity,
+                   int n) {
+  if (pd_polyhedron_has_acute_edge(&m->bodies[jf].shape))
+    return find_vf_formed(m, iv, pv, pv0, jf, pf, pf0, previous, previousCount, out, capacity, n, true);
+  return find_vf_formed(m, iv, pv, pv0, jf, pf, pf0, previous, previousCount, out, capacity, n, false);
 }
 
 // Closest points of the lines P + s u and Q + t v; false when (nearly) parallel.
@@ -360,20 +505,6 @@ static bool end_in_vf_contact(const pdContactGeom* found, int count, int body, i
   return false;
 }
 
-// Deepest a new EE contact may be beyond the bodies' own penetration, in the pair's δ_max: contacts are found as
-// they start (onsets are interpolated to 10⁻³ δ_max), so a deeper one is not where the bodies just met unless they
-// interpenetrate that deeply (find_ee: the pair's depth against their penetration depth).
-#define EE_NEW_DEPTH_MAX_DEFLECTIONS 3.0
-
-// The bodies' penetration depth at their poses (the separating-axis test's minimum overlap over the faces of their
-// Minkowski difference, 0 when apart), m.
-static double penetration_depth(const pdPolyhedron* sa, const pdPose* pa, const pdPolyhedron* sb, const pdPose* pb) {
-  pdSatCache cache = {PD_SAT_NONE, -1, -1, {0, 0, 0}};
-  pdSatResult r;
-  pd_interference(sa, pa->x, &pa->R, sb, pb->x, &pb->R, PD_SAT_MIN_DEPTH, &cache, &r);
-  return r.depth > 0.0 ? r.depth : 0.0;
-}
-
 // find_ee's per-search caches, on the stack: A's Gauss arcs of its first this many edges, the overlaps along the
 // first this many faces of each body (a bit of a faceMask per entry).
 #define FIND_EE_CACHED 64
@@ -407,8 +538,17 @@ static double least_face_overlap(const pdPolyhedron* sa, const pdPolyhedron* sb,
   return least;
 }
 
-static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
-                   int capacity, int n) {
+// Does the edge pair (ea of A, eb of B) continue one of the contacts `broken` (contact_analysis.h)?
+static bool continues_broken(const pdModel* model, int ia, int ea, int ib, int eb, const pdContactId* broken,
+                             int brokenCount) {
+  pdContactId id = {ia, ib, pd_contactEE, ea, eb};
+  for (int k = 0; k < brokenCount; ++k)
+    if (pd_contact_continues(model, &broken[k], &id)) return true;
+  return false;
+}
+
+static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, const pdContactId* broken,
+                   int brokenCount, pdContactGeom* out, int capacity, int n) {
   const pdPolyhedron* sa = &model->bodies[ia].shape;
   const pdPolyhedron* sb = &model->bodies[ib].shape;
   pdMat3 rel;  // B in A's frame
@@ -509,8 +649,15 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
         // (a pair deeper than the new-pair allowance, kept above for the bodies' penetration P, may have its points
         // up to δ_max + P outside: a 1 cm hull entering a body 58 δ_max deep with no contact, soak seed 32 scene
         // 733, had its edge pair refused here at δ_max)
-        double slack = g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax ? fmin(g.depth, deltaMax + penetration)
-                                                                         : fmin(g.depth, deltaMax);
+        // the successor of a hand-over (an edge pair that continues a contact of C0 that no longer tracks) gets the
+        // deep pair's slack at any depth: its predecessor carried the pair this deep (soak seed 3, scene 8454: a
+        // successor on the same edge was refused here at 2.5 δ_max and the pair sank 6.5 δ_max)
+        bool deep = g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax;
+        if (!deep && brokenCount > 0 && continues_broken(model, ia, i, ib, j, broken, brokenCount)) {
+          if (isnan(penetration)) penetration = penetration_depth(sa, pa, sb, pb);
+          deep = true;
+        }
+        double slack = deep ? fmin(g.depth, deltaMax + penetration) : fmin(g.depth, deltaMax);
         if (!inside_body(sa, onB, slack) || !inside_body(sb, onAinB, slack)) continue;
         pdVec3 u = pd_v3_scale(g.normal, -1.0);  // from A to B
         double overlap = fmin(overlap_along(sa, sb, &rel, off, u), overlap_along(sa, sb, &rel, off, g.normal));
@@ -523,6 +670,35 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
     }
   }
   return n;
+}
+
+// The vertices of contact id's feature on body `body` (a vertex: 1, an edge: 2; a face, or not its body: 0).
+static int feature_vertices(const pdModel* model, const pdContactId* id, int body, int v[2]) {
+  const pdPolyhedron* s = &model->bodies[body].shape;
+  if (id->body1 == body) {
+    if (id->kind == pd_contactVF) return v[0] = id->feat1, 1;
+    v[0] = s->edges[id->feat1].v[0], v[1] = s->edges[id->feat1].v[1];
+    return 2;
+  }
+  if (id->body2 == body && id->kind == pd_contactEE) {
+    v[0] = s->edges[id->feat2].v[0], v[1] = s->edges[id->feat2].v[1];
+    return 2;
+  }
+  return 0;
+}
+
+bool pd_contact_continues(const pdModel* model, const pdContactId* a, const pdContactId* b) {
+  bool samePair = (a->body1 == b->body1 && a->body2 == b->body2) || (a->body1 == b->body2 && a->body2 == b->body1);
+  if (!samePair) return false;
+  int bodies[2] = {a->body1, a->body2};
+  for (int k = 0; k < 2; ++k) {
+    int va[2], vb[2];
+    int na = feature_vertices(model, a, bodies[k], va), nb = feature_vertices(model, b, bodies[k], vb);
+    for (int i = 0; i < na; ++i)
+      for (int j = 0; j < nb; ++j)
+        if (va[i] == vb[j]) return true;
+  }
+  return false;
 }
 
 // Drops VF contacts whose vertex belongs to the higher-numbered body when a VF contact of the other
@@ -546,6 +722,12 @@ static int drop_coincident(pdContactGeom* c, int count, int lowBody) {
 int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, const pdPose* pa0,
                      const pdPose* pb0, const pdContactId* previous, int previousCount, pdContactGeom* out,
                      int capacity) {
+  return pd_contacts_find_handover(model, ia, pa, ib, pb, pa0, pb0, previous, previousCount, NULL, 0, out, capacity);
+}
+
+int pd_contacts_find_handover(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
+                              const pdPose* pa0, const pdPose* pb0, const pdContactId* previous, int previousCount,
+                              const pdContactId* broken, int brokenCount, pdContactGeom* out, int capacity) {
   PD_ASSERT(ia != ib && ia >= 0 && ib >= 0 && ia < model->bodyCount && ib < model->bodyCount);
   PD_ASSERT((pa0 == NULL) == (pb0 == NULL));
   if (ia > ib) {
@@ -558,7 +740,7 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
   int n = 0;
   n = find_vf(model, ia, pa, pa0, ib, pb, pb0, previous, previousCount, out, capacity, n);
   n = find_vf(model, ib, pb, pb0, ia, pa, pa0, previous, previousCount, out, capacity, n);
-  n = find_ee(model, ia, pa, ib, pb, out, capacity, n);
+  n = find_ee(model, ia, pa, ib, pb, broken, brokenCount, out, capacity, n);
   if (n > capacity) return n;
   n = drop_coincident(out, n, ia);
   // the contact state is kept sorted by id (§4.4): sort this pair's contacts (few: insertion sort)
@@ -688,7 +870,16 @@ bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const 
     // across it by roundoff and must not break and be found again on the side face
     double over = fmax(BOUNDARY_TOL_REL * model->bodies[id->body2].size,
                        FLUSH_TOL_DEFLECTIONS * pd_model_pair_delta_max(model, id->body1, id->body2));
-    return projects_inside(s2, id->feat2, q, over) && inside_body(s2, q, outside);
+    if (!projects_inside(s2, id->feat2, q, over)) return false;
+    if (inside_body(s2, q, outside)) return true;
+    // a vertex beyond an acute edge (find_vf) stays on its face while it presses on it as there: outside the body by
+    // at most its depth and δ_max, its body's support point along −n_F
+    double beyond = outside_by(s2, q);
+    if (!(beyond <= fmin(out->depth, pd_model_pair_delta_max(model, id->body1, id->body2)))) return false;
+    pdMat3 rel;
+    pdVec3 off;
+    pose_in_frame_of(p2, p1, &rel, &off);
+    return support_along(&model->bodies[id->body1].shape, id->feat1, &rel, q, s2->faces[id->feat2].normal);
   }
   // an edge pair stays a contact while its closest points lie inside both edges and it spans a face of
   // the Minkowski difference (its Gauss-map arcs still meet): past that, other features carry the contact
@@ -714,8 +905,10 @@ bool pd_contact_edge_lines(const pdModel* model, const pdContactId* id, const pd
 // at any poses within a motion `margin` of the ones it was issued at, so the caller may skip both. It rests on
 // conditions every contact the search reports must meet (find_vf, find_ee), each with its distance to failing:
 // - VF, vertex v of one body in the other: not outside any face plane of the other by more than max(tol,
-//   flushTol) (a face it is farther outside of is never a shared plane, and outside it, it is rejected). Margin:
-//   how far v is outside its farthest face plane, less that tolerance.
+//   flushTol) (a face it is farther outside of is never a shared plane, and outside it, it is rejected), or, when the
+//   other body has an acute edge, by more than δ_max (a vertex beyond an acute edge). Margin: how far v is outside
+//   its farthest face plane, less that tolerance. A vertex in the exempt list keeps its face while it is over the
+//   face's polygon (find_vf's face continuity): margin, how far its projection is inside the polygon.
 // - EE, edges ea of A and eb of B: each edge's closest point within max(tol, δ_max) + P of inside the other body
 //   (the slack find_ee allows; P, the bodies' penetration depth, only for a pair deeper than 3 δ_max), so neither
 //   edge may lie wholly beyond one face plane of the other body by more. A motion m moves the edge by at most m
@@ -812,23 +1005,47 @@ static double segment_distance2(pdVec3 p0, pdVec3 u, pdVec3 q0, pdVec3 v) {
   return pd_v3_dot(d, d);
 }
 
-static bool exempt_listed(const pdContactId* exempt, int count, pdContactKind kind, int body1, int feat1, int feat2) {
+// The exempt contact of this kind on body1's feature feat1 (and, for EE, feat2), or -1.
+static int exempt_index(const pdContactId* exempt, int count, pdContactKind kind, int body1, int feat1, int feat2) {
   for (int i = 0; i < count; ++i) {
     const pdContactId* c = &exempt[i];
     if (c->kind == kind && c->body1 == body1 && c->feat1 == feat1 && (kind == pd_contactVF || c->feat2 == feat2))
-      return true;
+      return i;
   }
-  return false;
+  return -1;
+}
+static bool exempt_listed(const pdContactId* exempt, int count, pdContactKind kind, int body1, int feat1, int feat2) {
+  return exempt_index(exempt, count, kind, body1, feat1, feat2) >= 0;
+}
+
+// How far q's projection onto face f's plane may move before it leaves the polygon by more than `over`, m.
+static double over_face_margin(const pdPolyhedron* s, int f, pdVec3 q, double over) {
+  const pdFace* face = &s->faces[f];
+  const int* idx = s->faceVertices + face->first;
+  double least = INFINITY;
+  for (int i = 0; i < face->count; ++i) {
+    pdVec3 a = s->vertices[idx[i]], b = s->vertices[idx[(i + 1) % face->count]];
+    pdVec3 e = pd_v3_sub(b, a);
+    double side = pd_v3_dot(pd_v3_cross(face->normal, e), pd_v3_sub(q, a)) / pd_v3_norm(e);
+    least = fmin(least, side + over);
+  }
+  return least;
 }
 
 // The least margin of the vertices of sv (given in sf's frame by rel, off) against sf, vertices listed as VF
 // contacts of body iv in `exempt` left out; stops at `bound` (no lower margin needed).
 static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf,
-                              double tolerance, const pdContactId* exempt, int exemptCount, double bound) {
+                              double tolerance, double over, const pdContactId* exempt, int exemptCount, double bound) {
   double least = bound;
   for (int i = 0; i < sv->vertexCount && least > 0.0; ++i) {
-    if (exempt_listed(exempt, exemptCount, pd_contactVF, iv, i, 0)) continue;
     pdVec3 q = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[i]));
+    int listed = exempt_index(exempt, exemptCount, pd_contactVF, iv, i, 0);
+    if (listed >= 0) {
+      // a vertex in contact keeps its face while it is over it (find_vf), and takes another once it is not
+      double margin = over_face_margin(sf, exempt[listed].feat2, q, over);
+      least = margin < least ? margin : least;
+      continue;
+    }
     double margin = outside_farthest(sf, q, least + tolerance) - tolerance;
     least = margin < least ? margin : least;
   }
@@ -852,10 +1069,13 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   double deltaMax = pd_model_pair_delta_max(model, ia, ib);
   double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
   double tolA = BOUNDARY_TOL_REL * sizeA, tolB = BOUNDARY_TOL_REL * sizeB;
-  // VF: B's vertices against A (A's frame), A's against B (B's frame)
-  double least =
-      vertices_margin(sb, ib, &cert.rel, cert.off, sa, fmax(tolA, flushTol) + guard, exempt, exemptCount, INFINITY);
-  least = vertices_margin(sa, ia, &relT, offA, sb, fmax(tolB, flushTol) + guard, exempt, exemptCount, least);
+  // VF: B's vertices against A (A's frame), A's against B (B's frame); against a body with an acute edge a vertex
+  // outside it by up to δ_max may be a contact too (a vertex beyond an acute edge, find_vf)
+  double onA = pd_polyhedron_has_acute_edge(sa) ? fmax(deltaMax, tolA) : fmax(tolA, flushTol);
+  double onB = pd_polyhedron_has_acute_edge(sb) ? fmax(deltaMax, tolB) : fmax(tolB, flushTol);
+  double overA = fmax(tolA, flushTol) - guard, overB = fmax(tolB, flushTol) - guard;  // find_vf's "over its face"
+  double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, exempt, exemptCount, INFINITY);
+  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, exempt, exemptCount, least);
   if (!(least > 0.0)) return cert;
   // EE: per edge, how far it lies beyond one face plane of the other body (then any pair with it is certified)
   enum { EDGES_MAX = 64 };

@@ -368,3 +368,8 @@ void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const
   s->s1n = fmin(s->s1n, 0.0);
   s->s2n = fmax(s->s2n, 0.0);
 }
+
+void pd_springs_clip_to_cone(pdSprings* s, const pdContactParams* p, double limit) {
+  s->s1t = clip_to_cone(s->s1t, p->k1t, limit);
+  s->s2t = clip_to_cone(s->s2t, p->k2t, limit);
+}

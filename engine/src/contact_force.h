@@ -99,3 +99,6 @@ static inline bool pd_contact_force_pulls(const pdContactForce* f) { return pd_c
 // length, and a spring beyond it relaxes through slip on the contact's own time scale (contact_force.c).
 // nOld and nNew must be unit vectors; fn is the normal force at the accepted state, N.
 void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const pdContactParams* p, double fn);
+// Shortens each tangential spring along itself so that its force stays within `limit` (N): |k_it s_it| <= limit (a
+// spring with k_it = 0 carries no force and is left alone). What a successor of a hand-over inherits (contact_set.c).
+void pd_springs_clip_to_cone(pdSprings* s, const pdContactParams* p, double limit);

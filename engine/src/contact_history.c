@@ -13,11 +13,20 @@ typedef struct trace {
   pdVec3 normal;
   double deltaMax;  // m
   bool taken;
+  double fn;  // N: a hand-over trace's normal force when its contact broke
+  int age;    // commits a hand-over trace has been kept
 } trace;
+
+// A growable list of traces.
+typedef struct traceList {
+  trace* items;
+  int count, capacity;
+} traceList;
 
 struct pdContactHistory {
   trace* items;  // [0, sortedCount) sorted by id (pd_contact_id_compare); then those left since the last age
   int count, capacity, sortedCount;
+  traceList handovers;  // contacts broken geometrically with no successor yet (pd_history_leave_handover)
 };
 
 pdContactHistory* pd_history_create(void) {
@@ -29,10 +38,11 @@ pdContactHistory* pd_history_create(void) {
 void pd_history_free(pdContactHistory* h) {
   if (!h) return;
   free(h->items);
+  free(h->handovers.items);
   free(h);
 }
 
-void pd_history_clear(pdContactHistory* h) { h->count = h->sortedCount = 0; }
+void pd_history_clear(pdContactHistory* h) { h->count = h->sortedCount = h->handovers.count = 0; }
 
 int pd_history_count(const pdContactHistory* h) { return h->count; }
 
@@ -42,7 +52,34 @@ void pd_history_leave(pdContactHistory* h, const pdContactId* id, const pdSpring
     h->capacity = h->capacity ? 2 * h->capacity : 16;
     h->items = pd_grow(h->items, (size_t)h->capacity, sizeof *h->items);
   }
-  h->items[h->count++] = (trace){*id, *springs, normal, deltaMax, false};
+  h->items[h->count++] = (trace){*id, *springs, normal, deltaMax, false, 0.0, 0};
+}
+
+void pd_history_leave_handover(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
+                               double fn) {
+  traceList* l = &h->handovers;
+  if (l->count == l->capacity) {
+    l->capacity = l->capacity ? 2 * l->capacity : 16;
+    l->items = pd_grow(l->items, (size_t)l->capacity, sizeof *l->items);
+  }
+  l->items[l->count++] = (trace){*id, *springs, normal, 0.0, false, fn, 0};
+}
+
+bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const pdContactId* id, pdVec3 normal,
+                              const pdContactParams* params, pdSprings* springs) {
+  traceList* l = &h->handovers;
+  for (int i = 0; i < l->count; ++i) {
+    trace* t = &l->items[i];
+    if (t->taken || !pd_contact_continues(model, &t->id, id)) continue;
+    // as a hand-over within one commit (contact_set.c): the springs turned into the new tangent plane and held within
+    // the cone of the predecessor's normal force
+    *springs = t->springs;
+    pd_springs_realign(springs, t->normal, normal, params->mu, params, t->fn);
+    pd_springs_clip_to_cone(springs, params, params->mu * fmax(t->fn, 0.0));
+    t->taken = true;
+    return true;
+  }
+  return false;
 }
 
 static int compare_traces(const void* a, const void* b) {
@@ -59,6 +96,15 @@ void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* pos
     if (-g.depth > PD_HISTORY_GAP_REL * t->deltaMax) continue;
     h->items[kept++] = *t;
   }
+  // hand-over traces wait a few commits for their successor (it is often found a step or two after its predecessor
+  // broke), then go
+  int waiting = 0;
+  for (int i = 0; i < h->handovers.count; ++i) {
+    trace* t = &h->handovers.items[i];
+    if (t->taken || ++t->age > PD_HANDOVER_COMMITS) continue;
+    h->handovers.items[waiting++] = *t;
+  }
+  h->handovers.count = waiting;
   // ids are unique among traces: a contact breaks only while listed, and a listed contact has no trace left
   if (kept > 1 && kept > h->sortedCount) qsort(h->items, (size_t)kept, sizeof *h->items, compare_traces);
   h->count = h->sortedCount = kept;

@@ -7,7 +7,8 @@
 // behind (a "trace", keyed by its id: the same two features), as long as its features stay tracked and within
 // PD_HISTORY_GAP_REL × δ_max of touching; a contact on the same features that starts again meanwhile takes them,
 // realigned to its normal. A trace whose features part farther, or leave each other (a vertex off its face), is
-// forgotten. Traces are kept per contact set: an island set up anew starts without them (as before this history).
+// forgotten. A contact whose features part (broken geometrically) with no successor in that commit leaves a hand-over
+// trace, taken by a successor on continuing features within a few commits. Traces are kept per contact set: an island set up anew starts without them (as before this history).
 #pragma once
 
 #include <stdbool.h>
@@ -21,6 +22,12 @@
 // that bounces off goes beyond it within a step or two.
 #define PD_HISTORY_GAP_REL 0.1
 
+// A contact broken geometrically with no successor in that commit leaves its springs for this many commits: a successor
+// on features that continue it (pd_contact_continues) found meanwhile takes them, as a hand-over in one commit does.
+// A corner of a box spinning at 560 rad/s across an edge turns its edge pairs over every 40–100 µs, and the successor
+// pair is found a step or two after its predecessor broke (soak seed 32, scene 592).
+#define PD_HANDOVER_COMMITS 4
+
 typedef struct pdContactHistory pdContactHistory;
 
 pdContactHistory* pd_history_create(void);
@@ -31,6 +38,15 @@ int pd_history_count(const pdContactHistory* h);
 // Contact `id` of the list broke by force with these springs, its normal `normal` and the pair's δ_max deltaMax (m).
 void pd_history_leave(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
                       double deltaMax);
+// Contact `id` of the list broke geometrically (its features parted) with these springs, its normal and normal force fn
+// (N), and no contact took over from it: kept PD_HANDOVER_COMMITS commits for a successor.
+void pd_history_leave_handover(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
+                               double fn);
+// A new contact `id` with normal `normal` that continues a hand-over trace (pd_contact_continues): its springs, normal
+// and tangential, turned to `normal` and the tangential ones held within the cone of the trace's normal force, into
+// *springs; the trace is forgotten; true. Else false.
+bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const pdContactId* id, pdVec3 normal,
+                              const pdContactParams* params, pdSprings* springs);
 // After a commit, at the bodies' new poses (indexed by model body): forgets every trace whose features no longer
 // track or are apart by more than the gap tolerance, and every trace left before this call and taken since.
 void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* poses);

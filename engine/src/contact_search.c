@@ -203,6 +203,22 @@ static void interference_range(void* ctx, int part, int begin, int end) {
   }
 }
 
+// The contact of C0 (among the pair's items[first .. first + count)) that new contact id takes over from: one that no
+// longer tracks and has handed over to none yet; face continuity first (the same vertex on another face), then the
+// first whose features id continues. -1: none.
+static int handover_predecessor(const pdModel* model, const pdContactSet* set, int first, int count,
+                                const pdContactId* id) {
+  for (int k = first; k < first + count && id->kind == pd_contactVF; ++k) {
+    const pdContactId* old = &set->items[k].id;
+    if (old->kind == pd_contactVF && old->body1 == id->body1 && old->feat1 == id->feat1 && !set->eval[k].tracked &&
+        !set->eval[k].transferred)
+      return k;
+  }
+  for (int k = first; k < first + count; ++k)
+    if (!set->eval[k].tracked && !set->eval[k].transferred && pd_contact_continues(model, &set->items[k].id, id)) return k;
+  return -1;
+}
+
 // Did pair p's search find nothing its contacts of C0 (`previous`, sorted like found[0 .. n)) do not have, with
 // each of them tracked?
 static bool quiet(const pdContactSet* set, int p, const pdContactGeom* found, int n, const pdContactId* previous) {
@@ -229,11 +245,16 @@ static void find_range(void* ctx, int part, int begin, int end) {
     set->pairFoundCount[p] = 0;
     if (set->certified[p]) continue;
     int a = set->pairs[p].a, b = set->pairs[p].b, first = set->pairPrevious[p], count = set->pairPreviousCount[p];
-    for (int k = 0; k < count; ++k) sp->previous[k] = set->items[first + k].id;
+    int brokenCount = 0;  // its contacts of C0 that no longer track: their successors are hand-overs
+    for (int k = 0; k < count; ++k) {
+      sp->previous[k] = set->items[first + k].id;
+      if (!set->eval[first + k].tracked) sp->broken[brokenCount++] = set->items[first + k].id;
+    }
     int n = 0;
     if (set->touching[p]) {
-      while ((n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous,
-                                   count, sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount)) >
+      while ((n = pd_contacts_find_handover(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b],
+                                            sp->previous, count, sp->broken, brokenCount, sp->found + sp->foundCount,
+                                            sp->foundCapacity - sp->foundCount)) >
              sp->foundCapacity - sp->foundCount) {
         sp->foundCapacity = 2 * (sp->foundCount + n);
         sp->found = pd_grow(sp->found, sp->foundCapacity, sizeof *sp->found);
@@ -298,16 +319,12 @@ void pd_contact_search(const pdModel* model, pdState* s, const double* y1, int p
       int b1 = g->id.body1, b2 = g->id.body2;
       pdVec3 du = relative_velocity(model, y1, poses1, &g->id, g->point);
       c.approaching = pd_v3_dot(du, g->normal) < 0.0;
-      // face continuity: the vertex of a VF contact of C0 that no longer tracks its face, now on another
-      for (int k = first; k < first + previousCount && g->id.kind == pd_contactVF; ++k) {
-        const pdContactId* old = &set->items[k].id;
-        if (old->kind == pd_contactVF && old->body1 == g->id.body1 && old->feat1 == g->id.feat1 &&
-            !set->eval[k].tracked && !set->eval[k].transferred) {
-          c.inherit = k;
-          set->eval[k].transferred = true;
-          break;
-        }
-      }
+      // a hand-over: the contact of C0 that no longer tracks and whose features this one continues carries on
+      // in it (springs and all): first face continuity (the vertex of a VF contact of C0, now on another face),
+      // then any feature change over a shared vertex (EE → VF at an edge's end, VF → EE along an edge at the
+      // vertex, EE → EE turning over at a vertex or along a shared edge)
+      c.inherit = handover_predecessor(model, set, first, previousCount, &g->id);
+      if (c.inherit >= 0) set->eval[c.inherit].transferred = true;
       if (c.inherit < 0) c.onset = pd_contact_onset(model, &g->id, &poses0[b1], &poses1[b1], &poses0[b2], &poses1[b2]);
       add_candidate(set, &c);
     }

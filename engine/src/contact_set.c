@@ -69,8 +69,10 @@ void pd_contact_set_reserve_list(pdContactSet* set, int capacity) {
   set->bodyList = pd_grow(set->bodyList, 2 * c, sizeof *set->bodyList);
   if (set->broad) {  // a view (pd_contact_set_create_view) has no contact events or stability bound
     set->eval = pd_grow(set->eval, c, sizeof *set->eval);
-    for (int part = 0; part < 2; ++part)
+    for (int part = 0; part < 2; ++part) {
       set->search[part].previous = pd_grow(set->search[part].previous, c, sizeof *set->search[part].previous);
+      set->search[part].broken = pd_grow(set->search[part].broken, c, sizeof *set->search[part].broken);
+    }
     set->stability = pd_grow(set->stability, c, sizeof *set->stability);
   } else {
     set->captured = pd_grow(set->captured, c, sizeof *set->captured);
@@ -131,7 +133,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->next);
   free(set->captured);
   free(set->recordedY);
-  for (int part = 0; part < 2; ++part) free(set->search[part].previous);
+  for (int part = 0; part < 2; ++part) free(set->search[part].previous), free(set->search[part].broken);
   free(set->force);
   free(set->stability);
   free(set->bodyFirst);
@@ -572,7 +574,13 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       s->count.releaseBoundSum += e->modeBound;
     }
     if (!e->tracked) {
-      if (!e->transferred) ++s->count.breaksGeometry;
+      if (!e->transferred) {
+        ++s->count.breaksGeometry;
+        if (set->history) {
+          pdSprings left = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
+          pd_history_leave_handover(set->history, &c->id, &left, e->geom.normal, e->force.fn);
+        }
+      }
       continue;
     }
     if (pd_contact_force_pulls(&e->force)) {
@@ -605,9 +613,13 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       const contactSlot* old = &set->items[cand->inherit];
       contactSlot* k = &set->next[count++];
       *k = new_slot(model, &cand->geom);
+      // the successor of a hand-over takes its predecessor's springs: the normal ones as they are, the tangential
+      // ones turned into its tangent plane and held within the friction cone of the predecessor's normal force,
+      // so the force goes on where it was (and a spring the cone would not carry does not load it with slip)
+      double fn = set->eval[cand->inherit].force.fn;
       k->springs = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * cand->inherit);
-      pd_springs_realign(&k->springs, old->normal, cand->geom.normal, k->params.mu, &k->params,
-                         set->eval[cand->inherit].force.fn);
+      pd_springs_realign(&k->springs, old->normal, cand->geom.normal, k->params.mu, &k->params, fn);
+      pd_springs_clip_to_cone(&k->springs, &k->params, k->params.mu * fmax(fn, 0.0));
       ++s->count.contactsTransferred;
     } else if (cand->approaching) {
       contactSlot* k = &set->next[count++];
@@ -615,6 +627,9 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       k->onsetAge = cand->onsetAge;
       if (set->history && pd_history_take(set->history, &cand->geom.id, cand->geom.normal, &k->params, &k->springs))
         ++s->count.historyKept;
+      else if (set->history && pd_history_take_handover(model, set->history, &cand->geom.id, cand->geom.normal,
+                                                        &k->params, &k->springs))
+        ++s->count.contactsTransferred;
       if (cand->onsetAge > 0.0) {
         s->count.onsetBoundMax = fmax(s->count.onsetBoundMax, cand->onsetBound);
         s->count.onsetBoundSum += cand->onsetBound;

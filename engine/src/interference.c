@@ -125,6 +125,7 @@ struct pdSatIndex {
   pdVec3 centre;        // the vertex average (strictly inside), m
   double inradius;      // distance from it to the nearest face plane, m
   double circumradius;  // to the farthest vertex, m
+  bool acuteEdge;       // two faces meet at less than 90° (pd_polyhedron_has_acute_edge)
   // Polyhedra with PD_SAT_INDEX_MIN_EDGES edges or more, else NULL (small ones: edge_record on the fly):
   satEdge* edge;        // (E)
   int* neighbourFirst;  // (V + 1) vertex v's neighbours are neighbours[neighbourFirst[v] .. neighbourFirst[v+1])
@@ -168,6 +169,16 @@ static int compare_z(const void* a, const void* b) {
   return *(const int*)a - *(const int*)b;
 }
 
+// Do two faces of p meet at an edge at less than 90°: their outward normals more than 90° apart by more than
+// PD_ACUTE_EDGE_COS?
+static bool acute_edge(const pdPolyhedron* p) {
+  for (int e = 0; e < p->edgeCount; ++e)
+    if (pd_v3_dot(p->faces[p->edges[e].f[0]].normal, p->faces[p->edges[e].f[1]].normal) < -PD_ACUTE_EDGE_COS) return true;
+  return false;
+}
+
+bool pd_polyhedron_has_acute_edge(const pdPolyhedron* p) { return p->satIndex ? p->satIndex->acuteEdge : acute_edge(p); }
+
 void pd_sat_index_build(pdPolyhedron* p) {
   struct pdSatIndex* x = pd_zeroed(1, sizeof *x);
   p->satIndex = x;
@@ -180,6 +191,7 @@ void pd_sat_index_build(pdPolyhedron* p) {
   for (int f = 0; f < F; ++f) x->inradius = fmin(x->inradius, p->faces[f].offset - pd_v3_dot(p->faces[f].normal, c));
   x->inradius = fmax(0.0, x->inradius);
   for (int v = 0; v < V; ++v) x->circumradius = fmax(x->circumradius, pd_v3_norm(pd_v3_sub(p->vertices[v], c)));
+  x->acuteEdge = acute_edge(p);
   if (E < PD_SAT_INDEX_MIN_EDGES) return;
   x->edge = pd_zeroed((size_t)E, sizeof *x->edge);
   for (int e = 0; e < E; ++e) x->edge[e] = edge_record(p, e);

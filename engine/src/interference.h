@@ -120,6 +120,13 @@ typedef struct pdSatResult {
 // exhaustively).
 #define PD_SAT_INDEX_MIN_EDGES 48
 void pd_sat_index_build(pdPolyhedron* p);
+// An edge is acute when its faces' outward normals are more than 90° apart by more than this cosine (a box's right
+// angles, rounded, are not).
+#define PD_ACUTE_EDGE_COS 1e-9
+// Does p have an edge whose faces meet at less than 90°? (Kept with the index; formed here for a polyhedron without.)
+// Where it has none, the contact search meets only the paper's contacts (contact_analysis.c, "a vertex beyond an
+// acute edge").
+bool pd_polyhedron_has_acute_edge(const pdPolyhedron* p);
 void pd_sat_index_free(struct pdSatIndex* index);
 
 // Do A (at xA, RA) and B (at xB, RB) interfere? Fills *out and returns !out->separated. Equal-depth

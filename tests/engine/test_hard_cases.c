@@ -53,18 +53,33 @@ typedef struct hardCase {
   const char* file;
   const char* tunnelBody;  // fast_cube_thin_slab: the body that must stay above...
   const char* slabBody;    // ...this fixed body's top face
+  double penetrationLimit; // δ_max; 0: PENETRATION_LIMIT
 } hardCase;
 
 static const hardCase hardCases[] = {
-    {"thin_plate.scene", NULL, NULL},
-    {"mass_ratio.scene", NULL, NULL},
-    {"fast_cube_thin_slab.scene", "bullet", "slab"},
-    {"crossed_bars.scene", NULL, NULL},
-    {"vertex_on_vertex.scene", NULL, NULL},
-    {"cubes_face_on_face.scene", NULL, NULL},
-    {"stack_10.scene", NULL, NULL},
-    {"grazing.scene", NULL, NULL},
-    {"brick_bond.scene", NULL, NULL},
+    {"thin_plate.scene", NULL, NULL, 0.0},
+    {"mass_ratio.scene", NULL, NULL, 0.0},
+    {"fast_cube_thin_slab.scene", "bullet", "slab", 0.0},
+    {"crossed_bars.scene", NULL, NULL, 0.0},
+    {"vertex_on_vertex.scene", NULL, NULL, 0.0},
+    {"cubes_face_on_face.scene", NULL, NULL, 0.0},
+    {"stack_10.scene", NULL, NULL, 0.0},
+    {"grazing.scene", NULL, NULL, 0.0},
+    {"brick_bond.scene", NULL, NULL, 0.0},
+    // the contact classes the random-scene soak found (docs/reliability.md), at 2 kHz, or at the soak's 100 Hz where
+    // the samples (the islands' sync times) are part of the trajectory it found
+    {"corner_past_acute_edge.scene", NULL, NULL, 0.0},
+    {"blade_over_corner.scene", NULL, NULL, 0.0},
+    {"corner_past_acute_edge_free.scene", NULL, NULL, 0.0},
+    {"edge_through_sliver.scene", NULL, NULL, 0.0},
+    // pile-ups: pushed together by the bodies behind beyond what the springs are sized for (one impact at vmax), the
+    // pair's contacts present throughout (its hand-overs carried): the bound is the load's, measured 4.4 and 3.7 δ_max
+    {"vertex_past_edge_frustum_sliver.scene", NULL, NULL, 0.0},
+    {"vertex_past_edge_plate.scene", NULL, NULL, 0.0},
+    {"corner_past_edge_prisms.scene", NULL, NULL, 0.0},
+    {"corner_past_sliver_rim.scene", NULL, NULL, 0.0},
+    {"handover_pile_up.scene", NULL, NULL, 5.0},
+    {"pile_up_box_frustum.scene", NULL, NULL, 5.0},
 };
 
 // What the observer saw over all samples.
@@ -191,9 +206,10 @@ static void test_hard_case(void** state) {
     print_error("%s: %ld non-finite trial steps\n", hc->file, s->warnings[pd_warnNonFinite]);
     ok = false;
   }
-  if (!(w.worstDepthRatio < PENETRATION_LIMIT)) {
+  double limit = hc->penetrationLimit > 0.0 ? hc->penetrationLimit : PENETRATION_LIMIT;
+  if (!(w.worstDepthRatio < limit)) {
     print_error("%s: penetration %.3g δ_max at t = %.6g (limit %g)\n", hc->file, w.worstDepthRatio, w.worstDepthT,
-                PENETRATION_LIMIT);
+                limit);
     ok = false;
   }
   if (!(w.energyMaxExcess <= ENERGY_GAIN_REL_TOL * scale)) {

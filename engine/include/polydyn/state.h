@@ -150,7 +150,8 @@ typedef struct pdCounters {
   long searchesSkipped;   // pair searches (interference and contact search) a search certificate made needless
   long contactsMade;      // contacts added at the end of a step (found, approaching)
   long contactsVirtual;   // contacts added at the start of a step (onset within the first dt_min)
-  long contactsTransferred;  // VF contacts whose sliding vertex moved on to an adjacent face (§4.4.3)
+  long contactsTransferred;  // hand-overs: a contact whose features changed over (a vertex onto the next face, §4.4.3;
+                             // EE → VF, VF → EE, EE → EE at a shared vertex) going on in its successor, springs kept
   long breaksForce;       // contacts dropped because the normal springs would pull
   long breaksGeometry;    // contacts dropped because a feature left the other (vertex off its face, EE off an edge)
   // What the step did not locate (docs/events.md): each corrected onset's error bound (onset_bound.h), in the units
