@@ -137,6 +137,9 @@ struct pdContactSet {
   int cacheCount, cacheCapacity;
   pdVec3 *force, *torque;  // (movingCount) contact force and moment on each moving body, world
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
+  double* reachScratch;    // contact_search.c's reaching_fraction: two bodies' vertex moves and bounding planes
+  int reachVertexMax, reachFaceMax;  // the most vertices and faces of a body (faces: at least 6)
+  double travelStep;       // s: the step the tunnelling guard lets the next one take (INFINITY: any)
   int onsetRetries;        // onset retries of the step under way
   // stability bound (pd_stability_prepare, stability_tight), sized with the list
   stabilityTerms* stability;  // (capacity)

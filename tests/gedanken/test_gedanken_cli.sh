@@ -96,7 +96,7 @@ check "a law: every variant judged, no reason" \
 
 # --- work-precision against the closed form (--precision) -------------------------------------------
 PREC=$SCRATCH/precision
-PHEADER='experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,judged,status,wall_seconds,wall_per_sim_second,steps,repeats,note'
+PHEADER='experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,judged,status,wall_seconds,wall_per_sim_second,steps,repeats,cpu_seconds,cpu_per_sim_second,note'
 run_pd gedanken --only a1_restitution,c3_eccentric_bar --precision --repeats 2 --out "$PREC"
 check "--precision: exit 0 and precision.csv with the fixed header" '[ $rc -eq 0 ] && [ "$(head -n 1 "$PREC/precision.csv")" = "$PHEADER" ]'
 # every knob of every engine, loosest first; an engine without an adapter is two not_built rows, never left out
