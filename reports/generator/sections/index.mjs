@@ -21,4 +21,4 @@ import experiments from './experiments.mjs';
 import parameters from './parameters.mjs';
 import cubetoss, { planarDrops } from './cubetoss.mjs';
 
-export const sections = [differ, scenes, summary, against, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, planarDrops, experiments, parameters];
+export const sections = [differ, scenes, against, summary, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, planarDrops, experiments, parameters];
