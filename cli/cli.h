@@ -77,8 +77,9 @@ bool pd_cli_positive(const char* text, double* value);
 
 // Parses --onsets' value, "pair", "exact", "auto" or "bounded"; false when it is none of them.
 bool pd_cli_onsets(const char* text, pdOnsets* onsets);
-// Parses --events' value: "exact" (the paper's loop, every onset located: pd_onsetsExact) or "bounded" (the default,
-// pd_onsetsBounded: an onset is corrected where its error bound allows, docs/events.md); false otherwise.
+// Parses --events' value: "exact" (the paper's loop, every onset located: pd_onsetsExact), "bounded" (the default,
+// pd_onsetsBounded: an onset is corrected where its error bound allows, docs/events.md) or "held" (pd_onsetsHeld:
+// bounded, with contact modes held within a step); false otherwise.
 bool pd_cli_events(const char* text, pdOnsets* onsets);
 
 // True when argv[i] is -h or --help.

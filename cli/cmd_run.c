@@ -16,7 +16,7 @@
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
     "                         [--stepper implicit|adaptive|fixed|embedded] [--variant native|matched]\n"
-    "                         [--events bounded|exact] [--onsets pair|exact|auto|bounded] [--islands on|off]\n"
+    "                         [--events bounded|exact|held] [--onsets pair|exact|auto|bounded] [--islands on|off]\n"
     "                         [--sleep on|off] [--threads N] [--step H] [--ode-friction pyramid|aligned]\n"
     "\n"
     "Simulates SCENE and writes DIR/trajectory.csv and DIR/summary.json. DIR is written under a\n"
@@ -36,7 +36,8 @@ static const char* const help =
     "                   embedded: RK4 with its embedded third-order error estimate\n"
     "  --events MODE    soft engine: bounded (default) corrects a contact onset inside a step where its\n"
     "                   error bound is within the tolerance's share and locates the others; exact locates\n"
-    "                   every onset, the paper's loop (docs/events.md; the same as --onsets bounded|exact)\n"
+    "                   every onset, the paper's loop (docs/events.md; the same as --onsets bounded|exact);\n"
+    "                   held as bounded with each contact's modes held within a step (docs/events.md)\n"
     "  --onsets MODE    soft engine, a contact that began inside a step: exact cuts the whole step back\n"
     "                   to its onset; pair joins it at the step's end, run for that pair alone since its\n"
     "                   onset, when it began within 1/omega and is shallow; auto pair in an island of more\n"
@@ -139,7 +140,7 @@ int pd_cmd_run(int argc, char** argv) {
           return pd_cli_usage_error("run", "--onsets must be pair, exact, auto or bounded");
       } else if (strcmp(a, "--events") == 0) {
         softOptionGiven = true;
-        if (!pd_cli_events(v, &onsets)) return pd_cli_usage_error("run", "--events must be bounded or exact");
+        if (!pd_cli_events(v, &onsets)) return pd_cli_usage_error("run", "--events must be bounded, exact or held");
       } else if (strcmp(a, "--islands") == 0) {
         softOptionGiven = true;
         if (strcmp(v, "on") == 0)

@@ -42,7 +42,7 @@
 
 static const char* const help =
     "usage: polydyn sweep SCENE --out DIR [--repeats R] [--engines soft,ode,bullet] [--tend T] [--jobs N]\n"
-    "                     [--events bounded|exact]\n"
+    "                     [--events bounded|exact|held]\n"
     "\n"
     "Work-precision sweep of SCENE: polydyn's default stepper (implicit: step doubling switching to ROS34PW2\n"
     "where the contacts' stability bound holds it), adaptive RK4 (step doubling alone) and its embedded RK4(3)\n"
@@ -378,7 +378,8 @@ int pd_cmd_sweep(int argc, char** argv) {
         }
         engines = v;
       } else if (strcmp(a, "--events") == 0) {
-        if (!pd_cli_events(v, &sweepOnsets)) return pd_cli_usage_error("sweep", "--events must be bounded or exact");
+        if (!pd_cli_events(v, &sweepOnsets))
+          return pd_cli_usage_error("sweep", "--events must be bounded, exact or held");
       } else if (strcmp(a, "--jobs") == 0) {
         if (!pd_cli_jobs(v, &jobs)) return pd_cli_usage_error("sweep", "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
       } else if (!pd_cli_positive(v, &base.tend)) {

@@ -105,6 +105,8 @@ bool pd_cli_events(const char* text, pdOnsets* onsets) {
     *onsets = pd_onsetsExact;
   else if (strcmp(text, "bounded") == 0)
     *onsets = pd_onsetsBounded;
+  else if (strcmp(text, "held") == 0)
+    *onsets = pd_onsetsHeld;
   else
     return false;
   return true;

@@ -85,6 +85,9 @@ static void normal_force(const pdContactParams* p, double s1, double s2, double 
 
 // ---------------------------------------------------------------- tangential direction
 
+// The tangential branch: decided by the force law (free), or held in stick or slip (pd_contact_force_held).
+typedef enum contactMode { modeFree, modeStick, modeSlip } contactMode;
+
 static pdVec3 in_plane(pdVec3 v, pdVec3 n) { return pd_v3_muladd(v, -pd_v3_dot(v, n), n); }
 
 // Both tangential dampers > 0: the damper-determined branch (tangential_damped), whose force is on the cone by
@@ -99,16 +102,25 @@ static bool tangential_damper_determined(const pdContactParams* p) { return p->c
 // F_t = −F⁺ b̂_t exactly on the cone and Δw_t = λ b_t/(1 + λ c*) = (|b_t| − F⁺)/c* b̂_t (10); the last form
 // stays finite for F⁺ = 0 (λ = ∞: the springs relax through their dampers, F_t = 0).
 // Rates: ṡ1 = (c2 (Δu_t − Δw_t) − k1 s1 − k2 s2)/(c1 + c2), ṡ2 = (−c1 (Δu_t − Δw_t) − k1 s1 − k2 s2)/(c1 + c2).
+// `forced` (contactMode): the branch the force law decides (free), or stick or slip held whatever |b_t| is. Held slip
+// below the cone continues slip's formulas: F_t = −F⁺ b̂_t stays on the cone and Δw_t = (|b_t| − F⁺)/c* b̂_t turns
+// against b_t (0 with b_t); held stick is F_t = −b_t beyond the cone. out->coneMargin = F⁺ − |b_t| either way.
 static void tangential_damped(const pdContactParams* p, pdVec3 s1, pdVec3 s2, pdVec3 dut, double limit,
-                              pdContactForce* out) {
+                              contactMode forced, pdContactForce* out) {
   const double k1 = p->k1t, k2 = p->k2t, c1 = p->c1t, c2 = p->c2t, c = c1 + c2, cstar = c1 * c2 / c;
   pdVec3 bt = pd_v3_scale(pd_v3_add(pd_v3_sub(pd_v3_scale(s1, c2 * k1), pd_v3_scale(s2, c1 * k2)),
                                     pd_v3_scale(dut, c1 * c2)),
                           1.0 / c);
   double bn = pd_v3_norm(bt);
   pdVec3 dw = {0, 0, 0};
-  if (bn <= limit) {
+  out->coneMargin = limit - bn;
+  bool slip = forced == modeFree ? !(bn <= limit) : forced == modeSlip;
+  if (!slip) {
     out->ft = pd_v3_scale(bt, -1.0);
+  } else if (bn == 0.0) {  // held slip with no force to follow: none
+    out->slip = true;
+    out->lambda = 0.0;
+    out->ft = dw;
   } else {
     pdVec3 dir = pd_v3_scale(bt, 1.0 / bn);
     out->slip = true;
@@ -217,7 +229,10 @@ static void tangential_mixed2(const pdContactParams* p, pdVec3 s1, pdVec3 s2, pd
 
 // ---------------------------------------------------------------- public
 
-void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du, pdContactForce* out) {
+// The force law with the tangential branch `forced` (held, or free) and, with `pushing`, the friction limit μ F_n
+// continued below F_n = 0 (a contact held pushing: no kink where the normal force crosses zero).
+static void contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du, contactMode forced,
+                          bool pushing, pdContactForce* out) {
 #ifdef PD_SELF_CHECKS
   // checked where constants are formed (pd_model_contact_params, pd_contact_modal_damping); here, once per contact
   // per evaluation, 2 % of cases/hard/stack_10.scene's instructions: in the sanitizer and Debug builds only
@@ -228,15 +243,16 @@ void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pd
   // `rep stos`, 10 % of this function: perf)
   out->slip = false;
   out->lambda = 0.0;
+  out->coneMargin = INFINITY;
   double du_n = pd_v3_dot(du, n);
   normal_force(p, s->s1n, s->s2n, du_n, out);
 
   if (p->mu > 0.0 && p->k1t + p->k2t > 0.0) {
     // fn > 0 ? fn : 0 equals fmax(fn, 0) for every fn (NaN and −0 included), without fmax's libm call
-    double limit = p->mu * (out->fn > 0.0 ? out->fn : 0.0);
+    double limit = p->mu * (pushing || out->fn > 0.0 ? out->fn : 0.0);
     pdVec3 dut = in_plane(du, n), s1 = in_plane(s->s1t, n), s2 = in_plane(s->s2t, n);
     if (tangential_damper_determined(p))
-      tangential_damped(p, s1, s2, dut, limit, out);
+      tangential_damped(p, s1, s2, dut, limit, forced, out);
     else if (p->c1t == 0.0 && p->c2t == 0.0)
       tangential_undamped(p, s1, dut, limit, out);
     else if (p->c1t == 0.0)
@@ -249,6 +265,19 @@ void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pd
     out->rate.s1t = out->rate.s2t = zero;
   }
   out->force = pd_v3_muladd(out->ft, out->fn, n);
+}
+
+void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du, pdContactForce* out) {
+  contact_force(p, s, n, du, modeFree, false, out);
+}
+
+void pd_contact_force_held(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du, bool pushing, bool slip,
+                           pdContactForce* out) {
+  contact_force(p, s, n, du, slip ? modeSlip : modeStick, pushing, out);
+}
+
+bool pd_contact_slip_held(const pdContactParams* p) {
+  return p->mu > 0.0 && p->k1t + p->k2t > 0.0 && tangential_damper_determined(p);
 }
 
 double pd_contact_normal_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du) {

@@ -58,6 +58,7 @@ typedef struct pdContactForce {
   pdVec3 ft;        // F_t, N, in P_t
   pdVec3 force;     // F_c = fn n + ft, applied to body 1 (body 2 gets −force), N
   bool slip;        // the friction limit is active: |F_t| = μ F_n⁺ (see contact_force.c for each branch)
+  double coneMargin;  // N: F⁺ − |b_t| of the damper-determined branch, > 0 in stick (INFINITY in the other branches)
   double lambda;    // λ of eq. (7)/(9), s/kg; 0 in stick; INFINITY when slipping with F_n⁺ = 0
   pdVec3 dw;        // Δw_t = −λ F_t, the slip velocity of the surface elements, m/s (0 in stick)
   pdSprings rate;   // ṡ1n, ṡ2n, ṡ1t, ṡ2t, m/s
@@ -68,6 +69,17 @@ typedef struct pdContactForce {
 // appears only while n turns inside an integration step; pd_springs_realign removes it), and the
 // tangential rates lie in P_t.
 void pd_contact_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du, pdContactForce* out);
+
+// The force law with its modes held as they were at a step's start (docs/events.md, "Modes within a step"): `pushing`,
+// the friction limit μ F_n continued below F_n = 0 (the caller applies the normal force whatever its sign); `slip`,
+// the damper-determined tangential branch held in slip (F_t on the cone, also below it) or in stick (F_t = −b_t,
+// also beyond it). So the force is one smooth function of the state over the step. The other tangential branches
+// (a tangential damper zero) keep the free law. With the modes the free law gives, the same numbers as
+// pd_contact_force.
+void pd_contact_force_held(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du, bool pushing, bool slip,
+                           pdContactForce* out);
+// Whether pd_contact_force_held holds this contact's stick or slip (friction, both tangential dampers > 0).
+bool pd_contact_slip_held(const pdContactParams* p);
 
 // F_n of pd_contact_force alone (the same number), N: what a caller needs before it realigns the springs.
 double pd_contact_normal_force(const pdContactParams* p, const pdSprings* s, pdVec3 n, pdVec3 du);

@@ -23,13 +23,22 @@ static void forces_range(void* ctx, int part, int begin, int end) {
   pdPairFrame frame;
   frame.p1 = NULL;  // empty (the rest is formed with it)
   for (int i = begin; i < end; ++i) {
+    const contactSlot* c = &set->items[i];
     pdSprings s = loop_springs(job, i);
     pdContactGeom g;
     pdVec3 du;
     pdContactForce f;
-    evaluate(job->model, &set->items[i], job->y, set->poses, &frame, &s, &g, NULL, &du, &f);
+    bool pulls;
+    if (set->holdModes) {  // the modes of the step's start, whatever the law would decide here (docs/events.md)
+      contact_motion(job->model, c, job->y, set->poses, &frame, &g, NULL, &du);
+      pd_contact_force_held(&c->params, &s, g.normal, du, c->heldPush, c->heldSlip, &f);
+      pulls = !c->heldPush;
+    } else {
+      evaluate(job->model, c, job->y, set->poses, &frame, &s, &g, NULL, &du, &f);
+      pulls = pd_contact_force_pulls(&f);
+    }
     springs_store(job->dydt + base + PD_CONTACT_STATE_SIZE * i, &f.rate);
-    set->push[i] = (contactPush){g.point, f.force, pd_contact_force_pulls(&f)};
+    set->push[i] = (contactPush){g.point, f.force, pulls};
   }
 }
 
@@ -131,12 +140,20 @@ void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y,
 #define PD_LINEARISE_STEP_REL 1.5e-8
 
 // F and ṡ of a contact as one vector: F (3), then the rates (8); F is 0 when it pulls (sums_range applies none).
-static void force_and_rates(const pdContactParams* p, const double s[PD_CONTACT_STATE_SIZE], pdVec3 n, pdVec3 du,
-                            double out[3 + PD_CONTACT_STATE_SIZE]) {
+// `held`: the contact's modes of the step's start (the set holds modes), as the derivative takes them.
+static void force_and_rates(const contactSlot* c, bool held, const double s[PD_CONTACT_STATE_SIZE], pdVec3 n,
+                            pdVec3 du, double out[3 + PD_CONTACT_STATE_SIZE]) {
   pdSprings sp = springs_load(s);
   pdContactForce f;
-  pd_contact_force(p, &sp, n, du, &f);
-  pdVec3 force = pd_contact_force_pulls(&f) ? (pdVec3){0, 0, 0} : f.force;
+  bool pulls;
+  if (held) {
+    pd_contact_force_held(&c->params, &sp, n, du, c->heldPush, c->heldSlip, &f);
+    pulls = !c->heldPush;
+  } else {
+    pd_contact_force(&c->params, &sp, n, du, &f);
+    pulls = pd_contact_force_pulls(&f);
+  }
+  pdVec3 force = pulls ? (pdVec3){0, 0, 0} : f.force;
   out[0] = force.x, out[1] = force.y, out[2] = force.z;
   springs_store(out + 3, &f.rate);
 }
@@ -163,12 +180,12 @@ void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const dou
     pdVec3 du = pd_v3_sub(velocity_at(model, y, b1, l->r1), velocity_at(model, y, b2, l->r2));
     double s[PD_CONTACT_STATE_SIZE], f0[3 + PD_CONTACT_STATE_SIZE], f1[3 + PD_CONTACT_STATE_SIZE];
     for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) s[j] = y[base + PD_CONTACT_STATE_SIZE * i + j];
-    force_and_rates(&c->params, s, c->normal, du, f0);
+    force_and_rates(c, set->holdModes, s, c->normal, du, f0);
     for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) {
       double keep = s[j];
       s[j] += PD_LINEARISE_STEP_REL * fmax(fabs(keep), c->deltaMax);
       double step = s[j] - keep;
-      force_and_rates(&c->params, s, c->normal, du, f1);
+      force_and_rates(c, set->holdModes, s, c->normal, du, f1);
       s[j] = keep;
       for (int r = 0; r < 3; ++r) l->Ds[r][j] = (f1[r] - f0[r]) / step;
       for (int r = 0; r < PD_CONTACT_STATE_SIZE; ++r) l->Gs[r][j] = (f1[3 + r] - f0[3 + r]) / step;
@@ -178,7 +195,7 @@ void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const dou
       double keep = u[j];
       u[j] += PD_LINEARISE_STEP_REL * fmax(fabs(keep), vmax);
       double step = u[j] - keep;
-      force_and_rates(&c->params, s, c->normal, (pdVec3){u[0], u[1], u[2]}, f1);
+      force_and_rates(c, set->holdModes, s, c->normal, (pdVec3){u[0], u[1], u[2]}, f1);
       u[j] = keep;
       for (int r = 0; r < 3; ++r) l->Du[r][j] = (f1[r] - f0[r]) / step;
       for (int r = 0; r < PD_CONTACT_STATE_SIZE; ++r) l->Gu[r][j] = (f1[3 + r] - f0[3 + r]) / step;

@@ -27,6 +27,14 @@ struct pdHelpDesk;
 void pd_contact_set_help(pdContactSet* set, struct pdHelpDesk* desk);
 struct pdHelpDesk* pd_contact_set_help_desk(const pdContactSet* set);
 int pd_contact_set_count(const pdContactSet* set);
+// Whether the derivative holds every contact's modes of the step's start over the step (its normal force applied
+// or not, its stick or slip: pd_contact_force_held), the changes the force law finds at the step's end corrected
+// there or located by a retry (pd_contact_events; docs/events.md, "Modes within a step"). Set by the stepper
+// before a step; off, the force law decides at every evaluation (the paper's loop).
+void pd_contact_set_hold_modes(pdContactSet* set, bool hold);
+// With `all`, every held mode's change is corrected whatever its bound, none located (tests measure the bound
+// against the located run's answer); off (the default), the bound decides.
+void pd_contact_set_correct_held(pdContactSet* set, bool all);
 
 // Inside the derivative: poses of every body from y (fixed bodies keep theirs), then for every contact
 // its force and moment on both bodies (summed per moving body, world: pd_contact_set_force/_torque) and
@@ -54,14 +62,14 @@ typedef enum pdEventVerdict {
 } pdEventVerdict;
 
 // After a trial step from (t0, y0 = state->y) to y1 (length state->n) of size h that the error control
-// accepted: analyses the contacts at y1 (broad phase, interference, contact search, tracking) and decides
+// accepted (yMid, nullable: the trial's own state at t0 + h/2, which places a held mode's change more closely): analyses the contacts at y1 (broad phase, interference, contact search, tracking) and decides
 // whether a contact onset or a reversal inside the step asks for a shorter step (Retry), whether
 // contacts must be added at the start (Restart: state->y and state->n are updated), or whether the step
 // stands (Accept). Onset retries are bounded per step, refinements by the refinement step. May grow the
 // state's vectors (Restart only: pointers into the stepper's scratch are then stale). Its stages are timed as
 // laps of `watch`, running since the caller's last lap.
-pdEventVerdict pd_contact_events(const pdModel* model, pdState* state, double h, const double* y1, double* hRetry,
-                                 pdStopwatch* watch);
+pdEventVerdict pd_contact_events(const pdModel* model, pdState* state, double h, const double* y1, const double* yMid,
+                                 double* hRetry, pdStopwatch* watch);
 // Accepts the step analysed by the last pd_contact_events: copies y1 into state->y with the new contact
 // list (breaks, transfers, new contacts with springs at 0), realigns the springs of continuing contacts
 // (§3.4) and records each contact's force for output. Grows the state's vectors if needed. Timed as one lap

@@ -33,6 +33,8 @@ typedef struct contactSlot {
   pdVec3 onsetImpulse;  // N·s, on body 1: pd_onsets_start_late' scratch
   double modalMass;     // kg: the mass per contact of its pair's joint motion along n (pd_modal_dampers; 0: none)
   int modalCount;       // contacts its pair had when pd_modal_dampers last set its dampers (0: not yet)
+  // its modes at the step's start (record()), held over the step when the set holds modes (pd_contact_force_held)
+  bool heldPush, heldSlip;
 } contactSlot;
 
 // A pair's search certificate (contact_analysis.h, "search certificates") and when to issue its next, kept beside
@@ -61,6 +63,11 @@ typedef struct contactEval {
   pdContactForce force;
   pdVec3 du;         // relative velocity at the contact point, m/s
   double modeBound;  // a stick–slip change left inside the step: its error bound (onset_bound.h), else 0
+  // a held mode that the force law left inside the step (holdModes), corrected at the commit: the impulse on body 1
+  // (N·s) and the change of its springs (m) that take out what the held law applied since the change
+  bool modeCorrected;
+  pdVec3 modeImpulse;
+  pdSprings modeSprings;
 } contactEval;
 
 // One contact's share of a derivative evaluation (pd_contact_forces), kept until the per-body sums.
@@ -141,6 +148,9 @@ struct pdContactSet {
   int reachVertexMax, reachFaceMax;  // the most vertices and faces of a body (faces: at least 6)
   double travelStep;       // s: the step the tunnelling guard lets the next one take (INFINITY: any)
   int onsetRetries;        // onset retries of the step under way
+  int modeRetries;         // trials of the step under way cut to a held mode's change (holdModes)
+  bool holdModes;          // the derivative holds each contact's modes of the step's start (pd_contact_set_hold_modes)
+  bool correctHeld;        // every held change corrected, none located (pd_contact_set_correct_held)
   // stability bound (pd_stability_prepare, stability_tight), sized with the list
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])
@@ -176,6 +186,11 @@ static inline int spring_base(const pdModel* model) { return PD_BODY_STATE_SIZE 
 
 static inline pdSprings springs_load(const double* y) {
   return (pdSprings){y[0], y[1], {y[2], y[3], y[4]}, {y[5], y[6], y[7]}};
+}
+
+static inline void springs_add(pdSprings* s, const pdSprings* d) {
+  s->s1n += d->s1n, s->s2n += d->s2n;
+  s->s1t = pd_v3_add(s->s1t, d->s1t), s->s2t = pd_v3_add(s->s2t, d->s2t);
 }
 
 static inline void springs_store(double* y, const pdSprings* s) {
@@ -270,6 +285,11 @@ static inline pdSprings loop_springs(const contactLoop* job, int i) {
 }
 
 // ---------------------------------------------------------------- between the files
+
+// onsets.c: gives body 1 of contact c the impulse j (N·s) at `point` and body 2 −j (fixed bodies take none; a
+// planar body its in-plane part), in y, with lever arms from `poses` and the list's world inverse inertias.
+void pd_contact_impulse(const pdModel* model, const pdContactSet* set, double* y, const pdPose* poses,
+                        const pdContactId* id, pdVec3 point, pdVec3 j);
 
 // contact_set.c: grows the list's per-contact arrays to hold `capacity` contacts (between steps).
 void pd_contact_set_reserve_list(pdContactSet* set, int capacity);

@@ -317,6 +317,8 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
                             double stableFraction, const probationLimits* probation, stepOutcome* outcome) {
   const pdSettings* set = &model->settings;
   stepperWork w = work_of(s);
+  // held events hold each contact's modes over the step (contact_set.h); the others let the law decide
+  pd_contact_set_hold_modes(s->contacts, s->onsets == pd_onsetsHeld);
   derivative(model, s, s->t, s->y, w.k1);
   bool eventCut = false;
   for (;;) {
@@ -361,7 +363,8 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     // contact events (Fig. 8): a new contact's onset or a reversal inside the step may shorten it; a
     // virtual contact restarts it with the contact list grown
     double hRetry = h;
-    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry, &watch);
+    const double* yMid = trial == trial_doubling ? w.half : NULL;  // the first half step's end
+    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, yMid, &hRetry, &watch);
     if (verdict == pd_eventRetry) {
       hMax = hRetry;
       eventCut = true;
@@ -463,6 +466,7 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
 
 static double fixed_step(const pdModel* model, pdState* s, double hMax) {
   stepperWork w = work_of(s);
+  pd_contact_set_hold_modes(s->contacts, false);  // its steps are the work-precision sweeps' reference: the law decides
   double h = fmin(model->settings.dt, hMax);
   derivative(model, s, s->t, s->y, w.k1);
   pdStopwatch watch;
@@ -477,7 +481,7 @@ static double fixed_step(const pdModel* model, pdState* s, double hMax) {
       return 0.0;
     }
     double hRetry = h;
-    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, &hRetry, &watch);
+    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, NULL, &hRetry, &watch);
     if (verdict == pd_eventAccept) break;
     if (verdict == pd_eventRestart) {
       w = work_of(s);

@@ -382,6 +382,9 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->transitionsUnlocated += c->transitionsUnlocated;
   to->transitionBoundMax = fmax(to->transitionBoundMax, c->transitionBoundMax);
   to->transitionBoundSum += c->transitionBoundSum;
+  to->releasesCorrected += c->releasesCorrected;
+  to->releaseBoundMax = fmax(to->releaseBoundMax, c->releaseBoundMax);
+  to->releaseBoundSum += c->releaseBoundSum;
   to->historyKept += c->historyKept;
 }
 
@@ -956,6 +959,9 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
           int k = set->activate[i];
           if (s->t > set->ct0 && !free_advance(s, set, k, s->t, true)) return false;
           set->free[k] = false;
+          // brought to T only: the interval is still to go (left marked advanced, an island that stays alone in the
+          // partition would keep T's numbers for T')
+          set->islands[set->islandOld[k]]->advanced = false;
           set_start(model, s, set, k, dt);
         }
     } while (set->sleep && wake_reached(model, s, set, dt));

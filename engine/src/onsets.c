@@ -349,22 +349,27 @@ int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, con
   for (int i = 0; i < set->count && started > 0; ++i) {
     contactSlot* c = &set->items[i];
     if (c->onsetAge <= 0.0) continue;
-    for (int side = 0; side < 2; ++side) {
-      int b = side == 0 ? c->id.body1 : c->id.body2;
-      const pdBody* body = &model->bodies[b];
-      if (body->fixed) continue;
-      pdVec3 j = side == 0 ? c->onsetImpulse : pd_v3_scale(c->onsetImpulse, -1.0);
-      double* yb = y + PD_BODY_STATE_SIZE * body->stateIndex;
-      pdVec3 v = pd_v3_add(pd_layout_v(yb), pd_v3_scale(j, body->invMass));
-      pdVec3 w = pd_v3_add(pd_layout_w(yb),
-                           pd_mat3_mulv(&set->invInertiaWorld[b], pd_v3_cross(pd_v3_sub(c->point, poses[b].x), j)));
-      if (body->planar) {  // the plane takes the impulse's out-of-plane part, as in the derivative (model.h)
-        v.y = pd_layout_v(yb).y;
-        w.x = pd_layout_w(yb).x, w.z = pd_layout_w(yb).z;
-      }
-      pd_layout_store(yb, v, w, pd_layout_x(yb), pd_layout_q(yb));
-    }
+    pd_contact_impulse(model, set, y, poses, &c->id, c->point, c->onsetImpulse);
     c->onsetAge = 0.0;
   }
   return started;
+}
+
+void pd_contact_impulse(const pdModel* model, const pdContactSet* set, double* y, const pdPose* poses,
+                        const pdContactId* id, pdVec3 point, pdVec3 j) {
+  for (int side = 0; side < 2; ++side) {
+    int b = side == 0 ? id->body1 : id->body2;
+    const pdBody* body = &model->bodies[b];
+    if (body->fixed) continue;
+    pdVec3 jb = side == 0 ? j : pd_v3_scale(j, -1.0);
+    double* yb = y + PD_BODY_STATE_SIZE * body->stateIndex;
+    pdVec3 v = pd_v3_add(pd_layout_v(yb), pd_v3_scale(jb, body->invMass));
+    pdVec3 w = pd_v3_add(pd_layout_w(yb),
+                         pd_mat3_mulv(&set->invInertiaWorld[b], pd_v3_cross(pd_v3_sub(point, poses[b].x), jb)));
+    if (body->planar) {  // the plane takes the impulse's out-of-plane part, as in the derivative (model.h)
+      v.y = pd_layout_v(yb).y;
+      w.x = pd_layout_w(yb).x, w.z = pd_layout_w(yb).z;
+    }
+    pd_layout_store(yb, v, w, pd_layout_x(yb), pd_layout_q(yb));
+  }
 }

@@ -670,6 +670,10 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
     write_number(out, c->transitionBoundMax);
     fputs(", \"transition_bound_sum\": ", out);
     write_number(out, c->transitionBoundSum);
+    fprintf(out, ", \"releases_corrected\": %ld, \"release_bound_max\": ", c->releasesCorrected);
+    write_number(out, c->releaseBoundMax);
+    fputs(", \"release_bound_sum\": ", out);
+    write_number(out, c->releaseBoundSum);
     fprintf(out, ", \"breaks\": %ld, \"history_kept\": %ld, \"body_seconds_asleep\": ", c->breaksForce + c->breaksGeometry,
             c->historyKept);
     write_number(out, c->bodySecondsAsleep);

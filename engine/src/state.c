@@ -34,7 +34,7 @@ pdState* pd_state_create(const pdModel* model, const pdStateOptions* options) {
   pdStateOptions o = options ? *options : pd_state_options_default();
   PD_ASSERT(o.valid == OPTIONS_VALID);  // made by pd_state_options_default
   PD_ASSERT(o.stepper >= pd_stepperRK4Adaptive && o.stepper <= pd_stepperImplicit);
-  PD_ASSERT(o.onsets >= pd_onsetsExact && o.onsets <= pd_onsetsBounded);
+  PD_ASSERT(o.onsets >= pd_onsetsExact && o.onsets <= pd_onsetsHeld);
   PD_ASSERT(o.islands == pd_islandsOff || o.islands == pd_islandsOn);
   PD_ASSERT(o.threads >= 1 && o.threads <= PD_THREADS_MAX);
   PD_ASSERT(o.h >= 0.0 && o.h < INFINITY);
@@ -180,6 +180,8 @@ const char* pd_onsets_name(pdOnsets onsets) {
       return "pair";
     case pd_onsetsBounded:
       return "bounded";
+    case pd_onsetsHeld:
+      return "held";
     case pd_onsetsAuto:
       break;
   }

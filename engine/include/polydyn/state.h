@@ -94,6 +94,11 @@ typedef enum pdOnsets {
                      // norm's units) is within the share of the tolerance an onset may spend; others as
                      // pd_onsetsExact. So the step follows the tolerance: slow onsets are corrected, fast impacts
                      // located (docs/events.md)
+  pd_onsetsHeld,     // as pd_onsetsBounded, and each contact's modes at a step's start (its normal force applied or
+                     // not, its stick or slip) held for the whole step, a change the force law finds at the step's
+                     // end corrected there or located by a retry (docs/events.md, "Modes within a step"). Measured:
+                     // no cheaper than pd_onsetsBounded, and an impact chain's result converges with tol less
+                     // well, hence not the default
 } pdOnsets;
 
 // More moving bodies than this in one system make pd_onsetsAuto join onsets as pairs. On
@@ -109,7 +114,7 @@ PD_API pdOnsets pd_onsets_effective(pdOnsets onsets, int movingBodies);
 // (the paper's loop: every onset located), `--events bounded` this default.
 #define PD_ONSETS_DEFAULT pd_onsetsBounded
 
-// The onset mode's name in summary.json: "pair", "exact", "auto" or "bounded".
+// The onset mode's name in summary.json: "pair", "exact", "auto", "bounded" or "held".
 PD_API const char* pd_onsets_name(pdOnsets onsets);
 
 // Whether the moving bodies advance as one system or as islands (engine/src/islands.c; docs/integration.md).
@@ -155,6 +160,9 @@ typedef struct pdCounters {
   long transitionsUnlocated;   // stick–slip changes left inside their step (bounded events), each with its bound:
   double transitionBoundMax;   // the largest
   double transitionBoundSum;   // and their sum, error-norm units as above
+  long releasesCorrected;      // normal forces that reached zero inside a step whose modes were held (docs/events.md):
+  double releaseBoundMax;      // the tension applied since taken out at the step's end, never located; each one's
+  double releaseBoundSum;      // error bound, largest and summed, error-norm units
   long historyKept;  // contacts that started on the features of one broken by force within the gap tolerance, with
                      // its tangential springs (engine/src/contact_history.h)
   // pd_islandsOn only (0 otherwise); the counts above are then summed over the islands
