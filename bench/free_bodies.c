@@ -6,7 +6,6 @@
 // usage: pd_bench_free [--bodies 1,10,100,1000] [--repeats 5] [--tend 1] [--seed 12345]
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +13,7 @@
 #include <time.h>
 
 #include "bench_common.h"
+#include "pdrun/text_buffer.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
@@ -39,58 +39,30 @@ static double lcg_uniform(lcg* g, double lo, double hi) {
 
 static int lcg_int(lcg* g, int lo, int hi) { return lo + (int)floor(lcg_uniform(g, 0.0, (double)(hi - lo + 1))); }
 
-// Growable text buffer.
-typedef struct text {
-  char* data;
-  size_t length, capacity;
-} text;
-
-static void text_printf(text* t, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
-
-static void text_printf(text* t, const char* fmt, ...) {
-  for (;;) {
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(t->data ? t->data + t->length : NULL, t->data ? t->capacity - t->length : 0, fmt, ap);
-    va_end(ap);
-    if (n < 0) abort();
-    if (t->data && t->length + (size_t)n < t->capacity) {
-      t->length += (size_t)n;
-      return;
-    }
-    size_t capacity = t->capacity ? 2 * t->capacity : 4096;
-    while (capacity < t->length + (size_t)n + 1) capacity *= 2;
-    char* grown = realloc(t->data, capacity);
-    if (!grown) abort();
-    t->data = grown;
-    t->capacity = capacity;
-  }
-}
-
 // A scene of `count` bodies on a cubic grid 1 m apart (no two overlap: every body fits in 0.6 m).
 static char* random_scene(int count, double tend, unsigned long seed) {
   lcg g = {seed};
-  text t = {NULL, 0, 0};
-  text_printf(&t, "# pd_bench_free: %d random bodies, seed %lu\ngravity 0 0 -9.81\ntend %.17g\n", count, seed, tend);
+  pdTextBuffer t = {NULL, 0, 0};
+  pd_text_appendf(&t, "# pd_bench_free: %d random bodies, seed %lu\ngravity 0 0 -9.81\ntend %.17g\n", count, seed, tend);
   int side = 1;
   while (side * side * side < count) ++side;
   for (int i = 0; i < count; ++i) {
     double sx = lcg_uniform(&g, 0.1, 0.4), sy = lcg_uniform(&g, 0.1, 0.4), sz = lcg_uniform(&g, 0.1, 0.4);
     switch (lcg_int(&g, 0, 3)) {
-      case 0: text_printf(&t, "cube b%d red %.6f %.6f %.6f\n", i, sx, sy, sz); break;
-      case 1: text_printf(&t, "prism b%d blue %d %.6f %.6f %.6f\n", i, lcg_int(&g, 3, 12), sx, sy, sz); break;
+      case 0: pd_text_appendf(&t, "cube b%d red %.6f %.6f %.6f\n", i, sx, sy, sz); break;
+      case 1: pd_text_appendf(&t, "prism b%d blue %d %.6f %.6f %.6f\n", i, lcg_int(&g, 3, 12), sx, sy, sz); break;
       case 2:
-        text_printf(&t, "tprism b%d green %d %.6f %.6f %.6f %.6f\n", i, lcg_int(&g, 3, 12), sx, sy, sz,
+        pd_text_appendf(&t, "tprism b%d green %d %.6f %.6f %.6f %.6f\n", i, lcg_int(&g, 3, 12), sx, sy, sz,
                     lcg_uniform(&g, 0.3, 1.0));
         break;
-      default: text_printf(&t, "sphere b%d grey %d %.6f %.6f %.6f\n", i, lcg_int(&g, 0, 2), sx, sy, sz); break;
+      default: pd_text_appendf(&t, "sphere b%d grey %d %.6f %.6f %.6f\n", i, lcg_int(&g, 0, 2), sx, sy, sz); break;
     }
-    text_printf(&t, "loc %d %d %d  %.6f %.6f %.6f %.6f\n", i % side, (i / side) % side, i / (side * side),
+    pd_text_appendf(&t, "loc %d %d %d  %.6f %.6f %.6f %.6f\n", i % side, (i / side) % side, i / (side * side),
                 lcg_uniform(&g, 0.0, 360.0), lcg_uniform(&g, -1, 1), lcg_uniform(&g, -1, 1), lcg_uniform(&g, 0.1, 1));
-    text_printf(&t, "vel %.6f %.6f %.6f  %.6f %.6f %.6f %.6f\n", lcg_uniform(&g, -2, 2), lcg_uniform(&g, -2, 2),
+    pd_text_appendf(&t, "vel %.6f %.6f %.6f  %.6f %.6f %.6f %.6f\n", lcg_uniform(&g, -2, 2), lcg_uniform(&g, -2, 2),
                 lcg_uniform(&g, 0, 5), lcg_uniform(&g, 90, 1080), lcg_uniform(&g, -1, 1), lcg_uniform(&g, -1, 1),
                 lcg_uniform(&g, 0.1, 1));
-    text_printf(&t, "spgrav %.6f\n", lcg_uniform(&g, 0.5, 8.0));
+    pd_text_appendf(&t, "spgrav %.6f\n", lcg_uniform(&g, 0.5, 8.0));
   }
   return t.data;
 }

@@ -10,27 +10,7 @@
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
 
-// Exit statuses (docs/commands.md).
-enum { PD_EXIT_OK = 0, PD_EXIT_FAILURE = 1, PD_EXIT_BAD_INPUT = 2 };
-
-int pd_cmd_run(int argc, char** argv);
-int pd_cmd_check(int argc, char** argv);
-int pd_cmd_compare(int argc, char** argv);
-int pd_cmd_sweep(int argc, char** argv);
-int pd_cmd_report(int argc, char** argv);
-int pd_cmd_view(int argc, char** argv);
-int pd_cmd_cubetoss(int argc, char** argv);
-int pd_cmd_gedanken(int argc, char** argv);
-int pd_cmd_oracle(int argc, char** argv);
-int pd_cmd_soak(int argc, char** argv);
-
-// `polydyn ARGS...`: argv[1] names the subcommand (cli/dispatch.c; main() calls it). Returns the exit status.
-int pd_cli_dispatch(int argc, char** argv);
-
-// Set only by the command-line fuzzer (tests/fuzz/fuzz_cli.c): each subcommand returns PD_EXIT_OK as soon as
-// its arguments are accepted, before it opens, reads or writes any file or starts any work. Help and usage
-// errors are printed as usual. Never set in the polydyn command.
-extern bool pd_cli_parse_only;
+#include "pdcli/commands.h"  // the commands, their exit statuses, the interrupt and parse-only flags
 
 // Reports a bad command-line argument as `polydyn SUBCOMMAND: message` on stderr (on MPI rank 0 only:
 // every rank sees the same arguments); returns 2.
@@ -48,7 +28,7 @@ void pd_cli_remove_tree(const char* path);
 // pd_cli_out_open refuses (message, false) an existing OUT without `marker` in it — not a directory of
 // this command — and makes tmp. pd_cli_out_close moves tmp into place, replacing a previous OUT; on
 // failure it prints why, removes tmp and returns false.
-// Under MPI (refcheck/include/polydyn/batch.h) both are collective: rank 0 makes, moves and removes the
+// Under MPI (runner/include/pdrun/batch.h) both are collective: rank 0 makes, moves and removes the
 // directories, every rank gets tmp's name (or false), and the others' pd_cli_out_close does nothing.
 bool pd_cli_out_open(const char* cmd, const char* out, const char* marker, char* tmp, size_t tmpSize);
 bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out);
@@ -57,8 +37,7 @@ bool pd_cli_out_close(const char* cmd, const char* tmp, const char* out);
 // and the command stops at its next check, removes what it had started and exits 130 ("interrupted; nothing
 // written"). pd_cli_out_close holds them back while it swaps the directories, so an interrupt never lands
 // between the two renames.
-extern volatile sig_atomic_t pd_cli_interrupted;
-void pd_cli_catch_interrupts(void);
+void pd_cli_catch_interrupts(void);  // sets pd_cli_interrupted (pdcli/commands.h)
 
 // --jobs N of the batch commands (docs/commands.md): a whole number 1..PD_CLI_MAX_JOBS; false when not.
 #define PD_CLI_MAX_JOBS 64

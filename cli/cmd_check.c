@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 
 static const char* const help =
     "usage: polydyn check SCENE\n"
@@ -167,18 +168,9 @@ static void print_body(const pdBody* b) {
 
 int pd_cmd_check(int argc, char** argv) {
   const char* scene = NULL;
-  for (int i = 1; i < argc; ++i) {
-    if (pd_cli_is_help(argv[i])) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-      return pd_cli_usage_error("check", "unknown option '%s'", argv[i]);
-    } else if (scene) {
-      return pd_cli_usage_error("check", "one scene at a time");
-    } else {
-      scene = argv[i];
-    }
-  }
+  pdCliPositionals scenes = {.values = &scene, .max = 1, .tooMany = "one scene at a time"};
+  int parsed = pd_cli_parse_options("check", argc, argv, NULL, 0, &scenes, help);
+  if (parsed >= 0) return parsed;
   if (!scene) return pd_cli_usage_error("check", "no scene given");
   if (pd_cli_parse_only) return PD_EXIT_OK;
   pdSceneSettings settings;

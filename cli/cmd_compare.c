@@ -1,5 +1,5 @@
 // polydyn compare — one scene (or every scene of a directory) in every engine, metrics against a tighter
-// soft run (docs/DESIGN.md §8.1). Each scene is one task of a batch (refcheck/include/polydyn/batch.h).
+// soft run (docs/DESIGN.md §8.1). Each scene is one task of a batch (runner/include/pdrun/batch.h).
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
@@ -12,10 +12,11 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 #include "compare_files.h"
 #include "pdutil/csv.h"
 #include "pdutil/json.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
@@ -545,6 +546,28 @@ static bool report_scenes(const sceneList* list, const pdBatchBuffer* results, c
   return true;
 }
 
+static bool accept_engines(const char* cmd, const char* v, void* target) {
+  static const char* const known[] = {"soft", "ode", "bullet", NULL};
+  char bad[64];
+  if (!list_valid(v, known, bad, sizeof bad)) {
+    pd_cli_usage_error(cmd, "--engines: unknown engine '%s' (soft, ode, bullet)", bad);
+    return false;
+  }
+  *(const char**)target = v;
+  return true;
+}
+
+static bool accept_variants(const char* cmd, const char* v, void* target) {
+  static const char* const known[] = {"native", "matched", NULL};
+  char bad[64];
+  if (!list_valid(v, known, bad, sizeof bad)) {
+    pd_cli_usage_error(cmd, "--variants: unknown variant '%s' (native, matched)", bad);
+    return false;
+  }
+  *(const char**)target = v;
+  return true;
+}
+
 int pd_cmd_compare(int argc, char** argv) {
   const char* scene = NULL;
   const char* out = NULL;
@@ -553,47 +576,22 @@ int pd_cmd_compare(int argc, char** argv) {
       .engines = "soft,ode,bullet",
       .variants = "native,matched",
       .refOptions = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid}};
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    } else if (strcmp(a, "--out") == 0 || strcmp(a, "--engines") == 0 || strcmp(a, "--variants") == 0 ||
-               strcmp(a, "--step") == 0 || strcmp(a, "--tend") == 0 || strcmp(a, "--sample") == 0 ||
-               strcmp(a, "--jobs") == 0) {
-      if (i + 1 >= argc) return pd_cli_usage_error("compare", "%s needs a value", a);
-      const char* v = argv[++i];
-      char bad[64];
-      if (strcmp(a, "--out") == 0) {
-        if (!v[0]) return pd_cli_usage_error("compare", "--out needs a directory name");
-        out = v;
-      } else if (strcmp(a, "--engines") == 0) {
-        static const char* const known[] = {"soft", "ode", "bullet", NULL};
-        if (!list_valid(v, known, bad, sizeof bad))
-          return pd_cli_usage_error("compare", "--engines: unknown engine '%s' (soft, ode, bullet)", bad);
-        c.engines = v;
-      } else if (strcmp(a, "--variants") == 0) {
-        static const char* const known[] = {"native", "matched", NULL};
-        if (!list_valid(v, known, bad, sizeof bad))
-          return pd_cli_usage_error("compare", "--variants: unknown variant '%s' (native, matched)", bad);
-        c.variants = v;
-      } else if (strcmp(a, "--step") == 0) {
-        if (!pd_cli_positive(v, &c.refOptions.step)) return pd_cli_usage_error("compare", "--step needs a number > 0");
-      } else if (strcmp(a, "--tend") == 0) {
-        if (!pd_cli_positive(v, &c.overrides.tend)) return pd_cli_usage_error("compare", "--tend needs a number > 0");
-      } else if (strcmp(a, "--jobs") == 0) {
-        if (!pd_cli_jobs(v, &jobs)) return pd_cli_usage_error("compare", "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
-      } else if (!pd_cli_positive(v, &c.overrides.sample)) {
-        return pd_cli_usage_error("compare", "--sample needs a number > 0");
-      }
-    } else if (a[0] == '-' && a[1] != '\0') {
-      return pd_cli_usage_error("compare", "unknown option '%s'", a);
-    } else if (scene) {
-      return pd_cli_usage_error("compare", "one scene or one directory of scenes ('%s' and '%s')", scene, a);
-    } else {
-      scene = a;
-    }
-  }
+  char jobsMessage[64];
+  snprintf(jobsMessage, sizeof jobsMessage, "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
+  const pdCliOption table[] = {
+      {.name = "--out", .kind = pd_optText, .target = &out, .message = "--out needs a directory name", .min = 1},
+      {.name = "--engines", .kind = pd_optAccept, .target = &c.engines, .accept = accept_engines},
+      {.name = "--variants", .kind = pd_optAccept, .target = &c.variants, .accept = accept_variants},
+      {.name = "--step", .kind = pd_optPositive, .target = &c.refOptions.step, .message = "--step needs a number > 0"},
+      {.name = "--tend", .kind = pd_optPositive, .target = &c.overrides.tend, .message = "--tend needs a number > 0"},
+      {.name = "--sample", .kind = pd_optPositive, .target = &c.overrides.sample,
+       .message = "--sample needs a number > 0"},
+      {.name = "--jobs", .kind = pd_optJobs, .target = &jobs, .message = jobsMessage},
+  };
+  pdCliPositionals scenes = {.values = &scene, .max = 1,
+                             .tooMany = "one scene or one directory of scenes ('%s' and '%s')"};
+  int parsed = pd_cli_parse_options("compare", argc, argv, table, sizeof table / sizeof table[0], &scenes, help);
+  if (parsed >= 0) return parsed;
   if (!scene) return pd_cli_usage_error("compare", "no scene given");
   if (!out) return pd_cli_usage_error("compare", "--out DIR is required");
   if (strlen(out) > COMPARE_PATH_MAX) return pd_cli_usage_error("compare", "--out: path longer than %d bytes", COMPARE_PATH_MAX);

@@ -1,5 +1,5 @@
 // polydyn cubetoss — real cube tosses in every engine, and fitting each engine's free parameters to them
-// (docs/DESIGN.md §8.4; the library part is refcheck/include/polydyn/cubetoss.h).
+// (docs/DESIGN.md §8.4; the library part is validation/include/polydyn/cubetoss.h).
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -11,8 +11,9 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 #include "pdutil/csv.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/cubetoss.h"
 #include "polydyn/output.h"
 
@@ -130,101 +131,125 @@ static bool known_engine(const char* name, size_t len) {
   return false;
 }
 
+// --engines: a comma-separated list of soft, ode, bullet and noise.
+static bool accept_engines(const char* cmd, const char* v, void* target) {
+  for (const char* p = v; p;) {
+    const char* comma = strchr(p, ',');
+    size_t len = comma ? (size_t)(comma - p) : strlen(p);
+    if (!known_engine(p, len)) {
+      pd_cli_usage_error(cmd, "--engines: unknown engine '%.*s' (soft, ode, bullet, noise)", (int)(len < 40 ? len : 40),
+                         p);
+      return false;
+    }
+    p = comma ? comma + 1 : NULL;
+  }
+  *(const char**)target = v;
+  return true;
+}
+
+// --params [ENGINE=]FILE: up to PARAM_FILES_MAX of them.
+static bool accept_params(const char* cmd, const char* v, void* target) {
+  options* o = target;
+  if (o->paramCount == PARAM_FILES_MAX) {
+    pd_cli_usage_error(cmd, "at most %d --params", PARAM_FILES_MAX);
+    return false;
+  }
+  const char* eq = strchr(v, '=');
+  const char* engine = "";
+  if (eq && known_engine(v, (size_t)(eq - v))) {
+    engine = v;
+    v = eq + 1;
+  }
+  if (!v[0]) {
+    pd_cli_usage_error(cmd, "--params needs a file name");
+    return false;
+  }
+  o->paramEngine[o->paramCount] = engine;
+  o->paramFile[o->paramCount++] = v;
+  return true;
+}
+
+static bool accept_label(const char* cmd, const char* v, void* target) {
+  if (!v[0] || strpbrk(v, ",\"\n\r ")) {
+    pd_cli_usage_error(cmd, "--label needs one word (no comma, quote, space)");
+    return false;
+  }
+  *(const char**)target = v;
+  return true;
+}
+
+static bool accept_tol(const char* cmd, const char* v, void* target) {
+  if (pd_cli_positive(v, target) && *(double*)target < 1.0) return true;
+  pd_cli_usage_error(cmd, "--tol needs a number in (0, 1)");
+  return false;
+}
+
+static bool accept_inertia(const char* cmd, const char* v, void* target) {
+  if (strcmp(v, "uniform") == 0) {
+    *(double*)target = 0.0;
+    return true;
+  }
+  if (pd_cli_positive(v, target)) return true;
+  pd_cli_usage_error(cmd, "--inertia needs a number > 0 (kg m^2) or uniform");
+  return false;
+}
+
+static bool accept_no_runs(const char* cmd, const char* v, void* target) {
+  (void)cmd, (void)v;
+  *(bool*)target = false;
+  return true;
+}
+
+static bool accept_train_every(const char* cmd, const char* v, void* target) {
+  if (positive_int(v, target)) return true;
+  pd_cli_usage_error(cmd, "--train-every needs an integer >= 1");
+  return false;
+}
+
+static bool accept_max_evals(const char* cmd, const char* v, void* target) {
+  if (positive_int(v, target)) return true;
+  pd_cli_usage_error(cmd, "--max-evals needs an integer >= 1");
+  return false;
+}
+
+static const char* const variantWords[] = {"native", "matched", NULL};
+static const int variantValues[] = {pd_refNative, pd_refMatched};
+
 // Parses argv into o; returns -1 to go on, else an exit status (help printed, or a usage error).
 static int parse_options(int argc, char** argv, options* o) {
   const char* cmd = o->fit ? "cubetoss fit" : "cubetoss";
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    }
-    if (strcmp(a, "--no-runs") == 0) {
-      if (o->fit) return pd_cli_usage_error(cmd, "--no-runs is for polydyn cubetoss (fit keeps no runs)");
-      o->runs = false;
-      continue;
-    }
-    static const char* const valued[] = {"--data",   "--out",  "--engines",     "--tosses",    "--params",
-                                         "--label",  "--variant", "--step",     "--tol",       "--inertia",
-                                         "--jobs",   "--train-every", "--max-evals", "--size-tol", NULL};
-    int which = -1;
-    for (int k = 0; valued[k]; ++k)
-      if (strcmp(a, valued[k]) == 0) which = k;
-    if (which < 0) {
-      if (a[0] == '-') return pd_cli_usage_error(cmd, "unknown option '%s'", a);
-      return pd_cli_usage_error(cmd, "unexpected argument '%s'", a);
-    }
-    if (i + 1 >= argc) return pd_cli_usage_error(cmd, "%s needs a value", a);
-    const char* v = argv[++i];
-    if (which >= 11 && !o->fit) return pd_cli_usage_error(cmd, "%s is for polydyn cubetoss fit", a);
-    switch (which) {
-      case 0:
-      case 1:
-        if (!v[0]) return pd_cli_usage_error(cmd, "%s needs a file name", a);
-        if (which == 0) o->data = v;
-        else o->out = v;
-        break;
-      case 2:
-        for (const char* p = v; p;) {
-          const char* comma = strchr(p, ',');
-          size_t len = comma ? (size_t)(comma - p) : strlen(p);
-          if (!known_engine(p, len))
-            return pd_cli_usage_error(cmd, "--engines: unknown engine '%.*s' (soft, ode, bullet, noise)", (int)(len < 40 ? len : 40), p);
-          p = comma ? comma + 1 : NULL;
-        }
-        o->engines = v;
-        break;
-      case 3:
-        if (!v[0]) return pd_cli_usage_error(cmd, "--tosses needs a list");
-        o->tosses = v;
-        break;
-      case 4: {
-        if (o->paramCount == PARAM_FILES_MAX) return pd_cli_usage_error(cmd, "at most %d --params", PARAM_FILES_MAX);
-        const char* eq = strchr(v, '=');
-        const char* engine = "";
-        if (eq && known_engine(v, (size_t)(eq - v))) {
-          engine = v;
-          v = eq + 1;
-        }
-        if (!v[0]) return pd_cli_usage_error(cmd, "--params needs a file name");
-        o->paramEngine[o->paramCount] = engine;
-        o->paramFile[o->paramCount++] = v;
-        break;
-      }
-      case 5:
-        if (!v[0] || strpbrk(v, ",\"\n\r ")) return pd_cli_usage_error(cmd, "--label needs one word (no comma, quote, space)");
-        o->label = v;
-        break;
-      case 6:
-        if (strcmp(v, "native") == 0) o->variant = pd_refNative;
-        else if (strcmp(v, "matched") == 0) o->variant = pd_refMatched;
-        else return pd_cli_usage_error(cmd, "--variant must be native or matched");
-        break;
-      case 7:
-        if (!pd_cli_positive(v, &o->step)) return pd_cli_usage_error(cmd, "--step needs a number > 0");
-        break;
-      case 8:
-        if (!pd_cli_positive(v, &o->tol) || o->tol >= 1.0) return pd_cli_usage_error(cmd, "--tol needs a number in (0, 1)");
-        break;
-      case 9:
-        o->inertiaGiven = true;
-        if (strcmp(v, "uniform") == 0) o->inertia = 0.0;
-        else if (!pd_cli_positive(v, &o->inertia)) return pd_cli_usage_error(cmd, "--inertia needs a number > 0 (kg m^2) or uniform");
-        break;
-      case 10:
-        if (!pd_cli_jobs(v, &o->jobs)) return pd_cli_usage_error(cmd, "--jobs needs an integer in 1..%d", PD_CLI_MAX_JOBS);
-        break;
-      case 11:
-        if (!positive_int(v, &o->trainEvery)) return pd_cli_usage_error(cmd, "--train-every needs an integer >= 1");
-        break;
-      case 12:
-        if (!positive_int(v, &o->maxEvals)) return pd_cli_usage_error(cmd, "--max-evals needs an integer >= 1");
-        break;
-      case 13:
-        if (!pd_cli_positive(v, &o->sizeTol)) return pd_cli_usage_error(cmd, "--size-tol needs a number > 0");
-        break;
-    }
-  }
+  const char* fitOnly = o->fit ? NULL : "%s is for polydyn cubetoss fit";
+  int variant = o->variant;
+  char jobsMessage[64];
+  snprintf(jobsMessage, sizeof jobsMessage, "--jobs needs an integer in 1..%d", PD_CLI_MAX_JOBS);
+  const pdCliOption table[] = {
+      {.name = "--no-runs", .kind = pd_optFlag, .target = &o->runs, .accept = accept_no_runs,
+       .refuse = o->fit ? "--no-runs is for polydyn cubetoss (fit keeps no runs)" : NULL},
+      {.name = "--data", .kind = pd_optText, .target = &o->data, .message = "--data needs a file name", .min = 1},
+      {.name = "--out", .kind = pd_optText, .target = &o->out, .message = "--out needs a file name", .min = 1},
+      {.name = "--engines", .kind = pd_optAccept, .target = &o->engines, .accept = accept_engines},
+      {.name = "--tosses", .kind = pd_optText, .target = &o->tosses, .message = "--tosses needs a list", .min = 1},
+      {.name = "--params", .kind = pd_optAccept, .target = o, .accept = accept_params},
+      {.name = "--label", .kind = pd_optAccept, .target = &o->label, .accept = accept_label},
+      {.name = "--variant", .kind = pd_optChoice, .target = &variant, .message = "--variant must be native or matched",
+       .words = variantWords, .values = variantValues},
+      {.name = "--step", .kind = pd_optPositive, .target = &o->step, .message = "--step needs a number > 0"},
+      {.name = "--tol", .kind = pd_optAccept, .target = &o->tol, .accept = accept_tol},
+      {.name = "--inertia", .kind = pd_optAccept, .target = &o->inertia, .accept = accept_inertia,
+       .given = &o->inertiaGiven},
+      {.name = "--jobs", .kind = pd_optJobs, .target = &o->jobs, .message = jobsMessage},
+      {.name = "--train-every", .kind = pd_optAccept, .target = &o->trainEvery, .accept = accept_train_every,
+       .refuse = fitOnly},
+      {.name = "--max-evals", .kind = pd_optAccept, .target = &o->maxEvals, .accept = accept_max_evals,
+       .refuse = fitOnly},
+      {.name = "--size-tol", .kind = pd_optPositive, .target = &o->sizeTol, .message = "--size-tol needs a number > 0",
+       .refuse = fitOnly},
+  };
+  // no positional argument ("fit" is taken before): anything starting with '-' is an unknown option
+  pdCliPositionals none = {.tooMany = "unexpected argument '%s'", .loneDashIsOption = true};
+  int parsed = pd_cli_parse_options(cmd, argc, argv, table, sizeof table / sizeof table[0], &none, help);
+  if (parsed >= 0) return parsed;
+  o->variant = (pdRefVariant)variant;
   if (!o->data) return pd_cli_usage_error(cmd, "--data FILE.csv is required");
   if (!o->out) return pd_cli_usage_error(cmd, "--out DIR is required");
   if (strlen(o->out) > CUBETOSS_PATH_MAX) return pd_cli_usage_error(cmd, "--out: path longer than %d bytes", CUBETOSS_PATH_MAX);

@@ -7,7 +7,8 @@
 #include <unistd.h>
 
 #include "cli.h"
-#include "polydyn/batch.h"
+#include "options.h"
+#include "pdrun/batch.h"
 #include "polydyn/gedanken.h"
 
 static const char* const help =
@@ -86,61 +87,77 @@ static int split(char* text, char** items, int max) {
   }
 }
 
+// --only: once, a comma-separated list kept as written (split once the other options are read).
+static bool accept_only(const char* cmd, const char* v, void* target) {
+  char** onlyText = target;
+  if (*onlyText) {
+    pd_cli_usage_error(cmd, "--only once, with a comma-separated list");
+    return false;
+  }
+  *onlyText = (char*)v;  // a string of argv: split in place
+  return true;
+}
+
+// --engines: once, a comma-separated list of the engines to run (split in place in argv).
+typedef struct enginesChoice {
+  bool given;
+  bool* engines;  // (pd_gkEngineCount) pdGkOptions.engines
+} enginesChoice;
+
+static bool accept_engines(const char* cmd, const char* v, void* target) {
+  enginesChoice* c = target;
+  if (c->given) {
+    pd_cli_usage_error(cmd, "--engines once, with a comma-separated list");
+    return false;
+  }
+  c->given = true;
+  char* names[pd_gkEngineCount * 2];
+  int count = split((char*)v, names, pd_gkEngineCount * 2);
+  if (count < 0) {
+    pd_cli_usage_error(cmd, "--engines needs a list like soft,ode,bullet");
+    return false;
+  }
+  for (int k = 0; k < count; ++k) {
+    pdGkEngine e;
+    if (!pd_gk_engine_named(names[k], &e)) {
+      pd_cli_usage_error(cmd, "unknown engine '%s' (soft, ode or bullet)", names[k]);
+      return false;
+    }
+    c->engines[e] = true;
+  }
+  return true;
+}
+
 int pd_cmd_gedanken(int argc, char** argv) {
   pdGkOptions options = {.toleranceScale = 1.0};
-  bool listOnly = false, enginesGiven = false;
+  bool listOnly = false;
   char* onlyText = NULL;
   char* onlyNames[MAX_ONLY];
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    } else if (strcmp(a, "--list") == 0) {
-      listOnly = true;
-    } else if (strcmp(a, "--fast") == 0) {
-      options.fast = true;
-    } else if (strcmp(a, "--precision") == 0) {
-      options.precision = true;
-    } else if (strcmp(a, "--out") == 0 || strcmp(a, "--only") == 0 || strcmp(a, "--engines") == 0 ||
-               strcmp(a, "--jobs") == 0 || strcmp(a, "--tolerance-scale") == 0 || strcmp(a, "--repeats") == 0) {
-      if (i + 1 >= argc) return pd_cli_usage_error("gedanken", "%s needs a value", a);
-      char* v = argv[++i];
-      if (strcmp(a, "--out") == 0) {
-        if (v[0] == '\0') return pd_cli_usage_error("gedanken", "--out needs a directory name");
-        options.out = v;
-      } else if (strcmp(a, "--only") == 0) {
-        if (onlyText) return pd_cli_usage_error("gedanken", "--only once, with a comma-separated list");
-        onlyText = v;
-      } else if (strcmp(a, "--engines") == 0) {
-        if (enginesGiven) return pd_cli_usage_error("gedanken", "--engines once, with a comma-separated list");
-        enginesGiven = true;
-        char* names[pd_gkEngineCount * 2];
-        int count = split(v, names, pd_gkEngineCount * 2);
-        if (count < 0) return pd_cli_usage_error("gedanken", "--engines needs a list like soft,ode,bullet");
-        for (int k = 0; k < count; ++k) {
-          int e = 0;
-          while (e < pd_gkEngineCount && strcmp(names[k], pdGkEngineNames[e]) != 0) ++e;
-          if (e == pd_gkEngineCount)
-            return pd_cli_usage_error("gedanken", "unknown engine '%s' (soft, ode or bullet)", names[k]);
-          options.engines[e] = true;
-        }
-      } else if (strcmp(a, "--jobs") == 0) {
-        if (!pd_cli_jobs(v, &options.jobs))
-          return pd_cli_usage_error("gedanken", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);
-      } else if (strcmp(a, "--repeats") == 0) {
-        char* end = NULL;
-        long r = strtol(v, &end, 10);
-        if (!end || *end || end == v || r < 1 || r > MAX_REPEATS)
-          return pd_cli_usage_error("gedanken", "--repeats needs a whole number from 1 to %d", MAX_REPEATS);
-        options.repeats = (int)r;
-      } else if (!pd_cli_positive(v, &options.toleranceScale)) {
-        return pd_cli_usage_error("gedanken", "--tolerance-scale needs a number > 0");
-      }
-    } else {
-      return pd_cli_usage_error("gedanken", "unknown argument '%s'", a);
-    }
-  }
+  enginesChoice engines = {false, options.engines};
+  long repeats = 0;
+  char jobsMessage[64], repeatsMessage[64];
+  snprintf(jobsMessage, sizeof jobsMessage, "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);
+  snprintf(repeatsMessage, sizeof repeatsMessage, "--repeats needs a whole number from 1 to %d", MAX_REPEATS);
+  const pdCliOption table[] = {
+      {.name = "--list", .kind = pd_optFlag, .target = &listOnly},
+      {.name = "--fast", .kind = pd_optFlag, .target = &options.fast},
+      {.name = "--precision", .kind = pd_optFlag, .target = &options.precision},
+      {.name = "--out", .kind = pd_optText, .target = &options.out, .message = "--out needs a directory name",
+       .min = 1},
+      {.name = "--only", .kind = pd_optAccept, .target = &onlyText, .accept = accept_only},
+      {.name = "--engines", .kind = pd_optAccept, .target = &engines, .accept = accept_engines},
+      {.name = "--jobs", .kind = pd_optJobs, .target = &options.jobs, .message = jobsMessage},
+      {.name = "--tolerance-scale", .kind = pd_optPositive, .target = &options.toleranceScale,
+       .message = "--tolerance-scale needs a number > 0"},
+      {.name = "--repeats", .kind = pd_optWhole, .target = &repeats, .message = repeatsMessage, .min = 1,
+       .max = MAX_REPEATS},
+  };
+  // no positional argument: anything else is refused, whether or not it starts with '-'
+  pdCliPositionals none = {.tooMany = "unknown argument '%s'", .unknownOption = "unknown argument '%s'"};
+  int parsed = pd_cli_parse_options("gedanken", argc, argv, table, sizeof table / sizeof table[0], &none, help);
+  if (parsed >= 0) return parsed;
+  options.repeats = (int)repeats;
+  bool enginesGiven = engines.given;
   options.jobs = pd_cli_default_jobs(options.jobs, 2);
   if (options.repeats && !options.precision) return pd_cli_usage_error("gedanken", "--repeats goes with --precision");
   if (!options.repeats) options.repeats = 1;

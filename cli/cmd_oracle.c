@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 #include "pdutil/files.h"
 #include "polydyn/oracle.h"
 #include "polydyn/state.h"
@@ -399,53 +400,44 @@ static bool parse_count(const char* text, unsigned long long hi, unsigned long l
   return true;
 }
 
+static bool accept_pairs(const char* cmd, const char* v, void* target) {
+  if (parse_count(v, 1000000000ull, target) && *(unsigned long long*)target != 0) return true;
+  pd_cli_usage_error(cmd, "--random needs a whole number of pairs, 1 to 1e9");
+  return false;
+}
+
+static bool accept_seed(const char* cmd, const char* v, void* target) {
+  if (parse_count(v, ~0ull, target)) return true;
+  pd_cli_usage_error(cmd, "--seed needs a whole number, 0 to 2^64-1");
+  return false;
+}
+
+static bool accept_repeats(const char* cmd, const char* v, void* target) {
+  if (parse_count(v, 101, target) && *(unsigned long long*)target != 0) return true;
+  pd_cli_usage_error(cmd, "--repeats needs a whole number, 1 to 101");
+  return false;
+}
+
 int pd_cmd_oracle(int argc, char** argv) {
   const char *scene = NULL, *out = NULL, *replay = NULL;
   unsigned long long count = 0, seed = 0, repeats = 5;
   bool random = false, seedGiven = false, timing = false, repeatsGiven = false;
   pdCliOverrides overrides = {0};
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    } else if (strcmp(a, "--timing") == 0) {
-      timing = true;
-    } else if (strcmp(a, "--random") == 0 || strcmp(a, "--seed") == 0 || strcmp(a, "--out") == 0 ||
-               strcmp(a, "--tend") == 0 || strcmp(a, "--sample") == 0 || strcmp(a, "--replay") == 0 ||
-               strcmp(a, "--repeats") == 0) {
-      if (i + 1 >= argc) return pd_cli_usage_error("oracle", "%s needs a value", a);
-      const char* v = argv[++i];
-      if (strcmp(a, "--random") == 0) {
-        random = true;
-        if (!parse_count(v, 1000000000ull, &count) || count == 0)
-          return pd_cli_usage_error("oracle", "--random needs a whole number of pairs, 1 to 1e9");
-      } else if (strcmp(a, "--seed") == 0) {
-        seedGiven = true;
-        if (!parse_count(v, ~0ull, &seed)) return pd_cli_usage_error("oracle", "--seed needs a whole number, 0 to 2^64-1");
-      } else if (strcmp(a, "--out") == 0) {
-        if (v[0] == '\0') return pd_cli_usage_error("oracle", "--out needs a file name");
-        out = v;
-      } else if (strcmp(a, "--repeats") == 0) {
-        repeatsGiven = true;
-        if (!parse_count(v, 101, &repeats) || repeats == 0)
-          return pd_cli_usage_error("oracle", "--repeats needs a whole number, 1 to 101");
-      } else if (strcmp(a, "--tend") == 0) {
-        if (!pd_cli_positive(v, &overrides.tend)) return pd_cli_usage_error("oracle", "--tend needs a number > 0");
-      } else if (strcmp(a, "--sample") == 0) {
-        if (!pd_cli_positive(v, &overrides.sample)) return pd_cli_usage_error("oracle", "--sample needs a number > 0");
-      } else {
-        if (v[0] == '\0') return pd_cli_usage_error("oracle", "--replay needs a file name");
-        replay = v;
-      }
-    } else if (a[0] == '-' && a[1] != '\0') {
-      return pd_cli_usage_error("oracle", "unknown option '%s'", a);
-    } else if (scene) {
-      return pd_cli_usage_error("oracle", "one scene at a time ('%s' and '%s')", scene, a);
-    } else {
-      scene = a;
-    }
-  }
+  const pdCliOption table[] = {
+      {.name = "--timing", .kind = pd_optFlag, .target = &timing},
+      {.name = "--random", .kind = pd_optAccept, .target = &count, .accept = accept_pairs, .given = &random},
+      {.name = "--seed", .kind = pd_optAccept, .target = &seed, .accept = accept_seed, .given = &seedGiven},
+      {.name = "--out", .kind = pd_optText, .target = &out, .message = "--out needs a file name", .min = 1},
+      {.name = "--tend", .kind = pd_optPositive, .target = &overrides.tend, .message = "--tend needs a number > 0"},
+      {.name = "--sample", .kind = pd_optPositive, .target = &overrides.sample,
+       .message = "--sample needs a number > 0"},
+      {.name = "--replay", .kind = pd_optText, .target = &replay, .message = "--replay needs a file name", .min = 1},
+      {.name = "--repeats", .kind = pd_optAccept, .target = &repeats, .accept = accept_repeats,
+       .given = &repeatsGiven},
+  };
+  pdCliPositionals scenes = {.values = &scene, .max = 1, .tooMany = "one scene at a time ('%s' and '%s')"};
+  int parsed = pd_cli_parse_options("oracle", argc, argv, table, sizeof table / sizeof table[0], &scenes, help);
+  if (parsed >= 0) return parsed;
   int modes = (scene != NULL) + random + (replay != NULL);
   if (modes != 1) return pd_cli_usage_error("oracle", "give exactly one of SCENE, --random N or --replay FILE");
   if (random != seedGiven) return pd_cli_usage_error("oracle", "--random and --seed go together");

@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 
 extern char** environ;
 
@@ -76,25 +77,15 @@ int pd_cmd_report(int argc, char** argv) {
   const char* out = NULL;
   const char* viewer = NULL;
   bool noViewer = false;
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--out") == 0 || strcmp(a, "--viewer") == 0) {
-      if (i + 1 >= argc) return pd_cli_usage_error("report", "%s needs a value", a);
-      if (strcmp(a, "--viewer") == 0) viewer = argv[++i];
-      else out = argv[++i];
-    } else if (strcmp(a, "--no-viewer") == 0) {
-      noViewer = true;
-    } else if (a[0] == '-' && a[1] != '\0') {
-      return pd_cli_usage_error("report", "unknown option '%s'", a);
-    } else if (!dir) {
-      dir = a;
-    } else {
-      return pd_cli_usage_error("report", "one directory expected, got '%s' and '%s'", dir, a);
-    }
-  }
+  const pdCliOption table[] = {
+      {.name = "-o", .kind = pd_optText, .target = &out},
+      {.name = "--out", .kind = pd_optText, .target = &out},
+      {.name = "--viewer", .kind = pd_optText, .target = &viewer},
+      {.name = "--no-viewer", .kind = pd_optFlag, .target = &noViewer},
+  };
+  pdCliPositionals dirs = {.values = &dir, .max = 1, .tooMany = "one directory expected, got '%s' and '%s'"};
+  int parsed = pd_cli_parse_options("report", argc, argv, table, sizeof table / sizeof table[0], &dirs, help);
+  if (parsed >= 0) return parsed;
   if (!dir) return pd_cli_usage_error("report", "DIR is missing");
   if (viewer && noViewer) return pd_cli_usage_error("report", "--viewer and --no-viewer exclude each other");
   if (pd_cli_parse_only) return PD_EXIT_OK;

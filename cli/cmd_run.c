@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 #include "pdutil/files.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
@@ -97,106 +98,89 @@ static bool observe(const pdModel* model, const pdState* state, void* user) {
 }
 
 
+// --engine: soft, or a reference engine this build has an adapter for.
+static bool accept_engine(const char* cmd, const char* v, void* target) {
+  if (strcmp(v, "soft") != 0 && strcmp(v, "ode") != 0 && strcmp(v, "bullet") != 0) {
+    pd_cli_usage_error(cmd, "--engine must be soft, ode or bullet, not '%s'", v);
+    return false;
+  }
+  if (strcmp(v, "soft") != 0 && !pd_ref_adapter(v)) {
+    pd_cli_usage_error(cmd, "--engine %s: this build of polydyn has no %s adapter", v, v);
+    return false;
+  }
+  *(const char**)target = v;
+  return true;
+}
+
+static bool accept_onsets(const char* cmd, const char* v, void* target) {
+  if (pd_cli_onsets(v, target)) return true;
+  pd_cli_usage_error(cmd, "--onsets must be pair, exact, auto or bounded");
+  return false;
+}
+
+static bool accept_events(const char* cmd, const char* v, void* target) {
+  if (pd_cli_events(v, target)) return true;
+  pd_cli_usage_error(cmd, "--events must be bounded, exact or held");
+  return false;
+}
+
+static const char* const onOff[] = {"on", "off", NULL};
+static const char* const stepperWords[] = {"adaptive", "fixed", "embedded", "implicit", NULL};
+static const int stepperValues[] = {pd_stepperRK4Adaptive, pd_stepperRK4Fixed, pd_stepperRK43Embedded,
+                                    pd_stepperImplicit};
+static const int islandsValues[] = {pd_islandsOn, pd_islandsOff};
+static const int sleepValues[] = {1, -1};  // pdCliOverrides.sleep
+static const char* const variantWords[] = {"native", "matched", NULL};
+static const int variantValues[] = {pd_refNative, pd_refMatched};
+static const char* const frictionWords[] = {"pyramid", "aligned", NULL};
+static const int frictionValues[] = {pd_odeFrictionPyramid, pd_odeFrictionAligned};
+
 int pd_cmd_run(int argc, char** argv) {
   const char* scene = NULL;
   const char* out = NULL;
   const char* engine = "soft";
   pdCliOverrides overrides = {0};
-  pdStepper stepper = PD_STEPPER_DEFAULT;
+  int stepper = PD_STEPPER_DEFAULT;
   pdRefOptions ref = {.variant = pd_refNative, .step = PD_REF_DEFAULT_STEP, .odeFriction = pd_odeFrictionPyramid};
+  int variant = ref.variant, odeFriction = ref.odeFriction;
   pdOnsets onsets = PD_ONSETS_DEFAULT;
-  pdIslands islands = PD_ISLANDS_DEFAULT;
+  int islands = PD_ISLANDS_DEFAULT;
   int threads = 1;  // one unless asked: a run's CPU time stays its own, and batch commands fill the cores
   bool refOptionGiven = false, softOptionGiven = false;
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    bool hasValue = i + 1 < argc;
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    } else if (strcmp(a, "--out") == 0 || strcmp(a, "--engine") == 0 || strcmp(a, "--tend") == 0 ||
-               strcmp(a, "--sample") == 0 || strcmp(a, "--stepper") == 0 || strcmp(a, "--variant") == 0 ||
-               strcmp(a, "--step") == 0 || strcmp(a, "--ode-friction") == 0 || strcmp(a, "--onsets") == 0 ||
-               strcmp(a, "--events") == 0 || strcmp(a, "--islands") == 0 || strcmp(a, "--sleep") == 0 ||
-               strcmp(a, "--threads") == 0) {
-      if (!hasValue) return pd_cli_usage_error("run", "%s needs a value", a);
-      const char* v = argv[++i];
-      if (strcmp(a, "--out") == 0) {
-        if (v[0] == '\0') return pd_cli_usage_error("run", "--out needs a directory name");
-        out = v;
-      } else if (strcmp(a, "--engine") == 0) {
-        if (strcmp(v, "soft") != 0 && strcmp(v, "ode") != 0 && strcmp(v, "bullet") != 0)
-          return pd_cli_usage_error("run", "--engine must be soft, ode or bullet, not '%s'", v);
-        if (strcmp(v, "soft") != 0 && !pd_ref_adapter(v))
-          return pd_cli_usage_error("run", "--engine %s: this build of polydyn has no %s adapter", v, v);
-        engine = v;
-      } else if (strcmp(a, "--tend") == 0) {
-        if (!pd_cli_positive(v, &overrides.tend)) return pd_cli_usage_error("run", "--tend needs a number > 0");
-      } else if (strcmp(a, "--sample") == 0) {
-        if (!pd_cli_positive(v, &overrides.sample)) return pd_cli_usage_error("run", "--sample needs a number > 0");
-      } else if (strcmp(a, "--onsets") == 0) {
-        softOptionGiven = true;
-        if (!pd_cli_onsets(v, &onsets))
-          return pd_cli_usage_error("run", "--onsets must be pair, exact, auto or bounded");
-      } else if (strcmp(a, "--events") == 0) {
-        softOptionGiven = true;
-        if (!pd_cli_events(v, &onsets)) return pd_cli_usage_error("run", "--events must be bounded, exact or held");
-      } else if (strcmp(a, "--islands") == 0) {
-        softOptionGiven = true;
-        if (strcmp(v, "on") == 0)
-          islands = pd_islandsOn;
-        else if (strcmp(v, "off") == 0)
-          islands = pd_islandsOff;
-        else
-          return pd_cli_usage_error("run", "--islands must be on or off, not '%s'", v);
-      } else if (strcmp(a, "--sleep") == 0) {
-        softOptionGiven = true;
-        if (strcmp(v, "on") == 0)
-          overrides.sleep = 1;
-        else if (strcmp(v, "off") == 0)
-          overrides.sleep = -1;
-        else
-          return pd_cli_usage_error("run", "--sleep must be on or off, not '%s'", v);
-      } else if (strcmp(a, "--threads") == 0) {
-        softOptionGiven = true;
-        if (!pd_cli_jobs(v, &threads) || threads > PD_THREADS_MAX)
-          return pd_cli_usage_error("run", "--threads needs a whole number 1..%d", PD_THREADS_MAX);
-      } else if (strcmp(a, "--variant") == 0) {
-        refOptionGiven = true;
-        if (strcmp(v, "native") == 0) ref.variant = pd_refNative;
-        else if (strcmp(v, "matched") == 0) ref.variant = pd_refMatched;
-        else return pd_cli_usage_error("run", "--variant must be native or matched");
-      } else if (strcmp(a, "--step") == 0) {
-        refOptionGiven = true;
-        if (!pd_cli_positive(v, &ref.step)) return pd_cli_usage_error("run", "--step needs a number > 0");
-      } else if (strcmp(a, "--ode-friction") == 0) {
-        refOptionGiven = true;
-        if (strcmp(v, "pyramid") == 0) ref.odeFriction = pd_odeFrictionPyramid;
-        else if (strcmp(v, "aligned") == 0) ref.odeFriction = pd_odeFrictionAligned;
-        else return pd_cli_usage_error("run", "--ode-friction must be pyramid or aligned");
-      } else if (strcmp(v, "adaptive") == 0) {
-        softOptionGiven = true;
-        stepper = pd_stepperRK4Adaptive;
-      } else if (strcmp(v, "fixed") == 0) {
-        softOptionGiven = true;
-        stepper = pd_stepperRK4Fixed;
-      } else if (strcmp(v, "embedded") == 0) {
-        softOptionGiven = true;
-        stepper = pd_stepperRK43Embedded;
-      } else if (strcmp(v, "implicit") == 0) {
-        softOptionGiven = true;
-        stepper = pd_stepperImplicit;
-      } else {
-        return pd_cli_usage_error("run", "--stepper must be adaptive, fixed, embedded or implicit");
-      }
-    } else if (a[0] == '-' && a[1] != '\0') {
-      return pd_cli_usage_error("run", "unknown option '%s'", a);
-    } else if (scene) {
-      return pd_cli_usage_error("run", "one scene at a time ('%s' and '%s')", scene, a);
-    } else {
-      scene = a;
-    }
-  }
+  char threadsMessage[64];
+  snprintf(threadsMessage, sizeof threadsMessage, "--threads needs a whole number 1..%d", PD_THREADS_MAX);
+  const pdCliOption table[] = {
+      {.name = "--out", .kind = pd_optText, .target = &out, .message = "--out needs a directory name", .min = 1},
+      {.name = "--engine", .kind = pd_optAccept, .target = &engine, .accept = accept_engine},
+      {.name = "--tend", .kind = pd_optPositive, .target = &overrides.tend, .message = "--tend needs a number > 0"},
+      {.name = "--sample", .kind = pd_optPositive, .target = &overrides.sample,
+       .message = "--sample needs a number > 0"},
+      {.name = "--stepper", .kind = pd_optChoice, .target = &stepper,
+       .message = "--stepper must be adaptive, fixed, embedded or implicit", .words = stepperWords,
+       .values = stepperValues, .given = &softOptionGiven},
+      {.name = "--onsets", .kind = pd_optAccept, .target = &onsets, .accept = accept_onsets, .given = &softOptionGiven},
+      {.name = "--events", .kind = pd_optAccept, .target = &onsets, .accept = accept_events, .given = &softOptionGiven},
+      {.name = "--islands", .kind = pd_optChoice, .target = &islands,
+       .message = "--islands must be on or off, not '%s'", .words = onOff, .values = islandsValues,
+       .given = &softOptionGiven},
+      {.name = "--sleep", .kind = pd_optChoice, .target = &overrides.sleep,
+       .message = "--sleep must be on or off, not '%s'", .words = onOff, .values = sleepValues,
+       .given = &softOptionGiven},
+      {.name = "--threads", .kind = pd_optJobs, .target = &threads, .message = threadsMessage, .max = PD_THREADS_MAX,
+       .given = &softOptionGiven},
+      {.name = "--variant", .kind = pd_optChoice, .target = &variant, .message = "--variant must be native or matched",
+       .words = variantWords, .values = variantValues, .given = &refOptionGiven},
+      {.name = "--step", .kind = pd_optPositive, .target = &ref.step, .message = "--step needs a number > 0",
+       .given = &refOptionGiven},
+      {.name = "--ode-friction", .kind = pd_optChoice, .target = &odeFriction,
+       .message = "--ode-friction must be pyramid or aligned", .words = frictionWords, .values = frictionValues,
+       .given = &refOptionGiven},
+  };
+  pdCliPositionals scenes = {.values = &scene, .max = 1, .tooMany = "one scene at a time ('%s' and '%s')"};
+  int parsed = pd_cli_parse_options("run", argc, argv, table, sizeof table / sizeof table[0], &scenes, help);
+  if (parsed >= 0) return parsed;
+  ref.variant = (pdRefVariant)variant;
+  ref.odeFriction = (pdOdeFriction)odeFriction;
   if (!scene) return pd_cli_usage_error("run", "no scene given");
   bool soft = strcmp(engine, "soft") == 0;
   if (soft && refOptionGiven)

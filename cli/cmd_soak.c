@@ -1,5 +1,5 @@
-// polydyn soak — the random-scene soak (refcheck/include/polydyn/soak.h; docs/reliability.md). Each scene
-// is one task of a batch (refcheck/include/polydyn/batch.h); its runs go through child processes.
+// polydyn soak — the random-scene soak (validation/include/polydyn/soak.h; docs/reliability.md). Each scene
+// is one task of a batch (runner/include/pdrun/batch.h); its runs go through child processes.
 #include <errno.h>
 #include <signal.h>
 #include <stdint.h>
@@ -12,7 +12,7 @@
 #include "cli.h"
 #include "pdutil/csv.h"
 #include "pdutil/files.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/soak.h"
 
 static const char* const help =

@@ -20,13 +20,14 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 #include "pdutil/csv.h"
 #include "pdutil/json.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/compare.h"
 #include "polydyn/refcheck.h"
 #include "polydyn/state.h"
-#include "polydyn/stats.h"
+#include "pdrun/stats.h"
 
 // The reference tolerance and its check: the sweep's tightest point is 1e-10, the reference two decades
 // below it, and its own error is estimated against one a decade tighter still.
@@ -343,6 +344,28 @@ static void self_reference_name(const keptRun* kept, const point* p, char* name,
   else snprintf(name, size, "soft tol=%g", SWEEP_REFERENCE_TOL);
 }
 
+// --engines: a comma-separated list of soft, ode and bullet.
+static bool accept_engines(const char* cmd, const char* v, void* target) {
+  for (const char* q = v; *q;) {
+    const char* comma = strchr(q, ',');
+    size_t len = comma ? (size_t)(comma - q) : strlen(q);
+    if (!((len == 4 && !strncmp(q, "soft", 4)) || (len == 3 && !strncmp(q, "ode", 3)) ||
+          (len == 6 && !strncmp(q, "bullet", 6)))) {
+      pd_cli_usage_error(cmd, "--engines: unknown engine '%.*s' (soft, ode, bullet)", (int)len, q);
+      return false;
+    }
+    q = comma ? comma + 1 : q + len;
+  }
+  *(const char**)target = v;
+  return true;
+}
+
+static bool accept_events(const char* cmd, const char* v, void* target) {
+  if (pd_cli_events(v, target)) return true;
+  pd_cli_usage_error(cmd, "--events must be bounded, exact or held");
+  return false;
+}
+
 int pd_cmd_sweep(int argc, char** argv) {
   const char* scene = NULL;
   const char* out = NULL;
@@ -350,49 +373,22 @@ int pd_cmd_sweep(int argc, char** argv) {
   long repeats = 3;
   int jobs = 0;
   pdCliOverrides base = {0};
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    } else if (strcmp(a, "--out") == 0 || strcmp(a, "--repeats") == 0 || strcmp(a, "--engines") == 0 ||
-               strcmp(a, "--tend") == 0 || strcmp(a, "--jobs") == 0 || strcmp(a, "--events") == 0) {
-      if (i + 1 >= argc) return pd_cli_usage_error("sweep", "%s needs a value", a);
-      const char* v = argv[++i];
-      if (strcmp(a, "--out") == 0) {
-        if (!v[0] || strlen(v) > 3000) return pd_cli_usage_error("sweep", "--out needs a directory name (< 3000 bytes)");
-        out = v;
-      } else if (strcmp(a, "--repeats") == 0) {
-        char* end = NULL;
-        repeats = strtol(v, &end, 10);
-        if (!end || *end || repeats < 1 || repeats > SWEEP_MAX_REPEATS)
-          return pd_cli_usage_error("sweep", "--repeats needs a whole number 1..%d", SWEEP_MAX_REPEATS);
-      } else if (strcmp(a, "--engines") == 0) {
-        for (const char* q = v; *q;) {
-          const char* comma = strchr(q, ',');
-          size_t len = comma ? (size_t)(comma - q) : strlen(q);
-          if (!((len == 4 && !strncmp(q, "soft", 4)) || (len == 3 && !strncmp(q, "ode", 3)) ||
-                (len == 6 && !strncmp(q, "bullet", 6))))
-            return pd_cli_usage_error("sweep", "--engines: unknown engine '%.*s' (soft, ode, bullet)", (int)len, q);
-          q = comma ? comma + 1 : q + len;
-        }
-        engines = v;
-      } else if (strcmp(a, "--events") == 0) {
-        if (!pd_cli_events(v, &sweepOnsets))
-          return pd_cli_usage_error("sweep", "--events must be bounded, exact or held");
-      } else if (strcmp(a, "--jobs") == 0) {
-        if (!pd_cli_jobs(v, &jobs)) return pd_cli_usage_error("sweep", "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
-      } else if (!pd_cli_positive(v, &base.tend)) {
-        return pd_cli_usage_error("sweep", "--tend needs a number > 0");
-      }
-    } else if (a[0] == '-' && a[1] != '\0') {
-      return pd_cli_usage_error("sweep", "unknown option '%s'", a);
-    } else if (scene) {
-      return pd_cli_usage_error("sweep", "one scene at a time ('%s' and '%s')", scene, a);
-    } else {
-      scene = a;
-    }
-  }
+  char repeatsMessage[64], jobsMessage[64];
+  snprintf(repeatsMessage, sizeof repeatsMessage, "--repeats needs a whole number 1..%d", SWEEP_MAX_REPEATS);
+  snprintf(jobsMessage, sizeof jobsMessage, "--jobs needs a whole number 1..%d", PD_CLI_MAX_JOBS);
+  const pdCliOption table[] = {
+      {.name = "--out", .kind = pd_optText, .target = &out, .message = "--out needs a directory name (< 3000 bytes)",
+       .min = 1, .max = 3000},
+      {.name = "--repeats", .kind = pd_optWhole, .target = &repeats, .message = repeatsMessage, .min = 1,
+       .max = SWEEP_MAX_REPEATS},
+      {.name = "--engines", .kind = pd_optAccept, .target = &engines, .accept = accept_engines},
+      {.name = "--tend", .kind = pd_optPositive, .target = &base.tend, .message = "--tend needs a number > 0"},
+      {.name = "--jobs", .kind = pd_optJobs, .target = &jobs, .message = jobsMessage},
+      {.name = "--events", .kind = pd_optAccept, .target = &sweepOnsets, .accept = accept_events},
+  };
+  pdCliPositionals scenes = {.values = &scene, .max = 1, .tooMany = "one scene at a time ('%s' and '%s')"};
+  int parsed = pd_cli_parse_options("sweep", argc, argv, table, sizeof table / sizeof table[0], &scenes, help);
+  if (parsed >= 0) return parsed;
   if (!scene) return pd_cli_usage_error("sweep", "no scene given");
   if (!out) return pd_cli_usage_error("sweep", "--out DIR is required");
   if (pd_cli_parse_only) return PD_EXIT_OK;

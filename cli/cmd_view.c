@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 #include "polydyn/view.h"
 
 extern char** environ;
@@ -140,6 +141,28 @@ static int make_movie(pdViewRun* const* runs, int count, const char* title, cons
   return status;
 }
 
+// --fps: frames per second of the movie, kept as written (the movie script reads it).
+static bool accept_fps(const char* cmd, const char* v, void* target) {
+  double x;
+  if (!pd_cli_positive(v, &x) || x > 240) {
+    pd_cli_usage_error(cmd, "--fps needs a number in (0, 240]");
+    return false;
+  }
+  *(const char**)target = v;
+  return true;
+}
+
+// --speed: simulated seconds per second of the movie, kept as written.
+static bool accept_speed(const char* cmd, const char* v, void* target) {
+  double x;
+  if (!pd_cli_positive(v, &x) || x < 0.01 || x > 100) {
+    pd_cli_usage_error(cmd, "--speed needs a number from 0.01 to 100");
+    return false;
+  }
+  *(const char**)target = v;
+  return true;
+}
+
 int pd_cmd_view(int argc, char** argv) {
   const char* dirs[MAX_RUNS];
   int dirCount = 0;
@@ -148,40 +171,19 @@ int pd_cmd_view(int argc, char** argv) {
   const char* movie = NULL;
   const char* fps = "60";
   const char* speed = "1";
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--title") == 0 || strcmp(a, "--movie") == 0 ||
-               strcmp(a, "--fps") == 0 || strcmp(a, "--speed") == 0) {
-      if (i + 1 >= argc) return pd_cli_usage_error("view", "%s needs a value", a);
-      const char* v = argv[++i];
-      double x;
-      if (strcmp(a, "-o") == 0) {
-        if (!*v) return pd_cli_usage_error("view", "-o needs a file name");
-        page = v;
-      } else if (strcmp(a, "--title") == 0) {
-        title = v;
-      } else if (strcmp(a, "--movie") == 0) {
-        if (!*v) return pd_cli_usage_error("view", "--movie needs a file name");
-        movie = v;
-      } else if (strcmp(a, "--fps") == 0) {
-        if (!pd_cli_positive(v, &x) || x > 240) return pd_cli_usage_error("view", "--fps needs a number in (0, 240]");
-        fps = v;
-      } else {
-        if (!pd_cli_positive(v, &x) || x < 0.01 || x > 100)
-          return pd_cli_usage_error("view", "--speed needs a number from 0.01 to 100");
-        speed = v;
-      }
-    } else if (a[0] == '-' && a[1] != '\0') {
-      return pd_cli_usage_error("view", "unknown option '%s'", a);
-    } else if (dirCount == MAX_RUNS) {
-      return pd_cli_usage_error("view", "at most %d run directories", MAX_RUNS);
-    } else {
-      dirs[dirCount++] = a;
-    }
-  }
+  char tooMany[64];
+  snprintf(tooMany, sizeof tooMany, "at most %d run directories", MAX_RUNS);
+  const pdCliOption table[] = {
+      {.name = "-o", .kind = pd_optText, .target = &page, .message = "-o needs a file name", .min = 1},
+      {.name = "--title", .kind = pd_optText, .target = &title},
+      {.name = "--movie", .kind = pd_optText, .target = &movie, .message = "--movie needs a file name", .min = 1},
+      {.name = "--fps", .kind = pd_optAccept, .target = &fps, .accept = accept_fps},
+      {.name = "--speed", .kind = pd_optAccept, .target = &speed, .accept = accept_speed},
+  };
+  pdCliPositionals positionals = {.values = dirs, .max = MAX_RUNS, .tooMany = tooMany};
+  int parsed = pd_cli_parse_options("view", argc, argv, table, sizeof table / sizeof table[0], &positionals, help);
+  if (parsed >= 0) return parsed;
+  dirCount = positionals.count;
   if (dirCount == 0) return pd_cli_usage_error("view", "no run directory given");
   if ((strcmp(fps, "60") != 0 || strcmp(speed, "1") != 0) && !movie)
     return pd_cli_usage_error("view", "--fps and --speed are for --movie");

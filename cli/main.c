@@ -3,10 +3,10 @@
 #include <stdio.h>
 
 #include "cli.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 
 // Under mpirun or srun every rank runs the same command: the batch commands split their tasks over the
-// ranks (refcheck/include/polydyn/batch.h) and rank 0 alone prints and writes the results.
+// ranks (runner/include/pdrun/batch.h) and rank 0 alone prints and writes the results.
 int main(int argc, char** argv) {
   char why[512];
   if (!pd_batch_mpi_start(&argc, &argv, why, sizeof why)) {

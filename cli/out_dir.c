@@ -9,7 +9,7 @@
 
 #include "cli.h"
 #include "pdutil/files.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 
 // out/NAME for scene path .../NAME.ext
 char* pd_cli_default_out_dir(const char* scene) {

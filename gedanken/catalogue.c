@@ -1,5 +1,34 @@
-// polydyn gedanken — the catalogue: every experiment, in the order results are written.
+// polydyn gedanken — the catalogue: every experiment, in the order results are written; the names of the engines,
+// statuses and kinds of experiment; which engine and variant judge an experiment (the suite and the work-precision
+// runs both ask).
 #include "gedanken_internal.h"
+
+const char* const pdGkEngineNames[pd_gkEngineCount] = {"soft", "ode", "bullet"};
+const char* const pdGkStatusNames[] = {"PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR", "NOT_APPLICABLE"};
+const char* const pdGkKindNames[] = {"law", "model_prediction"};
+
+bool pd_gk_engine_named(const char* name, pdGkEngine* engine) {
+  for (int e = 0; e < pd_gkEngineCount; ++e) {
+    if (strcmp(name, pdGkEngineNames[e]) == 0) {
+      *engine = (pdGkEngine)e;
+      return true;
+    }
+  }
+  return false;
+}
+
+unsigned pd_gk_variant_bit(pdGkEngine engine, bool matched) {
+  switch (engine) {
+    case pd_gkSoft: return PD_GK_SOFT;
+    case pd_gkOde: return matched ? PD_GK_ODE_MATCHED : PD_GK_ODE_NATIVE;
+    case pd_gkBullet: return matched ? PD_GK_BULLET_MATCHED : PD_GK_BULLET_NATIVE;
+    default: PD_ASSERT(!"no such engine"); return 0;
+  }
+}
+
+bool pd_gk_applies(const pdGkExperiment* e, pdGkEngine engine, bool matched) {
+  return e->kind == pd_gkLaw || (e->appliesTo & pd_gk_variant_bit(engine, matched)) != 0;
+}
 
 static const pdGkExperiment* const catalogue[] = {
     &pd_gk_a1_restitution, &pd_gk_a2_restitution_contacts, &pd_gk_a3_sinkage, &pd_gk_a4_elastic_apex,

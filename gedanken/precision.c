@@ -5,18 +5,18 @@
 // accuracy knob, and the experiment's own measure gives the error against its closed form (restitution error,
 // stop-distance error, acceleration error, ...). One point = one (experiment, engine, variant, setting) run
 // `repeats` times with no output files: the error from the first run (every run is deterministic), the wall time
-// the median. The points are the tasks of a batch (refcheck/include/polydyn/batch.h), written in task order:
+// the median. The points are the tasks of a batch (runner/include/pdrun/batch.h), written in task order:
 // the file is the same bytes whatever the number of processes, except the wall times.
 #include <errno.h>
 #include <stdint.h>
 #include <stdlib.h>
 
 #include "gedanken_internal.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
 #include "polydyn/scene.h"
-#include "polydyn/stats.h"
+#include "pdrun/stats.h"
 #include "pdutil/csv.h"
 
 // The knobs, loosest first (the header lists them; docs/validation.md).

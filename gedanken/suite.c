@@ -3,7 +3,7 @@
 //
 // Order of work: the scenes are generated and compiled first (compiling touches GSL's global error
 // handler), one model per (experiment, input), shared read-only by that case's runs. Every run is then one
-// task of a batch (refcheck/include/polydyn/batch.h: `jobs` worker processes, or MPI ranks): it writes its
+// task of a batch (runner/include/pdrun/batch.h: `jobs` worker processes, or MPI ranks): it writes its
 // run directory and returns its row and series text, which land in task order, so the files are the same
 // bytes whatever the number of processes, except wall times.
 #include <errno.h>
@@ -13,29 +13,12 @@
 #include <unistd.h>
 
 #include "gedanken_internal.h"
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/output.h"
 #include "polydyn/refcheck.h"
 #include "pdutil/csv.h"
 #include "pdutil/files.h"
 #include "pdutil/json.h"
-
-const char* const pdGkEngineNames[pd_gkEngineCount] = {"soft", "ode", "bullet"};
-const char* const pdGkStatusNames[] = {"PASS", "FAIL", "REFUSED", "NOT_BUILT", "ERROR", "NOT_APPLICABLE"};
-const char* const pdGkKindNames[] = {"law", "model_prediction"};
-
-unsigned pd_gk_variant_bit(pdGkEngine engine, bool matched) {
-  switch (engine) {
-    case pd_gkSoft: return PD_GK_SOFT;
-    case pd_gkOde: return matched ? PD_GK_ODE_MATCHED : PD_GK_ODE_NATIVE;
-    case pd_gkBullet: return matched ? PD_GK_BULLET_MATCHED : PD_GK_BULLET_NATIVE;
-    default: PD_ASSERT(!"no such engine"); return 0;
-  }
-}
-
-bool pd_gk_applies(const pdGkExperiment* e, pdGkEngine engine, bool matched) {
-  return e->kind == pd_gkLaw || (e->appliesTo & pd_gk_variant_bit(engine, matched)) != 0;
-}
 
 enum { SERIES_MAX_ROWS = 500 };  // per run (RESULT_SCHEMAS.md: "at most ~500 rows per run")
 

@@ -20,7 +20,7 @@
 #include "interference.h"
 #include "oracle_ccd.h"
 #include "polydyn/error.h"
-#include "polydyn/stats.h"
+#include "pdrun/stats.h"
 
 const char* const pdOracleKindNames[pd_oracleKindCount] = {
     "agree_overlap", "agree_separate", "we_overlap", "we_separate", "touching", "mpr_differs", "depth", "ccd_stalled",

@@ -16,26 +16,11 @@
 
 #include "interference.h"
 #include "polydyn/oracle.h"
+#include "scene_shape.h"
 
 // ---------------------------------------------------------------- specs
 
 static const char* const kindWords[] = {"cube", "prism", "tprism", "sphere", "hull"};
-
-static bool build_object(const pdSceneObject* o, pdPolyhedron* p, pdError* why) {
-  switch (o->kind) {
-    case pd_primCube:
-      return pd_polyhedron_cube(p, o->scale, why);
-    case pd_primPrism:
-      return pd_polyhedron_prism(p, o->n, o->scale, 1.0, why);
-    case pd_primTprism:
-      return pd_polyhedron_prism(p, o->n, o->scale, o->taper, why);
-    case pd_primSphere:
-      return pd_polyhedron_sphere(p, o->n, o->scale, why);
-    case pd_primHull:
-      return pd_polyhedron_hull(p, o->points, o->pointCount, why);
-  }
-  return false;
-}
 
 bool pd_oracle_shape_parse(const char* spec, pdOracleShape* out, char* why, int whySize) {
   PD_ASSERT(spec != NULL && out != NULL);
@@ -69,7 +54,7 @@ bool pd_oracle_shape_parse(const char* spec, pdOracleShape* out, char* why, int 
   // body frame as in pd_model_compile: the centre of mass does not depend on the density
   pdMassProperties mp;
   pdError shapeErr = {0};
-  bool ok = build_object(&scene->objects[0], &out->poly, &shapeErr);
+  bool ok = pd_scene_object_shape(&scene->objects[0], &out->poly, &shapeErr);
   if (ok && !pd_mass_properties(&out->poly, 1000.0, &mp, &shapeErr)) {
     pd_polyhedron_free(&out->poly);
     ok = false;

@@ -25,7 +25,7 @@
 #include "oracle_ccd.h"
 #include "polydyn/error.h"
 #include "polydyn/oracle.h"
-#include "polydyn/stats.h"
+#include "pdrun/stats.h"
 
 const char* const pdOracleTimingModeNames[pd_oracleTimingModeCount] = {
     "ours_first",  "ours_cached", "ours_min_depth",     "ccd_gjk",

@@ -8,7 +8,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "contact_set_internal.h"
+#include "contact_list.h"
 
 const pdPose* pd_contact_set_poses(const pdContactSet* set) { return set->poses; }
 const pdVec3* pd_contact_set_force(const pdContactSet* set) { return set->force; }

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "contact_set_internal.h"
+#include "contact_list.h"
 #include "grow.h"
 #include "model_contact.h"
 #include "onsets.h"

@@ -1,7 +1,7 @@
 // polydyn — the contact list of a state: its storage, the contact events between steps and their commit (paper
 // Fig. 8, §3.4, §4.2–§4.4; docs/DESIGN.md §5.3). The work they call on is in files of its own: the forces inside the
 // derivative (contact_forces.c), the modal dampers and the stability bound (stability_bound.c), the onsets (onsets.c)
-// and the contact search (contact_search.c), all over the structures of contact_set_internal.h.
+// and the contact search (contact_search.c), all over the structures of contact_list.h.
 //
 // Design note. The loop of Fig. 8 runs as: the stepper proposes a step from (t0, y0) to y1 with the
 // contact list C0 fixed; the error control accepts it; pd_contact_events then analyses y1:
@@ -27,12 +27,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "contact_set_internal.h"
+#include "contact_list.h"
 #include "grow.h"
+#include "implicit.h"
 #include "material.h"
 #include "model_contact.h"
 #include "onset_bound.h"
 #include "onsets.h"
+#include "state_layout.h"
 
 #define PI 3.14159265358979323846
 
@@ -742,4 +744,21 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
     for (int i = 0; i < from[p]->contacts->count; ++i)
       set->next[count++] = remapped_slot(subs[p], from[p], i, toModel[p]);
   install_moved(model, to, count);
+}
+
+// The state's vectors grow with its contact list: install, above, calls it between steps (state_layout.h).
+void pd_state_reserve_contacts(const pdModel* model, pdState* s, int contacts) {
+  pd_contact_set_reserve_list(s->contacts, contacts);
+  int needed = spring_base(model) + PD_CONTACT_STATE_SIZE * contacts;
+  if (needed > s->capacity) {
+    int c = s->capacity > 0 ? s->capacity : 1;
+    while (c < needed) c *= 2;
+    s->y = pd_grow(s->y, c, sizeof *s->y);
+    s->weight = pd_grow(s->weight, c, sizeof *s->weight);
+    // the stepper's vectors hold no data between steps: reallocate rather than copy
+    free(s->work);
+    s->work = pd_zeroed((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
+    s->capacity = c;
+  }
+  if (s->implicit) pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
 }

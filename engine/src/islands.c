@@ -1,4 +1,4 @@
-// polydyn — islands (pd_islandsOn; docs/DESIGN.md §5.4; docs/integration.md).
+// polydyn — islands (pd_islandsOn; docs/DESIGN.md §5.4; docs/integration.md); their partition: island_partition.c.
 //
 // Design note. With islands off, one state vector carries every moving body and contact: one step size,
 // one error norm (a max over all of y), and every contact onset anywhere cuts every body's step. With
@@ -92,22 +92,14 @@
 #include "grow.h"
 #include "integrator.h"
 #include "interference.h"
+#include "island_partition.h"
+#include "island_set.h"
 #include "model_contact.h"
 #include "pool.h"
 #include "samples.h"
 #include "sleep.h"
 #include "state_layout.h"
 
-// Slack of the travel bound, in the body's design deflections δ_max (deflection × size), plus a fraction of
-// its size: what its velocity at T does not show (its springs' deflection as loads shift, a push from a
-// neighbour inside its island, the integration's own error from the ballistic path). A body that moves
-// farther makes its island redo the interval (the bound is then grown), so the slack only trades redos
-// against islands joined for nothing: the tighter, the smaller the islands. On cases/bench/pile_1000.scene (0.5 s,
-// with the separating-axis test), the run time relative to 0.25 δ_max + 0.001 size (largest island 65, 23 redos):
-// 2 + 0.01 1.48× (222, no redo), 0.5 + 0.002 1.04× (84, 7 redos), 0.1 + 0 0.96× (48, 119 redos), 0 + 0 0.97× with
-// 7414 free bodies straying (never recovered: see the note).
-#define PD_ISLAND_SLACK_DEFLECTIONS 0.25
-#define PD_ISLAND_SLACK_SIZE 0.001
 // Sync times: a sample interval is cut into equal parts so that a body at the characteristic speed vmax travels
 // at most this fraction of the smallest moving body's size over one part, at most PD_ISLAND_SYNC_PARTS_MAX parts.
 // The bounds grow with the interval: with short ones, bodies that fall or bounce near each other stay in
@@ -126,90 +118,16 @@
 // rough guess; the heaviest go first, so that the last ones taken are small).
 #define PD_ISLAND_CONTACT_WEIGHT 1
 // A batch of one island wakes the other threads to serve its help desk (help_desk.h) from this weight on (bodies +
-// contacts): below it the per-contact loops are too short to split (PD_HELP_MIN_CONTACTS in contact_set_internal.h).
+// contacts): below it the per-contact loops are too short to split (PD_HELP_MIN_CONTACTS in contact_list.h).
 #define PD_ISLAND_HELP_WEIGHT 128
 
-typedef struct island {
-  int bodyCount;   // moving bodies
-  int* bodies;     // (bodyCount) their moving-body indices k (scene body model->movingBodies[k]), ascending
-  pdModel model;   // its moving bodies and every fixed body, scene order
-  int* toScene;    // (model.bodyCount) scene body index of each of its bodies
-  pdState* state;  // at T, or at T' once advanced
-  bool advanced;   // advanced over the interval under way
-  bool asleep;     // frozen (sleeping, below): never advanced; its state kept as it was when it fell asleep
-} island;
-
-struct pdIslandSet {
-  int movingCount, bodyCount, fixedCount;
-  int* fixedBodies;  // (fixedCount) scene indices of the fixed bodies, ascending
-  int* root;         // (movingCount) union-find over moving-body indices; a root is its set's lowest index
-  int* islandOf;     // (movingCount) island of each moving body in the partition under way
-  int* islandOld;    // (movingCount) index in `islands` of the island holding the body (-1: none)
-  int* members;      // (movingCount) moving bodies grouped by island, ascending within each
-  int* first;        // (movingCount + 1) island j's members: members[first[j] .. first[j + 1])
-  int partCount;     // islands in the partition under way
-  double* bound;     // (movingCount) m: how far the body's points may move over the interval
-  double* travel;    // (movingCount) m: how far they moved at most, measured at the island's step ends
-  double* h;         // (movingCount) s: the next step its island wanted at the last sync
-  pdVec3* x0;        // (movingCount) centre of mass at T, m
-  pdVec3* v0;        // (movingCount) its velocity at T, m/s
-  pdQuat* q0;        // (movingCount) orientation at T
-  pdMat3* r0;        // (movingCount) its rotation matrix (normalised)
-  pdAabb* box0;      // (movingCount) box at T
-  bool* touching;    // (movingCount) in a contact at T, or its box may reach a fixed body's
-  // the sample interval [T0, Ts] as a whole (free bodies: see the design note)
-  double ct0;         // s: T0
-  bool* free;         // (movingCount) alone and ballistic over the whole sample interval
-  pdVec3 *cx0, *cv0;  // (movingCount) centre of mass and velocity at T0
-  pdQuat* cq0;        // (movingCount) orientation at T0
-  double* cbound;     // (movingCount) m: the bound over the sample interval
-  double* ctravel;    // (movingCount) m: how far a free body strayed from its ballistic path since T0
-  pdAabb* cbox;       // (movingCount) its box over the sample interval (swept and grown)
-  int* activate;      // (movingCount) free bodies a fine box reached (partition)
-  long strays;        // free bodies that strayed from their box (never expected: counted, not recovered)
-  double t0;         // s: T
-  double sizeMin;    // m: the smallest moving body's size
-  pdAabb* boxes;     // (bodyCount) grown boxes (fixed bodies: their own)
-  pdBroadPhase* broad;
-  pdPair* pairs;
-  int pairCapacity;
-  // may_meet's separating feature of each pair it tested at the last partition, sorted by (a, b) (a hint)
-  pdPairSatCache *sat, *satNext;  // (pairCapacity)
-  int satCount;
-  int* toSub;        // (bodyCount) scratch: scene body → island body (-1 elsewhere)
-  int* contactOf;    // (contactCapacity) island of each of the scene's contacts at T
-  int* contacts;     // (contactCapacity) the scene's contacts grouped by island, ascending within each
-  int* contactFirst;  // (movingCount + 1) island j's contacts: contacts[contactFirst[j] .. contactFirst[j + 1])
-  int contactCapacity;
-  island** islands;  // (islandCapacity) the live islands, listed by their lowest body
-  island** next;     // (islandCapacity) scratch: the list being formed
-  int islandCount, islandCapacity;
-  const pdModel** subModels;  // (islandCapacity) scratch for the gather
-  const pdState** subStates;
-  const int** subMaps;
-  // work of islands freed so far (summed in with the live ones' at every sync)
-  pdCounters retired;
-  long retiredWarnings[pd_warnCount];
-  double retiredStages[pd_stageCount];
-  double observeSeconds;  // the scene's observer calls
-  long formed, largest, intervals, redos;
-  pdPool pool;  // the caller and pdState.threads − 1 workers (design note, "Threads"; pool.h)
-  // the batch: jobCount islands, all to jobTime
-  int jobCount;
-  double jobTime;
-  bool jobLand;          // cut the islands' last steps to end on jobTime (a sync time inside a sample interval)
-  island** jobs;         // (islandCapacity)
-  bool* jobCoarse;       // (islandCapacity) a free body's island (island_advance's coarse)
-  bool* jobOk;           // (islandCapacity) written by the job's thread
-  pdPoolOrder* order;    // (islandCapacity) the jobs by weight: the order the pool takes them in
-  pdSleepSet* sleep;     // the bodies' sleep records (NULL when settings.sleep is off)
-};
+// the set and its islands: island_set.h
 
 // ---------------------------------------------------------------- one island
 
 static void island_free(island* is) {
   if (!is) return;
-  pd_state_free(is->state);
+  pd_state_release(is->state);
   pd_material_table_free(is->model.materials);
   free(is->model.bodies);
   free(is->model.movingBodies);
@@ -550,204 +468,6 @@ static struct pdIslandSet* set_create(const pdModel* model, const pdState* s) {
   return set;
 }
 
-// ---------------------------------------------------------------- partition
-
-static int find(int* root, int k) {
-  while (root[k] != k) {
-    root[k] = root[root[k]];
-    k = root[k];
-  }
-  return k;
-}
-
-static void join(int* root, int a, int b) {
-  a = find(root, a);
-  b = find(root, b);
-  if (a < b)
-    root[b] = a;
-  else if (b < a)
-    root[a] = b;
-}
-
-static bool boxes_overlap(const pdAabb* a, const pdAabb* b) {
-  for (int d = 0; d < 3; ++d)
-    if (a->lo[d] > b->hi[d] || b->lo[d] > a->hi[d]) return false;
-  return true;
-}
-
-// How far body k's points can stray over the interval from where its ballistic motion (its velocity at T and
-// gravity, which every body shares) takes them, m (design note): an applied force's share, its spin's
-// (r |ω| Δ), and the slack; a body touching anything at T, or whose box may reach a fixed body's, may also
-// reverse its velocity and be held against gravity (2 |v| Δ + |g| Δ²).
-static double travel_bound(const pdModel* model, const struct pdIslandSet* set, int k, const double* yb,
-                           const pdAabb* box, bool* touchingOut, double t, double dt) {
-  const pdBody* b = &model->bodies[model->movingBodies[k]];
-  bool touching = *touchingOut;
-  double accel = 0.0;
-  if (b->hasForce) accel = (pd_v3_norm(b->force0) + pd_v3_norm(b->forceRate) * (fabs(t) + dt)) * b->invMass;
-  double slack = (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
-  // the spin a torque-free body can reach keeps its rotational energy: |ω| <= √(2 E_rot / I_min)
-  pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(pd_layout_q(yb)));
-  pdVec3 wb = pd_mat3_tmulv(&r, pd_layout_w(yb));
-  double twiceEnergy = pd_v3_dot(wb, pd_mat3_mulv(&b->inertia, wb));
-  double spinMax = b->principal[0] > 0.0 ? sqrt(fmax(0.0, twiceEnergy) / b->principal[0]) : 0.0;
-  double spin = fmax(pd_v3_norm(pd_layout_w(yb)), spinMax) * b->radius * dt;
-  double bound = 0.5 * accel * dt * dt + spin + slack;
-  double g = pd_v3_norm(model->settings.gravity), v = pd_v3_norm(pd_layout_v(yb));
-  if (!touching) {
-    // may it reach a fixed body? (its box grown by all it can move, gravity included)
-    double reach = v * dt + 0.5 * (g + accel) * dt * dt + spin + slack;
-    pdAabb grown = *box;
-    for (int d = 0; d < 3; ++d) grown.lo[d] -= reach, grown.hi[d] += reach;
-    for (int f = 0; f < set->fixedCount && !touching; ++f)
-      touching = boxes_overlap(&grown, &set->boxes[set->fixedBodies[f]]);
-  }
-  if (touching) bound += 2.0 * v * dt + g * dt * dt;
-  *touchingOut = touching;
-  return bound;
-}
-
-// Whether the axis of `sat` keeps two bodies apart over dt: its gap wider than they can close along it.
-static bool kept_apart(const pdSatResult* sat, pdVec3 relativeVelocity, double dt, double bounds) {
-  return sat->separated && -sat->depth > fmax(0.0, pd_v3_dot(sat->axis, relativeVelocity)) * dt + bounds;
-}
-
-// Whether moving bodies a and b, whose grown boxes overlap, may meet over the interval dt: unless the separating
-// axis test at T finds an axis u (from a to b) with a gap wider than all they can close along it. Each point of
-// body k stays, in the frame that falls with gravity, within bound_k of where v0_k τ takes it (design note), so
-// along u the gap shrinks by at most max(0, u·(v0_a − v0_b)) dt + bound_a + bound_b. Boxes of turned bodies
-// overlap long before the bodies do: in a settling pile, the box test alone joins bodies lying side by side
-// into islands of hundreds. The pair's separating feature from the last partition (cache) is tried first (the
-// same bodies, moved a little since); only when its axis does not keep them apart are all axes searched for the
-// widest gap. Either answer is safe, and the cache is a function of the pair's own past: still deterministic.
-static bool may_meet(const struct pdIslandSet* set, const pdBody* a, const pdBody* b, double dt, pdSatCache* cache) {
-  int ka = a->stateIndex, kb = b->stateIndex;
-  const pdMat3 *ra = &set->r0[ka], *rb = &set->r0[kb];
-  double bounds = set->bound[ka] + set->bound[kb];
-  pdVec3 dv = pd_v3_sub(set->v0[ka], set->v0[kb]);
-  pdSatResult sat;
-  if (cache->kind != PD_SAT_NONE) {
-    pd_interference(&a->shape, set->x0[ka], ra, &b->shape, set->x0[kb], rb, PD_SAT_FIRST_SEPARATING, cache, &sat);
-    if (kept_apart(&sat, dv, dt, bounds)) return false;
-  }
-  pd_interference(&a->shape, set->x0[ka], ra, &b->shape, set->x0[kb], rb, PD_SAT_MIN_DEPTH, cache, &sat);
-  return !kept_apart(&sat, dv, dt, bounds);
-}
-
-// The partition of the moving bodies at the scene's state s (T) with the bounds set->bound over the interval
-// dt: islandOf, members, first, partCount; and contactOf, the island of each contact of s. In the frame that
-// falls with gravity, body k's points stay within its box at T swept along v0 dt and grown by its bound.
-// With fine set (a sync interval), a free body keeps its box over the sample interval (cbox) and joins nothing:
-// a free body whose box another body's reaches is listed in set->activate instead, and the number of those is
-// returned (the partition is then incomplete: activate them and form it again). Without (the sample interval
-// as a whole), every body takes part.
-// Counting sort: items 0 .. n) grouped by group[i] (0 .. groups), ascending within each group, into
-// out[first[j] .. first[j + 1]).
-static void group_by(const int* group, int n, int groups, int* first, int* out) {
-  for (int j = 0; j <= groups; ++j) first[j] = 0;
-  for (int i = 0; i < n; ++i) ++first[group[i] + 1];
-  for (int j = 0; j < groups; ++j) first[j + 1] += first[j];
-  for (int i = 0; i < n; ++i) out[first[group[i]]++] = i;
-  for (int j = groups; j > 0; --j) first[j] = first[j - 1];
-  first[0] = 0;
-}
-
-// The bodies of each sleeping island stay one island: frozen, they move together (not at all), and a part of one
-// woken alone would leave the rest frozen against moving bodies.
-static void join_sleepers(struct pdIslandSet* set) {
-  if (!set->sleep) return;
-  for (int j = 0; j < set->islandCount; ++j) {
-    const island* is = set->islands[j];
-    if (!is || !is->asleep) continue;
-    for (int m = 1; m < is->bodyCount; ++m) join(set->root, is->bodies[0], is->bodies[m]);
-  }
-}
-
-static int partition(const pdModel* model, const pdState* s, struct pdIslandSet* set, double dt, bool fine) {
-  int m = set->movingCount, activations = 0;
-  for (int k = 0; k < m; ++k) {
-    set->root[k] = k;
-    if (fine && set->free[k]) {
-      set->boxes[model->movingBodies[k]] = set->cbox[k];
-      continue;
-    }
-    pdAabb box = set->box0[k];
-    double sweep[3] = {set->v0[k].x * dt, set->v0[k].y * dt, set->v0[k].z * dt};
-    for (int d = 0; d < 3; ++d) {
-      box.lo[d] += fmin(0.0, sweep[d]) - set->bound[k];
-      box.hi[d] += fmax(0.0, sweep[d]) + set->bound[k];
-    }
-    set->boxes[model->movingBodies[k]] = box;
-  }
-  // bodies in contact first: a pair already in one island needs no separation test
-  int contacts = pd_state_contact_count(s);
-  for (int c = 0; c < contacts; ++c) {
-    int b1, b2;
-    pd_contact_set_bodies(s->contacts, c, &b1, &b2);
-    const pdBody *a = &model->bodies[b1], *b = &model->bodies[b2];
-    if (!a->fixed && !b->fixed) join(set->root, a->stateIndex, b->stateIndex);
-  }
-  join_sleepers(set);
-  // every moving body in one island by its contacts alone (a stack, a wall): every pair below would be skipped as
-  // joined, with no free body to activate (a free body touches nothing), so the broad phase is not asked (its pairs
-  // come sorted whatever its history: broad_phase.h)
-  bool joined = true;
-  for (int k = 1; k < m && joined; ++k) joined = find(set->root, k) == find(set->root, 0);
-  int pairCount = 0;
-  if (!joined) {
-    int capacity = set->pairCapacity;
-    pairCount = pd_broad_phase_pairs_grown(set->broad, set->boxes, &set->pairs, &set->pairCapacity);
-    if (set->pairCapacity != capacity) {
-      set->sat = pd_grow(set->sat, (size_t)set->pairCapacity, sizeof *set->sat);
-      set->satNext = pd_grow(set->satNext, (size_t)set->pairCapacity, sizeof *set->satNext);
-    }
-  }
-  int cached = 0, tested = 0;
-  for (int p = 0; p < pairCount; ++p) {
-    const pdBody *a = &model->bodies[set->pairs[p].a], *b = &model->bodies[set->pairs[p].b];
-    if (a->fixed || b->fixed) continue;
-    bool freeA = fine && set->free[a->stateIndex], freeB = fine && set->free[b->stateIndex];
-    if (freeA && freeB) continue;  // their boxes over the sample interval overlap no other body's (coarse partition)
-    if (freeA || freeB) {
-      int k = freeA ? a->stateIndex : b->stateIndex;
-      bool listed = false;
-      for (int i = 0; i < activations && !listed; ++i) listed = set->activate[i] == k;
-      if (!listed) set->activate[activations++] = k;
-      continue;
-    }
-    if (find(set->root, a->stateIndex) == find(set->root, b->stateIndex)) continue;
-    int ia = set->pairs[p].a, ib = set->pairs[p].b;
-    pdPairSatCache* entry = &set->satNext[tested++];
-    *entry = (pdPairSatCache){ia, ib, pd_pair_sat_cache_find(set->sat, set->satCount, &cached, ia, ib)};
-    if (may_meet(set, a, b, dt, &entry->sat)) join(set->root, a->stateIndex, b->stateIndex);
-  }
-  pdPairSatCache* t = set->sat;
-  set->sat = set->satNext;
-  set->satNext = t;
-  set->satCount = tested;
-  if (activations > 0) return activations;
-  // islands named by their lowest body, in that order; members grouped by a counting sort
-  set->partCount = 0;
-  for (int k = 0; k < m; ++k) {
-    int r = find(set->root, k);
-    set->islandOf[k] = r == k ? set->partCount++ : set->islandOf[r];
-  }
-  group_by(set->islandOf, m, set->partCount, set->first, set->members);
-  if (contacts > set->contactCapacity) {
-    set->contactCapacity = 2 * contacts;
-    set->contactOf = pd_grow(set->contactOf, (size_t)set->contactCapacity, sizeof *set->contactOf);
-    set->contacts = pd_grow(set->contacts, (size_t)set->contactCapacity, sizeof *set->contacts);
-  }
-  for (int c = 0; c < contacts; ++c) {
-    int b1, b2;
-    pd_contact_set_bodies(s->contacts, c, &b1, &b2);
-    int moving = model->bodies[b1].fixed ? b2 : b1;
-    set->contactOf[c] = set->islandOf[model->bodies[moving].stateIndex];
-  }
-  group_by(set->contactOf, contacts, set->partCount, set->contactFirst, set->contacts);
-  return 0;
-}
-
 // Makes the live islands those of the partition: an island whose bodies did not change is kept as it is
 // (advanced or not); the others are freed and new ones set up from the scene's state at T. Returns the
 // number of islands set up.
@@ -801,7 +521,7 @@ static void set_start(const pdModel* model, const pdState* s, struct pdIslandSet
     set->bound[k] = 0.0;
     return;
   }
-  set->bound[k] = travel_bound(model, set, k, yb, &set->box0[k], &set->touching[k], s->t, dt);
+  set->bound[k] = pd_island_travel_bound(model, set, k, yb, &set->box0[k], &set->touching[k], s->t, dt);
 }
 
 // Marks in set->touching the moving bodies of the scene's contacts.
@@ -954,7 +674,7 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
     // a free body another body may reach joins the others from here: it is brought to T first; a sleeping island
     // another body may reach wakes here, and the partition is formed again with its bodies moving
     do {
-      for (int activations; (activations = partition(model, s, set, dt, true)) > 0;)
+      for (int activations; (activations = pd_island_partition(model, s, set, dt, true)) > 0;)
         for (int i = 0; i < activations; ++i) {
           int k = set->activate[i];
           if (s->t > set->ct0 && !free_advance(s, set, k, s->t, true)) return false;
@@ -1035,7 +755,7 @@ static void find_free(const pdModel* model, const pdState* s, struct pdIslandSet
     set->cbound[k] = set->bound[k];
     set->ctravel[k] = 0.0;
   }
-  partition(model, s, set, dt, false);
+  pd_island_partition(model, s, set, dt, false);
   for (int j = 0; j < set->partCount; ++j) {
     if (set->first[j + 1] - set->first[j] != 1) continue;
     int k = set->members[set->first[j]];
@@ -1055,7 +775,7 @@ static bool cuts_split_islands(const pdModel* model, const pdState* s, struct pd
   mark_touching(model, s, set);
   for (int k = 0; k < set->movingCount; ++k)
     if (!set->free[k]) set_start(model, s, set, k, dt);
-  int activations = partition(model, s, set, dt, true);
+  int activations = pd_island_partition(model, s, set, dt, true);
   return activations > 0 || set->partCount > whole;
 }
 

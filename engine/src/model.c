@@ -10,6 +10,7 @@
 #include "interference.h"
 #include "model_contact.h"
 #include "polydyn/state.h"
+#include "scene_shape.h"
 
 // The characteristic speed never drops below one length per second of the largest MOVING body: it weights
 // velocity errors, and a scene at rest without gravity would otherwise have no velocity scale at all
@@ -29,7 +30,7 @@ static char* copy_string(const char* s) {
   return c;
 }
 
-static bool build_shape(const pdSceneObject* o, pdPolyhedron* shape, pdError* why) {
+bool pd_scene_object_shape(const pdSceneObject* o, pdPolyhedron* shape, pdError* why) {
   switch (o->kind) {
     case pd_primCube:
       return pd_polyhedron_cube(shape, o->scale, why);
@@ -248,7 +249,7 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
 
     pdError why = {0};
     pdMassProperties mp;
-    if (!build_shape(o, &b->shape, &why) || !pd_mass_properties(&b->shape, b->density, &mp, &why)) {
+    if (!pd_scene_object_shape(o, &b->shape, &why) || !pd_mass_properties(&b->shape, b->density, &mp, &why)) {
       pd_error_set(err, scene->path, o->where.line, o->where.col, "object '%s': %s", o->name, why.message);
       pd_model_free(m);
       return NULL;

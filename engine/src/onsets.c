@@ -22,7 +22,7 @@
 
 #include <math.h>
 
-#include "contact_set_internal.h"
+#include "contact_list.h"
 #include "material.h"
 #include "model_contact.h"
 #include "onset_bound.h"

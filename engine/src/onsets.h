@@ -15,7 +15,7 @@
 double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPose* body1Start,
                         const pdPose* body1End, const pdPose* body2Start, const pdPose* body2End);
 
-// The earliest onset fraction δ among the candidates of the last contact search (contact_set_internal.h) that
+// The earliest onset fraction δ among the candidates of the last contact search (contact_list.h) that
 // approach, carry no springs over and went deeper than their onset tolerance; 2 when there is none. With pairOnsets a
 // candidate close enough to the step's end (of size h) to join there as a pair onset gets its onset age instead.
 double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdOnsets onsets, const double* y1);

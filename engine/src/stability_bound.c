@@ -13,7 +13,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "contact_set_internal.h"
+#include "contact_list.h"
 #include "material.h"
 
 // Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can

@@ -1,15 +1,16 @@
-// polydyn — the mutable state: creation, reset, growth, read-out (bodies, contacts, energy).
+// polydyn — the mutable state: options, creation, reset and release of its own parts, read-out of bodies and
+// energy. Its contacts' read-out and room: state_contacts.c; the public reset and free, which also free the
+// islands' states: state_free.c.
 #include "polydyn/state.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "contact_set_internal.h"
+#include "contact_set.h"
 #include "grow.h"
 #include "dense_output.h"
 #include "implicit.h"
-#include "islands.h"
 #include "state_layout.h"
 
 const char* const pdStageNames[pd_stageCount] = {"broad_phase", "interference", "contact_analysis", "forces",
@@ -42,11 +43,11 @@ pdState* pd_state_create(const pdModel* model, const pdStateOptions* options) {
   s->options = o;
   s->contacts = pd_contact_set_create(model);
   pd_state_reserve_contacts(model, s, 4 * model->movingCount + 16);
-  pd_state_reset(model, s);
+  pd_state_reset_own(model, s);
   return s;
 }
 
-void pd_state_reset(const pdModel* model, pdState* s) {
+void pd_state_reset_own(const pdModel* model, pdState* s) {
   const pdSettings* set = &model->settings;
   pd_dense_discard(s);  // first: a presented state's y and contacts are the presentation's
   s->t = 0.0;
@@ -58,8 +59,6 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   s->islands = s->options.islands;
   s->threads = s->options.threads;
   s->searchCertificates = s->options.searchCertificates;
-  pd_island_set_free(s->islandSet);
-  s->islandSet = NULL;
   pd_implicit_free(s->implicit);  // its switch (active, on probation, backing off) is the last run's
   s->implicit = NULL;
   s->nextSample = 0;
@@ -85,58 +84,16 @@ void pd_state_reset(const pdModel* model, pdState* s) {
   }
 }
 
-void pd_state_free(pdState* s) {
-  if (!s) return;
+void pd_state_release(pdState* s) {
+  PD_ASSERT(s->islandSet == NULL);  // pd_state_free frees it first
   pd_dense_resume(s);
   pd_dense_free(s->dense);
   free(s->y);
   free(s->weight);
   free(s->work);
   pd_contact_set_free(s->contacts);
-  pd_island_set_free(s->islandSet);
   pd_implicit_free(s->implicit);
   free(s);
-}
-
-void pd_state_reserve_contacts(const pdModel* model, pdState* s, int contacts) {
-  pd_contact_set_reserve_list(s->contacts, contacts);
-  int needed = spring_base(model) + PD_CONTACT_STATE_SIZE * contacts;
-  if (needed > s->capacity) {
-    int c = s->capacity > 0 ? s->capacity : 1;
-    while (c < needed) c *= 2;
-    s->y = pd_grow(s->y, c, sizeof *s->y);
-    s->weight = pd_grow(s->weight, c, sizeof *s->weight);
-    // the stepper's vectors hold no data between steps: reallocate rather than copy
-    free(s->work);
-    s->work = pd_zeroed((size_t)c * PD_STEPPER_WORK_VECTORS, sizeof *s->work);
-    s->capacity = c;
-  }
-  if (s->implicit) pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
-}
-
-int pd_state_contact_room(const pdModel* model, const pdState* s) {
-  return (s->capacity - spring_base(model)) / PD_CONTACT_STATE_SIZE;
-}
-
-int pd_state_contact_count(const pdState* s) { return s->contacts ? s->contacts->count : 0; }
-
-pdContactReport pd_state_contact(const pdState* s, int i) {
-  PD_ASSERT(s->contacts != NULL && i >= 0 && i < s->contacts->count);
-  const contactSlot* c = &s->contacts->items[i];
-  pdContactReport r;
-  r.bodyA = c->id.body1;
-  r.bodyB = c->id.body2;
-  r.edgeEdge = c->id.kind == pd_contactEE;
-  r.featureA = c->id.feat1;
-  r.featureB = c->id.feat2;
-  r.point = c->point;
-  r.normal = c->normal;
-  r.depth = c->depth;
-  bool pulls = pd_contact_force_pulls(&c->force);
-  r.fn = pulls ? 0.0 : c->force.fn;
-  r.ft = pulls ? (pdVec3){0, 0, 0} : c->force.ft;
-  r.slip = c->force.slip;
-  return r;
 }
 
 pdBodyState pd_state_body(const pdModel* model, const pdState* s, int bodyIndex) {

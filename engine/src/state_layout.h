@@ -28,7 +28,12 @@ static inline void pd_layout_store(double* y, pdVec3 v, pdVec3 w, pdVec3 x, pdQu
 }
 
 // Grows the state's y, weight and work, its contact list and the implicit stepper's workspace, to hold `contacts`
-// contacts (between steps only: the stepper's scratch in work is dropped, not copied). state.c.
+// contacts (between steps only: the stepper's scratch in work is dropped, not copied). contact_set.c.
 void pd_state_reserve_contacts(const pdModel* model, pdState* state, int contacts);
 // How many contacts the state's vectors hold (what pd_state_reserve_contacts has made room for).
-int pd_state_contact_room(const pdModel* model, const pdState* state);
+int pd_state_contact_room(const pdModel* model, const pdState* state);  // state_contacts.c
+
+// pd_state_reset and pd_state_free but for the island set (state.c): what islands.c uses for its islands' states,
+// which never have one (islands run with islands off); the public two (state_free.c) free the set first.
+void pd_state_reset_own(const pdModel* model, pdState* state);
+void pd_state_release(pdState* state);

@@ -1,12 +1,12 @@
 // polydyn for Python — the bench: the interference oracle (refcheck/include/polydyn/oracle.h), the Gedanken
 // suite (gedanken/include/polydyn/gedanken.h), and the batch commands whose orchestration belongs to the command
-// line (compare, cubetoss: cli/cli.h), run in this process with the command's own code.
+// line (compare, cubetoss: cli/include/pdcli/commands.h), run in this process with the command's own code.
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli.h"
+#include "pdcli/commands.h"
 #include "polydyn/gedanken.h"
 #include "polydyn/oracle.h"
 #include "pypolydyn.h"
@@ -246,9 +246,8 @@ static PyObject* gedanken(PyObject* module, PyObject* args, PyObject* kwargs) {
   const char** engineNames = string_array(engines, &engineCount);
   if (!engineNames) goto done;
   for (int i = 0; i < engineCount; ++i) {
-    int e = 0;
-    while (e < pd_gkEngineCount && strcmp(engineNames[i], pdGkEngineNames[e]) != 0) ++e;
-    if (e == pd_gkEngineCount) {
+    pdGkEngine e;
+    if (!pd_gk_engine_named(engineNames[i], &e)) {
       PyErr_Format(PyExc_ValueError, "engines must be among soft, ode, bullet, not '%s'", engineNames[i]);
       goto done;
     }

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Batch runs (docs/commands.md; refcheck/include/polydyn/batch.h): one batch command on a small input,
+# Batch runs (docs/commands.md; runner/include/pdrun/batch.h): one batch command on a small input,
 # serially (--jobs 1), in two worker processes (--jobs 2) and split over three MPI ranks
 # (mpirun --oversubscribe -np 3), must write the same files with the same bytes, except the measured times
 # (same_outputs.py names them: wall/CPU time columns, the timing of summary.json, wall_seconds of JSON).

@@ -28,7 +28,7 @@
 #include "polydyn/state.h"
 #include "scene_run.h"
 
-// The soak's limit (refcheck/soak.c, PD_SOAK_PENETRATION_LIMIT): the springs are sized so that an impact at vmax
+// The soak's limit (validation/soak.c, PD_SOAK_PENETRATION_LIMIT): the springs are sized so that an impact at vmax
 // deflects them by δ_max; a few δ_max means the contacts are not holding the bodies apart.
 #define PENETRATION_LIMIT 3.0
 // The deepest overlap allowed in the spinning-corner scene, in δ_max of the pair: what the successor pairs reach

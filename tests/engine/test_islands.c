@@ -60,7 +60,7 @@
 #define GROUP_OFF_TOL_REL 1e-4
 
 enum { MAX_BODIES = 32, MAX_SAMPLES = 1001 };
-// contact_set_internal.h's PD_HELP_MIN_CONTACTS: loops shorter than this are never split
+// contact_list.h's PD_HELP_MIN_CONTACTS: loops shorter than this are never split
 #define PD_TEST_HELP_MIN_CONTACTS 128
 
 typedef struct trace {

@@ -1,4 +1,4 @@
-// libFuzzer target for the cube-toss CSV reader (refcheck/cubetoss_data.c: pd_toss_parse_buffer, the code of
+// libFuzzer target for the cube-toss CSV reader (validation/cubetoss_data.c: pd_toss_parse_buffer, the code of
 // pd_toss_read) and the toss lists of --tosses (pd_toss_select). The input is the CSV, optionally followed by
 // a NUL byte and a toss list (the reader refuses a NUL byte anyway, so the list never reaches it). Any bytes
 // must give either a set that keeps the reader's promises (cubetoss.h) or one well-formed error; a list,

@@ -220,6 +220,8 @@ void pd_gk_input_label(const pdGkExperiment* e, double input, char* buf, int siz
 
 typedef enum pdGkEngine { pd_gkSoft, pd_gkOde, pd_gkBullet, pd_gkEngineCount } pdGkEngine;
 extern const char* const pdGkEngineNames[pd_gkEngineCount];  // "soft", "ode", "bullet"
+// The engine named `name` (one of pdGkEngineNames); false when none is.
+bool pd_gk_engine_named(const char* name, pdGkEngine* engine);
 
 // NOT_APPLICABLE: a model prediction measured on a variant it does not apply to (pdGkKind): not judged.
 typedef enum pdGkStatus {

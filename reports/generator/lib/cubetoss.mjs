@@ -96,7 +96,7 @@ export function loadTypical(dir, ct) {
   return out;
 }
 
-// Angle of q_ref⁻¹ q in rad, [0, π], as refcheck/cubetoss_sim.c computes it (atan2 keeps small angles exact).
+// Angle of q_ref⁻¹ q in rad, [0, π], as validation/cubetoss_sim.c computes it (atan2 keeps small angles exact).
 export function rotationAngle(q, ref) {
   const [w0, x0, y0, z0] = ref, [w1, x1, y1, z1] = q;
   // conj(ref) * q

@@ -1,4 +1,4 @@
-// polydyn refcheck — one cube toss: its scene, its run in an engine, its errors against the record, the
+// polydyn validation — one cube toss: its scene, its run in an engine, its errors against the record, the
 // record as a run directory, statistics and parameter fragments (conventions in cubetoss.h).
 #include <errno.h>
 #include <math.h>
@@ -8,13 +8,13 @@
 #include <string.h>
 #include <time.h>
 
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/cubetoss.h"
 #include "polydyn/output.h"
 #include "polydyn/scene.h"
-#include "polydyn/stats.h"
+#include "pdrun/stats.h"
 #include "pdutil/json.h"
-#include "text_buffer.h"
+#include "pdrun/text_buffer.h"
 
 // Default stiffness of each side, N/m: eq. (11) for the cube, m vmax²/δ_max² with δ_max = 0.01 × side
 // (the engine's default deflection): 0.37 × 2.5² / (0.01 × 0.1048)² = 2.105e6, rounded.

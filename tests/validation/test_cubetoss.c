@@ -1,4 +1,4 @@
-// Tests of the cube-toss validation (refcheck/cubetoss*.c) on synthetic tosses, so they need no data: a
+// Tests of the cube-toss validation (validation/cubetoss*.c) on synthetic tosses, so they need no data: a
 // toss in free flight whose record is the closed-form parabola and torque-free spin, bad CSV files, the
 // statistics, toss lists, parameter fragments and the worker processes.
 #include <math.h>

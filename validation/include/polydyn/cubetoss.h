@@ -1,4 +1,4 @@
-// polydyn refcheck — validation against real cube tosses (docs/DESIGN.md §8.4, `polydyn cubetoss`).
+// polydyn validation — validation against real cube tosses (docs/DESIGN.md §8.4, `polydyn cubetoss`).
 //
 // The data (shared/data/cube-toss/README.md): tosses of a wooden cube onto a flat board, tracked by camera
 // at 148 Hz, from the ContactNets data set (Pfrommer, Halm & Posa, CoRL 2020), also used by Acosta, Yang &

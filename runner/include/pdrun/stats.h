@@ -1,4 +1,4 @@
-// polydyn refcheck — small statistics over arrays of doubles, shared by the bench's commands (medians of
+// polydyn runner — small statistics over arrays of doubles, shared by the bench's commands (medians of
 // repeated wall times, percentiles of errors).
 #pragma once
 

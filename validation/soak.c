@@ -17,7 +17,7 @@
 #include "polydyn/refcheck.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
-#include "text_buffer.h"
+#include "pdrun/text_buffer.h"
 
 const char* const pdSoakKindNames[pd_soakKindCount] = {"drop", "stack", "throw", "free", "overlap"};
 const char* const pdSoakStatusNames[pd_soakStatusCount] = {"ok", "refused", "over-budget", "failed", "not-built"};

@@ -1,4 +1,4 @@
-// Tests of the planar drops in the cube-toss machinery (refcheck/cubetoss*.c, pd_planar_drops) on synthetic
+// Tests of the planar drops in the cube-toss machinery (validation/cubetoss*.c, pd_planar_drops) on synthetic
 // drops, so they need no data: a drop in free flight whose record is the closed-form parabola and uniform
 // turn, the bounces of a closed-form bouncing record, the noise floor's run, bad drop files, and the fit's
 // held-out split (shared with the cube tosses).

@@ -1,4 +1,4 @@
-// Batch runs (refcheck/include/polydyn/batch.h): results land in task order with the same bytes whatever
+// Batch runs (runner/include/pdrun/batch.h): results land in task order with the same bytes whatever
 // the number of worker processes, including results larger than a pipe holds; a worker that dies and a
 // progress callback that says stop fail the batch with a message; a plain process is a world of one.
 #include <setjmp.h>
@@ -10,7 +10,7 @@
 
 #include <cmocka.h>
 
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 
 enum { TASKS = 9 };
 

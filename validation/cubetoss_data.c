@@ -1,4 +1,4 @@
-// polydyn refcheck — reading the cube-toss CSV, the train/test split and toss lists (cubetoss.h).
+// polydyn validation — reading the cube-toss CSV, the train/test split and toss lists (cubetoss.h).
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>

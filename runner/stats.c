@@ -1,5 +1,5 @@
-// polydyn refcheck — small statistics over arrays of doubles (refcheck/include/polydyn/stats.h).
-#include "polydyn/stats.h"
+// polydyn runner — small statistics over arrays of doubles (runner/include/pdrun/stats.h).
+#include "pdrun/stats.h"
 
 #include <stdlib.h>
 

@@ -1,4 +1,4 @@
-// polydyn refcheck — batch runs over worker processes and MPI ranks (batch.h).
+// polydyn runner — batch runs over worker processes and MPI ranks (batch.h).
 //
 // Locally, workers are fork()ed children: a counter in a shared anonymous mapping hands out the next task,
 // each worker sends (task, size, bytes) back over its own pipe. Over MPI, rank r takes every R-th task
@@ -25,7 +25,7 @@
 #include <mpi.h>
 #endif
 
-#include "polydyn/batch.h"
+#include "pdrun/batch.h"
 #include "polydyn/error.h"
 
 // How often the parent asks `progress` whether to go on while no task finishes, ms.

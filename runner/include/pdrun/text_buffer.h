@@ -1,4 +1,4 @@
-// polydyn refcheck (internal) — a growing text buffer for generated scene files (cube tosses, the soak).
+// polydyn runner — a growing text buffer for generated scene files (cube tosses, the soak).
 #pragma once
 
 #include <stddef.h>

@@ -1,5 +1,5 @@
-// polydyn refcheck — a growing text buffer (text_buffer.h).
-#include "text_buffer.h"
+// polydyn runner — a growing text buffer (text_buffer.h).
+#include "pdrun/text_buffer.h"
 
 #include <stdarg.h>
 #include <stdio.h>

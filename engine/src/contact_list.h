@@ -1,7 +1,7 @@
-// polydyn (internal) — the contact list's private structures and the helpers its files share: contact_set.c (the
+// polydyn (internal) — the contact list's structures and the helpers the contact files share: contact_set.c (the
 // list, its events and commit), contact_forces.c (forces in the derivative, linearisation), stability_bound.c (modal
 // dampers, the stable step), onsets.c (late onsets), contact_search.c (broad phase, travel, certificates, search) and
-// state.c (the state's contact read-out). Nothing outside these files includes it: everyone else sees
+// state_contacts.c (the state's contact read-out). Nothing outside these files includes it: everyone else sees
 // pdContactSet through contact_set.h alone.
 #pragma once
 

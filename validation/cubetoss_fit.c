@@ -1,4 +1,4 @@
-// polydyn refcheck — fitting an engine's free parameters to the training tosses with GSL's Nelder–Mead
+// polydyn validation — fitting an engine's free parameters to the training tosses with GSL's Nelder–Mead
 // simplex (objective, bounds and steps in cubetoss.h); the held-out split, several engines in turn and their
 // fit.csv, for both data sets (cube tosses, planar drops).
 #include <math.h>

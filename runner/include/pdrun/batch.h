@@ -1,5 +1,5 @@
-// polydyn refcheck — batch runs: a list of independent tasks run in local worker processes or split over
-// MPI ranks, their results gathered in task order (refcheck/batch.c).
+// polydyn runner — batch runs: a list of independent tasks run in local worker processes or split over
+// MPI ranks, their results gathered in task order (runner/batch.c).
 //
 // A task is a function of its index that may write files (under a directory every process sees) and
 // returns bytes. Whoever ran a task and in whatever order, task i's bytes land in results[i], so what the
