@@ -1,6 +1,7 @@
 // polydyn check — parse and compile a scene, print what the engine derived from it.
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
@@ -14,7 +15,9 @@ static const char* const help =
     "with where each came from, and the contact model's material parameters (paper §3.2, §3.3): per\n"
     "body the material as requested and as used (mu, kn, kt, cn, ct), the mass that sized it, the\n"
     "minimum effective mass and the time constants; then the number of material classes and every\n"
-    "time-constant adjustment made to fit dtmin (or \"adjustments: none\").\n"
+    "time-constant adjustment made to fit dtmin (or \"adjustments: none\"); then the stacks (moving\n"
+    "bodies joined by contacts after 0.1 s of the run, or at tend if sooner; scenes of at most 64\n"
+    "moving bodies) with the frequency and damping ratio of each of their contact modes.\n"
     "Refuses (exit 2) what `polydyn run` refuses, including a restitution below 0.01 and bodies that\n"
     "overlap at t = 0. Exit status: 0 ok, 2 bad input.\n";
 
@@ -146,6 +149,88 @@ static void print_adjustments(const pdModel* m) {
   if (dropped > 0) printf("  ... and %d more not listed (dropped)\n", dropped);
 }
 
+// The stacks are those of the state after this long (s), or at tend if sooner: a stack set down at rest forms from
+// the floor up, one interface per contact period (a few ms; cases/bench/stack_20.scene's top box is reached after
+// about 60 ms).
+#define PD_CHECK_STACKS_AFTER 0.1
+// Scenes of more moving bodies than this are not run for their stacks (`check` stays quick: a pile of 1000 would
+// take seconds).
+#define PD_CHECK_STACKS_BODIES_MAX 64
+// At most this many roots are printed per stack (the slowest; 12 per body in all).
+#define PD_CHECK_STACK_ROOTS_MAX 12
+
+static void print_stack(const pdModel* m, const pdState* s, const int* stackOf, int stack) {
+  int bodies = 0, contacts = 0;
+  double lightest = INFINITY, heaviest = 0.0;
+  printf("  stack %d:", stack + 1);
+  for (int k = 0; k < m->bodyCount; ++k)
+    if (stackOf[k] == stack) {
+      printf("%s %s", bodies ? "," : "", m->bodies[k].name);
+      ++bodies;
+      lightest = fmin(lightest, m->bodies[k].mass);
+      heaviest = fmax(heaviest, m->bodies[k].mass);
+    }
+  for (int i = 0, n = pd_state_contact_count(s); i < n; ++i) {
+    pdContactReport c = pd_state_contact(s, i);
+    contacts += stackOf[c.bodyA] == stack || stackOf[c.bodyB] == stack;
+  }
+  printf(" (%d bodies, %d contacts, masses %.6g to %.6g kg)\n", bodies, contacts, lightest, heaviest);
+  pdStackMode modes[12 * PD_STACK_MODES_BODIES_MAX];
+  int count = pd_state_stack_modes(m, s, stackOf, stack, modes, 12 * PD_STACK_MODES_BODIES_MAX);
+  if (count < 0) {
+    printf("    modes not analysed (more than %d bodies)\n", PD_STACK_MODES_BODIES_MAX);
+    return;
+  }
+  int oscillating = 0, real = 0;
+  double slowestDecay = INFINITY, slowestPeriod = 0.0, leastZeta = INFINITY;
+  for (int j = 0; j < count; ++j) {
+    double decay = modes[j].omega * modes[j].zeta;  // 1/s: −Re λ
+    slowestDecay = fmin(slowestDecay, decay);
+    if (modes[j].real) {
+      ++real;
+      continue;
+    }
+    ++oscillating;
+    slowestPeriod = fmax(slowestPeriod, 2.0 * 3.14159265358979323846 / modes[j].omega);
+    leastZeta = fmin(leastZeta, modes[j].zeta);
+  }
+  printf("    modes         %d oscillating, %d overdamped roots; the slowest %d:\n", oscillating, real,
+         count < PD_CHECK_STACK_ROOTS_MAX ? count : PD_CHECK_STACK_ROOTS_MAX);
+  for (int j = 0; j < count && j < PD_CHECK_STACK_ROOTS_MAX; ++j) {
+    if (modes[j].real)
+      printf("      overdamped    decay rate %.6g 1/s\n", modes[j].omega);
+    else
+      printf("      %9.6g Hz  damping ratio %.4f\n", modes[j].omega / (2.0 * 3.14159265358979323846), modes[j].zeta);
+  }
+  if (oscillating > 0)
+    printf("    least damped  damping ratio %.4f; amplitudes fall 1000-fold within %.3g s = %.3g periods of the "
+           "slowest mode\n",
+           leastZeta, log(1000.0) / slowestDecay, log(1000.0) / slowestDecay / slowestPeriod);
+}
+
+// The stacks at the state after PD_CHECK_STACKS_AFTER, with the roots of each.
+static void print_stacks(const pdModel* m) {
+  if (m->movingCount > PD_CHECK_STACKS_BODIES_MAX) {
+    printf("stacks: not analysed (%d moving bodies; at most %d)\n", m->movingCount, PD_CHECK_STACKS_BODIES_MAX);
+    return;
+  }
+  pdState* s = pd_state_create(m, NULL);
+  if (!s) return;
+  double t = fmin(PD_CHECK_STACKS_AFTER, m->settings.tend);
+  if (!pd_advance(m, s, t, NULL, NULL)) {
+    printf("stacks: not known (the first %.3g s did not run)\n", t);
+    pd_state_free(s);
+    return;
+  }
+  int* stackOf = malloc((size_t)m->bodyCount * sizeof *stackOf);
+  if (!stackOf) abort();
+  int stacks = pd_state_stacks(m, s, stackOf);
+  printf("stacks: %d after %.3g s (moving bodies joined by contacts; their contact modes, paper §3.3)\n", stacks, t);
+  for (int k = 0; k < stacks; ++k) print_stack(m, s, stackOf, k);
+  free(stackOf);
+  pd_state_free(s);
+}
+
 static void print_body(const pdBody* b) {
   printf("  %s: %s, colour %s, %s (line %d)\n", b->name, primitive_word(b->kind), b->color,
          b->fixed ? "fixed" : "moving", b->where.line);
@@ -187,6 +272,7 @@ int pd_cmd_check(int argc, char** argv) {
          pd_model_material_class_count(m));
   print_contact_pairs(m);
   print_adjustments(m);
+  print_stacks(m);
   pd_model_free(m);
   return PD_EXIT_OK;
 }

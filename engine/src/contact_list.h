@@ -1,8 +1,8 @@
 // polydyn (internal) — the contact list's structures and the helpers the contact files share: contact_set.c (the
 // list, its events and commit), contact_forces.c (forces in the derivative, linearisation), stability_bound.c (modal
-// dampers, the stable step), onsets.c (late onsets), contact_search.c (broad phase, travel, certificates, search) and
-// state_contacts.c (the state's contact read-out). Nothing outside these files includes it: everyone else sees
-// pdContactSet through contact_set.h alone.
+// dampers, the stable step), stack_modes.c (the modes of stacks), onsets.c (late onsets), contact_search.c (broad
+// phase, travel, certificates, search) and state_contacts.c (the state's contact read-out). Nothing outside these
+// files includes it: everyone else sees pdContactSet through contact_set.h alone.
 #pragma once
 
 #include <stdbool.h>
@@ -33,6 +33,8 @@ typedef struct contactSlot {
   pdVec3 onsetImpulse;  // N·s, on body 1: pd_onsets_start_late' scratch
   double modalMass;     // kg: the mass per contact of its pair's joint motion along n (pd_modal_dampers; 0: none)
   int modalCount;       // contacts its pair had when pd_modal_dampers last set its dampers (0: not yet)
+  int modalBodyContacts[2];  // contacts of body1, body2 (moving) then: a neighbour's change re-sizes its dampers
+  double stackScale[2];      // ζ of its modal dampers at the pair's own mass over the requested (n, P_t; >= 1)
   // its modes at the step's start (record()), held over the step when the set holds modes (pd_contact_force_held)
   bool heldPush, heldSlip;
 } contactSlot;
@@ -161,9 +163,11 @@ struct pdContactSet {
   bodySpaceBlock* bodyBlocks;  // (bodyCount) stability_tight's
   const pdPose* stablePoses;   // the poses of the list's pd_stability_prepare (unchanged until the step's limit)
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
+  double stackTau;         // s: the largest c/k along n of contacts whose dampers a stack sized (0: none; step_of)
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
+  struct pdStackScratch* stackScratch;  // the modal dampers' local mode analyses (stack_modes.h)
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation
   // the state record() formed every contact's force at (its slots' force, point and rates), while recordedValid:
   // a derivative at the very same numbers takes them from there (pd_contact_forces)

@@ -34,6 +34,7 @@
 #include "model_contact.h"
 #include "onset_bound.h"
 #include "onsets.h"
+#include "stack_modes.h"
 #include "state_layout.h"
 
 #define PI 3.14159265358979323846
@@ -87,6 +88,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   set->bodyFirst = pd_grow(NULL, n + 1, sizeof *set->bodyFirst);
   set->invInertiaWorld = pd_grow(NULL, n, sizeof *set->invInertiaWorld);
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
+  set->stackScratch = pd_stack_scratch_create();
   set->stableStep = set->stableCheap = INFINITY;
   set->stableKnown = true;
   set->bodyRowsK = pd_grow(NULL, n, sizeof *set->bodyRowsK);
@@ -138,6 +140,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->bodyBlocks);
   free(set->bodyRowsRight);
   free(set->invInertiaWorld);
+  pd_stack_scratch_free(set->stackScratch);
   free(set->travel);
   free(set->torque);
   free(set->poses);

@@ -309,13 +309,17 @@ static double damping_over_stiffness(double zeta, double kSeries, double mass) {
   return kSeries > 0.0 ? 2.0 * zeta * sqrt(mass / kSeries) : 0.0;
 }
 
-void pd_contact_modal_damping(pdContactParams* p, double massN, double massT) {
+void pd_contact_modal_damping(pdContactParams* p, double massN, double massT, double stackN, double stackT,
+                              double scale[2]) {
+  scale[0] = scale[1] = 1.0;
   if (p->modalN) {
-    double m = fmin(massN, p->massPair);
+    double own = fmin(massN, p->massPair), m = fmax(own, stackN);
+    scale[0] = sqrt(m / own);
     derived_dampers(damping_over_stiffness(p->zetaN, pd_series(p->k1n, p->k2n), m), p->k1n, p->k2n, &p->c1n, &p->c2n);
   }
   if (p->modalT) {
-    double m = fmin(massT, p->massPair);
+    double own = fmin(massT, p->massPair), m = fmax(own, stackT);
+    scale[1] = sqrt(m / own);
     derived_dampers(damping_over_stiffness(p->zetaT, pd_series(p->k1t, p->k2t), m), p->k1t, p->k2t, &p->c1t, &p->c2t);
   }
   PD_ASSERT(pd_contact_params_valid(p));  // a mass that is not a number >= 0 gives NaN or negative dampers

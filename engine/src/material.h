@@ -189,8 +189,11 @@ void pd_contact_params_pair(const pdMaterialSide* s1, const pdMaterialSide* s2, 
 
 // Sets the modal dampers of one contact (the directions whose p->modalN, p->modalT are set) for the mass
 // per contact of the pair's joint motion along n (massN) and in the tangent plane (massT), kg: c_s =
-// 2ζ√(k_s m_c), each side c_i = (c_s/k_s) k_i. Masses above the pair's reduced mass are clamped to it.
-void pd_contact_modal_damping(pdContactParams* p, double massN, double massT);
+// 2ζ√(k_s m_c), each side c_i = (c_s/k_s) k_i. Masses above the pair's reduced mass are clamped to it. In a stack
+// the mass is at least stackN (stackT), k_s/Ω² of the slow mode the pair takes part in (stack_modes.h; 0: none).
+// Returns in scale[0] (n) and scale[1] (P_t) how many times ζ the dampers give at the pair's own mass (>= 1).
+void pd_contact_modal_damping(pdContactParams* p, double massN, double massT, double stackN, double stackT,
+                              double scale[2]);
 
 static inline pdContactParams pd_contact_params_swapped(const pdContactParams* p) {
   pdContactParams q = *p;

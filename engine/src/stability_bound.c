@@ -15,6 +15,7 @@
 
 #include "contact_list.h"
 #include "material.h"
+#include "stack_modes.h"
 
 // Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can
 // take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (pd_stability_prepare). Classic
@@ -73,7 +74,54 @@ static void add_body_terms(const pdBody* b, const pdMat3* invWorld, const modalS
 // from the pose after every step: a damper that followed the pose step by step was a staircase in time, whose
 // steps made impacts converge only as ~tol^0.24 (the exit velocity of cases/sweep/eccentric_impact.scene's first
 // impact 1.1e-5 m/s from tol 1e-12's at tol 1e-8); held, the force is smooth between contact events (1.4e-7).
+static bool own_contacts_unchanged(const pdContactSet* set, int first, int last) {
+  for (int i = first; i < last; ++i)
+    if (set->items[i].modalCount != last - first) return false;
+  return true;
+}
+
+// In a stack (stack_modes.c) a pair's dampers are also set anew when a contact of one of its moving bodies with another
+// body is made or broken (its count of contacts changed): that changes the modes its dampers are sized for.
+static bool neighbours_unchanged(const pdModel* model, const pdContactSet* set, int first, int last) {
+  for (int i = first; i < last; ++i) {
+    const contactSlot* c = &set->items[i];
+    int ends[2] = {c->id.body1, c->id.body2};
+    for (int e = 0; e < 2; ++e)
+      if (!model->bodies[ends[e]].fixed &&
+          c->modalBodyContacts[e] != set->bodyFirst[ends[e] + 1] - set->bodyFirst[ends[e]])
+        return false;
+  }
+  return true;
+}
+
+static void note_body_contacts(contactSlot* c, const pdContactSet* set) {
+  c->modalBodyContacts[0] = set->bodyFirst[c->id.body1 + 1] - set->bodyFirst[c->id.body1];
+  c->modalBodyContacts[1] = set->bodyFirst[c->id.body2 + 1] - set->bodyFirst[c->id.body2];
+}
+
+// A stack's mass per contact enters where its slow mode is far slower than the pair's own: from (ω_own/Ω)² =
+// PD_STACK_SLOW_FROM in proportion to the logarithm, fully from PD_STACK_SLOW_FULL. Among boxes of one mass
+// (ω_own/Ω)² is 5 in cases/hard/stack_10.scene and up to 8.5 in cases/hard/brick_bond.scene, and the heavier dampers
+// there only cost steps (1.4 and 1.7 times the derivative evaluations, the overdamped part of the stability bound);
+// a heavy body on a pad of a tenth of its mass gives 20 (√(M/m) slower, times the two interfaces in series), where
+// the pair's own dampers leave its bounce at ζ 0.08.
+#define PD_STACK_SLOW_FROM 10.0
+#define PD_STACK_SLOW_FULL 20.0
+
+// In a stack, along n: the mass per contact k_s/Ω² of the slow mode the pair takes part in (stack_modes.h), weighed
+// as above against the pair's own mass per contact `own`; 0: the pair's own dampers.
+static double stack_mass(const pdModel* model, pdContactSet* set, const pdPose* poses, int first, int last,
+                         double own) {
+  const pdContactParams* p = &set->items[first].params;
+  double omega;
+  if (!p->modalN || !pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omega)) return 0.0;
+  double mass = pd_series(p->k1n, p->k2n) / (omega * omega);
+  double weight = log(mass / own / PD_STACK_SLOW_FROM) / log(PD_STACK_SLOW_FULL / PD_STACK_SLOW_FROM);
+  return weight > 0.0 ? fmin(1.0, weight) * mass : 0.0;
+}
+
 void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses) {
+  if (!set->bodyListValid) pd_contact_set_list_bodies(model, set);
   for (int first = 0, last; first < set->count; first = last) {
     contactSlot* c0 = &set->items[first];
     int a = c0->id.body1 < c0->id.body2 ? c0->id.body1 : c0->id.body2;
@@ -81,9 +129,8 @@ void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* pos
     last = first + 1;
     while (last < set->count && compare_to_pair(&set->items[last].id, a, b) == 0) ++last;
     if (!c0->params.modalN && !c0->params.modalT) continue;
-    bool unchanged = true;
-    for (int i = first; i < last && unchanged; ++i) unchanged = set->items[i].modalCount == last - first;
-    if (unchanged) continue;
+    bool own = own_contacts_unchanged(set, first, last);
+    if (own && neighbours_unchanged(model, set, first, last)) continue;
     modalSums sa = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, sb = sa;
     for (int i = first; i < last; ++i) {
       const contactSlot* c = &set->items[i];
@@ -107,10 +154,17 @@ void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* pos
     double qt = count * count * (A->invMass + B->invMass) + 0.5 * (trace - pd_v3_dot(axis, pd_mat3_mulv(&mt, axis)));
     // a degenerate sum (normals cancelling) leaves 1ᵀA1 ~ 0: the clamp to the reduced mass takes over
     double massN = qn > 0.0 ? count / qn : INFINITY, massT = qt > 0.0 ? count / qt : INFINITY;
+    double stackN = stack_mass(model, set, poses, first, last, fmin(massN, c0->params.massPair));
+    if (own && stackN == 0.0 && c0->stackScale[0] == 1.0) {  // its own dampers, held: only a neighbour changed
+      for (int i = first; i < last; ++i) note_body_contacts(&set->items[i], set);
+      continue;
+    }
     for (int i = first; i < last; ++i) {
-      pd_contact_modal_damping(&set->items[i].params, massN, massT);
-      set->items[i].modalMass = fmin(massN, set->items[i].params.massPair);
-      set->items[i].modalCount = last - first;
+      contactSlot* c = &set->items[i];
+      pd_contact_modal_damping(&c->params, massN, massT, stackN, 0.0, c->stackScale);
+      c->modalMass = fmin(massN, c->params.massPair);
+      c->modalCount = last - first;
+      note_body_contacts(c, set);
     }
   }
 }
@@ -134,8 +188,12 @@ static void add_weighted_rows(const pdMat3* a, pdVec3 w, double scale, double ro
     rows[r] += scale * (fabs(a->m[r][0]) * w.x + fabs(a->m[r][1]) * w.y + fabs(a->m[r][2]) * w.z);
 }
 
-static double step_of(double omega2, double overdamp) {
-  double omega = sqrt(omega2) * overdamp;
+// A stack's dampers are sized for a mode slower than the pair's own (stack_modes.c), so c/k = τ is larger, and a
+// mode at ω has the damping ratio τω/2 (dampers proportional to the springs): at the bound's ω_max it may be
+// overdamped, with a real root ω(ζ + √(ζ² − 1)) up to τω². stackTau: the largest such τ of the list (0: none).
+static double step_of(double omega2, double overdamp, double stackTau) {
+  double omega = sqrt(omega2);
+  omega *= fmax(overdamp, overdamp_factor(0.5 * stackTau * omega));
   // the stepper keeps the result of two half steps (integrator.c): they are the ones that must be stable
   return omega > 0.0 ? 2.0 * PD_STABLE_STEP_OMEGA / omega : INFINITY;
 }
@@ -307,6 +365,7 @@ void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose*
   }
   pd_contact_set_list_bodies(model, set);
   set->stablePoses = poses;
+  set->stackTau = 0.0;
   int bodies = model->bodyCount;
   for (int k = 0; k < bodies; ++k) set->bodyRowsK[k] = set->bodyRowsRight[k] = (pdVec3){0, 0, 0};
   for (int i = 0; i < set->count; ++i) {
@@ -321,6 +380,10 @@ void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose*
     for (int r = 0; r < 3; ++r)
       for (int q = 0; q < 3; ++q) t->k.m[r][q] = (r == q ? st : 0.0) + (sn - st) * nv[r] * nv[q];
     double zn = isfinite(p->zetaN) ? p->zetaN : 0.0, zt = p->mu > 0.0 && isfinite(p->zetaT) ? p->zetaT : 0.0;
+    if (p->modalN && c->stackScale[0] > 1.0) {
+      double ks = pd_series(p->k1n, p->k2n);
+      if (ks > 0.0) set->stackTau = fmax(set->stackTau, pd_series(p->c1n, p->c2n) / ks);
+    }
     t->overdamp = fmax(overdamp_factor(zn), overdamp_factor(zt));
     int ends[2] = {c->id.body1, c->id.body2};
     for (int e = 0; e < 2; ++e) {
@@ -351,7 +414,7 @@ void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose*
     cheap2 = fmax(cheap2, fmax(rows[0], fmax(rows[1], rows[2])));
   }
   set->cheapOmega2 = cheap2 * (1.0 + PD_STABLE_MARGIN);
-  set->stableCheap = step_of(set->cheapOmega2, set->overdamp);
+  set->stableCheap = step_of(set->cheapOmega2, set->overdamp, set->stackTau);
 #ifdef PD_SELF_CHECKS
   stability_self_check(model, set);
 #endif
@@ -366,7 +429,7 @@ double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double
   if (!set->stableKnown) {
     ++set->tightFormed;
     double tight2 = stability_tight(model, set) * (1.0 + PD_STABLE_MARGIN);
-    set->stableStep = step_of(fmin(set->cheapOmega2, tight2), set->overdamp);
+    set->stableStep = step_of(fmin(set->cheapOmega2, tight2), set->overdamp, set->stackTau);
     set->stableKnown = true;
   }
   return fmin(h, fraction * set->stableStep);

@@ -221,11 +221,17 @@ static void test_pair_dampers_are_modal_and_proportional_by_default(void** state
   expect_rel(series(p.c1t, p.c2t), 2.0 * PD_TANGENTIAL_DAMPING_RATIO * sqrt(series(p.k1t, p.k2t) * 2.0), 1e-13,
              "c_t at the default ζ_t");
   // four contacts of a face: m_c = m/4 each, ζ per contact as requested
-  pd_contact_modal_damping(&p, 0.5, 0.5);
+  double scale[2];
+  pd_contact_modal_damping(&p, 0.5, 0.5, 0.0, 0.0, scale);
   expect_rel(series(p.c1n, p.c2n), 2.0 * zeta * sqrt(ks * 0.5), 1e-13, "c_s at m/4");
+  expect_rel(scale[0], 1.0, 0.0, "no stack: the requested ζ");
   // a mass above m_pair is clamped to it
-  pd_contact_modal_damping(&p, 50.0, INFINITY);
+  pd_contact_modal_damping(&p, 50.0, INFINITY, 0.0, 0.0, scale);
   expect_rel(series(p.c1n, p.c2n), 2.0 * zeta * sqrt(ks * 2.0), 1e-13, "clamped to m_pair");
+  // a stack's slow mode (stack_modes.h) sizes it above m_pair, and says by how much ζ grows at the pair's own mass
+  pd_contact_modal_damping(&p, 0.5, 0.5, 8.0, 0.0, scale);
+  expect_rel(series(p.c1n, p.c2n), 2.0 * zeta * sqrt(ks * 8.0), 1e-13, "the stack's mass");
+  expect_rel(scale[0], 4.0, 1e-15, "ζ 4 times at m/4");
   // restitution 1 on both: no normal damper
   pdMaterialRequest elastic = {.mu = 0.5, .restitution = 1.0, .setMask = PD_SET_RESTITUTION};
   s1 = side_of(&BODY, &elastic);

@@ -279,6 +279,29 @@ typedef struct pdContactReport {
 PD_API int pd_state_contact_count(const pdState* state);
 PD_API pdContactReport pd_state_contact(const pdState* state, int i);
 
+// Stacks: the moving bodies joined by the state's contacts (a fixed body joins none). stackOf (model->bodyCount)
+// gets each body's stack, 0 … count − 1 in the order of their lowest body index, or −1 for a fixed body and for a
+// moving one without contacts. Returns the number of stacks.
+PD_API int pd_state_stacks(const pdModel* model, const pdState* state, int* stackOf);
+
+// One root λ of a stack's linearised contact dynamics det(λ² 𝕄 + λ C + K) = 0 (docs/contact-model.md, "Stacks").
+typedef struct pdStackMode {
+  double omega;  // rad/s: |λ| (an oscillating mode's natural frequency; a real root's decay rate)
+  double zeta;   // −Re λ/|λ|: the damping ratio of an oscillating mode (< 1); 1 for a real root
+  bool real;     // a real root: half of an overdamped mode, which does not oscillate
+} pdStackMode;
+
+// Stacks of more moving bodies than this are not analysed (the eigenproblem has 12 roots per body).
+#define PD_STACK_MODES_BODIES_MAX 16
+
+// The roots of stack `stack` of stackOf (pd_state_stacks), one per complex-conjugate pair, sorted by omega: K and C
+// from every contact touching the stack (normal springs and dampers, and the tangential ones of sticking contacts,
+// each the series of both sides; fixed bodies hold still), 𝕄 the bodies' masses and world inertias; roots below
+// 1e-9 of the largest (free motions: a body sliding without tangential springs) are left out. Writes at most
+// `capacity` roots and returns how many there are, or −1 for a stack of more than PD_STACK_MODES_BODIES_MAX bodies.
+PD_API int pd_state_stack_modes(const pdModel* model, const pdState* state, const int* stackOf, int stack,
+                                pdStackMode* modes, int capacity);
+
 // Called at every output sample, with state->t exactly k / sampleRate. Returning false asks
 // pd_advance to stop after this sample (state->stopped is set). The observer reads the state (it is
 // const) and may do anything else, but must not call pd_advance or pd_state_reset on this state.

@@ -1,0 +1,26 @@
+// polydyn (internal) — the contact modes of stacks: the slow frequency that sizes a pair's modal dampers when its
+// bodies rest on, or carry, other bodies (stack_modes.c, docs/contact-model.md "Stacks"), and the damped modes that
+// `polydyn check` reports (polydyn/modes.h).
+#pragma once
+
+#include <stdbool.h>
+
+#include "contact_list.h"
+
+typedef struct pdStackScratch pdStackScratch;
+
+// A pair's local system holds at most this many moving bodies: the pair's and its bodies' neighbours in contact,
+// in body order; the bodies beyond count as fixed. A brick inside a wall has 6 to 8 neighbours.
+#define PD_STACK_LOCAL_BODIES_MAX 12
+
+pdStackScratch* pd_stack_scratch_create(void);
+void pd_stack_scratch_free(pdStackScratch* scratch);
+
+// The slow frequency Ω (rad/s) that pair [first, last) of the list takes part in along the normals, from the
+// undamped normal modes of its local system (the pair's moving bodies and their neighbours in contact, every contact
+// touching them; bodies outside it fixed): 1/Ω = max over modes j of min(1, s_j / PD_STACK_SHARE) / ω_j, s_j the
+// share of mode j's strain energy in the pair's springs. Returns false (*omega unset) for a pair whose bodies touch
+// nothing else, whose local system's masses are within PD_STACK_MASS_RATIO of each other, or which has no normal
+// stiffness: its dampers are the pair's own. The body lists (bodyFirst, bodyList) must be current.
+bool pd_stack_pair_frequency(const pdModel* model, const pdContactSet* set, const pdPose* poses, int first,
+                             int last, pdStackScratch* scratch, double* omega);

@@ -1,0 +1,145 @@
+// Stacks of bodies of very different masses come to rest, and a heavy body's impact on a light one keeps the
+// requested restitution (docs/contact-model.md, "Stacks"): the modal dampers sized for the slow mode a pair takes
+// part in (engine/src/stack_modes.c), and that mode's damping ratio as pd_state_stack_modes finds it.
+#include <math.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "material.h"
+#include "model_contact.h"
+#include "polydyn/model.h"
+#include "polydyn/state.h"
+#include "scene_run.h"
+
+// Settled: every body slower than this after SETTLE_TIME (the requirement).
+#define SETTLED_SPEED 1e-3  // m/s
+#define SETTLE_TIME 1.0     // s
+// The restitution of the heavy body's first impact within this of the requested one.
+#define RESTITUTION_TOL 0.01
+// The stack's bounce (the slowest mode along the normals: the block on both interfaces in series) gets the
+// requested damping ratio: within this (the pad's mass couples it to the pad's own mode; measured below 0.004).
+#define BOUNCE_ZETA_TOL 0.02
+// ζ for the default restitution 0.5 (eq. (15)).
+#define DEFAULT_ZETA 0.2553
+#define PI 3.14159265358979323846
+
+static double speed(pdBodyState b) { return sqrt(b.v.x * b.v.x + b.v.y * b.v.y + b.v.z * b.v.z); }
+
+#define BLOCK_MASS 8.0                   // kg: a 0.2 m cube of water
+#define PAD_VOLUME (0.3 * 0.3 * 0.02)    // m³
+
+// A block on a pad on a floor as a newcomer writes it: default materials, the pad's density set for the mass
+// ratio; `pad` and `block` add lines to those objects (the block's default: set down on the pad at rest).
+static pdModel* block_on_pad(double ratio, const char* settings, const char* pad, const char* block) {
+  char text[1024];
+  snprintf(text, sizeof text,
+           "%s\n"
+           "cube floor grey 1 1 0.1\nfixed\nloc 0 0 -0.05\n"
+           "cube pad blue 0.3 0.3 0.02\nspgrav %.17g\nloc 0 0 0.01\n%s\n"
+           "cube block red 0.2 0.2 0.2\n%s\n",
+           settings, BLOCK_MASS / ratio / PAD_VOLUME / 1000.0, pad, block[0] ? block : "loc 0 0 0.12");
+  return compile_text(text);
+}
+
+static void test_stacks_of_any_mass_ratio_settle(void** state) {
+  (void)state;
+  const double ratios[] = {1.0, 10.0, 100.0, 1000.0};
+  for (int i = 0; i < 4; ++i) {
+    pdModel* m = block_on_pad(ratios[i], "tend 1\nsample 100", "", "");
+    pdState* s = NULL;
+    record* r = run(m, &s);
+    double fastest = 0.0, lastFast = 0.0;
+    for (int k = 0; k < r->count; ++k)
+      for (int b = 0; b < m->movingCount; ++b)
+        if (speed(r->body[b][k]) > SETTLED_SPEED) lastFast = r->t[k];
+    for (int b = 0; b < m->movingCount; ++b) fastest = fmax(fastest, speed(r->body[b][r->count - 1]));
+    print_message("mass ratio %6g: faster than %g m/s until %.3f s, %.2e m/s at %.1f s, overlap %.3f delta_max\n",
+                  ratios[i], SETTLED_SPEED, lastFast, fastest, r->t[r->count - 1], deepest_overlap(m, s, NULL, NULL));
+    assert_true(r->t[r->count - 1] >= SETTLE_TIME);
+    assert_true(fastest < SETTLED_SPEED);
+    free(r);
+    pd_state_free(s);
+    pd_model_free(m);
+  }
+}
+
+// The stack's modes at rest (pd_state_stack_modes): the slowest vertical one, the block bouncing on both
+// interfaces, has the requested damping ratio at every mass ratio.
+static void test_stack_bounce_has_the_requested_damping_ratio(void** state) {
+  (void)state;
+  const double ratios[] = {10.0, 100.0, 1000.0};
+  for (int i = 0; i < 3; ++i) {
+    pdModel* m = block_on_pad(ratios[i], "tend 0.2\nsample 10", "", "");
+    pdState* s = pd_state_create(m, NULL);
+    assert_true(pd_advance(m, s, 0.2, NULL, NULL));
+    int* stackOf = malloc((size_t)m->bodyCount * sizeof *stackOf);
+    assert_non_null(stackOf);
+    assert_int_equal(pd_state_stacks(m, s, stackOf), 1);
+    pdStackMode modes[24];
+    int count = pd_state_stack_modes(m, s, stackOf, 0, modes, 24);
+    assert_true(count > 0 && count <= 24);
+    // the bounce: the oscillating mode whose frequency is that of the block on both interfaces in series
+    // (four corners on each interface)
+    pdContactParams pf = pd_model_contact_params(m, body_index(m, "pad"), body_index(m, "floor"));
+    pdContactParams bp = pd_model_contact_params(m, body_index(m, "block"), body_index(m, "pad"));
+    double k = pd_series(4.0 * pd_series(pf.k1n, pf.k2n), 4.0 * pd_series(bp.k1n, bp.k2n));
+    double bounce = sqrt(k / m->bodies[body_index(m, "block")].mass), best = INFINITY;
+    int j = -1;
+    for (int q = 0; q < count; ++q)
+      if (!modes[q].real && fabs(modes[q].omega - bounce) < best) best = fabs(modes[q].omega - bounce), j = q;
+    assert_true(j >= 0);
+    print_message("mass ratio %6g: bounce %.2f Hz (series springs: %.2f Hz), damping ratio %.4f\n", ratios[i],
+                  modes[j].omega / (2.0 * PI), bounce / (2.0 * PI), modes[j].zeta);
+    assert_true(fabs(modes[j].omega - bounce) < 0.05 * bounce);
+    assert_true(fabs(modes[j].zeta - DEFAULT_ZETA) < BOUNCE_ZETA_TOL);
+    free(stackOf);
+    pd_state_free(s);
+    pd_model_free(m);
+  }
+}
+
+// A heavy block dropped on a light pad that a force holds on the floor, gravity off (so that the impact alone sets
+// the speeds): its first impact rebounds with the requested restitution. The speed keeps the springs within
+// about 2 δ_max (they are sized for the pad's mass: eq. (11) for the pair).
+static void test_heavy_body_on_light_pad_keeps_its_restitution(void** state) {
+  (void)state;
+  const double ratios[] = {100.0, 1000.0};
+  for (int i = 0; i < 2; ++i) {
+    double v = sqrt(10.0 / ratios[i]);  // m/s
+    char motion[128];
+    snprintf(motion, sizeof motion, "loc 0 0 0.17\nvel 0 0 %.17g", -v);
+    char pad[64];
+    snprintf(pad, sizeof pad, "force 0 0 %.17g", -9.81 * BLOCK_MASS / ratios[i]);
+    pdModel* pressed = block_on_pad(ratios[i], "tend 0.8\nsample 20000\nvmax 1\ngravity 0 0 0", pad, motion);
+    pdState* s = NULL;
+    record* r = run(pressed, &s);
+    int block = 1;  // moving-body order: pad, block
+    double out = -INFINITY;
+    for (int k = 0; k < r->count; ++k) {
+      double vz = r->body[block][k].v.z;
+      if (vz > 0.0) out = fmax(out, vz);
+      if (out > 0.0 && vz < 0.0) break;
+    }
+    double e = out / v;
+    print_message("mass ratio %6g: drop at %.4f m/s, rebound %.5f m/s: e %.4f (requested 0.5)\n", ratios[i], v, out,
+                  e);
+    assert_true(fabs(e - 0.5) <= RESTITUTION_TOL);
+    free(r);
+    pd_state_free(s);
+    pd_model_free(pressed);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_stacks_of_any_mass_ratio_settle),
+      cmocka_unit_test(test_stack_bounce_has_the_requested_damping_ratio),
+      cmocka_unit_test(test_heavy_body_on_light_pad_keeps_its_restitution),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
