@@ -82,6 +82,8 @@ double gk_effective_mass(const pdModel* model, int body, pdVec3 p, pdVec3 n);
 
 // Monotonic wall clock, s (for the measured wall times).
 double gk_wall_seconds(void);
+// The calling thread's CPU time, s: a run's cost that other processes on the machine do not inflate.
+double gk_cpu_seconds(void);
 
 
 // ---------------------------------------------------------------------------------------------------------

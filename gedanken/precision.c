@@ -54,7 +54,7 @@ typedef struct gkPoint {
   double value;
   // measured (travels between processes as gkPointResult)
   gkPointStatus status;
-  double measured, error, wall;
+  double measured, error, wall, cpu;
   long steps;
   char note[PD_GK_NOTE_MAX];
 } gkPoint;
@@ -62,7 +62,7 @@ typedef struct gkPoint {
 typedef struct gkPointResult {
   int32_t status;
   int32_t unused;
-  double measured, error, wall;
+  double measured, error, wall, cpu;
   int64_t steps;
   char note[PD_GK_NOTE_MAX];
 } gkPointResult;
@@ -122,12 +122,12 @@ static double error_of(const gkCase* c, double measured) {
 }
 
 static void measure_point(const gkPrecision* s, gkPoint* p) {
-  p->measured = p->error = p->wall = NAN;
+  p->measured = p->error = p->wall = p->cpu = NAN;
   p->steps = 0;
   p->note[0] = '\0';
   const gkCase* c = p->c;
   int repeats = s->options->repeats;
-  double walls[MAX_REPEATS];
+  double walls[MAX_REPEATS], cpus[MAX_REPEATS];
   pdGkRecord rec;
   pd_gk_record_init(&rec, c->model->movingCount);
   bool completed = true;
@@ -153,9 +153,10 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
       // the reference variant of the contact events: every onset located (docs/events.md)
       if (strcmp(p->variant, "exact-events") == 0) options.onsets = pd_onsetsExact;
       pdState* state = pd_state_create(model, &options);
-      double t0 = gk_wall_seconds();
+      double t0 = gk_wall_seconds(), c0 = gk_cpu_seconds();
       completed = pd_advance(model, state, model->settings.tend, observe, &observer);
       walls[r] = gk_wall_seconds() - t0;
+      cpus[r] = gk_cpu_seconds() - c0;
       p->steps = state->count.accepted;
       if (!completed) point_note(p, "the run stopped at t = %.6g s", state->t);
       pd_state_free(state);
@@ -168,6 +169,7 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
       pdRefRunStats stats;
       bool ran = pd_ref_run(c->model, adapter, &options, NULL, observe, &observer, &stats, &err);
       walls[r] = stats.wallSeconds;
+      cpus[r] = stats.cpuSeconds;
       p->steps = stats.steps;
       if (!ran && stats.refused) {
         p->status = gkPointRefused;
@@ -199,6 +201,7 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
   p->measured = m.value;
   p->error = error_of(c, m.value);
   p->wall = pd_median_in_place(walls, repeats);
+  p->cpu = pd_median_in_place(cpus, repeats);
 }
 
 static void point_task(int task, pdBatchBuffer* result, void* user) {
@@ -211,6 +214,7 @@ static void point_task(int task, pdBatchBuffer* result, void* user) {
   r.measured = p->measured;
   r.error = p->error;
   r.wall = p->wall;
+  r.cpu = p->cpu;
   r.steps = p->steps;
   memcpy(r.note, p->note, sizeof r.note);
   pd_batch_append(result, &r, sizeof r);
@@ -225,6 +229,7 @@ static void take_point(gkPoint* p, const pdBatchBuffer* bytes) {
   p->measured = r.measured;
   p->error = r.error;
   p->wall = r.wall;
+  p->cpu = r.cpu;
   p->steps = (long)r.steps;
   memcpy(p->note, r.note, sizeof p->note);
 }
@@ -292,7 +297,7 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
   }
   fputs(
       "experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,"
-      "judged,status,wall_seconds,wall_per_sim_second,steps,repeats,note\n",
+      "judged,status,wall_seconds,wall_per_sim_second,steps,repeats,cpu_seconds,cpu_per_sim_second,note\n",
       out);
   for (int i = 0; i < s->count; ++i) {
     const gkPoint* p = &s->points[i];
@@ -320,6 +325,10 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
     fputc(',', out);
     pdu_csv_number(out, p->wall / c->model->settings.tend, 17);
     fprintf(out, ",%ld,%d,", p->steps, s->options->repeats);
+    pdu_csv_number(out, p->cpu, 17);
+    fputc(',', out);
+    pdu_csv_number(out, p->cpu / c->model->settings.tend, 17);
+    fputc(',', out);
     pdu_csv_text(out, p->note);
     fputc('\n', out);
   }

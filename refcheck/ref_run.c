@@ -15,6 +15,12 @@ static double wall_seconds(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static double cpu_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 extern const pdRefAdapter pd_ode_adapter;
 extern const pdRefAdapter pd_bullet_adapter;
 
@@ -105,7 +111,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
   PD_ASSERT(model && adapter && options && stats && options->step > 0.0);
   memset(stats, 0, sizeof *stats);
   sampling plan = plan_sampling(options->step, model->settings.sampleRate);
-  double wall0 = wall_seconds();
+  double wall0 = wall_seconds(), cpu0 = cpu_seconds();
   pdRefWorld* world = adapter->create(model, options, err);
   if (!world) {
     stats->refused = true;
@@ -145,6 +151,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
   free(contacts.items);
   if (writer) pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
   stats->wallSeconds = wall_seconds() - wall0;
+  stats->cpuSeconds = cpu_seconds() - cpu0;
   stats->completed = ok && !stopped;
   state->count.accepted = stats->steps;
 

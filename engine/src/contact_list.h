@@ -147,6 +147,9 @@ struct pdContactSet {
   int cacheCount, cacheCapacity;
   pdVec3 *force, *torque;  // (movingCount) contact force and moment on each moving body, world
   double* travel;          // (bodyCount) how far each body's points moved over the analysed step, m (fixed: 0)
+  double* reachScratch;    // contact_search.c's reaching_fraction: two bodies' vertex moves and bounding planes
+  int reachVertexMax, reachFaceMax;  // the most vertices and faces of a body (faces: at least 6)
+  double travelStep;       // s: the step the tunnelling guard lets the next one take (INFINITY: any)
   int onsetRetries;        // onset retries of the step under way
   int modeRetries;         // trials of the step under way cut to a held mode's change (holdModes)
   bool holdModes;          // the derivative holds each contact's modes of the step's start (pd_contact_set_hold_modes)

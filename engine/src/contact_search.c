@@ -26,6 +26,12 @@
 // moment of contact. It costs steps only while two bodies' swept boxes overlap.
 #define PD_TRAVEL_DEFLECTIONS 2.0
 #define PD_TRAVEL_RETRY_SAFETY 0.9
+// How far past the step just taken the guard looks for the next one (travelStep): the error control grows a step by at
+// most 5×; twice is enough to keep a step the guard holds from being tried too long and retried, every step.
+#define PD_TRAVEL_ROOM_MAX 2.0
+// Numbers per vertex in reaching_fraction's scratch: its point at the step's start (3), its chord over the step, and
+// how far the arc it follows may stray from that chord.
+#define PD_REACH_VERTEX_SIZE 5
 
 // The contact search's per-pair lists, to cacheCapacity.
 static void grow_pair_lists(pdContactSet* set) {
@@ -55,6 +61,15 @@ void pd_contact_search_create(const pdModel* model, pdContactSet* set, const boo
   set->cacheNext = pd_grow(NULL, set->cacheCapacity, sizeof *set->cacheNext);
   set->touching = pd_grow(NULL, set->cacheCapacity, sizeof *set->touching);
   grow_pair_lists(set);
+  // reaching_fraction's scratch: two bodies' vertex moves and their bounding planes (a box's 6 or a fixed body's faces)
+  set->reachVertexMax = 1, set->reachFaceMax = 6;
+  for (int i = 0; i < n; ++i) {
+    const pdPolyhedron* shape = &model->bodies[i].shape;
+    if (shape->vertexCount > set->reachVertexMax) set->reachVertexMax = shape->vertexCount;
+    if (shape->faceCount > set->reachFaceMax) set->reachFaceMax = shape->faceCount;
+  }
+  set->reachScratch = pd_grow(NULL, 2 * (PD_REACH_VERTEX_SIZE * set->reachVertexMax + 4 * set->reachFaceMax),
+                              sizeof *set->reachScratch);
 }
 
 void pd_contact_search_free(pdContactSet* set) {
@@ -65,6 +80,7 @@ void pd_contact_search_free(pdContactSet* set) {
   free(set->cache);
   free(set->cacheNext);
   free(set->touching);
+  free(set->reachScratch);
   free(set->pairPrevious);
   free(set->pairPreviousCount);
   free(set->pairFound);
@@ -114,29 +130,162 @@ static double travel(const pdBody* b, const pdPose* p0, const pdPose* p1) {
   return pd_v3_norm(pd_v3_sub(p1->x, p0->x)) + b->radius * acos(cosAngle);
 }
 
-// The longest step (as a fraction of the step just taken) that keeps every listed pair's relative travel
-// within PD_TRAVEL_WIDTH_FRACTION of the thinner body's width; 1 when the step is short enough.
-static double travel_limit(const pdModel* model, pdContactSet* set, int pairCount) {
+// The planes that bound where a point may end inside body i at the step's end (4 numbers a plane: normal, offset;
+// a point p lies beyond one where n·p > offset), into planes; returns their count. A fixed body's own face planes;
+// a moving body's swept box's six (set->boxes: it holds the body at the step's end, and at a part of the step).
+static int bounding_planes(const pdModel* model, const pdContactSet* set, int i, double* planes) {
+  const pdBody* body = &model->bodies[i];
+  if (!body->fixed) {
+    const pdAabb* box = &set->boxes[i];
+    for (int side = 0; side < 6; ++side) {
+      double* pl = planes + 4 * side;
+      int axis = side / 2;
+      pl[0] = pl[1] = pl[2] = 0.0;
+      pl[axis] = side % 2 ? 1.0 : -1.0;
+      pl[3] = side % 2 ? box->hi[axis] : -box->lo[axis];
+    }
+    return 6;
+  }
+  const pdPose* pose = &set->poses1[i];
+  for (int f = 0; f < body->shape.faceCount; ++f) {
+    pdVec3 n = pd_mat3_mulv(&pose->R, body->shape.faces[f].normal);
+    double* pl = planes + 4 * f;
+    pl[0] = n.x, pl[1] = n.y, pl[2] = n.z;
+    pl[3] = body->shape.faces[f].offset + pd_v3_dot(n, pose->x);
+  }
+  return body->shape.faceCount;
+}
+
+static double beyond(const double* plane, const double* p) {
+  return plane[0] * p[0] + plane[1] * p[1] + plane[2] * p[2] - plane[3];
+}
+
+// Each vertex of body i at the step's start and how far a fraction λ of the step may move it, into scratch
+// (PD_REACH_VERTEX_SIZE numbers a vertex): along the step's screw motion (rotation by φ about u, the centre moving
+// uniformly) a point w from the centre of mass is at most λ c + ρ φ²/4 from its start, c the chord of the whole step
+// and ρ = |u × w| (the arc strays from the chord by at most λ(1 − λ)/2 of its second derivative, ρφ², per
+// component). Both terms are convex over the body. A rolling wheel's rim point on the ground has a short chord where
+// |Δx| + φ ρ, the arc's length, would be twice its speed times the step.
+static void vertex_moves(const pdBody* body, const pdPose* p0, const pdPose* p1, double* scratch) {
+  pdMat3 r0t = pd_mat3_transpose(&p0->R);
+  pdMat3 d = pd_mat3_mul(&p1->R, &r0t);
+  double cosAngle = fmax(-1.0, fmin(1.0, 0.5 * (d.m[0][0] + d.m[1][1] + d.m[2][2] - 1.0)));
+  double angle = acos(cosAngle);
+  pdVec3 sinAxis = {0.5 * (d.m[2][1] - d.m[1][2]), 0.5 * (d.m[0][2] - d.m[2][0]), 0.5 * (d.m[1][0] - d.m[0][1])};
+  double sinAngle = pd_v3_norm(sinAxis);
+  // near φ = 0 or π the axis is ill-defined from the skew part: ρ <= |w| holds for any axis
+  bool axisKnown = sinAngle > 1e-6;
+  for (int v = 0; v < body->shape.vertexCount; ++v) {
+    pdVec3 w = pd_mat3_mulv(&p0->R, body->shape.vertices[v]);
+    pdVec3 start = pd_v3_add(p0->x, w);
+    pdVec3 end = pd_v3_add(p1->x, pd_mat3_mulv(&p1->R, body->shape.vertices[v]));
+    double lever = axisKnown ? pd_v3_norm(pd_v3_cross(sinAxis, w)) / sinAngle : pd_v3_norm(w);
+    double* at = scratch + PD_REACH_VERTEX_SIZE * v;
+    at[0] = start.x, at[1] = start.y, at[2] = start.z;
+    at[3] = pd_v3_norm(pd_v3_sub(end, start));
+    at[4] = 0.25 * lever * angle * angle;
+  }
+}
+
+// The largest move, over a fraction lambda of the step, of the points of a body (its vertices in `moves`:
+// vertex_moves) that may end it inside the other body (bounded by `planes`: bounding_planes), m: what the tunnelling
+// guard needs to bound, where travel() bounds every point's. A rigid body's move bound above is convex over it, so a
+// point's is at most the barycentric mix of its polyhedron's vertices'; and a point p can end inside the other body only
+// if λ d(p) > g(p) for every plane, g its signed distance beyond the plane (1-Lipschitz and affine). For one plane the
+// set where λ d − g > 0 is a convex part of the body whose corners are vertices and crossings on edges, so the largest
+// move over it is at one of those; each plane gives a bound, the smallest is kept. A spinning or rolling body's far
+// points move fast but cannot reach the other body: only the ones that can count (a top spinning on its tip, a wheel
+// on its rim).
+static double reaching_move(const pdPolyhedron* shape, const double* moves, const double* planes, int planeCount,
+                            double lambda) {
+  double best = INFINITY;
+  for (int k = 0; k < planeCount && best > 0.0; ++k) {
+    const double* plane = planes + 4 * k;
+    double most = 0.0;
+    for (int v = 0; v < shape->vertexCount; ++v) {
+      const double* at = moves + PD_REACH_VERTEX_SIZE * v;
+      double move = lambda * at[3] + at[4];
+      if (move > beyond(plane, at)) most = fmax(most, move);
+    }
+    for (int e = 0; e < shape->edgeCount && most < best; ++e) {
+      const double* u = moves + PD_REACH_VERTEX_SIZE * shape->edges[e].v[0];
+      const double* w = moves + PD_REACH_VERTEX_SIZE * shape->edges[e].v[1];
+      double mu = lambda * u[3] + u[4], mw = lambda * w[3] + w[4];
+      double fu = mu - beyond(plane, u), fw = mw - beyond(plane, w);
+      if ((fu > 0.0) == (fw > 0.0)) continue;  // in or out as a whole: its vertices tell
+      double t = fu / (fu - fw);                 // where it crosses out
+      most = fmax(most, (1.0 - t) * mu + t * mw);
+    }
+    best = fmin(best, most);
+  }
+  return best;
+}
+
+// Bisections of the step fraction a pair's reaching travel allows: the fraction is then known to ~1e-3 of the
+// step, far finer than the retry's safety (PD_TRAVEL_RETRY_SAFETY).
+#define PD_TRAVEL_BISECTIONS 10
+
+// The largest fraction of the step, between `floor` (known to hold) and `most`, over which pair (a, b)'s reaching
+// travel (reaching_move of each body against the other, summed) stays within `allowed`; `most` when all of it does.
+// Fractions above 1 extrapolate the step's motion: what the next step may take if the motion goes on.
+static double reaching_fraction(const pdModel* model, pdContactSet* set, int a, int b, double allowed, double floor,
+                                double most) {
+  const pdBody *ba = &model->bodies[a], *bb = &model->bodies[b];
+  double* movesA = set->reachScratch;
+  double* movesB = movesA + PD_REACH_VERTEX_SIZE * set->reachVertexMax;
+  double* planesA = movesB + PD_REACH_VERTEX_SIZE * set->reachVertexMax;  // bounding body a: for b's points
+  double* planesB = planesA + 4 * set->reachFaceMax;
+  int countA = 0, countB = 0;
+  if (!ba->fixed) {
+    vertex_moves(ba, &set->poses0[a], &set->poses1[a], movesA);
+    countB = bounding_planes(model, set, b, planesB);
+  }
+  if (!bb->fixed) {
+    vertex_moves(bb, &set->poses0[b], &set->poses1[b], movesB);
+    countA = bounding_planes(model, set, a, planesA);
+  }
+  double lo = floor, hi = most;
+  for (int k = -1; k < PD_TRAVEL_BISECTIONS; ++k) {
+    double lambda = k < 0 ? most : 0.5 * (lo + hi);
+    double moved = (ba->fixed ? 0.0 : reaching_move(&ba->shape, movesA, planesB, countB, lambda)) +
+                   (bb->fixed ? 0.0 : reaching_move(&bb->shape, movesB, planesA, countA, lambda));
+    if (moved <= allowed) {
+      if (k < 0) return most;
+      lo = lambda;
+    } else {
+      hi = lambda;
+    }
+  }
+  return lo;
+}
+
+// The longest step (as a fraction of the step just taken, at most PD_TRAVEL_ROOM_MAX) that keeps every listed pair's
+// relative travel within PD_TRAVEL_WIDTH_FRACTION of the thinner body's width and PD_TRAVEL_DEFLECTIONS of its
+// δ_max. A pair whose bodies' whole travel (travel()) exceeds it is measured again over the points that may reach the
+// other body (reaching_fraction).
+static double travel_room(const pdModel* model, pdContactSet* set, int pairCount) {
   for (int k = 0; k < model->movingCount; ++k) {
     int i = model->movingBodies[k];
     set->travel[i] = travel(&model->bodies[i], &set->poses0[i], &set->poses1[i]);
   }
-  double limit = 1.0;
+  double room = PD_TRAVEL_ROOM_MAX;
   for (int p = 0; p < pairCount; ++p) {
     int a = set->pairs[p].a, b = set->pairs[p].b;
     double moved = set->travel[a] + set->travel[b];
     double allowed = fmin(PD_TRAVEL_WIDTH_FRACTION * fmin(model->bodies[a].width, model->bodies[b].width),
                           PD_TRAVEL_DEFLECTIONS * pd_model_pair_delta_max(model, a, b));
-    if (moved > allowed) limit = fmin(limit, allowed / moved);
+    if (room * moved > allowed) room = reaching_fraction(model, set, a, b, allowed, allowed / moved, room);
   }
-  return limit;
+  return room;
 }
 
 bool pd_contact_search_travel_retry(const pdModel* model, pdContactSet* set, int pairCount, double h,
                                     double* hRetry) {
-  double limit = travel_limit(model, set, pairCount);
-  if (!(limit < 1.0 && limit * h > model->settings.dtmin)) return false;
-  *hRetry = fmax(model->settings.dtmin, PD_TRAVEL_RETRY_SAFETY * limit * h);
+  double room = travel_room(model, set, pairCount);
+  // the step the guard lets the next one take if the motion goes on (the stepper starts from at most that)
+  set->travelStep = room < PD_TRAVEL_ROOM_MAX ? PD_TRAVEL_RETRY_SAFETY * room * h : INFINITY;
+  if (!(room < 1.0 && room * h > model->settings.dtmin)) return false;
+  *hRetry = fmax(model->settings.dtmin, PD_TRAVEL_RETRY_SAFETY * room * h);
   return true;
 }
 

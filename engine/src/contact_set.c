@@ -93,6 +93,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   set->stackScratch = pd_stack_scratch_create();
   set->stableStep = set->stableCheap = INFINITY;
   set->stableKnown = true;
+  set->travelStep = INFINITY;
   set->bodyRowsK = pd_grow(NULL, n, sizeof *set->bodyRowsK);
   set->bodyBlocks = pd_grow(NULL, n, sizeof *set->bodyBlocks);
   set->bodyRowsRight = pd_grow(NULL, n, sizeof *set->bodyRowsRight);
@@ -163,8 +164,11 @@ void pd_contact_set_clear(pdContactSet* set) {
   set->candidateCount = 0;
   set->cacheCount = 0;
   set->onsetRetries = 0;
+  set->travelStep = INFINITY;
   set->modeRetries = 0;
 }
+
+double pd_contact_set_travel_step(const pdContactSet* set) { return set->travelStep; }
 
 int pd_contact_set_count(const pdContactSet* set) { return set->count; }
 

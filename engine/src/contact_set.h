@@ -83,6 +83,11 @@ void pd_contact_events_commit(const pdModel* model, pdState* state, const double
 // does not let h through; *tightNeeded says whether it was needed.
 double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction, bool* tightNeeded);
 
+// The step the tunnelling guard (contact_search.c) lets the step after the last analysed one take if the bodies'
+// motion goes on, s (INFINITY: no pair near its travel limit). The adaptive steppers start their next trial from at
+// most this, rather than from what their error control wants, each time to be cut back by the guard.
+double pd_contact_set_travel_step(const pdContactSet* set);
+
 // How many times the tight stability bound was formed for this set (work counter for the tests: at most once per
 // contact list whose step the cheap bound does not settle).
 long pd_contact_set_tight_formed(const pdContactSet* set);

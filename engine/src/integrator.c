@@ -384,7 +384,14 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       double grow = norm > 0.0 ? STEP_SAFETY * pow(set->tol / norm, 1.0 / order) : STEP_GROW_MAX;
       grow = fmin(STEP_GROW_MAX, fmax(STEP_SHRINK_MIN, grow));
       s->h = fmin(set->dtmax, fmax(set->dtmin, grow * h));
+    } else if (eventCut) {
+      // a step a contact event cut short grows from what it took, as any step does: tried again at the size the
+      // event cut, the next step would meet the same contact (an onset whose interpolation came early, a tunnelling
+      // guard) and be cut again, one whole trial lost each time
+      s->h = fmin(s->h, STEP_GROW_MAX * h);
     }
+    // the tunnelling guard's step for the motion as it goes on: a longer trial would only be cut back to it
+    s->h = fmax(set->dtmin, fmin(s->h, pd_contact_set_travel_step(s->contacts)));
     if (outcome) *outcome = (stepOutcome){s->h, eventCut, false};
     // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge (an implicit
     // trial has none: stableFraction INFINITY)

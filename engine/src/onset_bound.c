@@ -3,9 +3,10 @@
 
 #include <math.h>
 
-double pd_onset_error_bound(double omega, double tau, double depth, double approach, double vmax, double size) {
+double pd_onset_error_bound(double omega, double tau, double depth, double approach, double vmax, double size,
+                            double friction) {
   double wt = omega * tau;
-  double velocity = PD_ONSET_BOUND_C * wt * wt * wt * fabs(approach) / vmax;
+  double velocity = (PD_ONSET_BOUND_C * wt * wt * wt * fabs(approach) + friction) / vmax;
   double position = fmax(depth, 0.0) * wt * wt / (6.0 * size);
   return fmax(velocity, position);
 }
@@ -15,3 +16,4 @@ double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, doub
   double kinkSlope = omegaT2 * fabs(slide) + mu * omegaN2 * fabs(approach);  // m/s³
   return kinkSlope * h * h / (48.0 * vmax);
 }
+

@@ -1,7 +1,7 @@
 // polydyn (internal) — the error a corrected onset may add, and whether the step may spend it (docs/events.md).
 //
 // Design note. A contact that began τ seconds before a step's end, found there at depth d approaching at v_n, can
-// join at the step's end as its pair alone would be after τ (contact_set.c, start_late_contacts: springs at the
+// join at the step's end as its pair alone would be after τ (onsets.c, pd_onsets_start_late: springs at the
 // deflection x of a Kelvin–Voigt element at the pair's modal mass, the bodies given the impulse that element took).
 // Along the normal of one point mass that is the exact motion; what it misses is the rest of the system over τ: the
 // bodies' turning under the impulse (a modal mass, not the motion of every contact of the pair), the other contacts,
@@ -10,7 +10,12 @@
 //   velocity: |δe| v_n / vmax, with |δe| <= PD_ONSET_BOUND_C (ωτ)³, the restitution error of a corrected onset
 //             (C measured: tests/engine/test_events.c, the drops whose onsets are forced to be corrected);
 //   position: (d − x) / L <= d (ωτ)² / (6 L), how much deeper the contact's rest point sits than a located onset's,
-//             L the smaller moving body's size,
+//             L the smaller moving body's size;
+//   friction: added to the velocity term where the pair slides at the onset: the correction gives the tangential
+//             impulse J_t of springs loaded by the slip, within the cone (onsets.c, onset_motion), as if the slip
+//             stayed what it was; it changes over τ by the impulse's own effect, so J_t is off by at most
+//             PD_ONSET_FRICTION_C ωτ of it, times how far a tangential impulse moves the point and turns the bodies
+//             (onsets.c, onset_terms),
 // with ω = √(k_s / m_min) the pair's fastest undamped frequency. An onset is corrected only where the larger of the
 // two is at most PD_ONSET_TOL_SHARE × tol, and ωτ and d stay within the ranges the correction holds in (contact_set.c,
 // PD_ONSET_PAIR_OMEGA_TAU, PD_ONSET_PAIR_DEPTH_REL); others are located, as the paper does with every one.
@@ -18,24 +23,39 @@
 
 #include <stdbool.h>
 
-// Restitution error of a corrected onset over (ωτ)³: the 1-D spring–dashpot figure of the cruder impulse
-// (c v_n + ½ k δ₀) τ, 0.08, halved because the element is integrated (onset_motion), not approximated. Measured on a
-// single body (tests/engine/test_events.c: a cube landing on a face, a corner and an edge, e 0.3–0.8, ωτ 0.02–0.82,
-// at tol 1e-10): every corrected landing within 3e-3 of this bound (≤ 1.1e-4 (ωτ)³, at the integration's noise). So
-// it is conservative where measured; in a crowd a pair's other contacts act over τ too, which no test isolates.
+// Restitution error of a corrected onset over (ωτ)³. The correction integrates the pair's normal element exactly over
+// τ; what it leaves out (the bodies turning under that impulse, so the point's effective mass drifting, and the onset
+// time's interpolation) enters the velocity at third order in ωτ. Measured on single bodies (tests/engine/test_events.c:
+// a cube landing on a face, a corner and an edge, e 0.3–0.8, at 0.02–3 m/s, stiff and soft, ωτ up to 0.82, at tol
+// 1e-10): at most 1.1e-4 (ωτ)³, so 0.004 keeps a factor of ~36 for what no test isolates (a crowd's other contacts
+// over τ). The 1-D spring–dashpot figure of the cruder impulse (c v_n + ½ k δ₀) τ is 0.08.
 #define PD_ONSET_BOUND_C 0.04
+// The friction term's coefficient: the correction's tangential impulse is off by at most this × ωτ of it. Calibrated
+// (tests/engine/test_events.c): grazing corner, edge and face landings, sliding and sticking, stiff and soft ones
+// stay within 1 % of the bound; a bar 0.6 m long landing on its edge while turning at 4 rad/s, sliding, within 41 %
+// (at 1 it was 4× over: the turning changes the slip over τ faster than the slip's own impulse does).
+#define PD_ONSET_FRICTION_C 10.0
+// The turning term's coefficient (onsets.c, correction_bound): a body turning at Ω as it lands changes its point's
+// approach by Ω² r τ over the τ the correction stands in for; calibrated with the friction term's, on the same bar.
+#define PD_ONSET_TURNING_C 10.0
 // The share of tol one corrected onset may spend: the size of one accepted step's own local error. An onset joined
 // within it changes the result no more than one more step would; beyond it the onset is located (a retried step).
 #define PD_ONSET_TOL_SHARE 1.0
 
 // The error bound of joining, corrected, an onset of a contact whose pair's fastest frequency is omega (1/s), that
 // began tau seconds before the step's end, found at depth (m) approaching at approach (m/s, > 0), in a scene whose
-// velocity scale is vmax (m/s) and whose smaller moving body of the pair is size (m) across: the larger of the two
-// terms above (dimensionless, the error norm's units).
-double pd_onset_error_bound(double omega, double tau, double depth, double approach, double vmax, double size);
+// velocity scale is vmax (m/s) and whose smaller moving body of the pair is size (m) across, with `friction` (m/s) the
+// friction term: the larger of the two terms above, friction / vmax added to the velocity one (dimensionless, the
+// error norm's units).
+double pd_onset_error_bound(double omega, double tau, double depth, double approach, double vmax, double size,
+                            double friction);
 
 // Whether an onset of that bound may be corrected at tolerance tol (else it is located).
 static inline bool pd_onset_bound_allows(double bound, double tol) { return bound <= PD_ONSET_TOL_SHARE * tol; }
+
+// The part of the tolerance's share a located onset's retried step aims to leave its correction: half, so that the
+// contact found at the retried step's end, its onset a little off the estimate, is still corrected.
+#define PD_ONSET_AIM_SHARE 0.5
 
 // A stick–slip change left inside a step (docs/events.md). The contact force is continuous there but its rate jumps,
 // by at most [Ḟ] = k_t |Δu_t| + μ k_n |Δu_n| (the spring rates of stick against those of the cone; series constants),

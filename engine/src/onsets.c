@@ -120,18 +120,110 @@ static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double a
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
 
-// The error bound (onset_bound.h) of joining new contact g at y1 (poses in set->poses1) as a pair onset `age` seconds
-// after its onset.
-static double onset_bound(const pdModel* model, const pdContactSet* set, const double* y1, const pdContactGeom* g,
-                          double age) {
+static void onset_motion(double omega2, double damping, double v0, double tau, double mu, double slipDamp,
+                         double slipRate, double* xOut, double* uOut, double* wOut);
+static double point_mass_at(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
+                            pdVec3 point, pdVec3 normal);
+
+// What the error bound (onset_bound.h) of joining new contact g (found at y1, poses in set->poses1) as a corrected
+// onset is formed from, apart from its age and depth.
+typedef struct onsetTerms {
+  double omega;      // 1/s: the pair's fastest undamped frequency, √(k_s / m_min)
+  double approach;   // m/s: its approach speed now
+  double size;       // m: the smaller moving body's
+  double mass;       // kg: the effective mass at the point along the normal (the correction's element)
+  double stiffness;  // 1/s²: k_s / mass
+  double damping;    // 1/s: c_s / mass
+  double mu;
+  double slip;       // m/s: the slip speed at the point (0: none)
+  double slipDamp;   // m/s²: c_t × slip / mass, the tangential damper's force per unit mass
+  double slipRate;   // m/s³: k_t × slip / mass, how fast the tangential springs load
+  double lever;      // 1/kg: how far a tangential impulse there may move the state, per kg·m/s (0: no slip)
+  double turning;    // m/s²: Ω² r, the bodies' turning's acceleration of the point (Ω their relative rate)
+} onsetTerms;
+
+static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, const double* y1, const pdContactGeom* g) {
   int a = g->id.body1, b = g->id.body2;
   pdContactParams p = pd_model_contact_params(model, a, b);
-  double approach = -pd_v3_dot(relative_velocity(model, y1, set->poses1, &g->id, g->point), g->normal);
-  double size = INFINITY;
-  if (!model->bodies[a].fixed) size = model->bodies[a].size;
-  if (!model->bodies[b].fixed) size = fmin(size, model->bodies[b].size);
-  return pd_onset_error_bound(sqrt(pd_series(p.k1n, p.k2n) / p.massMin), age, g->depth, approach,
-                              model->settings.vmax, size);
+  pdVec3 du = relative_velocity(model, y1, set->poses1, &g->id, g->point);
+  onsetTerms t = {.omega = sqrt(pd_series(p.k1n, p.k2n) / p.massMin), .approach = -pd_v3_dot(du, g->normal),
+                  .size = INFINITY, .mu = p.mu};
+  t.mass = point_mass_at(model, set, set->poses1, &g->id, g->point, g->normal);
+  t.slip = pd_v3_norm(pd_v3_sub(du, pd_v3_scale(g->normal, -t.approach)));
+  if (!(p.mu > 0.0) || t.slip <= PD_ONSET_PAIR_SLIP_REL * pd_v3_norm(du)) t.slip = 0.0;
+  if (isfinite(t.mass)) {
+    t.stiffness = pd_series(p.k1n, p.k2n) / t.mass;
+    t.damping = pd_series(p.c1n, p.c2n) / t.mass;
+    t.slipDamp = pd_series(p.c1t, p.c2t) * t.slip / t.mass;
+    t.slipRate = pd_series(p.k1t, p.k2t) * t.slip / t.mass;
+  }
+  pdVec3 spin = {0.0, 0.0, 0.0};
+  double reach = 0.0;
+  for (int side = 0; side < 2; ++side) {
+    const pdBody* body = &model->bodies[side == 0 ? a : b];
+    if (body->fixed) continue;
+    t.size = fmin(t.size, body->size);
+    pdVec3 w = pd_layout_w(y1 + PD_BODY_STATE_SIZE * body->stateIndex);
+    spin = side == 0 ? pd_v3_add(spin, w) : pd_v3_sub(spin, w);
+    reach = fmax(reach, pd_v3_norm(pd_v3_sub(g->point, set->poses1[side == 0 ? a : b].x)));
+    // a tangential impulse J at the point moves it by at most |J| λ_max(K) <= |J| tr K (K its inverse mass matrix
+    // there, 1/m + [r]ᵀ I⁻¹ [r], tr <= 3/m + |r|² tr I⁻¹) and turns the body by at most |J| |r| tr I⁻¹, which the
+    // error norm weighs by size / vmax
+    double r = pd_v3_norm(pd_v3_sub(g->point, set->poses1[side == 0 ? a : b].x));
+    double trInv = body->invInertia.m[0][0] + body->invInertia.m[1][1] + body->invInertia.m[2][2];
+    t.lever += fmax(3.0 * body->invMass + r * r * trInv, r * trInv * body->size);
+  }
+  t.turning = pd_v3_dot(spin, spin) * reach;
+  return t;
+}
+
+// The bound of joining the contact `age` seconds after its onset at `depth`. Its friction term: the tangential
+// impulse the correction gives (onset_motion's, as if the slip stayed what it is now) is off by what the slip's own
+// change over the age makes of it, at most ωτ of it (PD_ONSET_FRICTION_C), times what such an impulse moves. Its
+// turning term: the correction starts the element at the approach speed found at the step's end, which the bodies'
+// turning changed over the age by up to Ω² r τ without the contact; the element's response to that is at most ωτ of
+// it (PD_ONSET_TURNING_C).
+static double correction_bound(const pdModel* model, const onsetTerms* t, double age, double depth) {
+  double frictionVelocity = PD_ONSET_TURNING_C * t->turning * age * t->omega * age;
+  if (t->slip > 0.0 && isfinite(t->mass) && t->approach > 0.0) {
+    double x, u, w;
+    onset_motion(t->stiffness, t->damping, t->approach, age, t->mu, t->slipDamp, t->slipRate, &x, &u, &w);
+    frictionVelocity += PD_ONSET_FRICTION_C * t->omega * age * t->lever * t->mass * fmin(w, t->slip);
+  }
+  return pd_onset_error_bound(t->omega, age, depth, t->approach, model->settings.vmax, t->size, frictionVelocity);
+}
+
+// Bisections of the age a retried step aims at (retry_target): to ~1e-3 of the range, far finer than its share.
+#define PD_ONSET_AIM_BISECTIONS 10
+
+// The step fraction a retry aims at for a candidate that has to be located (its onset at fraction c->onset of h).
+// Exact events: the onset itself (the paper). Bounded events: past it by the largest age whose correction's bound
+// (the depth then taken as approach × age) is PD_ONSET_AIM_SHARE of the tolerance's share, within the pair-onset
+// ranges, so that the retried step ends with the contact shallow and joins it corrected. Aimed at the onset itself, a
+// retry whose onset estimate comes early (a vertex swinging down on a rolling body) ends before the contact, and the
+// next full step finds it again a little later: a rimless wheel took thousands of such steps, each closer to the same
+// onset.
+static double retry_target(const pdModel* model, const pdContactSet* set, const double* y1, const candidate* c,
+                           double h, pdOnsets onsets) {
+  if (onsets != pd_onsetsBounded) return c->onset;
+  onsetTerms t = onset_terms(model, set, y1, &c->geom);
+  if (!(t.approach > 0.0) || !(t.omega > 0.0)) return c->onset;
+  double deltaMax = pd_model_pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
+  double spend = PD_ONSET_AIM_SHARE * PD_ONSET_TOL_SHARE * model->settings.tol;
+  double lo = 0.0, hi = fmin(PD_ONSET_PAIR_OMEGA_TAU / t.omega, PD_ONSET_PAIR_DEPTH_REL * deltaMax / t.approach);
+  if (correction_bound(model, &t, hi, t.approach * hi) <= spend) {
+    lo = hi;
+  } else {
+    for (int k = 0; k < PD_ONSET_AIM_BISECTIONS; ++k) {
+      double age = 0.5 * (lo + hi);
+      if (correction_bound(model, &t, age, t.approach * age) <= spend)
+        lo = age;
+      else
+        hi = age;
+    }
+  }
+  double target = c->onset + lo / h;
+  return target < 1.0 ? target : c->onset;
 }
 
 double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdOnsets onsets, const double* y1) {
@@ -141,14 +233,15 @@ double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdO
     if (!c->approaching || c->inherit >= 0) continue;
     double age = (1.0 - c->onset) * h;
     if (onsets != pd_onsetsExact && joins_as_pair(model, &c->geom, age)) {
-      c->onsetBound = onset_bound(model, set, y1, &c->geom, age);
+      onsetTerms t = onset_terms(model, set, y1, &c->geom);
+      c->onsetBound = correction_bound(model, &t, age, c->geom.depth);
       if (onsets == pd_onsetsPair || pd_onset_bound_allows(c->onsetBound, model->settings.tol)) {
         c->onsetAge = age;
         continue;
       }
     }
     double tol = PD_ONSET_DEPTH_TOL_REL * pd_model_pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
-    if (c->geom.depth > tol) earliest = fmin(earliest, c->onset);
+    if (c->geom.depth > tol) earliest = fmin(earliest, retry_target(model, set, y1, c, h, onsets));
   }
   return earliest;
 }
@@ -160,33 +253,49 @@ bool pd_onsets_may_retry(const pdContactSet* set) { return set->onsetRetries < P
 // The normal motion of one contact over the τ since its onset, alone at the effective mass m, undamped
 // frequency² k/m and damping c/m (a Kelvin–Voigt element, force never pulling): from deflection 0 at
 // approach speed v0 to its deflection *x and approach speed *u at τ. Linear and short
-// (ω τ <= PD_ONSET_PAIR_OMEGA_TAU): a few classic RK4 substeps are exact to ~(ωτ/8)⁵.
+// (ω τ <= PD_ONSET_PAIR_OMEGA_TAU): a few classic RK4 substeps are exact to ~(ωτ/8)⁵. With it, the friction over τ
+// per unit mass, *w (m/s): the tangential spring and damper under the slip, slipDamp + slipRate t (c_t × slip / m and
+// k_t × slip / m), within the cone μ F_n / m, the force at each time the smaller of the two. A slow slip's springs
+// take a while to reach the cone, which the normal damper makes large at once: the cone's impulse μ J_n alone would
+// be first order in τ there, where the springs give second.
 #define PD_ONSET_PAIR_SUBSTEPS 8
-static void onset_motion(double omega2, double damping, double v0, double tau, double* xOut, double* uOut) {
-  double x = 0.0, u = v0, dt = tau / PD_ONSET_PAIR_SUBSTEPS;
+static void onset_motion(double omega2, double damping, double v0, double tau, double mu, double slipDamp,
+                         double slipRate, double* xOut, double* uOut, double* wOut) {
+  double x = 0.0, u = v0, w = 0.0, dt = tau / PD_ONSET_PAIR_SUBSTEPS;
   for (int i = 0; i < PD_ONSET_PAIR_SUBSTEPS; ++i) {
-    double a1 = -fmax(0.0, omega2 * x + damping * u);
-    double x2 = x + 0.5 * dt * u, u2 = u + 0.5 * dt * a1, a2 = -fmax(0.0, omega2 * x2 + damping * u2);
-    double x3 = x + 0.5 * dt * u2, u3 = u + 0.5 * dt * a2, a3 = -fmax(0.0, omega2 * x3 + damping * u3);
-    double x4 = x + dt * u3, u4 = u + dt * a3, a4 = -fmax(0.0, omega2 * x4 + damping * u4);
+    double t = i * dt;
+    double a1 = fmax(0.0, omega2 * x + damping * u);
+    double x2 = x + 0.5 * dt * u, u2 = u - 0.5 * dt * a1, a2 = fmax(0.0, omega2 * x2 + damping * u2);
+    double x3 = x + 0.5 * dt * u2, u3 = u - 0.5 * dt * a2, a3 = fmax(0.0, omega2 * x3 + damping * u3);
+    double x4 = x + dt * u3, u4 = u - dt * a3, a4 = fmax(0.0, omega2 * x4 + damping * u4);
+    double f1 = fmin(mu * a1, slipDamp + slipRate * t), f2 = fmin(mu * a2, slipDamp + slipRate * (t + 0.5 * dt));
+    double f3 = fmin(mu * a3, slipDamp + slipRate * (t + 0.5 * dt)), f4 = fmin(mu * a4, slipDamp + slipRate * (t + dt));
     x += dt / 6.0 * (u + 2.0 * u2 + 2.0 * u3 + u4);
-    u += dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+    u -= dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+    w += dt / 6.0 * (f1 + 2.0 * f2 + 2.0 * f3 + f4);
   }
   *xOut = x;
   *uOut = u;
+  *wOut = w;
+}
+
+// The effective mass of the bodies of contact `id` along `normal` at `point`, kg (INFINITY if neither moves).
+static double point_mass_at(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
+                            pdVec3 point, pdVec3 normal) {
+  double invMass = 0.0;
+  for (int side = 0; side < 2; ++side) {
+    int b = side == 0 ? id->body1 : id->body2;
+    const pdBody* body = &model->bodies[b];
+    if (body->fixed) continue;
+    pdVec3 rn = pd_v3_cross(pd_v3_sub(point, poses[b].x), normal);
+    invMass += body->invMass + pd_v3_dot(rn, pd_mat3_mulv(&set->invInertiaWorld[b], rn));
+  }
+  return invMass > 0.0 ? 1.0 / invMass : INFINITY;
 }
 
 // The effective mass of contact c's two bodies along its normal at its point, kg (INFINITY if neither moves).
 static double point_mass(const pdModel* model, const pdContactSet* set, const pdPose* poses, const contactSlot* c) {
-  double invMass = 0.0;
-  for (int side = 0; side < 2; ++side) {
-    int b = side == 0 ? c->id.body1 : c->id.body2;
-    const pdBody* body = &model->bodies[b];
-    if (body->fixed) continue;
-    pdVec3 rn = pd_v3_cross(pd_v3_sub(c->point, poses[b].x), c->normal);
-    invMass += body->invMass + pd_v3_dot(rn, pd_mat3_mulv(&set->invInertiaWorld[b], rn));
-  }
-  return invMass > 0.0 ? 1.0 / invMass : INFINITY;
+  return point_mass_at(model, set, poses, &c->id, c->point, c->normal);
 }
 
 // Pair onsets of a list just installed at state y (poses those of y; world inverse inertias and modal dampers
@@ -214,20 +323,20 @@ int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, con
     c->onsetImpulse = (pdVec3){0, 0, 0};
     double mass = c->modalMass > 0.0 && isfinite(c->modalMass) ? c->modalMass : point_mass(model, set, poses, c);
     if (isfinite(mass) && approach > 0.0 && k > 0.0) {
-      double x, u;
-      onset_motion(k / mass, damper / mass, approach, c->onsetAge, &x, &u);
+      double kt = pd_series(p->k1t, p->k2t), ct = pd_series(p->c1t, p->c2t), x, u, w;
+      onset_motion(k / mass, damper / mass, approach, c->onsetAge, p->mu, ct * slipSpeed / mass, kt * slipSpeed / mass,
+                   &x, &u, &w);
       x = fmin(fmax(x, 0.0), fmax(c->depth, 0.0));
       pdSprings sp = springs_load(y + base + PD_CONTACT_STATE_SIZE * i);
       sp.s1n = -k * x / p->k1n;
       sp.s2n = k * x / p->k2n;
       double normalImpulse = mass * fmax(0.0, approach - fmax(u, 0.0));  // the pair's contacts together slow it so
       c->onsetImpulse = pd_v3_scale(n, normalImpulse);
-      // friction over τ: sliding, the cone's impulse μ J against the slip (at most what stops it), and the
-      // tangential springs loaded to the cone (or to the slip since the onset, if less) against it
-      double kt = pd_series(p->k1t, p->k2t);
+      // friction over τ: sliding, the springs' impulse against the slip, within the cone (onset_motion; at most what
+      // stops it), and the tangential springs loaded to the cone (or to the slip since the onset, if less) against it
       if (p->mu > 0.0 && kt > 0.0 && slipSpeed > 0.0) {
         pdVec3 along = pd_v3_scale(slip, 1.0 / slipSpeed);
-        double frictionImpulse = fmin(p->mu * normalImpulse, mass * slipSpeed);
+        double frictionImpulse = fmin(mass * w, mass * slipSpeed);
         c->onsetImpulse = pd_v3_sub(c->onsetImpulse, pd_v3_scale(along, frictionImpulse));
         double ft = fmin(p->mu * k * x, kt * slipSpeed * c->onsetAge);  // |F_t| on body 1, against the slip
         sp.s1t = pd_v3_scale(along, ft / p->k1t);                       // F_t = −k1t s1t = k2t s2t = −ft · along

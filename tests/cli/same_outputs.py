@@ -4,7 +4,7 @@
 usage: same_outputs.py DIR_A DIR_B
 
 The same files must exist in both, with the same bytes, except (docs/commands.md):
-  - CSV columns named wall_seconds, cpu_seconds or wall_per_sim_second, and CSV rows whose quantity is one of
+  - CSV columns named wall_seconds, cpu_seconds, wall_per_sim_second or cpu_per_sim_second, and CSV rows whose quantity is one of
     them (cubetoss's summary.csv): their other fields must be the same strings;
   - in JSON files the "timing" line of a run's summary.json and the value of "wall_seconds" (sweep's
     reference.json).
@@ -16,7 +16,7 @@ import os
 import re
 import sys
 
-TIMING = {"wall_seconds", "cpu_seconds", "wall_per_sim_second"}
+TIMING = {"wall_seconds", "cpu_seconds", "wall_per_sim_second", "cpu_per_sim_second"}
 
 
 def files(root):

@@ -392,12 +392,12 @@ class PrecisionReport(ReportInDir):
             cls.results = list(csv.DictReader(f))
         cls.html, cls.json = make_report(cls.src, cls.dir)
 
-    def expected_cost(self, experiment, ev, setting=None):
+    def expected_cost(self, experiment, ev, setting=None, column="wall_per_sim_second"):
         """(kind, cost, smallest error) of one curve (one knob of an engine-variant; None: the cheapest that reaches
         the tolerance): the first setting, loosest first (largest tol or step, fewest iterations), whose error is
-        within the tolerance, the cost interpolated log-log from the setting before it."""
+        within the tolerance, the cost (`column`) interpolated log-log from the setting before it."""
         if setting is None:
-            curves = [self.expected_cost(experiment, ev, k) for k in {r["setting"] for r in self.rows
+            curves = [self.expected_cost(experiment, ev, k, column) for k in {r["setting"] for r in self.rows
                       if r["experiment"] == experiment and f'{r["engine"]} {r["variant"]}' == ev}]
             reached = [c for c in curves if c[0] in ("at_most", "interpolated")]
             return min(reached, key=lambda c: c[1]) if reached else curves[0]
@@ -405,7 +405,7 @@ class PrecisionReport(ReportInDir):
                and (r["setting"] == setting or r["status"] == "not_built")]
         if all(r["status"] == "not_built" for r in pts):
             return "not_built", None, None
-        ok = sorted(([float(r["value"]), float(r["error"]), float(r["wall_per_sim_second"])] for r in pts if r["status"] == "ok"),
+        ok = sorted(([float(r["value"]), float(r["error"]), float(r[column])] for r in pts if r["status"] == "ok"),
                     reverse=setting != "iterations")
         tol = float(pts[0]["tolerance"])
         smallest = min(e for _, e, _ in ok) if ok else None
@@ -418,9 +418,33 @@ class PrecisionReport(ReportInDir):
                 return "interpolated", math.exp(math.log(w0) + s * (math.log(w) - math.log(w0))), smallest
         return "never", None, smallest
 
-    def test_summary_opens_the_report_and_precision_is_a_section(self):
-        self.assertEqual(self.json["sections"][0], "summary")
+    def test_the_cost_against_the_rigid_engines_opens_the_report_then_the_summary(self):
+        self.assertEqual(self.json["sections"][:2], ["against", "summary"])
         self.assertIn("precision", self.json["sections"])
+
+    def test_cost_ratios_are_the_cpu_costs_to_the_tolerance_over_each_other(self):
+        judged = {(r["experiment"], f'{r["engine"]} {r["variant"]}') for r in self.rows if r["judged"] == "true"}
+        checked = 0
+        for row in self.table("against"):
+            if row["experiment"].startswith("median"):
+                continue
+            self.assertEqual(row["unit"], "cpu")
+            mine = self.expected_cost(row["experiment"], "soft implicit", column="cpu_per_sim_second")
+            for ev in ("ode native", "ode matched", "bullet native", "bullet matched"):
+                key = "ratio_" + ev.replace(" ", "_")
+                if key not in row:
+                    continue
+                other = self.expected_cost(row["experiment"], ev, column="cpu_per_sim_second")
+                reached = (row["experiment"], ev) in judged and mine[0] in ("at_most", "interpolated") and \
+                    other[0] in ("at_most", "interpolated")
+                if not reached:
+                    self.assertEqual(row[key], "", f'{row["experiment"]} {ev}')
+                    continue
+                want = mine[1] / other[1]
+                self.assertAlmostEqual(float(row[key]), want, delta=1e-9 * want, msg=f'{row["experiment"]} {ev}')
+                checked += 1
+        if any(r["engine"] == "bullet" and r["status"] == "ok" for r in self.rows):  # a build with Bullet
+            self.assertGreater(checked, 0)
 
     def test_one_curve_per_experiment_and_engine_variant_with_the_cost_to_its_tolerance(self):
         got = {(r["experiment"], f'{r["engine"]} {r["variant"]}', r["setting"]): r for r in self.table("precision")}

@@ -18,7 +18,9 @@ export const SWEEP_HEADER_V2 = [...SWEEP_HEADER_V1, 'self_error', 'self_referenc
 export const SWEEP_HEADER = [...SWEEP_HEADER_V2, 'derivatives'];
 export const PRECISION_HEADER = ['experiment', 'kind', 'engine', 'variant', 'setting', 'value', 'input', 'quantity', 'unit',
   'measured', 'expected', 'error', 'relative', 'tolerance', 'judged', 'status', 'wall_seconds', 'wall_per_sim_second', 'steps',
-  'repeats', 'note'];
+  'repeats', 'cpu_seconds', 'cpu_per_sim_second', 'note'];
+// before the CPU time was measured
+const PRECISION_HEADER_WALL_ONLY = PRECISION_HEADER.filter((h) => !h.startsWith('cpu_'));
 export const PRECISION_STATUSES = ['ok', 'failed', 'no_measure', 'refused', 'not_built'];
 export const METRICS_HEADER = ['scene', 'engine', 'variant', 'reference', 'pos_err_final', 'pos_err_rms',
   'rot_err_final_rad', 'rot_err_rms_rad', 'energy_drift_rel', 'momentum_drift_rel', 'max_penetration_over_size',
@@ -262,7 +264,7 @@ export function readPrecision(dir) {
   const src = readText(dir, 'precision.csv');
   if (!src) return null;
   const rows = [];
-  for (const { line, f } of table(src, PRECISION_HEADER)) {
+  for (const { line, f } of table(src, PRECISION_HEADER, [PRECISION_HEADER_WALL_ONLY])) {
     if (f.experiment === '') throw new InputError(src.file, line, 'experiment: empty');
     const status = oneOf(f.status, PRECISION_STATUSES, 'status', src.file, line);
     if (status !== 'not_built' && !['tol', 'step', 'iterations'].includes(f.setting))
@@ -289,6 +291,8 @@ export function readPrecision(dir) {
       wall_per_sim_second: number(f.wall_per_sim_second, 'wall_per_sim_second', src.file, line),
       steps: number(f.steps, 'steps', src.file, line, { integer: true }),
       repeats: number(f.repeats, 'repeats', src.file, line, { integer: true }),
+      cpu_seconds: number(f.cpu_seconds ?? '', 'cpu_seconds', src.file, line),
+      cpu_per_sim_second: number(f.cpu_per_sim_second ?? '', 'cpu_per_sim_second', src.file, line),
       note: f.note,
     };
     if (status === 'ok' && (row.error === null || row.wall_per_sim_second === null))

@@ -62,8 +62,12 @@ export function precision(prec, experiments) {
       const curve = {
         label, ev, engine: pts[0].engine, variant: pts[0].variant, setting: pts[0].setting, judged,
         points: ordered.map((p) => ({ value: p.value, measured: p.measured, error: p.error, wall_seconds: p.wall_seconds,
-          wall_per_sim_second: p.wall_per_sim_second, steps: p.steps, status: p.status, note: p.note })),
+          wall_per_sim_second: p.wall_per_sim_second, cpu_per_sim_second: p.cpu_per_sim_second ?? null, steps: p.steps,
+          status: p.status, note: p.note })),
         to_tolerance: to,
+        // the same read on the CPU time, where every usable point has it (precision.csv before it: null)
+        to_tolerance_cpu: notBuilt || !ordered.filter(usable).every((p) => Number.isFinite(p.cpu_per_sim_second) && p.cpu_per_sim_second > 0)
+          ? null : costToReach(ordered.filter(usable).map((p) => ({ ...p, wall_per_sim_second: p.cpu_per_sim_second })), first.tolerance),
         floor: null,
         never: null,
       };

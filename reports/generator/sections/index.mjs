@@ -6,6 +6,7 @@
 // each csv into report-NAME.csv beside the page. Charts are made with ctx.chart(echartsOption).
 // To add a section, write sections/NAME.mjs and list it here.
 import summary from './summary.mjs';
+import against from './against.mjs';
 import verdict from './verdict.mjs';
 import precision from './precision.mjs';
 import matrix from './matrix.mjs';
@@ -20,4 +21,4 @@ import experiments from './experiments.mjs';
 import parameters from './parameters.mjs';
 import cubetoss, { planarDrops } from './cubetoss.mjs';
 
-export const sections = [differ, scenes, summary, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, planarDrops, experiments, parameters];
+export const sections = [differ, scenes, against, summary, verdict, matrix, restitution, frictionCone, precision, workPrecision, cost, compare, cubetoss, planarDrops, experiments, parameters];

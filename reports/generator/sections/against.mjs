@@ -1,0 +1,113 @@
+// What polydyn's answers cost against the rigid engines', on the report's first screen: over the experiments that
+// polydyn (its default stepper) and another engine-variant both reach at the experiment's tolerance, the median of
+// polydyn's cost over the other's, how often polydyn is the cheaper, the target the project set, and per experiment
+// the ratios with what bounds polydyn's cost there. The cost is the CPU time per simulated second where
+// precision.csv has it (a loaded machine inflates the wall time of a long run more than that of a sub-millisecond
+// one, so wall-time ratios drift with the load), else the wall time.
+import { esc, num, table } from '../lib/html.mjs';
+import { median } from '../lib/derive.mjs';
+
+const SOFT = 'soft implicit';
+// The project's targets for the median ratio (docs/validation.md, "Cost against the rigid engines").
+const TARGETS = { 'ode native': 3, 'ode matched': 2 };
+const OTHERS = ['ode native', 'ode matched', 'bullet native', 'bullet matched'];
+
+// The cheapest reach of an engine-variant's judged curves on one experiment, in `unit` ('cpu' or 'wall'), or null.
+function reach(e, ev, unit) {
+  let best = null;
+  for (const c of e.curves.filter((x) => x.ev === ev && x.judged)) {
+    const t = unit === 'cpu' ? c.to_tolerance_cpu : c.to_tolerance;
+    if (!t || (t.kind !== 'interpolated' && t.kind !== 'at_most')) continue;
+    if (!best || t.wall_per_sim_second < best.cost) {
+      const at = t.kind === 'at_most' ? c.points.find((p) => p.value === t.setting_value) : null;
+      best = { cost: t.wall_per_sim_second, kind: t.kind, setting: c.setting, value: t.setting_value, loosest: c.points[0].value,
+        steps: at ? at.steps : null };
+    }
+  }
+  return best;
+}
+
+// Why polydyn's cost on an experiment is what it is, from where its curve reaches the tolerance and the other's.
+function bound(soft, other) {
+  if (soft.kind === 'at_most')
+    return 'its loosest tolerance already reaches the answer: the steps resolve the contacts (a soft contact must resolve each ' +
+      'impact and each contact period, whatever the tolerance), not the error' +
+      (other && other.kind === 'at_most' && other.setting === 'step' ? '; the rigid engine’s coarsest step reaches it too (a rigid ' +
+        'contact resolves an impact within one step)' : '');
+  return 'the error control: a tighter tolerance is needed to reach the answer';
+}
+
+export default {
+  id: 'against',
+  title: 'Cost against the rigid engines',
+  inputs: ['precision.csv'],
+  build(ctx) {
+    const pr = ctx.precision;
+    if (!pr || !pr.engine_variants.includes(SOFT)) return null;
+    const hasCpu = pr.experiments.some((e) => e.curves.some((c) => c.ev === SOFT && c.to_tolerance_cpu));
+    const unit = hasCpu ? 'cpu' : 'wall';
+    const others = OTHERS.filter((ev) => pr.engine_variants.includes(ev));
+    const perExperiment = pr.experiments.map((e) => {
+      const soft = reach(e, SOFT, unit);
+      const ratios = {};
+      const wallRatios = {};
+      for (const ev of others) {
+        const o = reach(e, ev, unit), ow = reach(e, ev, 'wall'), sw = reach(e, SOFT, 'wall');
+        ratios[ev] = soft && o ? { ratio: soft.cost / o.cost, other: o } : null;
+        wallRatios[ev] = sw && ow ? sw.cost / ow.cost : null;
+      }
+      return { experiment: e.experiment, soft, ratios, wallRatios };
+    }).filter((x) => x.soft);
+    const summary = others.map((ev) => {
+      const both = perExperiment.filter((x) => x.ratios[ev]);
+      const r = both.map((x) => x.ratios[ev].ratio);
+      const w = perExperiment.map((x) => x.wallRatios[ev]).filter((x) => x !== null);
+      const med = median(r);
+      return { ev, both: both.length, median_ratio: med, median_wall_ratio: median(w), cheaper: r.filter((x) => x < 1).length,
+        target: TARGETS[ev] ?? null, met: TARGETS[ev] === undefined || med === null ? null : med <= TARGETS[ev] };
+    });
+    const what = hasCpu ? 'CPU time' : 'wall time';
+    let html = `<p>Over the experiments that polydyn (${esc(SOFT)}, the default) and the other engine-variant both reach at the ` +
+      `experiment’s tolerance: the median of polydyn’s cost to reach it over the other’s (${what} per simulated second` +
+      `${hasCpu ? '; the wall-time median beside it' : ''}), and on how many polydyn is the cheaper.</p>`;
+    html += table(['against', 'experiments both reach', `median cost ratio (${what})`, ...(hasCpu ? ['median ratio (wall time)'] : []),
+      'polydyn cheaper on', 'target'], summary.map((s) => [
+      { html: esc(s.ev) },
+      { html: String(s.both), cls: 'n' },
+      { html: s.median_ratio === null ? '—' : `${num(s.median_ratio)}×`, cls: 'n' + (s.met === false ? ' bad' : '') },
+      ...(hasCpu ? [{ html: s.median_wall_ratio === null ? '—' : `${num(s.median_wall_ratio)}×`, cls: 'n muted' }] : []),
+      { html: `${s.cheaper} of ${s.both}`, cls: 'n' },
+      { html: s.target === null ? '—' : `≤ ${s.target}× ${s.met ? '(met)' : '(not met)'}`, cls: 'n' + (s.met === false ? ' bad' : '') },
+    ]), 'against-table');
+    const rows = [...perExperiment].sort((a, b) => (b.ratios['ode native']?.ratio ?? 0) - (a.ratios['ode native']?.ratio ?? 0));
+    html += '<h3>Per experiment</h3>';
+    html += table(['experiment', ...others.map((ev) => `÷ ${ev}`), 'polydyn reaches it at', 'what bounds polydyn’s cost'],
+      rows.map((x) => {
+        const over = (x.ratios['ode native'] && x.ratios['ode native'].ratio > TARGETS['ode native']) ||
+          (x.ratios['ode matched'] && x.ratios['ode matched'].ratio > TARGETS['ode matched']);
+        return [
+          { html: esc(x.experiment) },
+          ...others.map((ev) => ({ html: x.ratios[ev] ? `${num(x.ratios[ev].ratio)}×` : '—', cls: 'n' +
+            (TARGETS[ev] !== undefined && x.ratios[ev] && x.ratios[ev].ratio > TARGETS[ev] ? ' bad' : '') })),
+          { html: `${x.soft.kind === 'at_most' ? '≤ ' : ''}${num(x.soft.cost)} s/s${x.soft.kind === 'at_most'
+            ? ` (tol ${num(x.soft.value)}${x.soft.steps !== null ? `, ${x.soft.steps} steps` : ''})` : ''}`, cls: 'n' },
+          { html: over ? esc(bound(x.soft, x.ratios['ode native']?.other)) : '<span class="muted">within the targets</span>' },
+        ];
+      }), 'against-experiments');
+    html += '<p class="legend">Ratio: polydyn’s cost to reach the experiment’s tolerance over the other engine-variant’s (each the cheaper ' +
+      'of its knobs; “—”: one of the two never reaches it, or the experiment does not judge that variant). Read on the work-precision curves ' +
+      'below (Work-precision against the closed form).</p>';
+    return {
+      html,
+      data: { unit, summary, experiments: perExperiment.map((x) => ({ experiment: x.experiment, soft: x.soft,
+        ratios: Object.fromEntries(others.map((ev) => [ev, x.ratios[ev] ? x.ratios[ev].ratio : null])) })) },
+      csv: [{ name: 'against', header: ['experiment', 'unit', ...others.map((ev) => `ratio_${ev.replace(' ', '_')}`), 'soft_cost',
+        'soft_to_tolerance', 'soft_setting_value', 'soft_steps'],
+      rows: [
+        ...summary.map((s) => [`median over ${s.both} (${s.ev})`, unit, ...others.map((ev) => (ev === s.ev ? s.median_ratio : '')), '', '', '', '']),
+        ...perExperiment.map((x) => [x.experiment, unit, ...others.map((ev) => (x.ratios[ev] ? x.ratios[ev].ratio : '')), x.soft.cost,
+          x.soft.kind, x.soft.value, x.soft.steps]),
+      ] }],
+    };
+  },
+};
