@@ -16,15 +16,16 @@
 #include "polydyn/soak.h"
 
 static const char* const help =
-    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I]\n"
+    "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--generator G]\n"
     "                    [--engines soft,soft-islands-off,ode,bullet] [--budget SECONDS] [--jobs N]\n"
-    "                    [--onsets pair|exact|auto|bounded]\n"
+    "                    [--onsets pair|exact|auto|bounded] [--check steps|samples]\n"
     "\n"
-    "Generates N random scenes (campaign S: scene i is the same text on every machine) and runs each in\n"
-    "every engine, in a child process per run, checking at every output sample: no NaN or Inf; for the soft\n"
-    "engine also penetration below 3 delta_max of the pair, no energy gained beyond 1e-3 of E(0) in a\n"
-    "dissipative scene, the momentum kept in a scene without gravity or fixed bodies; and that the run\n"
-    "reaches its end. Scenes of two overlapping boxes must be refused. A run over its wall-time budget is\n"
+    "Generates N random scenes (campaign S of generator G: scene i is the same text on every machine) and\n"
+    "runs each in every engine, in a child process per run, checking at every output sample: no NaN or Inf;\n"
+    "for the soft engine also penetration below 3 delta_max of the pair, no energy gained beyond 1e-3 of E(0)\n"
+    "in a dissipative scene, the momentum kept in a scene without gravity or fixed bodies; and that the run\n"
+    "reaches its end. The soft engine's penetration and energy are also checked at every accepted step.\n"
+    "Scenes of two overlapping boxes must be refused. A run over its wall-time budget is\n"
     "stopped and counted as over budget (a cost finding, not a failure).\n"
     "Writes DIR/summary.csv (one row per scene and engine), DIR/failures/SCENE-ENGINE.scene (every failed\n"
     "run's scene, replayable with `polydyn run`) and DIR/over-budget/SCENE-ENGINE.scene; prints the counts.\n"
@@ -33,11 +34,15 @@ static const char* const help =
     "  --scenes N       how many scenes (default 100)\n"
     "  --seed S         the campaign (default 1)\n"
     "  --first I        start at scene I (default 0): scenes I .. I+N-1\n"
+    "  --generator G    the scene generator: 1 (boxes, prisms, frusta, spheres, hulls, 100:1 blades), 2 (also\n"
+    "                   plates 3:1 .. 30:1, loose and in stacks; the default)\n"
     "  --engines LIST   soft, soft-islands-off (the soft engine with --islands off), ode, bullet (default soft)\n"
     "  --budget SECONDS wall-time budget of one run (default 20)\n"
     "  --jobs N         scenes in N worker processes (default 1; under mpirun or srun split over the ranks)\n"
     "  --onsets MODE    soft engine: how a contact that began inside a step joins, pair, exact or auto (default:\n"
     "                   the engine's, as polydyn run --onsets; docs/contact-model.md)\n"
+    "  --check WHEN     soft engine: penetration and energy at every accepted step and every sample (steps,\n"
+    "                   the default) or at the output samples only (samples)\n"
     "\n"
     "Exit status: 0 no failure, 1 a run failed (or the results could not be written), 2 bad input,\n"
     "130 interrupted (nothing written).\n";
@@ -46,20 +51,20 @@ enum { ENGINES_MAX = 4 };
 static const char* const engineNames[ENGINES_MAX] = {"soft", "soft-islands-off", "ode", "bullet"};
 
 typedef struct soakJob {
+  int generator;
   unsigned long seed;
   long first;
   const char* engines[ENGINES_MAX];
   int engineCount;
-  double budget;
-  pdOnsets onsets;  // the soft engine's
+  pdSoakRunOptions run;
 } soakJob;
 
 static void soak_task(int task, pdBatchBuffer* result, void* user) {
   const soakJob* job = user;
-  pdSoakScene scene = pd_soak_scene(job->seed, job->first + task);
+  pdSoakScene scene = pd_soak_scene(job->generator, job->seed, job->first + task);
   for (int e = 0; e < job->engineCount; ++e) {
     pdSoakResult r;
-    pd_soak_run(&scene, job->engines[e], job->onsets, job->budget, &r);
+    pd_soak_run(&scene, job->engines[e], &job->run, &r);
     pd_batch_append(result, &r, sizeof r);
   }
   pd_soak_scene_free(&scene);
@@ -95,7 +100,9 @@ static bool write_scene_file(const char* dir, const char* sub, long index, const
 }
 
 int pd_cmd_soak(int argc, char** argv) {
-  soakJob job = {.seed = 1, .budget = 20.0, .onsets = PD_ONSETS_DEFAULT};
+  soakJob job = {.generator = PD_SOAK_GENERATOR_LATEST,
+                 .seed = 1,
+                 .run = {.onsets = PD_ONSETS_DEFAULT, .budgetSeconds = 20.0, .everyStep = true}};
   long scenes = 100;
   int jobs = 0;
   const char* out = NULL;
@@ -125,13 +132,23 @@ int pd_cmd_soak(int argc, char** argv) {
       if (end == v || *end || errno || v[0] == '-' || s > 0xffffffffull)
         return pd_cli_usage_error("soak", "--seed needs a whole number from 0 to 4294967295");
       job.seed = (unsigned long)s;
+    } else if (strcmp(a, "--generator") == 0) {
+      long g = strtol(v, &end, 10);
+      if (end == v || *end || errno || g < PD_SOAK_GENERATOR_BLADES || g > PD_SOAK_GENERATOR_LATEST)
+        return pd_cli_usage_error("soak", "--generator needs %d to %d", PD_SOAK_GENERATOR_BLADES,
+                                  PD_SOAK_GENERATOR_LATEST);
+      job.generator = (int)g;
+    } else if (strcmp(a, "--check") == 0) {
+      if (strcmp(v, "steps") != 0 && strcmp(v, "samples") != 0)
+        return pd_cli_usage_error("soak", "--check must be steps or samples");
+      job.run.everyStep = strcmp(v, "steps") == 0;
     } else if (strcmp(a, "--engines") == 0) {
       engines = v;
     } else if (strcmp(a, "--budget") == 0) {
-      if (!pd_cli_positive(v, &job.budget) || job.budget > 86400)
+      if (!pd_cli_positive(v, &job.run.budgetSeconds) || job.run.budgetSeconds > 86400)
         return pd_cli_usage_error("soak", "--budget needs seconds > 0 (at most a day)");
     } else if (strcmp(a, "--onsets") == 0) {
-      if (!pd_cli_onsets(v, &job.onsets)) return pd_cli_usage_error("soak", "--onsets must be pair, exact, auto or bounded");
+      if (!pd_cli_onsets(v, &job.run.onsets)) return pd_cli_usage_error("soak", "--onsets must be pair, exact, auto or bounded");
     } else if (strcmp(a, "--jobs") == 0) {
       if (!pd_cli_jobs(v, &jobs))
         return pd_cli_usage_error("soak", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);
@@ -187,11 +204,11 @@ int pd_cmd_soak(int argc, char** argv) {
     bool ok = csv != NULL;
     if (ok)
       fputs("seed,scene,kind,objects,dissipative,engine,status,wall_seconds,simulated,steps,penetration_over_delta_max,"
-            "energy_gain_rel,momentum_error_rel,message\n",
+            "energy_gain_rel,momentum_error_rel,penetration_at_samples_over_delta_max,generator,message\n",
             csv);
     for (long s = 0; s < scenes && ok; ++s) {
       long index = job.first + s;
-      pdSoakScene scene = pd_soak_scene(job.seed, index);
+      pdSoakScene scene = pd_soak_scene(job.generator, job.seed, index);
       size_t offset = 0;
       for (int e = 0; e < job.engineCount && ok; ++e) {
         pdSoakResult r;
@@ -204,15 +221,16 @@ int pd_cmd_soak(int argc, char** argv) {
         while (engineNames[engine] != job.engines[e]) ++engine;
         ++counts[engine][r.status];
         if (e == 0) ++kinds[scene.kind][r.status];
-        fprintf(csv, "%lu,%ld,%s,%d,%d,%s,%s,%.4g,%.6g,%ld,%.4g,%.4g,%.4g,", job.seed, index, pdSoakKindNames[scene.kind],
-                scene.objects, scene.dissipative, job.engines[e], pdSoakStatusNames[r.status], r.wallSeconds,
-                r.simulated, r.steps, r.penetration, r.energyGain, r.momentumError);
+        fprintf(csv, "%lu,%ld,%s,%d,%d,%s,%s,%.4g,%.6g,%ld,%.4g,%.4g,%.4g,%.4g,%d,", job.seed, index,
+                pdSoakKindNames[scene.kind], scene.objects, scene.dissipative, job.engines[e],
+                pdSoakStatusNames[r.status], r.wallSeconds, r.simulated, r.steps, r.penetration, r.energyGain,
+                r.momentumError, r.penetrationSampled, job.generator);
         pdu_csv_quoted(csv, r.message);  // quoted in every row, as it always was
         fputc('\n', csv);
         if (r.status == pd_soakFailed)
-          ok = write_scene_file(tmp, "failures", index, job.engines[e], job.onsets, &scene, &r);
+          ok = write_scene_file(tmp, "failures", index, job.engines[e], job.run.onsets, &scene, &r);
         if (r.status == pd_soakOverBudget)
-          ok = write_scene_file(tmp, "over-budget", index, job.engines[e], job.onsets, &scene, &r);
+          ok = write_scene_file(tmp, "over-budget", index, job.engines[e], job.run.onsets, &scene, &r);
         if (r.status == pd_soakFailed) {
           status = PD_EXIT_FAILURE;
           printf("FAILED scene %ld (%s) in %s: %s\n", index, pdSoakKindNames[scene.kind], job.engines[e], r.message);
@@ -221,7 +239,8 @@ int pd_cmd_soak(int argc, char** argv) {
       pd_soak_scene_free(&scene);
     }
     if (csv) ok = !ferror(csv) && fclose(csv) == 0 && ok;
-    printf("polydyn soak: seed %lu, scenes %ld .. %ld\n", job.seed, job.first, job.first + scenes - 1);
+    printf("polydyn soak: generator %d, seed %lu, scenes %ld .. %ld, checked at every %s\n", job.generator, job.seed,
+           job.first, job.first + scenes - 1, job.run.everyStep ? "step" : "sample");
     printf("%-12s %8s %8s %12s %8s %10s\n", "engine", "ok", "refused", "over-budget", "failed", "not-built");
     for (int e = 0; e < ENGINES_MAX; ++e) {
       bool used = false;

@@ -36,13 +36,18 @@ static void unit_vector(gsl_rng* r, double u[3]) {
   u[0] = s * cos(phi), u[1] = s * sin(phi), u[2] = z;
 }
 
-// One body's shape line; returns the radius of a sphere about its centre that holds it (for spacing).
-static double shape_line(gsl_rng* r, pdTextBuffer* t, const char* name, double size, bool flatEnds) {
+// A plate's thickness over its larger width: thick enough for side faces of several δ_max (δ_max is at most a
+// quarter of the thinner body's width, docs/contact-model.md), thin enough to rest, slide and be hit on its rim.
+static double plate_ratio(gsl_rng* r) { return log_uniform(r, 3.0, 30.0); }
+
+// One body's shape line; returns the radius of a sphere about its centre that holds it (for spacing). The
+// generator's shapes (PD_SOAK_GENERATOR_*): the first draws five kinds, the second a sixth, plates.
+static double shape_line(gsl_rng* r, int generator, pdTextBuffer* t, const char* name, double size) {
   static const char* const colors[] = {"red", "blue", "green", "orange", "tan", "grey", "brown", "purple"};
   const char* color = colors[gsl_rng_uniform_int(r, sizeof colors / sizeof colors[0])];
-  int choice = flatEnds ? (int)gsl_rng_uniform_int(r, 2) : (int)gsl_rng_uniform_int(r, 5);
+  int choice = (int)gsl_rng_uniform_int(r, generator >= PD_SOAK_GENERATOR_PLATES ? 6 : 5);
   double sx = size * log_uniform(r, 0.5, 2.0), sy = size * log_uniform(r, 0.5, 2.0), sz = size * log_uniform(r, 0.5, 2.0);
-  if (choice == 0 && chance(r, 0.15)) sz = fmax(sx, sy) / 100.0;  // a 100:1 plate
+  if (choice == 0 && chance(r, 0.15)) sz = fmax(sx, sy) / 100.0;  // a 100:1 blade
   switch (choice) {
     case 0:
       pd_text_appendf(t, "cube %s %s %.17g %.17g %.17g\n", name, color, sx, sy, sz);
@@ -59,6 +64,19 @@ static double shape_line(gsl_rng* r, pdTextBuffer* t, const char* name, double s
       pd_text_appendf(t, "sphere %s %s %d %.17g %.17g %.17g\n", name, color, (int)gsl_rng_uniform_int(r, 2), sx, sy,
                       sz);
       return 0.5 * fmax(sx, fmax(sy, sz));
+    case 5: {
+      // a plate: a thin box, a thin regular prism, or a thin frustum (its side faces bevelled)
+      sz = fmax(sx, sy) / plate_ratio(r);
+      int shape = (int)gsl_rng_uniform_int(r, 5), sides = 3 + (int)gsl_rng_uniform_int(r, 6);
+      if (shape < 2)
+        pd_text_appendf(t, "cube %s %s %.17g %.17g %.17g\n", name, color, sx, sy, sz);
+      else if (shape < 4)
+        pd_text_appendf(t, "prism %s %s %d %.17g %.17g %.17g\n", name, color, sides, sx, sy, sz);
+      else
+        pd_text_appendf(t, "tprism %s %s %d %.17g %.17g %.17g %.17g\n", name, color, sides, sx, sy, sz,
+                        uniform(r, 0.6, 0.95));
+      return 0.5 * sqrt(sx * sx + sy * sy + sz * sz);
+    }
     default: {
       // a hull of 6 … 12 random points in a box, sometimes squashed to a sliver (20:1)
       int n = 6 + (int)gsl_rng_uniform_int(r, 7);
@@ -104,7 +122,7 @@ static void floor_lines(pdTextBuffer* t, double half) {
                   0.1 * half, -0.05 * half);
 }
 
-static int drop_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
+static int drop_scene(gsl_rng* r, int generator, pdTextBuffer* t, double L, bool* elastic) {
   int n = 1 + (int)gsl_rng_uniform_int(r, 30);
   settings_lines(r, t, 0.5);
   // pitch from the largest body: every body's sphere fits in its cell
@@ -115,7 +133,7 @@ static int drop_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
     sizes[i] = L * log_uniform(r, 0.3, 3.0);
     char name[16];
     snprintf(name, sizeof name, "b%d", i);
-    radii[i] = shape_line(r, &bodies, name, sizes[i], false);
+    radii[i] = shape_line(r, generator, &bodies, name, sizes[i]);
     pitch = fmax(pitch, 2.2 * radii[i]);
     // placeholder: the loc line is written below, once the pitch is known
     pd_text_appendf(&bodies, "@LOC%d\n", i);
@@ -147,7 +165,7 @@ static int drop_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   return n + 1;
 }
 
-static int stack_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
+static int stack_scene(gsl_rng* r, int generator, pdTextBuffer* t, double L, bool* elastic) {
   int n = 2 + (int)gsl_rng_uniform_int(r, 7);
   settings_lines(r, t, 0.5);
   floor_lines(t, 20.0 * L);
@@ -156,6 +174,7 @@ static int stack_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   for (int i = 0; i < n; ++i) {
     double h = L * log_uniform(r, 0.3, 1.5);
     double sx = flush ? w : L * log_uniform(r, 0.5, 2.0), sy = flush ? d : L * log_uniform(r, 0.5, 2.0);
+    if (generator >= PD_SOAK_GENERATOR_PLATES && chance(r, 0.3)) h = fmax(sx, sy) / plate_ratio(r);  // a plate
     pd_text_appendf(t, "cube s%d tan %.17g %.17g %.17g\n", i, sx, sy, h);
     double angle = flush ? 0.0 : uniform(r, 0.0, 90.0);
     pd_text_appendf(t, "loc 0 0 %.17g %.17g 0 0 1\n", z + 0.5 * h, angle);
@@ -165,7 +184,7 @@ static int stack_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   return n + 1;
 }
 
-static int throw_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
+static int throw_scene(gsl_rng* r, int generator, pdTextBuffer* t, double L, bool* elastic) {
   int n = 1 + (int)gsl_rng_uniform_int(r, 10);
   settings_lines(r, t, 0.3);
   floor_lines(t, 40.0 * L);
@@ -176,7 +195,7 @@ static int throw_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
     char name[16];
     snprintf(name, sizeof name, "t%d", i);
     double size = L * log_uniform(r, 0.3, 2.0);
-    double radius = shape_line(r, t, name, size, false), angle, axis[3], spin[3];
+    double radius = shape_line(r, generator, t, name, size), angle, axis[3], spin[3];
     turn(r, &angle, axis);
     // a column along y, spaced by the largest possible sphere: thrown towards +x and down
     double y = (i - 0.5 * (n - 1)) * 3.0 * (2.0 * L), z = fmax(radius * 1.05, uniform(r, 1.0, 4.0) * L);
@@ -191,7 +210,7 @@ static int throw_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   return n + 2;
 }
 
-static int free_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
+static int free_scene(gsl_rng* r, int generator, pdTextBuffer* t, double L, bool* elastic) {
   int n = 2 + (int)gsl_rng_uniform_int(r, 9);
   settings_lines(r, t, 0.5);
   pd_text_appendf(t, "gravity 0 0 0\n");
@@ -200,7 +219,7 @@ static int free_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   for (int i = 0; i < n; ++i) {
     char name[16];
     snprintf(name, sizeof name, "f%d", i);
-    shape_line(r, t, name, L * log_uniform(r, 0.5, 2.0), false);
+    shape_line(r, generator, t, name, L * log_uniform(r, 0.5, 2.0));
     double a = 2.0 * PI * i / n, x = R * cos(a), y = R * sin(a), z = uniform(r, -0.3, 0.3) * L, angle, axis[3], spin[3];
     turn(r, &angle, axis);
     pd_text_appendf(t, "loc %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", x, y, z, angle, axis[0], axis[1], axis[2]);
@@ -232,7 +251,8 @@ static int overlap_scene(gsl_rng* r, pdTextBuffer* t, double L, bool* elastic) {
   return 3;
 }
 
-pdSoakScene pd_soak_scene(unsigned long seed, long index) {
+pdSoakScene pd_soak_scene(int generator, unsigned long seed, long index) {
+  PD_ASSERT(generator >= PD_SOAK_GENERATOR_BLADES && generator <= PD_SOAK_GENERATOR_LATEST);
   gsl_rng* r = gsl_rng_alloc(gsl_rng_mt19937);
   if (!r) abort();
   // one stream per scene: a scene's text never depends on the scenes before it
@@ -240,14 +260,19 @@ pdSoakScene pd_soak_scene(unsigned long seed, long index) {
   pdSoakScene s = {.kind = (pdSoakKind)gsl_rng_uniform_int(r, pd_soakKindCount)};
   double L = log_uniform(r, 0.01, 10.0);  // the scene's length scale: three orders of magnitude
   pdTextBuffer t = {0};
-  pd_text_appendf(&t, "# polydyn soak: seed %lu, scene %ld (%s), length scale %.3g m\n", seed, index,
-                  pdSoakKindNames[s.kind], L);
+  // the first generator's header as it always was (its scenes replay byte for byte)
+  if (generator == PD_SOAK_GENERATOR_BLADES)
+    pd_text_appendf(&t, "# polydyn soak: seed %lu, scene %ld (%s), length scale %.3g m\n", seed, index,
+                    pdSoakKindNames[s.kind], L);
+  else
+    pd_text_appendf(&t, "# polydyn soak: generator %d, seed %lu, scene %ld (%s), length scale %.3g m\n", generator,
+                    seed, index, pdSoakKindNames[s.kind], L);
   bool elastic = false;
   switch (s.kind) {
-    case pd_soakDrop: s.objects = drop_scene(r, &t, L, &elastic); break;
-    case pd_soakStack: s.objects = stack_scene(r, &t, L, &elastic); break;
-    case pd_soakThrow: s.objects = throw_scene(r, &t, L, &elastic); break;
-    case pd_soakFree: s.objects = free_scene(r, &t, L, &elastic); break;
+    case pd_soakDrop: s.objects = drop_scene(r, generator, &t, L, &elastic); break;
+    case pd_soakStack: s.objects = stack_scene(r, generator, &t, L, &elastic); break;
+    case pd_soakThrow: s.objects = throw_scene(r, generator, &t, L, &elastic); break;
+    case pd_soakFree: s.objects = free_scene(r, generator, &t, L, &elastic); break;
     default: s.objects = overlap_scene(r, &t, L, &elastic); break;
   }
   s.dissipative = !elastic;
@@ -269,9 +294,10 @@ typedef struct watch {
   bool started, overBudget, nonFinite;
   double e0, momentumScale;
   pdVec3 p0;
+  double stretchE0;  // the energy of the system stepped where its stretch began (observe_step)
   pdSoakResult* out;
-  char broke[200];  // the first invariant that broke (soft), empty while all hold
-  char deepest[120];  // where the deepest overlap was: the two bodies and the time
+  char broke[240];  // the first invariant that broke (soft), empty while all hold
+  char deepest[160];  // where the deepest overlap was: the two bodies and the time
 } watch;
 
 static double now(void) {
@@ -338,6 +364,7 @@ static bool observe(const pdModel* m, const pdState* s, void* user) {
   if (w->e0 > 0.0) o->energyGain = fmax(o->energyGain, (e - w->e0) / w->e0);
   int pi = -1, pj = -1;
   double depth = deepest_overlap(m, s, &pi, &pj);
+  o->penetrationSampled = fmax(o->penetrationSampled, depth);
   if (depth > o->penetration) {
     o->penetration = depth;
     snprintf(w->deepest, sizeof w->deepest, "%.40s and %.40s at t = %.6g s", m->bodies[pi].name, m->bodies[pj].name, s->t);
@@ -352,6 +379,30 @@ static bool observe(const pdModel* m, const pdState* s, void* user) {
   return true;
 }
 
+// The step observer (polydyn/state.h): the overlap and the energy of the system stepped (the scene, or one
+// island over a sync interval) at every accepted step; its bodies' names and δ_max are the scene's.
+static void observe_step(const pdModel* m, const pdState* s, bool start, void* user) {
+  watch* w = user;
+  pdSoakResult* o = w->out;
+  if (!finite_state(m, s) || !isfinite(pd_state_energy(m, s))) {
+    w->nonFinite = true;
+    return;
+  }
+  double e = pd_state_energy(m, s);
+  if (start) {
+    w->stretchE0 = e;
+    return;
+  }
+  if (w->e0 > 0.0) o->energyGain = fmax(o->energyGain, (e - w->stretchE0) / w->e0);
+  int pi = -1, pj = -1;
+  double depth = deepest_overlap(m, s, &pi, &pj);
+  if (depth > o->penetration) {
+    o->penetration = depth;
+    snprintf(w->deepest, sizeof w->deepest, "%.40s and %.40s at t = %.6g s (an accepted step)",
+             m->bodies[pi].name, m->bodies[pj].name, s->t);
+  }
+}
+
 bool pd_soak_engine_is_soft(const char* engine, pdIslands* islands) {
   *islands = PD_ISLANDS_DEFAULT;
   if (strcmp(engine, "soft-islands-off") == 0) *islands = pd_islandsOff;
@@ -359,7 +410,7 @@ bool pd_soak_engine_is_soft(const char* engine, pdIslands* islands) {
 }
 
 // The run itself (in the child process).
-static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budget, pdSoakResult* o) {
+static void run_here(const pdSoakScene* scene, const char* engine, const pdSoakRunOptions* run, pdSoakResult* o) {
   pdError err = {0};
   pdScene* parsed = pd_scene_parse_buffer("soak.scene", scene->text, strlen(scene->text), &err);
   pdModel* m = parsed ? pd_model_compile(parsed, &err) : NULL;
@@ -376,14 +427,15 @@ static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onse
     pd_model_free(m);
     return;
   }
-  watch w = {.scene = scene, .budget = budget, .wall0 = now(), .out = o};
+  watch w = {.scene = scene, .budget = run->budgetSeconds, .wall0 = now(), .out = o};
   bool completed = false;
   pdIslands islands;
   bool soft = pd_soak_engine_is_soft(engine, &islands);
   if (soft) {
     pdStateOptions options = pd_state_options_default();
     options.islands = islands;
-    options.onsets = onsets;
+    options.onsets = run->onsets;
+    if (run->everyStep) options.stepObserver = observe_step, options.stepUser = &w;
     pdState* s = pd_state_create(m, &options);
     completed = pd_advance(m, s, m->settings.tend, observe, &w);
     completed = completed && !s->failed;
@@ -416,8 +468,8 @@ static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onse
   if (w.nonFinite) snprintf(w.broke, sizeof w.broke, "a non-finite number at t = %.6g s", o->simulated);
   // the invariants of the soft model (the reference engines' rigid contacts are shown, not judged)
   if (!w.broke[0] && soft && o->penetration > PD_SOAK_PENETRATION_LIMIT)
-    snprintf(w.broke, sizeof w.broke, "penetration %.3g delta_max (limit %g): %s", o->penetration,
-             PD_SOAK_PENETRATION_LIMIT, w.deepest);
+    snprintf(w.broke, sizeof w.broke, "penetration %.3g delta_max (limit %g): %.150s; %.3g at the samples", o->penetration,
+             PD_SOAK_PENETRATION_LIMIT, w.deepest, o->penetrationSampled);
   if (!w.broke[0] && soft && scene->dissipative && o->energyGain > PD_SOAK_ENERGY_GAIN_REL)
     snprintf(w.broke, sizeof w.broke, "energy rose %.3g of E(0) in a dissipative scene (limit %g)", o->energyGain,
              PD_SOAK_ENERGY_GAIN_REL);
@@ -441,8 +493,7 @@ static void run_here(const pdSoakScene* scene, const char* engine, pdOnsets onse
 // A hard limit over the budget (the observer sees only samples: one sample interval may not end).
 #define SOAK_HARD_LIMIT_FACTOR 3.0
 
-void pd_soak_run(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budgetSeconds,
-                 pdSoakResult* out) {
+void pd_soak_run(const pdSoakScene* scene, const char* engine, const pdSoakRunOptions* options, pdSoakResult* out) {
   memset(out, 0, sizeof *out);
   int fds[2];
   if (pipe(fds) != 0) {
@@ -462,10 +513,10 @@ void pd_soak_run(const pdSoakScene* scene, const char* engine, pdOnsets onsets, 
   }
   if (pid == 0) {
     close(fds[0]);
-    alarm((unsigned)ceil(SOAK_HARD_LIMIT_FACTOR * budgetSeconds + 1.0));
+    alarm((unsigned)ceil(SOAK_HARD_LIMIT_FACTOR * options->budgetSeconds + 1.0));
     pdSoakResult r;
     memset(&r, 0, sizeof r);
-    run_here(scene, engine, onsets, budgetSeconds, &r);
+    run_here(scene, engine, options, &r);
     const char* p = (const char*)&r;
     size_t left = sizeof r;
     while (left > 0) {

@@ -515,6 +515,12 @@ static double one_step(const pdModel* model, pdState* s, double target, bool lan
   }
 }
 
+// After a step (or at the state presented at tEnd): the caller's hook, then the state's step observer (state.h).
+static void step_ended(const pdModel* model, const pdState* s, pdStepHookFcn* hook, void* hookUser) {
+  if (hook) hook(model, s, hookUser);
+  if (s->stepObserver) s->stepObserver(model, s, false, s->stepUser);
+}
+
 bool pd_step_until(const pdModel* model, pdState* s, double tEnd, bool landOnEnd, pdObserverFcn* observer, void* user,
                    pdStepHookFcn* hook, void* hookUser) {
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
@@ -524,9 +530,10 @@ bool pd_step_until(const pdModel* model, pdState* s, double tEnd, bool landOnEnd
   while (pd_sample_time(model, s->nextSample) < s->t) ++s->nextSample;
   if (pd_sample_time(model, s->nextSample) == s->t) pd_observe(model, s, observer, user);
   if (s->stopped) return false;
+  if (s->stepObserver) s->stepObserver(model, s, true, s->stepUser);
   // a state presented at the last call's end goes on from the integration's own, later, state; that step's end was
   // never shown to the hook (it lay beyond that call's end)
-  if (pd_dense_resume(s) && hook && s->t <= tEnd) hook(model, s, hookUser);
+  if (pd_dense_resume(s) && s->t <= tEnd) step_ended(model, s, hook, hookUser);
   for (;;) {
     // the samples up to the integration's time: the last step's end itself, or presented inside that step (a stop
     // leaves the state at that sample, presented)
@@ -553,11 +560,11 @@ bool pd_step_until(const pdModel* model, pdState* s, double tEnd, bool landOnEnd
     bool lands =
         next <= target && (taken >= target - s->t || target - next <= TIME_SNAP_ULPS * DBL_EPSILON * fabs(target));
     s->t = lands ? target : next;
-    if (hook && taken > 0.0 && s->t <= tEnd) hook(model, s, hookUser);
+    if (taken > 0.0 && s->t <= tEnd) step_ended(model, s, hook, hookUser);
   }
   if (s->t > tEnd) {
     pd_dense_present(model, s, tEnd);
-    if (hook) hook(model, s, hookUser);
+    step_ended(model, s, hook, hookUser);
   }
   return true;
 }

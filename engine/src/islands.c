@@ -183,6 +183,8 @@ static void island_load(const pdModel* model, const pdState* s, struct pdIslandS
   sub->stepper = s->stepper;
   sub->onsets = s->onsets;
   sub->searchCertificates = s->searchCertificates;
+  sub->stepObserver = s->stepObserver;
+  sub->stepUser = s->stepUser;
   sub->t = s->t;
   sub->nextSample = s->nextSample;
   double h = INFINITY;

@@ -59,6 +59,8 @@ void pd_state_reset_own(const pdModel* model, pdState* s) {
   s->islands = s->options.islands;
   s->threads = s->options.threads;
   s->searchCertificates = s->options.searchCertificates;
+  s->stepObserver = s->options.stepObserver;
+  s->stepUser = s->options.stepUser;
   pd_implicit_free(s->implicit);  // its switch (active, on probation, backing off) is the last run's
   s->implicit = NULL;
   s->nextSample = 0;

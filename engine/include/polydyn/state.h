@@ -179,6 +179,18 @@ typedef struct pdCounters {
   double bodySecondsAsleep;  // s: the sum over moving bodies of the time each spent asleep
 } pdCounters;
 
+// A step observer (pdStateOptions.stepObserver; nullable, NULL by default, and then nothing is called and nothing
+// costs): called with `start` true with the state where a stretch of integration begins (pd_advance's start with
+// islands off; with islands on, an island's start at each sync time, again when the island is redone), then with
+// `start` false after every accepted step of that stretch (and once with the state presented at its end when the
+// last step passed it). With islands on, `model` and `state` are the island's own (its moving bodies and every
+// fixed body, in scene order; pd_state_body and the model's bodies and names as for a scene), and with threads > 1
+// the calls of different islands come from their threads at the same time; one island's calls come from one
+// thread, in order. It reads the state (const) and must not step it. For checks between output samples (the
+// soak: docs/reliability.md); the observer of pd_advance sees the whole scene at the samples only.
+struct pdState;
+typedef void pdStepObserverFcn(const pdModel* model, const struct pdState* state, bool start, void* user);
+
 // The caller's settings of a state. Start from pd_state_options_default() and change the fields you need:
 //   pdStateOptions o = pd_state_options_default();
 //   o.islands = pd_islandsOff;
@@ -198,6 +210,8 @@ typedef struct pdStateOptions {
                             // (contact_analysis.h); false searches every pair after every step. The results are
                             // the same bit for bit; false is for tests and measurements.
   double h;           // the first step to try, s (> 0); 0 (the default): the scene's settings.dt
+  pdStepObserverFcn* stepObserver;  // nullable (the default): called at every accepted step (pdStepObserverFcn)
+  void* stepUser;                   // handed to stepObserver
   int valid;          // set by pd_state_options_default; do not set (catches options never initialised)
 } pdStateOptions;
 
@@ -213,6 +227,8 @@ typedef struct pdState {
   pdIslands islands;
   bool searchCertificates;
   int threads;
+  pdStepObserverFcn* stepObserver;  // and its user pointer: the options' (an island's: the scene state's)
+  void* stepUser;
   pdStateOptions options;  // as given to pd_state_create (pd_state_reset returns to them)
   int n;             // length of y: 13 per moving body + 8 per active contact
   int capacity;      // allocated length of y, weight and each stepper vector (grown only between steps)

@@ -1,17 +1,19 @@
 // polydyn refcheck — the random-scene soak (docs/reliability.md; `polydyn soak`).
 //
-// A campaign is a seed and a count: scene i of campaign S is a function of (S, i) alone, written as
-// scene-language text, so a failing scene is replayed with `polydyn run` on its file. The scenes are
-// what nobody tuned for: 1 to 30 bodies of random convex shapes (boxes down to 100:1 plates, prisms,
-// frusta, geodesic spheres, random hulls including slivers), scene scales from 1 cm to 10 m, densities
-// over two orders, μ 0 … 1.5, restitution 0.1 … 1 or the default, sometimes vmax, deflection and tol set.
+// A campaign is a generator, a seed and a count: scene i of campaign S is a function of (generator, S, i)
+// alone, written as scene-language text, so a failing scene is replayed with `polydyn run` on its file. The
+// scenes are what nobody tuned for: 1 to 30 bodies of random convex shapes (boxes down to 100:1 blades,
+// prisms, frusta, geodesic spheres, random hulls including slivers; the second generator also plates, thin
+// boxes and prisms 3:1 … 30:1 with side faces), scene scales from 1 cm to 10 m, densities over two orders,
+// μ 0 … 1.5, restitution 0.1 … 1 or the default, sometimes deflection and tol set.
 // Kinds: bodies dropped onto a floor; stacks set down touching (often flush); bodies thrown at up to
 // 50 m/s at a floor and a wall; bodies colliding without gravity or fixed bodies; two bodies placed
 // interpenetrating, which the scene compiler must refuse.
 //
 // Each scene runs in a child process per engine (a crash is a result, not the end of the campaign),
-// with the invariants checked at every output sample (pdSoakResult). A run that exceeds its wall-time
-// budget is stopped and reported as over budget: a cost finding, not a failure of the invariants.
+// with the invariants checked at every output sample and, in the soft engine, the overlap and the energy
+// also at every accepted step (pdSoakResult). A run that exceeds its wall-time budget is stopped and
+// reported as over budget: a cost finding, not a failure of the invariants.
 #pragma once
 
 #include <stdbool.h>
@@ -37,13 +39,24 @@ typedef struct pdSoakScene {
   char* text;             // the scene file (malloc'd; pd_soak_scene_free)
 } pdSoakScene;
 
-// Scene `index` of campaign `seed`: the same text for the same (seed, index) on every machine (GSL's
-// MT19937 seeded from both, numbers written with %.17g).
-pdSoakScene pd_soak_scene(unsigned long seed, long index);
+// The scene generators. A new generator is a new number: the scenes of the earlier ones stay as they were, so
+// committed campaigns and the failures they list replay.
+enum {
+  PD_SOAK_GENERATOR_BLADES = 1,  // boxes, prisms, frusta, spheres, hulls; thin only as 100:1 blades and slivers
+  PD_SOAK_GENERATOR_PLATES = 2,  // as 1, plus plates (thin boxes, prisms and frusta 3:1 … 30:1) in every kind
+                                 // that draws shapes, and plates in stacks
+  PD_SOAK_GENERATOR_LATEST = PD_SOAK_GENERATOR_PLATES
+};
+
+// Scene `index` of campaign `seed` of `generator` (1 .. PD_SOAK_GENERATOR_LATEST, asserted): the same text for
+// the same (generator, seed, index) on every machine (GSL's MT19937 seeded from seed and index, numbers written
+// with %.17g).
+pdSoakScene pd_soak_scene(int generator, unsigned long seed, long index);
 void pd_soak_scene_free(pdSoakScene* scene);
 
 // Invariant limits (docs/reliability.md, says why each is what it is).
-// Deepest overlap of any two bodies over the pair's δ_max (pd_model_pair_delta_max), soft engine.
+// Deepest overlap of any two bodies over the pair's δ_max (pd_model_pair_delta_max), soft engine, at every
+// accepted step (between the output samples too: an impact can come and go within one sample interval).
 #define PD_SOAK_PENETRATION_LIMIT 3.0
 // Largest rise of the energy above its start in a dissipative scene, relative to the start (potential
 // energy counted from the floor's top at z = 0, so E(0) > 0 is what the scene can release): the adaptive
@@ -72,8 +85,11 @@ typedef struct pdSoakResult {
   double wallSeconds;
   double simulated;          // s reached
   long steps;                // soft: accepted steps; reference engines: their steps
-  double penetration;        // deepest overlap / δ_max of the pair over all samples (all engines: shown)
-  double energyGain;         // max (E(t) − E(0)) / E(0), kinetic + gravitational (+ springs: soft)
+  double penetration;        // deepest overlap / δ_max of the pair over all samples (all engines: shown) and,
+                             // when everyStep, over every accepted step (soft)
+  double penetrationSampled; // the same at the output samples only
+  double energyGain;         // max (E(t) − E(0)) / E(0), kinetic + gravitational (+ springs: soft); when
+                             // everyStep also every stretch's rise within itself (pdSoakRunOptions)
   double momentumError;      // max |P(t) − P(0)| / Σ m|v(0)| (free scenes), else 0
 } pdSoakResult;
 
@@ -81,8 +97,18 @@ typedef struct pdSoakResult {
 // (--islands off); *islands gets its island mode.
 bool pd_soak_engine_is_soft(const char* engine, pdIslands* islands);
 
+typedef struct pdSoakRunOptions {
+  pdOnsets onsets;       // soft engine: how contact onsets join (docs/contact-model.md)
+  double budgetSeconds;  // wall time of one run
+  // Soft engine: also check at every accepted step (the engine's step observer, polydyn/state.h): the deepest
+  // overlap of the bodies of the system stepped (the scene with islands off, an island with islands on: two
+  // islands cannot touch between their sync times, and the samples see the whole scene), and the rise of that
+  // system's energy since its stretch began (the whole run with islands off, the island's sync interval with
+  // islands on; over E(0) of the scene: a step of a dissipative system never adds energy, and the samples check
+  // what the stretches add up to). False: at the output samples only, as campaigns before the step observer.
+  bool everyStep;
+} pdSoakRunOptions;
+
 // Runs the scene in `engine` ("soft", "soft-islands-off", "ode", "bullet") in a child process with the wall-time budget
-// and checks the invariants; the soft engine joins contact onsets as `onsets` says (docs/contact-model.md). The
-// result is filled in every case.
-void pd_soak_run(const pdSoakScene* scene, const char* engine, pdOnsets onsets, double budgetSeconds,
-                 pdSoakResult* out);
+// and checks the invariants as `options` says. The result is filled in every case.
+void pd_soak_run(const pdSoakScene* scene, const char* engine, const pdSoakRunOptions* options, pdSoakResult* out);
