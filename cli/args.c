@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "pdrun/batch.h"
+#include "pdutil/clock.h"
 
 bool pd_cli_parse_only = false;
 
@@ -35,11 +36,7 @@ bool pd_cli_positive(const char* text, double* value) {
   return true;
 }
 
-double pd_cli_wall_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double pd_cli_wall_seconds(void) { return pd_wall_seconds(); }
 
 bool pd_cli_list_has(const char* list, const char* word) {
   size_t n = strlen(word);

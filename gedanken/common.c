@@ -3,6 +3,7 @@
 #include <time.h>
 
 #include "gedanken_internal.h"
+#include "pdutil/clock.h"
 
 // ---------------------------------------------------------------------------------------------------------
 // closed forms
@@ -167,14 +168,6 @@ double gk_energy_gain(const pdGkRecord* rec) {
   return pd_gk_largest_rise(rec->energy, rec->count, rec->energy[0]);
 }
 
-double gk_wall_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double gk_wall_seconds(void) { return pd_wall_seconds(); }
 
-double gk_cpu_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double gk_cpu_seconds(void) { return pd_thread_cpu_seconds(); }

@@ -21,16 +21,13 @@
 #include "oracle_ccd.h"
 #include "polydyn/error.h"
 #include "pdrun/stats.h"
+#include "pdutil/clock.h"
 
 const char* const pdOracleKindNames[pd_oracleKindCount] = {
     "agree_overlap", "agree_separate", "we_overlap", "we_separate", "touching", "mpr_differs", "depth", "ccd_stalled",
 };
 
-double pd_oracle_cpu_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double pd_oracle_cpu_seconds(void) { return pd_process_cpu_seconds(); }
 
 void pd_oracle_ccd_support(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out) {
   const ccdBody* b = obj;

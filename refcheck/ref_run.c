@@ -7,19 +7,8 @@
 #include <time.h>
 
 #include "polydyn/refcheck.h"
+#include "pdutil/clock.h"
 
-
-static double wall_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double cpu_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 extern const pdRefAdapter pd_ode_adapter;
 extern const pdRefAdapter pd_bullet_adapter;
@@ -111,7 +100,7 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
   PD_ASSERT(model && adapter && options && stats && options->step > 0.0);
   memset(stats, 0, sizeof *stats);
   sampling plan = plan_sampling(options->step, model->settings.sampleRate);
-  double wall0 = wall_seconds(), cpu0 = cpu_seconds();
+  double wall0 = pd_wall_seconds(), cpu0 = pd_thread_cpu_seconds();
   pdRefWorld* world = adapter->create(model, options, err);
   if (!world) {
     stats->refused = true;
@@ -150,8 +139,8 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
   }
   free(contacts.items);
   if (writer) pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
-  stats->wallSeconds = wall_seconds() - wall0;
-  stats->cpuSeconds = cpu_seconds() - cpu0;
+  stats->wallSeconds = pd_wall_seconds() - wall0;
+  stats->cpuSeconds = pd_thread_cpu_seconds() - cpu0;
   stats->completed = ok && !stopped;
   state->count.accepted = stats->steps;
 

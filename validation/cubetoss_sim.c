@@ -13,6 +13,7 @@
 #include "polydyn/output.h"
 #include "polydyn/scene.h"
 #include "pdrun/stats.h"
+#include "pdutil/clock.h"
 #include "pdutil/json.h"
 #include "pdrun/text_buffer.h"
 
@@ -24,18 +25,6 @@
 #define TOSS_DEFAULT_TOL 1e-6
 
 static const double kPi = 3.14159265358979323846;
-
-static double wall_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double cpu_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 pdTossParams pd_toss_default_params(void) {
   return (pdTossParams){.mu = TOSS_DEFAULT_MU,
@@ -230,15 +219,15 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
   }
   pdTrajectory* trajectory = pd_trajectory_create(model);
   bool ok;
-  double cpu0 = cpu_now();
+  double cpu0 = pd_process_cpu_seconds();
   if (soft) {
     pdState* state = pd_state_create(model, NULL);
     softObserver o = {writer, trajectory};
-    double e0 = pd_state_energy(model, state), t0 = wall_now();
+    double e0 = pd_state_energy(model, state), t0 = pd_wall_seconds();
     bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
     if (writer) pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
-    r->wallSeconds = wall_now() - t0;
-    r->cpuSeconds = cpu_now() - cpu0;
+    r->wallSeconds = pd_wall_seconds() - t0;
+    r->cpuSeconds = pd_process_cpu_seconds() - cpu0;
     r->steps = state->count.accepted;
     pdRunInfo info = {.engine = "polydyn-soft", .energyStart = e0, .energyEnd = pd_state_energy(model, state),
                       .wallSeconds = r->wallSeconds, .completed = completed};
@@ -255,7 +244,7 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
   } else {
     pdRefRunStats stats;
     ok = pd_ref_run(model, adapter, &engine->ref, writer, pd_trajectory_observe, trajectory, &stats, &err);
-    r->cpuSeconds = cpu_now() - cpu0;
+    r->cpuSeconds = pd_process_cpu_seconds() - cpu0;
     r->wallSeconds = stats.wallSeconds;
     r->steps = stats.steps;
     r->runWritten = ok && writer != NULL;  // pd_ref_run finishes the writer unless it returns false

@@ -18,6 +18,7 @@
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
 #include "pdrun/text_buffer.h"
+#include "pdutil/clock.h"
 
 const char* const pdSoakKindNames[pd_soakKindCount] = {"drop", "stack", "throw", "free", "overlap"};
 const char* const pdSoakStatusNames[pd_soakStatusCount] = {"ok", "refused", "over-budget", "failed", "not-built"};
@@ -300,12 +301,6 @@ typedef struct watch {
   char deepest[160];  // where the deepest overlap was: the two bodies and the time
 } watch;
 
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static pdVec3 momentum(const pdModel* m, const pdState* s, double* scale) {
   pdVec3 p = {0, 0, 0};
   double sum = 0.0;
@@ -372,7 +367,7 @@ static bool observe(const pdModel* m, const pdState* s, void* user) {
   if (w->scene->kind == pd_soakFree && w->momentumScale > 0.0)
     o->momentumError =
         fmax(o->momentumError, pd_v3_norm(pd_v3_sub(momentum(m, s, NULL), w->p0)) / w->momentumScale);
-  if (now() - w->wall0 > w->budget) {
+  if (pd_wall_seconds() - w->wall0 > w->budget) {
     w->overBudget = true;
     return false;
   }
@@ -427,7 +422,7 @@ static void run_here(const pdSoakScene* scene, const char* engine, const pdSoakR
     pd_model_free(m);
     return;
   }
-  watch w = {.scene = scene, .budget = run->budgetSeconds, .wall0 = now(), .out = o};
+  watch w = {.scene = scene, .budget = run->budgetSeconds, .wall0 = pd_wall_seconds(), .out = o};
   bool completed = false;
   pdIslands islands;
   bool soft = pd_soak_engine_is_soft(engine, &islands);
@@ -464,7 +459,7 @@ static void run_here(const pdSoakScene* scene, const char* engine, const pdSoakR
     if (!completed && !w.overBudget && !w.nonFinite)
       snprintf(w.broke, sizeof w.broke, "%.180s", err.message[0] ? err.message : "the engine produced a non-finite state");
   }
-  o->wallSeconds = now() - w.wall0;
+  o->wallSeconds = pd_wall_seconds() - w.wall0;
   if (w.nonFinite) snprintf(w.broke, sizeof w.broke, "a non-finite number at t = %.6g s", o->simulated);
   // the invariants of the soft model (the reference engines' rigid contacts are shown, not judged)
   if (!w.broke[0] && soft && o->penetration > PD_SOAK_PENETRATION_LIMIT)
@@ -502,7 +497,7 @@ void pd_soak_run(const pdSoakScene* scene, const char* engine, const pdSoakRunOp
     return;
   }
   fflush(NULL);
-  double t0 = now();
+  double t0 = pd_wall_seconds();
   pid_t pid = fork();
   if (pid < 0) {
     close(fds[0]);
@@ -541,7 +536,7 @@ void pd_soak_run(const pdSoakScene* scene, const char* engine, const pdSoakRunOp
   }
   if (got == sizeof *out && WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
   memset(out, 0, sizeof *out);
-  out->wallSeconds = now() - t0;
+  out->wallSeconds = pd_wall_seconds() - t0;
   if (WIFSIGNALED(status) && WTERMSIG(status) == SIGALRM) {
     out->status = pd_soakOverBudget;
     snprintf(out->message, sizeof out->message, "killed at the hard limit, %.3g s (no sample within it)",
