@@ -17,9 +17,9 @@
 #include "pdutil/csv.h"
 #include "pdutil/json.h"
 #include "pdrun/batch.h"
-#include "polydyn/compare.h"
+#include "pdref/compare.h"
 #include "polydyn/output.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "polydyn/state.h"
 
 // The reference run's tolerance over the scene's: docs/DESIGN.md §8.1 ("our own run at a 100× tighter tolerance").

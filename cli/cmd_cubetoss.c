@@ -1,5 +1,5 @@
 // polydyn cubetoss — real cube tosses in every engine, and fitting each engine's free parameters to them
-// (docs/DESIGN.md §8.4; the library part is validation/include/polydyn/cubetoss.h).
+// (docs/DESIGN.md §8.4; the library part is validation/include/pdval/cubetoss.h).
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -14,7 +14,7 @@
 #include "options.h"
 #include "pdutil/csv.h"
 #include "pdrun/batch.h"
-#include "polydyn/cubetoss.h"
+#include "pdval/cubetoss.h"
 #include "polydyn/output.h"
 
 // Longest --out path: the run directories' paths below it fit the fixed buffers.

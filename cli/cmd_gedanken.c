@@ -9,7 +9,7 @@
 #include "cli.h"
 #include "options.h"
 #include "pdrun/batch.h"
-#include "polydyn/gedanken.h"
+#include "pdgk/gedanken.h"
 
 static const char* const help =
     "usage: polydyn gedanken --out DIR [--only NAME[,NAME...]] [--engines ENGINE[,ENGINE...]] [--fast]\n"

@@ -12,7 +12,7 @@
 #include "cli.h"
 #include "options.h"
 #include "pdutil/files.h"
-#include "polydyn/oracle.h"
+#include "pdref/oracle.h"
 #include "polydyn/state.h"
 
 static const char* const help =

@@ -11,7 +11,7 @@
 #include "options.h"
 #include "pdutil/files.h"
 #include "polydyn/output.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "polydyn/state.h"
 
 static const char* const help =

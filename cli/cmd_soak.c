@@ -1,4 +1,4 @@
-// polydyn soak — the random-scene soak (validation/include/polydyn/soak.h; docs/reliability.md). Each scene
+// polydyn soak — the random-scene soak (validation/include/pdval/soak.h; docs/reliability.md). Each scene
 // is one task of a batch (runner/include/pdrun/batch.h); its runs go through child processes.
 #include <errno.h>
 #include <signal.h>
@@ -13,7 +13,7 @@
 #include "pdutil/csv.h"
 #include "pdutil/files.h"
 #include "pdrun/batch.h"
-#include "polydyn/soak.h"
+#include "pdval/soak.h"
 
 static const char* const help =
     "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--generator G]\n"

@@ -24,8 +24,8 @@
 #include "pdutil/csv.h"
 #include "pdutil/json.h"
 #include "pdrun/batch.h"
-#include "polydyn/compare.h"
-#include "polydyn/refcheck.h"
+#include "pdref/compare.h"
+#include "pdref/refcheck.h"
 #include "polydyn/state.h"
 #include "pdrun/stats.h"
 

@@ -11,7 +11,7 @@
 
 #include "cli.h"
 #include "options.h"
-#include "polydyn/view.h"
+#include "pdview/view.h"
 
 extern char** environ;
 

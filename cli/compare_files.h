@@ -5,7 +5,7 @@
 #include <stdbool.h>
 #include <stdio.h>
 
-#include "polydyn/compare_detail.h"
+#include "pdref/compare_detail.h"
 
 // Samples per run in series.csv at most (every k-th sample, and the last): enough for a plot, small
 // enough for a page that carries every body's curves.

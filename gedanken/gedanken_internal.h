@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "polydyn/gedanken.h"
+#include "pdgk/gedanken.h"
 
 #define GK_G 9.81  // m/s², the scene default; scenes that change gravity say so
 

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "polydyn/gedanken.h"
+#include "pdgk/gedanken.h"
 
 // ---------------------------------------------------------------------------------------------------------
 // record

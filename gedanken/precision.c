@@ -14,7 +14,7 @@
 #include "gedanken_internal.h"
 #include "pdrun/batch.h"
 #include "polydyn/output.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "polydyn/scene.h"
 #include "pdrun/stats.h"
 #include "pdutil/csv.h"

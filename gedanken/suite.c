@@ -15,7 +15,7 @@
 #include "gedanken_internal.h"
 #include "pdrun/batch.h"
 #include "polydyn/output.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "pdutil/csv.h"
 #include "pdutil/files.h"
 #include "pdutil/json.h"

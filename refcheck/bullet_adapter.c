@@ -16,7 +16,7 @@
 #include <stdlib.h>
 
 #include "bullet_shim.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "pdutil/json.h"
 
 #define PI 3.14159265358979323846

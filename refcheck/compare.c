@@ -1,5 +1,5 @@
 // polydyn refcheck — trajectories in memory and the comparison metrics (conventions in compare.h).
-#include "polydyn/compare.h"
+#include "pdref/compare.h"
 
 #include <math.h>
 #include <stdlib.h>

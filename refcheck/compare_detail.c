@@ -1,6 +1,6 @@
 // polydyn refcheck — per-body series, first divergence against chaos, impacts and contact tallies of
 // `polydyn compare` (conventions in compare_detail.h).
-#include "polydyn/compare_detail.h"
+#include "pdref/compare_detail.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -8,7 +8,7 @@
 
 #include "compare_internal.h"
 #include "polydyn/error.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 
 pdBodySample* pd_compare_body_samples(const pdModel* model, const pdTrajectory* run, const pdTrajectory* reference,
                                       const long* sampleIndex, long count) {

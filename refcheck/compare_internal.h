@@ -1,7 +1,7 @@
 // polydyn refcheck — the parts of compare.c that compare_detail.c uses too (conventions in compare.h).
 #pragma once
 
-#include "polydyn/compare.h"
+#include "pdref/compare.h"
 
 // Moving body k at sample s.
 const pdBodyState* pd_trajectory_sample(const pdTrajectory* trajectory, long s, int k);

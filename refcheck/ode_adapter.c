@@ -43,7 +43,7 @@
 #include <ode/ode.h>
 #include <ode/version.h>
 
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "pdutil/json.h"
 
 // World constraint parameters of the native variant, stated rather than inherited: ODE's defaults.

@@ -1,5 +1,5 @@
 // polydyn refcheck — the interference oracle: one pair checked by our SAT and by libccd, and the
-// statistics over many pairs (conventions and tolerances in polydyn/oracle.h).
+// statistics over many pairs (conventions and tolerances in pdref/oracle.h).
 //
 // Design
 // - libccd sees each body through a support function over its vertices (a linear scan, as our SAT
@@ -9,7 +9,7 @@
 //   one, and the touching band can be stated relative to the scale.
 // - The four libccd queries (GJK and MPR booleans, EPA depth when GJK overlaps, MPR depth when MPR
 //   overlaps) each run with a fresh support-call budget; see PD_ORACLE_SUPPORT_CAP.
-#include "polydyn/oracle.h"
+#include "pdref/oracle.h"
 
 #include <ccd/ccd.h>
 #include <math.h>

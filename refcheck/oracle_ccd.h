@@ -4,7 +4,7 @@
 
 #include <ccd/ccd.h>
 
-#include "polydyn/oracle.h"
+#include "pdref/oracle.h"
 
 // A body as libccd sees it: scaled world coordinates.
 typedef struct ccdBody {

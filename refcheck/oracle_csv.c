@@ -1,12 +1,12 @@
 // polydyn refcheck — the oracle's disagreement CSV: one row per listed pair, enough to replay it
-// (polydyn/oracle.h). RFC 4180 quoting for the text fields (scene body names may hold commas).
+// (pdref/oracle.h). RFC 4180 quoting for the text fields (scene body names may hold commas).
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "pdutil/csv.h"
-#include "polydyn/oracle.h"
+#include "pdref/oracle.h"
 
 // A quaternion read back must be unit to this (|q| − 1): %.17g round-trips exactly, so only a
 // hand-edited file can miss it; a non-unit q would scale the body.

@@ -1,5 +1,5 @@
 // polydyn refcheck — the oracle's shapes: specs written as scene object commands, the seeded random
-// generator, and random pairs posed near touching (polydyn/oracle.h).
+// generator, and random pairs posed near touching (pdref/oracle.h).
 //
 // Design
 // - A spec is parsed by the scene parser itself (as a one-object scene), so a spec means exactly what the
@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "interference.h"
-#include "polydyn/oracle.h"
+#include "pdref/oracle.h"
 #include "scene_shape.h"
 
 // ---------------------------------------------------------------- specs

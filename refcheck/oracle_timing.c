@@ -1,5 +1,5 @@
 // polydyn refcheck — the oracle's timing (`polydyn oracle --random N --seed S --timing`): our SAT and
-// libccd's queries on the same random pairs, each timed over whole batches (polydyn/oracle.h).
+// libccd's queries on the same random pairs, each timed over whole batches (pdref/oracle.h).
 //
 // Design
 // - The pairs are drawn once (pd_oracle_random_pair, the oracle's generator), posed (rotation matrices and
@@ -24,7 +24,7 @@
 #include "interference.h"
 #include "oracle_ccd.h"
 #include "polydyn/error.h"
-#include "polydyn/oracle.h"
+#include "pdref/oracle.h"
 #include "pdrun/stats.h"
 
 const char* const pdOracleTimingModeNames[pd_oracleTimingModeCount] = {

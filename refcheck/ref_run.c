@@ -6,7 +6,7 @@
 
 #include <time.h>
 
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "pdutil/clock.h"
 
 

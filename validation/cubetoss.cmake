@@ -1,4 +1,4 @@
-# Validation against real cube tosses (`polydyn cubetoss`, validation/include/polydyn/cubetoss.h): reading the
+# Validation against real cube tosses (`polydyn cubetoss`, validation/include/pdval/cubetoss.h): reading the
 # data, one toss in each engine and its errors, the worker processes, and the Nelder–Mead fit (GSL, linked
 # through the engine).
 target_sources(polydyn_validation PRIVATE

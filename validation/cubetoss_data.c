@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "pdutil/csv.h"
-#include "polydyn/cubetoss.h"
+#include "pdval/cubetoss.h"
 
 #define TOSS_HEADER "toss,t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz"
 #define DROP_HEADER "drop,t,x,z,th,vx,vz,vth"

@@ -9,7 +9,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_multimin.h>
 
-#include "polydyn/cubetoss.h"
+#include "pdval/cubetoss.h"
 
 // The box of the scaled coordinates and the simplex's first steps (cubetoss.h).
 enum { FIT_DIM_MAX = 3 };

@@ -9,7 +9,7 @@
 #include <time.h>
 
 #include "pdrun/batch.h"
-#include "polydyn/cubetoss.h"
+#include "pdval/cubetoss.h"
 #include "polydyn/output.h"
 #include "polydyn/scene.h"
 #include "pdrun/stats.h"

@@ -1,5 +1,5 @@
-// polydyn refcheck — the random-scene soak: scene generation and the invariants (polydyn/soak.h).
-#include "polydyn/soak.h"
+// polydyn refcheck — the random-scene soak: scene generation and the invariants (pdval/soak.h).
+#include "pdval/soak.h"
 
 #include <errno.h>
 #include <gsl/gsl_rng.h>
@@ -14,7 +14,7 @@
 
 #include "interference.h"
 #include "polydyn/model.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
 #include "pdrun/text_buffer.h"

@@ -28,7 +28,7 @@ def _oracle_table(raw):
 
 
 def oracle(a=None, b=None, *, scene=None, random=None, seed=1, tend=None, sample=None):
-    """Our interference test against libccd's GJK, MPR and EPA (refcheck/include/polydyn/oracle.h).
+    """Our interference test against libccd's GJK, MPR and EPA (refcheck/include/pdref/oracle.h).
 
     oracle(a, b): one pair, each a (spec, x, q) with spec a scene object without name and colour ("cube 0.1 0.1
     0.1", "sphere 2 0.1 0.1 0.1", "hull x y z ..."), x the shape frame's origin (m) and q its orientation (w first).

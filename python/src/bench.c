@@ -1,5 +1,5 @@
-// polydyn for Python — the bench: the interference oracle (refcheck/include/polydyn/oracle.h), the Gedanken
-// suite (gedanken/include/polydyn/gedanken.h), and the batch commands whose orchestration belongs to the command
+// polydyn for Python — the bench: the interference oracle (refcheck/include/pdref/oracle.h), the Gedanken
+// suite (gedanken/include/pdgk/gedanken.h), and the batch commands whose orchestration belongs to the command
 // line (compare, cubetoss: cli/include/pdcli/commands.h), run in this process with the command's own code.
 #include <math.h>
 #include <stdint.h>
@@ -7,8 +7,8 @@
 #include <string.h>
 
 #include "pdcli/commands.h"
-#include "polydyn/gedanken.h"
-#include "polydyn/oracle.h"
+#include "pdgk/gedanken.h"
+#include "pdref/oracle.h"
 #include "pypolydyn.h"
 
 // ---------------------------------------------------------------- oracle

@@ -13,7 +13,7 @@
 #include <time.h>
 
 #include "polydyn/output.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "pypolydyn.h"
 
 // One contact of one sample (contacts.csv's columns, with the sample's index and the contact's depth).

@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "fuzz_checks.h"
-#include "polydyn/cubetoss.h"
+#include "pdval/cubetoss.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 

@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "fuzz_checks.h"
-#include "polydyn/oracle.h"
+#include "pdref/oracle.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 

@@ -12,7 +12,7 @@
 
 #include <cmocka.h>
 
-#include "polydyn/gedanken.h"
+#include "pdgk/gedanken.h"
 #include "polydyn/scene.h"
 
 #define MIN_EXPERIMENTS 20  // the catalogue's promise: at least 20 experiments

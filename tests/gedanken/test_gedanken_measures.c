@@ -12,7 +12,7 @@
 
 #include <cmocka.h>
 
-#include "polydyn/gedanken.h"
+#include "pdgk/gedanken.h"
 
 #define ROUND_OFF 1e-12  // synthetic series are exact: only floating-point rounding separates the answers
 

@@ -3,7 +3,7 @@
 // helper in the including file.
 #pragma once
 
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 
 // A free body in zero gravity under F(t) = F0 + t·Ḟ at its centre of mass, 1000 steps of 1 ms. Semi-implicit
 // Euler changes v by h·F(t + h/2)/m per step, the exact impulse of a linear F: v(T) = (F0 T + Ḟ T²/2)/m to the

@@ -18,7 +18,7 @@
 #include "material.h"
 #include "polydyn/model.h"
 #include "polydyn/output.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "polydyn/scene.h"
 #include "test_files.h"
 

@@ -11,8 +11,8 @@
 
 #include <cmocka.h>
 
-#include "polydyn/compare.h"
-#include "polydyn/compare_detail.h"
+#include "pdref/compare.h"
+#include "pdref/compare_detail.h"
 #include "polydyn/scene.h"
 
 static pdModel* compile_text(const char* text) {

@@ -26,7 +26,7 @@
 
 #include "polydyn/model.h"
 #include "polydyn/output.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
 #include "test_files.h"

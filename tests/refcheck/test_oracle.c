@@ -16,7 +16,7 @@
 #include <cmocka.h>
 
 #include "polydyn/model.h"
-#include "polydyn/oracle.h"
+#include "pdref/oracle.h"
 #include "polydyn/vecmath.h"
 
 #define PI 3.14159265358979323846

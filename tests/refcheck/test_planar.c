@@ -15,7 +15,7 @@
 #include <cmocka.h>
 
 #include "polydyn/model.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
 

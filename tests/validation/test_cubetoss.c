@@ -12,7 +12,7 @@
 
 #include <cmocka.h>
 
-#include "polydyn/cubetoss.h"
+#include "pdval/cubetoss.h"
 
 static const double kPi = 3.14159265358979323846;
 static const double kG = 9.81;

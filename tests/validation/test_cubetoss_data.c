@@ -12,7 +12,7 @@
 
 #include <cmocka.h>
 
-#include "polydyn/cubetoss.h"
+#include "pdval/cubetoss.h"
 
 #define DATA_PATH PD_SOURCE_DIR "/../shared/data/cube-toss/tosses-train.csv"
 

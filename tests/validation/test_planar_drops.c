@@ -12,7 +12,7 @@
 
 #include <cmocka.h>
 
-#include "polydyn/cubetoss.h"
+#include "pdval/cubetoss.h"
 
 static const double kG = 9.81;
 

@@ -1,4 +1,4 @@
-// The random-scene soak (validation/include/polydyn/soak.h; docs/reliability.md):
+// The random-scene soak (validation/include/pdval/soak.h; docs/reliability.md):
 // - the checks at every accepted step see what the samples miss: a cube that hits a floor 5 times faster than its
 //   springs were sized for and leaves it again between two samples (about 5 δ_max deep at a step, nothing at
 //   either sample), and an applied force whose work raises the energy by 1 % of E(0) and takes it back within one
@@ -18,7 +18,7 @@
 #include "pdutil/files.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
-#include "polydyn/soak.h"
+#include "pdval/soak.h"
 
 static const char* const softEngines[] = {"soft", "soft-islands-off"};
 

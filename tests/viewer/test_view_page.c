@@ -1,4 +1,4 @@
-// The page generator's C API as a report uses it (viewer/include/polydyn/view.h): several replays in
+// The page generator's C API as a report uses it (viewer/include/pdview/view.h): several replays in
 // one page sharing one copy of the bundle; the data block round-trips exactly (float64 poses).
 //
 // Writes PD_BINARY_DIR/tests/viewer/report.html, which the browser test opens (CTest fixture).
@@ -12,7 +12,7 @@
 #include <sys/stat.h>
 #include <cmocka.h>
 
-#include "polydyn/view.h"
+#include "pdview/view.h"
 #include "test_files.h"
 
 static const char* const summary =

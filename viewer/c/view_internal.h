@@ -3,7 +3,7 @@
 
 #include <stdint.h>
 
-#include "polydyn/view.h"
+#include "pdview/view.h"
 
 // Columns of the data block (all little-endian; each array starts at a multiple of 8 bytes).
 enum {

@@ -33,10 +33,10 @@
 #include <stddef.h>
 #include <stdio.h>
 
-#include "polydyn/compare.h"
+#include "pdref/compare.h"
 #include "polydyn/error.h"
 #include "polydyn/model.h"
-#include "polydyn/refcheck.h"
+#include "pdref/refcheck.h"
 #include "polydyn/state.h"
 
 // ---------------------------------------------------------------- the experiment (data README)

@@ -28,7 +28,7 @@
 
 #include <stdbool.h>
 
-#include "polydyn/compare.h"
+#include "pdref/compare.h"
 #include "polydyn/model.h"
 #include "polydyn/state.h"
 
