@@ -56,6 +56,8 @@ bool pd_cli_positive(const char* text, double* value);
 
 // Parses --onsets' value, "pair", "exact", "auto" or "bounded"; false when it is none of them.
 bool pd_cli_onsets(const char* text, pdOnsets* onsets);
+// The same as an option table's accept function (options.h): a usage error for a value it does not know.
+bool pd_cli_accept_onsets(const char* cmd, const char* value, void* onsets);
 // Parses --events' value: "exact" (the paper's loop, every onset located: pd_onsetsExact), "bounded" (the default,
 // pd_onsetsBounded: an onset is corrected where its error bound allows, docs/events.md) or "held" (pd_onsetsHeld:
 // bounded, with contact modes held within a step); false otherwise.

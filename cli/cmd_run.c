@@ -112,12 +112,6 @@ static bool accept_engine(const char* cmd, const char* v, void* target) {
   return true;
 }
 
-static bool accept_onsets(const char* cmd, const char* v, void* target) {
-  if (pd_cli_onsets(v, target)) return true;
-  pd_cli_usage_error(cmd, "--onsets must be pair, exact, auto or bounded");
-  return false;
-}
-
 static bool accept_events(const char* cmd, const char* v, void* target) {
   if (pd_cli_events(v, target)) return true;
   pd_cli_usage_error(cmd, "--events must be bounded, exact or held");
@@ -158,7 +152,7 @@ int pd_cmd_run(int argc, char** argv) {
       {.name = "--stepper", .kind = pd_optChoice, .target = &stepper,
        .message = "--stepper must be adaptive, fixed, embedded or implicit", .words = stepperWords,
        .values = stepperValues, .given = &softOptionGiven},
-      {.name = "--onsets", .kind = pd_optAccept, .target = &onsets, .accept = accept_onsets, .given = &softOptionGiven},
+      {.name = "--onsets", .kind = pd_optAccept, .target = &onsets, .accept = pd_cli_accept_onsets, .given = &softOptionGiven},
       {.name = "--events", .kind = pd_optAccept, .target = &onsets, .accept = accept_events, .given = &softOptionGiven},
       {.name = "--islands", .kind = pd_optChoice, .target = &islands,
        .message = "--islands must be on or off, not '%s'", .words = onOff, .values = islandsValues,

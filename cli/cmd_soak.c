@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 #include "pdutil/csv.h"
 #include "pdutil/files.h"
 #include "pdrun/batch.h"
@@ -99,63 +100,63 @@ static bool write_scene_file(const char* dir, const char* sub, long index, const
   return fclose(f) == 0 && ok;
 }
 
+// --seed: a whole number 0 .. 2^32 - 1 (the generator's seed is 32 bits).
+static bool accept_seed(const char* cmd, const char* v, void* target) {
+  char* end = NULL;
+  errno = 0;
+  unsigned long long s = strtoull(v, &end, 10);
+  if (end == v || *end || errno || v[0] == '-' || s > 0xffffffffull) {
+    pd_cli_usage_error(cmd, "--seed needs a whole number from 0 to 4294967295");
+    return false;
+  }
+  *(unsigned long*)target = (unsigned long)s;
+  return true;
+}
+
+// --budget: seconds > 0, at most a day (a run that needs more is a finding of its own).
+static bool accept_budget(const char* cmd, const char* v, void* target) {
+  if (pd_cli_positive(v, target) && *(double*)target <= 86400) return true;
+  pd_cli_usage_error(cmd, "--budget needs seconds > 0 (at most a day)");
+  return false;
+}
+
 int pd_cmd_soak(int argc, char** argv) {
   soakJob job = {.generator = PD_SOAK_GENERATOR_LATEST,
                  .seed = 1,
                  .run = {.onsets = PD_ONSETS_DEFAULT, .budgetSeconds = 20.0, .everyStep = true}};
   long scenes = 100;
+  long generator = PD_SOAK_GENERATOR_LATEST;
+  int everyStep = 1;
   int jobs = 0;
   const char* out = NULL;
   const char* engines = "soft";
-  for (int i = 1; i < argc; ++i) {
-    const char* a = argv[i];
-    if (pd_cli_is_help(a)) {
-      fputs(help, stdout);
-      return PD_EXIT_OK;
-    }
-    if (i + 1 >= argc) return pd_cli_usage_error("soak", "unknown argument '%s' or %s without a value", a, a);
-    const char* v = argv[++i];
-    char* end = NULL;
-    errno = 0;
-    if (strcmp(a, "--out") == 0) {
-      if (!v[0]) return pd_cli_usage_error("soak", "--out needs a directory name");
-      out = v;
-    } else if (strcmp(a, "--scenes") == 0 || strcmp(a, "--first") == 0) {
-      long n = strtol(v, &end, 10);
-      bool isScenes = strcmp(a, "--scenes") == 0;
-      if (end == v || *end || errno || n < (isScenes ? 1 : 0) || n > 100000000)
-        return pd_cli_usage_error("soak", "%s needs a whole number from %d to 100000000", a, isScenes ? 1 : 0);
-      if (isScenes) scenes = n;
-      else job.first = n;
-    } else if (strcmp(a, "--seed") == 0) {
-      unsigned long long s = strtoull(v, &end, 10);
-      if (end == v || *end || errno || v[0] == '-' || s > 0xffffffffull)
-        return pd_cli_usage_error("soak", "--seed needs a whole number from 0 to 4294967295");
-      job.seed = (unsigned long)s;
-    } else if (strcmp(a, "--generator") == 0) {
-      long g = strtol(v, &end, 10);
-      if (end == v || *end || errno || g < PD_SOAK_GENERATOR_BLADES || g > PD_SOAK_GENERATOR_LATEST)
-        return pd_cli_usage_error("soak", "--generator needs %d to %d", PD_SOAK_GENERATOR_BLADES,
-                                  PD_SOAK_GENERATOR_LATEST);
-      job.generator = (int)g;
-    } else if (strcmp(a, "--check") == 0) {
-      if (strcmp(v, "steps") != 0 && strcmp(v, "samples") != 0)
-        return pd_cli_usage_error("soak", "--check must be steps or samples");
-      job.run.everyStep = strcmp(v, "steps") == 0;
-    } else if (strcmp(a, "--engines") == 0) {
-      engines = v;
-    } else if (strcmp(a, "--budget") == 0) {
-      if (!pd_cli_positive(v, &job.run.budgetSeconds) || job.run.budgetSeconds > 86400)
-        return pd_cli_usage_error("soak", "--budget needs seconds > 0 (at most a day)");
-    } else if (strcmp(a, "--onsets") == 0) {
-      if (!pd_cli_onsets(v, &job.run.onsets)) return pd_cli_usage_error("soak", "--onsets must be pair, exact, auto or bounded");
-    } else if (strcmp(a, "--jobs") == 0) {
-      if (!pd_cli_jobs(v, &jobs))
-        return pd_cli_usage_error("soak", "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);
-    } else {
-      return pd_cli_usage_error("soak", "unknown argument '%s'", a);
-    }
-  }
+  char generatorMessage[64], jobsMessage[64];
+  snprintf(generatorMessage, sizeof generatorMessage, "--generator needs %d to %d", PD_SOAK_GENERATOR_BLADES,
+           PD_SOAK_GENERATOR_LATEST);
+  snprintf(jobsMessage, sizeof jobsMessage, "--jobs needs a whole number from 1 to %d", PD_CLI_MAX_JOBS);
+  static const char* const checkWords[] = {"steps", "samples", NULL};
+  static const int checkValues[] = {1, 0};
+  const pdCliOption table[] = {
+      {.name = "--out", .kind = pd_optText, .target = &out, .message = "--out needs a directory name", .min = 1},
+      {.name = "--scenes", .kind = pd_optWhole, .target = &scenes, .min = 1, .max = 100000000,
+       .message = "--scenes needs a whole number from 1 to 100000000"},
+      {.name = "--first", .kind = pd_optWhole, .target = &job.first, .min = 0, .max = 100000000,
+       .message = "--first needs a whole number from 0 to 100000000"},
+      {.name = "--seed", .kind = pd_optAccept, .target = &job.seed, .accept = accept_seed},
+      {.name = "--generator", .kind = pd_optWhole, .target = &generator, .min = PD_SOAK_GENERATOR_BLADES,
+       .max = PD_SOAK_GENERATOR_LATEST, .message = generatorMessage},
+      {.name = "--check", .kind = pd_optChoice, .target = &everyStep, .words = checkWords, .values = checkValues,
+       .message = "--check must be steps or samples"},
+      {.name = "--engines", .kind = pd_optText, .target = &engines},
+      {.name = "--budget", .kind = pd_optAccept, .target = &job.run.budgetSeconds, .accept = accept_budget},
+      {.name = "--onsets", .kind = pd_optAccept, .target = &job.run.onsets, .accept = pd_cli_accept_onsets},
+      {.name = "--jobs", .kind = pd_optJobs, .target = &jobs, .message = jobsMessage},
+  };
+  pdCliPositionals none = {.max = 0, .tooMany = "unknown argument '%s'"};
+  int parsed = pd_cli_parse_options("soak", argc, argv, table, sizeof table / sizeof table[0], &none, help);
+  if (parsed >= 0) return parsed;
+  job.generator = (int)generator;
+  job.run.everyStep = everyStep != 0;
   if (!out) return pd_cli_usage_error("soak", "--out DIR is required");
   if (job.first + scenes > 2000000000L) return pd_cli_usage_error("soak", "--first + --scenes is too large");
   // the engines, in the order given, each once
