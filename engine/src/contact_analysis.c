@@ -99,6 +99,47 @@ static int previous_face(const pdContactId* previous, int count, int vertexBody,
   return -1;
 }
 
+// The face of jf an edge-edge contact of `previous` hands vertex `vertex` of vertexBody over to, or -1: where the
+// contact's edge on vertexBody ends at that vertex and the vertex (q, jf's frame) lies within `reach` of its edge e_F
+// on jf, the deeper of e_F's two faces below which q lies and over whose polygon it projects (§4.4's EE → VF, design
+// note "hand-overs"). Edge e_F's crossing with an edge ending at v has passed v, which now lies in the wedge of e_F's
+// faces, the pair's depth d from e_F: its depth below each face is d times the cosine between that face's normal
+// and the pair's normal, so the deeper face is the one nearer the predecessor's normal, and the force goes on along
+// it. The nearest face (the other side of the wedge, which v crossed in this step) turns the normal by up to the
+// wedge's angle and reads a fraction of the depth. A vertex farther from e_F than a new edge pair may be deep did
+// not come from that crossing, and takes its face by the rules below.
+// Distance from q to the segment a–b, m.
+static double segment_distance(pdVec3 a, pdVec3 b, pdVec3 q) {
+  pdVec3 u = pd_v3_sub(b, a);
+  double s = pd_v3_dot(pd_v3_sub(q, a), u) / pd_v3_dot(u, u);
+  s = s < 0.0 ? 0.0 : s > 1.0 ? 1.0 : s;
+  return pd_v3_norm(pd_v3_sub(q, pd_v3_muladd(a, s, u)));
+}
+
+static int face_after_edge_pair(const pdModel* m, const pdContactId* previous, int count, int vertexBody, int vertex,
+                                int faceBody, pdVec3 q, double tol, double over, double reach) {
+  const pdPolyhedron* sv = &m->bodies[vertexBody].shape;
+  const pdPolyhedron* sf = &m->bodies[faceBody].shape;
+  int face = -1;
+  double deepest = tol;
+  for (int i = 0; i < count; ++i) {
+    const pdContactId* c = &previous[i];
+    if (c->kind != pd_contactEE) continue;
+    int edgeV, edgeF;
+    if (c->body1 == vertexBody && c->body2 == faceBody) edgeV = c->feat1, edgeF = c->feat2;
+    else if (c->body2 == vertexBody && c->body1 == faceBody) edgeV = c->feat2, edgeF = c->feat1;
+    else continue;
+    if (sv->edges[edgeV].v[0] != vertex && sv->edges[edgeV].v[1] != vertex) continue;
+    const pdEdge* e = &sf->edges[edgeF];
+    if (segment_distance(sf->vertices[e->v[0]], sf->vertices[e->v[1]], q) > reach) continue;
+    for (int k = 0; k < 2; ++k) {
+      int f = sf->edges[edgeF].f[k];
+      double d = face_depth(sf, f, q);
+      if (d > deepest && projects_inside(sf, f, q, over)) deepest = d, face = f;
+    }
+  }
+  return face;
+}
 
 // The bodies' penetration depth at their poses (the separating-axis test's minimum overlap over the faces of their
 // Minkowski difference, 0 when apart), m.
@@ -261,6 +302,9 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
     // off it onto the next face is found there now, so that its contact hands over in this commit (a successor found
     // only at the next commit leaves the vertex without a contact for a step)
     if (face >= 0 && !projects_inside(sf, face, q, fmax(tol, flushTol))) face = -1;
+    // the successor of an edge pair whose crossing passed this vertex: the face that carries its normal on
+    if (face < 0) face = face_after_edge_pair(m, previous, previousCount, iv, i, jf, q, tol, fmax(tol, flushTol),
+                                             EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax);
     // a new contact: the face whose plane it crossed during the step. Depth alone misleads where the
     // vertex also lies just inside another plane (a brick's corner a roundoff inside the side plane of
     // the brick below, which it slides along, while it sinks into the top face).
