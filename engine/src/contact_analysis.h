@@ -54,12 +54,6 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
                      const pdPose* pb0, const pdContactId* previous, int previousCount, pdContactGeom* out,
                      int capacity);
 
-// pd_contacts_find, told which of the pair's contacts of `previous` no longer track (`broken`, nullable): an edge pair
-// that continues one of them (pd_contact_continues) is its successor, the same touch on the next features, and gets
-// the slack of a pair as deep as the bodies' penetration (find_ee).
-int pd_contacts_find_handover(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
-                              const pdPose* pa0, const pdPose* pb0, const pdContactId* previous, int previousCount,
-                              const pdContactId* broken, int brokenCount, pdContactGeom* out, int capacity);
 
 // Does contact b continue contact a of the same pair (a hand-over): on one of the two bodies, a vertex or edge of each
 // that share a vertex, so the touch moved from one feature to the next over their common vertex (a vertex onto the
@@ -99,7 +93,7 @@ bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const 
                              pdPairFrame* frame, pdContactGeom* out);
 void pd_contact_geometry_framed(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                                 pdPairFrame* frame, pdContactGeom* out);
-// A certificate of a pair's contact search (contact_analysis.c, "search certificates"): at any poses whose motion
+// A certificate of a pair's contact search (contact_certificate.c, its design note): at any poses whose motion
 // from the ones it was issued at (pd_search_motion) is below `margin`, pd_contacts_find reports no contact of the
 // pair (ia < ib) outside the exempt list it was issued with. margin 0: none.
 typedef struct pdSearchCertificate {
