@@ -145,8 +145,9 @@ static void test_swept(void** state) {
 
 // Each the smallest scene of a kind of collision a step can pass over, found by the soak.
 static const char* const sweptCases[] = {
-    "spinning_baton.scene",  // a body turning through its collision with the floor
-    "vertex_past_edge_plate.scene",  // a spinning plate among free bodies, whose corner met another with no contact
+    "spinning_baton.scene",      // a body turning through its collision with the floor
+    "baton_past_block.scene",    // ... through a corner of a free body
+    "vertex_past_edge_plate.scene",  // a spinning plate among free bodies whose corner met another with no contact
 };
 
 int main(void) {
