@@ -67,3 +67,13 @@ static inline bool pd_onset_bound_allows(double bound, double tol) { return boun
 // else the step is halved towards it as the paper does (contact_set.c, refine_step).
 double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, double slide, double approach, double h,
                                  double vmax);
+
+// The same change located at `at` seconds after the step's start, to within `width` seconds (contact_set.c: bisected
+// on the step's interpolant). Simpson's rule over a half step H = h/2 with a kink of slope [a'] at distance d from its
+// nearer end errs by [a'] (H d/6 − d²/2), at most [a'] H d/6 in size for d up to H/2 (0 where the kink sits at a
+// node); twice that, as above:
+//   bound = (ω_t² |Δu_t| + μ ω_n² |Δu_n|) h (d + width) / (6 vmax),
+// never above pd_transition_error_bound (the kink anywhere). A change within a small d of a node costs little: a
+// change located that close to the end of a retried step (contact_set.c, slip_retry_end) may stay in it.
+double pd_transition_placed_bound(double omegaT2, double omegaN2, double mu, double slide, double approach, double h,
+                                  double at, double width, double vmax);
