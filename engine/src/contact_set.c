@@ -65,6 +65,9 @@
 // Trials of one step cut to end just past a located stick–slip change (slip_retry_end); past this many the step is
 // halved towards the changes still too costly, as the paper refines them.
 #define PD_SLIP_RETRIES_MAX 2
+// The span, in half steps, over which the margin's slope on either side of a located change is taken (its rate jump):
+// wide enough that the interpolant's rounding does not enter, narrow enough to stay near the change.
+#define PD_SLIP_RATE_SPAN (1.0 / 16.0)
 // Bisections of the distance past a located change that a retried step aims at (slip_retry_end): to ~1e-3 of it.
 #define PD_SLIP_AIM_BISECTIONS 10
 
@@ -324,17 +327,25 @@ static int prepare_list(const pdModel* model, pdContactSet* set, double* y, cons
 // error control (refining them cost pile_10 a third of its derivative evaluations).
 static bool changes_mode(const contactSlot* c, const pdContactForce* f) { return c->force.slip != f->slip; }
 
+// A stick–slip change located inside a step (slip_change_time): when, in seconds after the step's start, to within
+// `width`, and the jump of the tangential force's rate there (N/s).
+typedef struct slipChange {
+  double at, width, rateJump;
+} slipChange;
+
 // The error bound (onset_bound.h) of leaving contact c's stick–slip change (evaluated at the step's end in e) inside
-// a step of h: anywhere in it (at NAN), or located `at` seconds after its start to within `width`.
-static double transition_bound(const pdModel* model, const contactSlot* c, const contactEval* e, double h, double at,
-                               double width) {
+// a step of h: anywhere in it (located NULL), or where `located` places it.
+static double transition_bound(const pdModel* model, const contactSlot* c, const contactEval* e, double h,
+                               const slipChange* located) {
   const pdContactParams* p = &c->params;
+  double vmax = model->settings.vmax;
+  if (located)
+    return pd_transition_placed_bound(located->rateJump, p->massMin, fmin(p->c1t, p->c2t), c->deltaMax, h,
+                                      located->at, located->width, vmax);
   double approach = pd_v3_dot(e->du, e->geom.normal);
   double slide = pd_v3_norm(pd_v3_sub(e->du, pd_v3_scale(e->geom.normal, approach)));
-  double omegaT2 = pd_series(p->k1t, p->k2t) / p->massMin, omegaN2 = pd_series(p->k1n, p->k2n) / p->massMin;
-  double vmax = model->settings.vmax;
-  if (isnan(at)) return pd_transition_error_bound(omegaT2, omegaN2, p->mu, slide, fabs(approach), h, vmax);
-  return pd_transition_placed_bound(omegaT2, omegaN2, p->mu, slide, fabs(approach), h, at, width, vmax);
+  return pd_transition_error_bound(pd_series(p->k1t, p->k2t) / p->massMin, pd_series(p->k1n, p->k2n) / p->massMin,
+                                   p->mu, slide, fabs(approach), h, vmax);
 }
 
 // Contacts [begin, end) of C0 tracked to y1 and their forces there (set->eval).
@@ -425,50 +436,69 @@ static const double* contact_on_interpolant(const pdModel* model, pdState* s, in
   return set->locateY;
 }
 
-// When contact i's stick–slip change happened, in seconds after the step's start, from the cone's margin F⁺ − |b_t|
-// (>= 0 in stick, continuous through the change): its sign at the step's nodes (the force law's own at y0, yHalf and
-// y1) picks the half step, bisection on the interpolant the time in it; *width is half the bracket left. NAN where the
-// margin does not tell: a branch without one (undamped springs), or a change and back inside a half step.
-static double slip_change_time(const pdModel* model, pdState* s, int i, const double* y1, const pdTrialNodes* nodes,
-                               double h, double* width) {
+// The cone's margin F⁺ − |b_t| of contact i at θ of the step on the trial's interpolant.
+static double margin_on_interpolant(const pdModel* model, pdState* s, int i, const double* y1, const pdTrialNodes* nodes,
+                                    double h, double theta) {
+  double fn, g;
+  switching_at(model, s->contacts, i, contact_on_interpolant(model, s, i, y1, nodes, h, theta), &fn, &g);
+  return g;
+}
+
+// Contact i's stick–slip change inside the step, from the cone's margin g = F⁺ − |b_t| (>= 0 in stick, continuous
+// through the change): its sign at the step's nodes (the force law's own at y0, yHalf and y1) picks the half step,
+// bisection on the interpolant the time in it (width: half the bracket left). The tangential force's rate jumps there
+// by |ġ| (stick: F_t = −b_t; slip: F_t = −F⁺ b̂_t, whose rates differ by (Ḟ⁺ − d|b_t|/dt) b̂_t = ġ b̂_t where
+// |b_t| = F⁺; b_t's own rate is continuous, the slip velocity being 0 there), taken as the larger of the margin's
+// slopes over PD_SLIP_RATE_SPAN of the half step on either side. False where the margin does not tell: a branch
+// without one (undamped springs), or a change and back inside a half step.
+static bool slip_change_time(const pdModel* model, pdState* s, int i, const double* y1, const pdTrialNodes* nodes,
+                             double h, slipChange* out) {
   pdContactSet* set = s->contacts;
   double g0 = set->items[i].force.coneMargin, g1 = set->eval[i].force.coneMargin, fn, gm;
-  if (!isfinite(g0) || !isfinite(g1) || (g0 >= 0.0) == (g1 >= 0.0)) return NAN;
+  if (!isfinite(g0) || !isfinite(g1) || (g0 >= 0.0) == (g1 >= 0.0)) return false;
   switching_at(model, set, i, nodes->yHalf, &fn, &gm);
-  if (!isfinite(gm)) return NAN;
+  if (!isfinite(gm)) return false;
   bool stickBefore = g0 >= 0.0;
-  double lo = (gm >= 0.0) == stickBefore ? 0.5 : 0.0, hi = lo + 0.5;
+  double lo = (gm >= 0.0) == stickBefore ? 0.5 : 0.0, hi = lo + 0.5, halfStart = lo;
   for (int k = 0; k < PD_SLIP_LOCATE_BISECTIONS; ++k) {
-    double mid = 0.5 * (lo + hi), g;
-    switching_at(model, set, i, contact_on_interpolant(model, s, i, y1, nodes, h, mid), &fn, &g);
-    if (!isfinite(g)) return NAN;
+    double mid = 0.5 * (lo + hi), g = margin_on_interpolant(model, s, i, y1, nodes, h, mid);
+    if (!isfinite(g)) return false;
     if ((g >= 0.0) == stickBefore)
       lo = mid;
     else
       hi = mid;
   }
-  *width = 0.5 * (hi - lo) * h;
-  return 0.5 * (lo + hi) * h;
+  double theta = 0.5 * (lo + hi), span = 0.5 * PD_SLIP_RATE_SPAN;
+  double before = fmax(halfStart, theta - span), after = fmin(halfStart + 0.5, theta + span);
+  double gBefore = margin_on_interpolant(model, s, i, y1, nodes, h, before);
+  double gAt = margin_on_interpolant(model, s, i, y1, nodes, h, theta);
+  double gAfter = margin_on_interpolant(model, s, i, y1, nodes, h, after);
+  double slope = 0.0;
+  if (theta > before) slope = fmax(slope, fabs(gAt - gBefore) / ((theta - before) * h));
+  if (after > theta) slope = fmax(slope, fabs(gAfter - gAt) / ((after - theta) * h));
+  if (!isfinite(slope)) return false;
+  *out = (slipChange){theta * h, 0.5 * (hi - lo) * h, slope};
+  return true;
 }
 
-// The end of a retried step for contact c's change located at `at` (± width) in a step of h: past the change by the
-// largest distance whose placed bound in the retried step (the change that close to its end) is PD_ONSET_AIM_SHARE of
-// the tolerance's share, so that the retry ends with the change inside it and keeps it there; at most a quarter of
-// `at` past it, so that the change stays in the retried step's last quarter. NAN where no distance is cheap enough
-// (the change is then refined by halving).
-static double slip_retry_end(const pdModel* model, const contactSlot* c, const contactEval* e, double at, double width,
+// The end of a retried step for contact c's change located at ch->at in a step of h: past the change by the largest
+// distance whose placed bound in the retried step (the change that close to its end) is PD_ONSET_AIM_SHARE of the
+// tolerance's share, so that the retry ends with the change inside it and keeps it there; at most a quarter of `at`
+// past it, so that the change stays in the retried step's last quarter. NAN where no distance is cheap enough (the
+// change is then refined by halving).
+static double slip_retry_end(const pdModel* model, const contactSlot* c, const contactEval* e, const slipChange* ch,
                              double h) {
   double spend = PD_ONSET_AIM_SHARE * PD_ONSET_TOL_SHARE * model->settings.tol;
-  if (transition_bound(model, c, e, at + width, at, width) > spend) return NAN;
-  double lo = 0.0, hi = fmin(0.25 * at, h - at);
+  if (transition_bound(model, c, e, ch->at + ch->width, ch) > spend) return NAN;
+  double lo = 0.0, hi = fmin(0.25 * ch->at, h - ch->at);
   for (int k = 0; k < PD_SLIP_AIM_BISECTIONS; ++k) {
     double past = 0.5 * (lo + hi);
-    if (transition_bound(model, c, e, at + past, at, width) <= spend)
+    if (transition_bound(model, c, e, ch->at + past, ch) <= spend)
       lo = past;
     else
       hi = past;
   }
-  return at + fmax(lo, width);
+  return ch->at + fmax(lo, ch->width);
 }
 
 // Whether the force law at the step's end left a mode contact c held over the step (holdModes): the normal force's
@@ -576,21 +606,21 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     if (!changes_mode(c, &e->force)) continue;
     // bounded events leave a change inside the step where its bound allows (onset_bound.h); others refine it
     if (bounded) {
-      double bound = transition_bound(model, c, e, h, NAN, 0.0);
+      double bound = transition_bound(model, c, e, h, NULL);
       if (pd_onset_bound_allows(bound, model->settings.tol)) {
         e->modeBound = bound;
         continue;
       }
       // step doubling's nodes place the change: left where it lies close enough to a node, else one retry ends the
       // step just past it (docs/events.md, "Stick–slip changes")
-      double width = 0.0, at = nodes ? slip_change_time(model, s, i, y1, nodes, h, &width) : NAN;
-      if (!isnan(at)) {
-        double placed = transition_bound(model, c, e, h, at, width);
+      slipChange ch;
+      if (nodes && slip_change_time(model, s, i, y1, nodes, h, &ch)) {
+        double placed = transition_bound(model, c, e, h, &ch);
         if (pd_onset_bound_allows(placed, model->settings.tol)) {
           e->modeBound = placed;
           continue;
         }
-        double end = slip_retry_end(model, c, e, at, width, h);
+        double end = slip_retry_end(model, c, e, &ch, h);
         if (set->slipRetries < PD_SLIP_RETRIES_MAX && end > model->settings.dtmin && end < h &&
             0.5 * h >= refine_step(model, &c->params)) {
           slipEnd = fmin(slipEnd, end);
