@@ -152,9 +152,6 @@ struct pdContactSet {
   double travelStep;       // s: the step the tunnelling guard lets the next one take (INFINITY: any)
   int onsetRetries;        // onset retries of the step under way
   int modeRetries;         // trials of the step under way cut to a held mode's change (holdModes)
-  int slipRetries;         // trials of the step under way cut to a stick–slip change located on the interpolant
-  double* locateY;         // (locateCapacity) a state on a trial's interpolant: only a located contact's numbers
-  int locateCapacity;
   bool holdModes;          // the derivative holds each contact's modes of the step's start (pd_contact_set_hold_modes)
   bool correctHeld;        // every held change corrected, none located (pd_contact_set_correct_held)
   // stability bound (pd_stability_prepare, stability_tight), sized with the list

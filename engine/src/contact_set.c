@@ -28,7 +28,6 @@
 #include <string.h>
 
 #include "contact_list.h"
-#include "dense_output.h"
 #include "grow.h"
 #include "implicit.h"
 #include "material.h"
@@ -59,17 +58,6 @@
 // releasing together: each correction is formed alone, and the others' releases bend its force's path), and by 0.002
 // of it at best; 32 covers every one measured (tests/engine/test_held_modes.c).
 #define PD_MODE_BOUND_SAFETY 32.0
-// A stick–slip change is located on the step's quartic interpolant to 2^-this of the half step that holds it: the
-// bracket left enters its placed bound (onset_bound.h, pd_transition_placed_bound) as a distance from the node.
-#define PD_SLIP_LOCATE_BISECTIONS 12
-// Trials of one step cut to end just past a located stick–slip change (slip_retry_end); past this many the step is
-// halved towards the changes still too costly, as the paper refines them.
-#define PD_SLIP_RETRIES_MAX 2
-// The span, in half steps, over which the margin's slope on either side of a located change is taken (its rate jump):
-// wide enough that the interpolant's rounding does not enter, narrow enough to stay near the change.
-#define PD_SLIP_RATE_SPAN (1.0 / 16.0)
-// Bisections of the distance past a located change that a retried step aims at (slip_retry_end): to ~1e-3 of it.
-#define PD_SLIP_AIM_BISECTIONS 10
 
 void pd_contact_set_reserve_list(pdContactSet* set, int capacity) {
   if (capacity <= set->capacity) return;
@@ -146,7 +134,6 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->next);
   free(set->captured);
   free(set->recordedY);
-  free(set->locateY);
   for (int part = 0; part < 2; ++part) free(set->search[part].previous), free(set->search[part].broken);
   free(set->force);
   free(set->stability);
@@ -179,7 +166,6 @@ void pd_contact_set_clear(pdContactSet* set) {
   set->onsetRetries = 0;
   set->travelStep = INFINITY;
   set->modeRetries = 0;
-  set->slipRetries = 0;
 }
 
 double pd_contact_set_travel_step(const pdContactSet* set) { return set->travelStep; }
@@ -327,25 +313,14 @@ static int prepare_list(const pdModel* model, pdContactSet* set, double* y, cons
 // error control (refining them cost pile_10 a third of its derivative evaluations).
 static bool changes_mode(const contactSlot* c, const pdContactForce* f) { return c->force.slip != f->slip; }
 
-// A stick–slip change located inside a step (slip_change_time): when, in seconds after the step's start, to within
-// `width`, and the jump of the tangential force's rate there (N/s).
-typedef struct slipChange {
-  double at, width, rateJump;
-} slipChange;
-
 // The error bound (onset_bound.h) of leaving contact c's stick–slip change (evaluated at the step's end in e) inside
-// a step of h: anywhere in it (located NULL), or where `located` places it.
-static double transition_bound(const pdModel* model, const contactSlot* c, const contactEval* e, double h,
-                               const slipChange* located) {
+// a step of h.
+static double transition_bound(const pdModel* model, const contactSlot* c, const contactEval* e, double h) {
   const pdContactParams* p = &c->params;
-  double vmax = model->settings.vmax;
-  if (located)
-    return pd_transition_placed_bound(located->rateJump, p->massMin, fmin(p->c1t, p->c2t), c->deltaMax, h,
-                                      located->at, located->width, vmax);
   double approach = pd_v3_dot(e->du, e->geom.normal);
   double slide = pd_v3_norm(pd_v3_sub(e->du, pd_v3_scale(e->geom.normal, approach)));
   return pd_transition_error_bound(pd_series(p->k1t, p->k2t) / p->massMin, pd_series(p->k1n, p->k2n) / p->massMin,
-                                   p->mu, slide, fabs(approach), h, vmax);
+                                   p->mu, slide, fabs(approach), h, model->settings.vmax);
 }
 
 // Contacts [begin, end) of C0 tracked to y1 and their forces there (set->eval).
@@ -413,94 +388,6 @@ static void switching_at(const pdModel* model, pdContactSet* set, int i, const d
   *margin = f.coneMargin;
 }
 
-// Contact i's numbers (its moving bodies' and its springs') at θ of the step of h on the trial's quartic interpolant
-// (dense_output.h), in set->locateY at their places in the state vector; its other numbers are not formed.
-static const double* contact_on_interpolant(const pdModel* model, pdState* s, int i, const double* y1,
-                                            const pdTrialNodes* nodes, double h, double theta) {
-  pdContactSet* set = s->contacts;
-  if (set->locateCapacity < s->n) {  // grown with the state, after a step
-    set->locateCapacity = 2 * s->n;
-    set->locateY = pd_grow(set->locateY, (size_t)set->locateCapacity, sizeof *set->locateY);
-  }
-  const contactSlot* c = &set->items[i];
-  int first[3] = {-1, -1, spring_base(model) + PD_CONTACT_STATE_SIZE * i};
-  int size[3] = {PD_BODY_STATE_SIZE, PD_BODY_STATE_SIZE, PD_CONTACT_STATE_SIZE};
-  const pdBody* b1 = &model->bodies[c->id.body1];
-  const pdBody* b2 = &model->bodies[c->id.body2];
-  if (!b1->fixed) first[0] = PD_BODY_STATE_SIZE * b1->stateIndex;
-  if (!b2->fixed) first[1] = PD_BODY_STATE_SIZE * b2->stateIndex;
-  for (int k = 0; k < 3; ++k) {
-    for (int j = first[k]; first[k] >= 0 && j < first[k] + size[k]; ++j)
-      set->locateY[j] = pd_dense_quartic(s->y[j], nodes->f0[j], nodes->yHalf[j], nodes->fHalf[j], y1[j], h, theta);
-  }
-  return set->locateY;
-}
-
-// The cone's margin F⁺ − |b_t| of contact i at θ of the step on the trial's interpolant.
-static double margin_on_interpolant(const pdModel* model, pdState* s, int i, const double* y1, const pdTrialNodes* nodes,
-                                    double h, double theta) {
-  double fn, g;
-  switching_at(model, s->contacts, i, contact_on_interpolant(model, s, i, y1, nodes, h, theta), &fn, &g);
-  return g;
-}
-
-// Contact i's stick–slip change inside the step, from the cone's margin g = F⁺ − |b_t| (>= 0 in stick, continuous
-// through the change): its sign at the step's nodes (the force law's own at y0, yHalf and y1) picks the half step,
-// bisection on the interpolant the time in it (width: half the bracket left). The tangential force's rate jumps there
-// by |ġ| (stick: F_t = −b_t; slip: F_t = −F⁺ b̂_t, whose rates differ by (Ḟ⁺ − d|b_t|/dt) b̂_t = ġ b̂_t where
-// |b_t| = F⁺; b_t's own rate is continuous, the slip velocity being 0 there), taken as the larger of the margin's
-// slopes over PD_SLIP_RATE_SPAN of the half step on either side. False where the margin does not tell: a branch
-// without one (undamped springs), or a change and back inside a half step.
-static bool slip_change_time(const pdModel* model, pdState* s, int i, const double* y1, const pdTrialNodes* nodes,
-                             double h, slipChange* out) {
-  pdContactSet* set = s->contacts;
-  double g0 = set->items[i].force.coneMargin, g1 = set->eval[i].force.coneMargin, fn, gm;
-  if (!isfinite(g0) || !isfinite(g1) || (g0 >= 0.0) == (g1 >= 0.0)) return false;
-  switching_at(model, set, i, nodes->yHalf, &fn, &gm);
-  if (!isfinite(gm)) return false;
-  bool stickBefore = g0 >= 0.0;
-  double lo = (gm >= 0.0) == stickBefore ? 0.5 : 0.0, hi = lo + 0.5, halfStart = lo;
-  for (int k = 0; k < PD_SLIP_LOCATE_BISECTIONS; ++k) {
-    double mid = 0.5 * (lo + hi), g = margin_on_interpolant(model, s, i, y1, nodes, h, mid);
-    if (!isfinite(g)) return false;
-    if ((g >= 0.0) == stickBefore)
-      lo = mid;
-    else
-      hi = mid;
-  }
-  double theta = 0.5 * (lo + hi), span = 0.5 * PD_SLIP_RATE_SPAN;
-  double before = fmax(halfStart, theta - span), after = fmin(halfStart + 0.5, theta + span);
-  double gBefore = margin_on_interpolant(model, s, i, y1, nodes, h, before);
-  double gAt = margin_on_interpolant(model, s, i, y1, nodes, h, theta);
-  double gAfter = margin_on_interpolant(model, s, i, y1, nodes, h, after);
-  double slope = 0.0;
-  if (theta > before) slope = fmax(slope, fabs(gAt - gBefore) / ((theta - before) * h));
-  if (after > theta) slope = fmax(slope, fabs(gAfter - gAt) / ((after - theta) * h));
-  if (!isfinite(slope)) return false;
-  *out = (slipChange){theta * h, 0.5 * (hi - lo) * h, slope};
-  return true;
-}
-
-// The end of a retried step for contact c's change located at ch->at in a step of h: past the change by the largest
-// distance whose placed bound in the retried step (the change that close to its end) is PD_ONSET_AIM_SHARE of the
-// tolerance's share, so that the retry ends with the change inside it and keeps it there; at most a quarter of `at`
-// past it, so that the change stays in the retried step's last quarter. NAN where no distance is cheap enough (the
-// change is then refined by halving).
-static double slip_retry_end(const pdModel* model, const contactSlot* c, const contactEval* e, const slipChange* ch,
-                             double h) {
-  double spend = PD_ONSET_AIM_SHARE * PD_ONSET_TOL_SHARE * model->settings.tol;
-  if (transition_bound(model, c, e, ch->at + ch->width, ch) > spend) return NAN;
-  double lo = 0.0, hi = fmin(0.25 * ch->at, h - ch->at);
-  for (int k = 0; k < PD_SLIP_AIM_BISECTIONS; ++k) {
-    double past = 0.5 * (lo + hi);
-    if (transition_bound(model, c, e, ch->at + past, ch) <= spend)
-      lo = past;
-    else
-      hi = past;
-  }
-  return ch->at + fmax(lo, ch->width);
-}
-
 // Whether the force law at the step's end left a mode contact c held over the step (holdModes): the normal force's
 // sign, or stick and slip where they are held (pd_contact_slip_held) and the contact pushed throughout.
 static bool held_mode_changed(const contactSlot* c, const contactEval* e) {
@@ -556,8 +443,8 @@ static double held_change(const pdModel* model, pdContactSet* set, int i, const 
   return PD_MODE_BOUND_SAFETY * fmax(fmax(velocity, spring * spread / c->deltaMax), position);
 }
 
-pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, const double* y1,
-                                 const pdTrialNodes* nodes, double* hRetry, pdStopwatch* watch) {
+pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, const double* y1, const double* yMid,
+                                 double* hRetry, pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
   int base = spring_base(model);
   poses_from(model, s->y, set->poses0);
@@ -580,8 +467,6 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, tracking_range, &job);
   double refineStep = 0.0;  // the largest refinement bound among the contacts that changed mode (0: none)
   double locate = h;        // the step that ends just past the earliest held mode's change to locate (h: none)
-  double slipEnd = h;       // the step that ends just past the earliest located stick–slip change (h: none)
-  const double* yMid = nodes ? nodes->yHalf : NULL;
   pdOnsets mode = pd_onsets_effective(s->onsets, model->movingCount);
   bool bounded = mode == pd_onsetsBounded || mode == pd_onsetsHeld;
   for (int i = 0; i < set->count; ++i) {
@@ -606,26 +491,10 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     if (!changes_mode(c, &e->force)) continue;
     // bounded events leave a change inside the step where its bound allows (onset_bound.h); others refine it
     if (bounded) {
-      double bound = transition_bound(model, c, e, h, NULL);
+      double bound = transition_bound(model, c, e, h);
       if (pd_onset_bound_allows(bound, model->settings.tol)) {
         e->modeBound = bound;
         continue;
-      }
-      // step doubling's nodes place the change: left where it lies close enough to a node, else one retry ends the
-      // step just past it (docs/events.md, "Stick–slip changes")
-      slipChange ch;
-      if (nodes && slip_change_time(model, s, i, y1, nodes, h, &ch)) {
-        double placed = transition_bound(model, c, e, h, &ch);
-        if (pd_onset_bound_allows(placed, model->settings.tol)) {
-          e->modeBound = placed;
-          continue;
-        }
-        double end = slip_retry_end(model, c, e, &ch, h);
-        if (set->slipRetries < PD_SLIP_RETRIES_MAX && end > model->settings.dtmin && end < h &&
-            0.5 * h >= refine_step(model, &c->params)) {
-          slipEnd = fmin(slipEnd, end);
-          continue;
-        }
       }
     }
     refineStep = fmax(refineStep, refine_step(model, &c->params));
@@ -634,13 +503,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
   if (refineStep > 0.0 && s->stepper != pd_stepperRK4Fixed && 0.5 * h >= refineStep) {
     ++s->count.refinements;
-    *hRetry = fmin(0.5 * h, slipEnd);
-    return pd_eventRetry;
-  }
-  if (slipEnd < h) {
-    ++s->count.transitionRetries;
-    ++set->slipRetries;
-    *hRetry = slipEnd;
+    *hRetry = 0.5 * h;
     return pd_eventRetry;
   }
   if (locate < h) {
@@ -781,7 +644,6 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
   set->candidateCount = 0;
   set->onsetRetries = 0;
   set->modeRetries = 0;
-  set->slipRetries = 0;
   // y1 lives in the stepper's scratch, which install may drop: the bodies' numbers go to state->y first, with the
   // held modes' corrections (all formed before any is applied: the list's order does not matter)
   memcpy(s->y, y1, (size_t)base * sizeof *s->y);
@@ -873,7 +735,6 @@ static void install_moved(const pdModel* model, pdState* to, int count) {
   to->contacts->candidateCount = 0;
   to->contacts->onsetRetries = 0;
   to->contacts->modeRetries = 0;
-  to->contacts->slipRetries = 0;
   install(model, to, count);  // sorted by id: the order the slots came in does not matter
 }
 

@@ -61,24 +61,14 @@ typedef enum pdEventVerdict {
                     // (state->n changed), re-evaluate the derivative at the start and try again
 } pdEventVerdict;
 
-// What a step-doubling trial knows inside its step (nullable where a stepper has no such nodes): the slope at its
-// start f0 = f(y0), the first half step's end yHalf and its slope fHalf, all of length state->n. They give the step's
-// quartic interpolant (dense_output.h), on which a stick–slip change is located, and yHalf places a held mode's
-// change more closely.
-typedef struct pdTrialNodes {
-  const double *f0, *yHalf, *fHalf;
-} pdTrialNodes;
-
 // After a trial step from (t0, y0 = state->y) to y1 (length state->n) of size h that the error control
-// accepted (nodes, nullable: the trial's own nodes inside the step): analyses the contacts at y1 (broad phase,
-// interference, contact search, tracking) and decides
+// accepted (yMid, nullable: the trial's own state at t0 + h/2, which places a held mode's change more closely): analyses the contacts at y1 (broad phase, interference, contact search, tracking) and decides
 // whether a contact onset or a reversal inside the step asks for a shorter step (Retry), whether
 // contacts must be added at the start (Restart: state->y and state->n are updated), or whether the step
 // stands (Accept). Onset retries are bounded per step, refinements by the refinement step. May grow the
 // state's vectors (Restart only: pointers into the stepper's scratch are then stale). Its stages are timed as
 // laps of `watch`, running since the caller's last lap.
-pdEventVerdict pd_contact_events(const pdModel* model, pdState* state, double h, const double* y1,
-                                 const pdTrialNodes* nodes,
+pdEventVerdict pd_contact_events(const pdModel* model, pdState* state, double h, const double* y1, const double* yMid,
                                  double* hRetry, pdStopwatch* watch);
 // Accepts the step analysed by the last pd_contact_events: copies y1 into state->y with the new contact
 // list (breaks, transfers, new contacts with springs at 0), realigns the springs of continuing contacts

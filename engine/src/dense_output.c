@@ -88,24 +88,22 @@ void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* 
   d->captured = true;
 }
 
-double pd_dense_quartic(double y0, double f0, double yHalf, double fHalf, double y1, double h, double theta) {
-  // p(θ) = y0 + h f0 θ + a θ² + b θ³ + c θ⁴ through p(½) = y½, p'(½) = h f½, p(1) = y1 (derivation: the three
-  // conditions solved for a, b, c with D½ = y½ − y0 − h f0/2, Df = h (f½ − f0), D1 = y1 − y0 − h f0)
-  double slope = h * f0;
-  double dHalf = yHalf - y0 - 0.5 * slope, dSlope = h * (fHalf - f0), dEnd = y1 - y0 - slope;
-  double a = dEnd - 4.0 * dSlope + 16.0 * dHalf;
-  double b = -4.0 * dEnd + 12.0 * dSlope - 32.0 * dHalf;
-  double c = 4.0 * dEnd - 8.0 * dSlope + 16.0 * dHalf;
-  return y0 + theta * (slope + theta * (a + theta * (b + theta * c)));
-}
-
 // The interpolant at θ into out (d->n numbers).
 static void interpolate(const pdDense* d, double theta, double* out) {
   const double *y0 = d->node[NODE_Y0], *f0 = d->node[NODE_F0], *y1 = d->node[NODE_Y1];
   double h = d->h;
   if (d->quartic) {
+    // p(θ) = y0 + h f0 θ + a θ² + b θ³ + c θ⁴ through p(½) = y½, p'(½) = h f½, p(1) = y1 (derivation: the three
+    // conditions solved for a, b, c with D½ = y½ − y0 − h f0/2, Df = h (f½ − f0), D1 = y1 − y0 − h f0)
     const double *yh = d->node[NODE_YHALF], *fh = d->node[NODE_FHALF];
-    for (int i = 0; i < d->n; ++i) out[i] = pd_dense_quartic(y0[i], f0[i], yh[i], fh[i], y1[i], h, theta);
+    for (int i = 0; i < d->n; ++i) {
+      double slope = h * f0[i];
+      double dHalf = yh[i] - y0[i] - 0.5 * slope, dSlope = h * (fh[i] - f0[i]), dEnd = y1[i] - y0[i] - slope;
+      double a = dEnd - 4.0 * dSlope + 16.0 * dHalf;
+      double b = -4.0 * dEnd + 12.0 * dSlope - 32.0 * dHalf;
+      double c = 4.0 * dEnd - 8.0 * dSlope + 16.0 * dHalf;
+      out[i] = y0[i] + theta * (slope + theta * (a + theta * (b + theta * c)));
+    }
     return;
   }
   const double* f1 = d->node[NODE_F1];

@@ -45,8 +45,5 @@ double* pd_dense_slope_scratch(pdDense* d, int n);
 void pd_dense_present(const pdModel* model, pdState* s, double t);
 // Puts the integration's own state back; returns whether the state was presented.
 bool pd_dense_resume(pdState* s);
-// Step doubling's quartic (above) for one number: y0 with slope f0 at the step's start, yHalf with slope fHalf at its
-// middle, y1 at its end, at θ of a step of h (the contact events locate a stick–slip change on it, contact_set.c).
-double pd_dense_quartic(double y0, double f0, double yHalf, double fHalf, double y1, double h, double theta);
 // Forgets the captured step (the state is set up anew: islands.c's island_load, pd_state_reset).
 void pd_dense_discard(pdState* s);

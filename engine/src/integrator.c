@@ -363,9 +363,8 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     // contact events (Fig. 8): a new contact's onset or a reversal inside the step may shorten it; a
     // virtual contact restarts it with the contact list grown
     double hRetry = h;
-    const pdTrialNodes nodes = {w.k1, w.half, w.k1half};  // step doubling's: its first half step's end and slopes
-    pdEventVerdict verdict =
-        pd_contact_events(model, s, h, w.trial, trial == trial_doubling ? &nodes : NULL, &hRetry, &watch);
+    const double* yMid = trial == trial_doubling ? w.half : NULL;  // the first half step's end
+    pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, yMid, &hRetry, &watch);
     if (verdict == pd_eventRetry) {
       hMax = hRetry;
       eventCut = true;

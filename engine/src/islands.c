@@ -289,7 +289,6 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->onsetsInterpolated += c->onsetsInterpolated;
   to->travelRetries += c->travelRetries;
   to->refinements += c->refinements;
-  to->transitionRetries += c->transitionRetries;
   to->stabilityTight += c->stabilityTight;
   to->implicitSteps += c->implicitSteps;
   to->searchesSkipped += c->searchesSkipped;

@@ -17,11 +17,3 @@ double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, doub
   return kinkSlope * h * h / (48.0 * vmax);
 }
 
-double pd_transition_placed_bound(double rateJump, double massMin, double dampMin, double deltaMax, double h, double at,
-                                  double width, double vmax) {
-  double half = 0.5 * h;
-  double inHalf = fmin(half, fmax(0.0, at < half ? at : at - half));
-  double reach = fmin(fmin(inHalf, half - inHalf) + fabs(width), 0.125 * h);
-  double scale = fmax(1.0 / (massMin * vmax), dampMin > 0.0 ? 1.0 / (dampMin * deltaMax) : INFINITY);
-  return fabs(rateJump) * scale * h * reach / 6.0;
-}

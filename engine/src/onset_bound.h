@@ -67,17 +67,3 @@ static inline bool pd_onset_bound_allows(double bound, double tol) { return boun
 // else the step is halved towards it as the paper does (contact_set.c, refine_step).
 double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, double slide, double approach, double h,
                                  double vmax);
-
-// The same change located at `at` seconds after the step's start, to within `width` seconds (contact_set.c: bisected
-// on the step's interpolant), where the tangential force's rate jumps by rateJump (N/s, measured there). Simpson's
-// rule over a half step H = h/2 with a kink of slope [a'] at distance d from its nearer end errs by [a'] (H d/6 −
-// d²/2), at most [a'] H d/6 in size for d up to H/2 (0 where the kink sits at a node); twice that, as above, with d
-// no farther than the kink anywhere (h/8 gives pd_transition_error_bound's h²/48). The kink is in the bodies'
-// acceleration, [a'] = rateJump / massMin, and in the rate of the tangential springs, which take the slip velocity's
-// rate through their dampers, [s̈] <= rateJump / dampMin (dampMin the smaller tangential damper, N·s/m); each in the
-// error norm's units (velocity over vmax, springs over deltaMax):
-//   bound = rateJump max(1/(massMin vmax), 1/(dampMin deltaMax)) h min(d + width, h/8) / 6.
-// A change within a small d of a node costs little: one located that close to the end of a retried step
-// (contact_set.c, slip_retry_end) may stay in it.
-double pd_transition_placed_bound(double rateJump, double massMin, double dampMin, double deltaMax, double h, double at,
-                                  double width, double vmax);

@@ -666,8 +666,7 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
     write_number(out, c->onsetBoundMax);
     fputs(", \"onset_bound_sum\": ", out);
     write_number(out, c->onsetBoundSum);
-    fprintf(out, ", \"transitions_unlocated\": %ld, \"transition_retries\": %ld, \"transition_bound_max\": ",
-            c->transitionsUnlocated, c->transitionRetries);
+    fprintf(out, ", \"transitions_unlocated\": %ld, \"transition_bound_max\": ", c->transitionsUnlocated);
     write_number(out, c->transitionBoundMax);
     fputs(", \"transition_bound_sum\": ", out);
     write_number(out, c->transitionBoundSum);

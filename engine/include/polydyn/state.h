@@ -144,7 +144,6 @@ typedef struct pdCounters {
   long onsetsInterpolated;  // contacts that joined at a step's end from an onset inside it (pd_onsetsPair)
   long travelRetries;     // trial steps cut short because two bodies that may meet moved too far (tunnelling)
   long refinements;       // trial steps halved around a reversal or a stick/slip change (§3.4)
-  long transitionRetries; // trial steps cut to end just past a stick/slip change located on the step's interpolant
   long stabilityTight;    // accepted steps whose limit needed the tight stability bound: the cheap bound allowed
                           // less than the step the error control wanted (docs/integration.md)
   long implicitSteps;     // accepted steps taken by the implicit method (pd_stepperImplicit; 0 with other steppers)
