@@ -31,7 +31,8 @@
 #define STICK_UNTIL 0.3  // s: t*, the force's ramp set from the block's mass
 #define TEND 0.5         // s
 // of the closed form's slide: the soft contact's own departures from the rigid closed form (its tangential springs'
-// deflection at the change, μ m g / k_t, and the block's settling on its normal springs at the start) are ~1e-4 of it
+// deflection at the change, μ m g / k_t, and the block's settling on its normal springs at the start): measured up to
+// 2e-4 of it
 #define SLIDE_REL_TOL 2e-3
 // of the slide: bounded events against exact ones at tol REFERENCE_TOL. A change left inside its step adds at most
 // the tolerance's share to the error norm, tol × vmax in velocity, ~1e-7 m over the ~0.2 s that follow: a few 1e-6 of
