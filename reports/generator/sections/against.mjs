@@ -6,6 +6,7 @@
 // one, so wall-time ratios drift with the load), else the wall time.
 import { esc, num, table } from '../lib/html.mjs';
 import { median } from '../lib/derive.mjs';
+import { STEP_LIMITS } from '../lib/inputs.mjs';
 
 const SOFT = 'soft implicit';
 // The project's targets for the median ratio (docs/validation.md, "Cost against the rigid engines").
@@ -21,20 +22,49 @@ function reach(e, ev, unit) {
     if (!best || t.wall_per_sim_second < best.cost) {
       const at = t.kind === 'at_most' ? c.points.find((p) => p.value === t.setting_value) : null;
       best = { cost: t.wall_per_sim_second, kind: t.kind, setting: c.setting, value: t.setting_value, loosest: c.points[0].value,
-        steps: at ? at.steps : null };
+        steps: at ? at.steps : null, derivatives: at ? at.derivatives ?? null : null,
+        limited: at ? at.steps_limited_by ?? null : null,
+        // simulated seconds of the run (the scene's tend), from the point's wall time and its rate
+        tend: at && at.wall_per_sim_second > 0 ? at.wall_seconds / at.wall_per_sim_second : null };
     }
   }
   return best;
 }
 
-// Why polydyn's cost on an experiment is what it is, from where its curve reaches the tolerance and the other's.
+// What each step limit means, in the words of the per-experiment table.
+const LIMIT_WORDS = {
+  error: 'the error control',
+  largest: 'the largest step (dtmax)',
+  stability: 'the contacts’ stability bound',
+  travel: 'the tunnelling guard',
+  event: 'contact events (onsets located, stick–slip changes refined)',
+  landing: 'sync times between islands',
+};
+
+// "38 % the contacts' stability bound, 21 % ...": the limits that set at least 5 % of the steps, largest first.
+function limitShares(limited) {
+  const total = STEP_LIMITS.reduce((a, l) => a + limited[l], 0);
+  if (!(total > 0)) return '';
+  return STEP_LIMITS.filter((l) => limited[l] >= 0.05 * total).sort((a, b) => limited[b] - limited[a])
+    .map((l) => `${Math.round((100 * limited[l]) / total)} % ${LIMIT_WORDS[l]}`).join(', ');
+}
+
+// Why polydyn's cost on an experiment is what it is, from where its curve reaches the tolerance and the other's, and
+// what set the size of its steps there (precision.csv's steps_* columns, where it has them).
 function bound(soft, other) {
-  if (soft.kind === 'at_most')
-    return 'its loosest tolerance already reaches the answer: the steps resolve the contacts (a soft contact must resolve each ' +
-      'impact and each contact period, whatever the tolerance), not the error' +
-      (other && other.kind === 'at_most' && other.setting === 'step' ? '; the rigid engine’s coarsest step reaches it too (a rigid ' +
-        'contact resolves an impact within one step)' : '');
-  return 'the error control: a tighter tolerance is needed to reach the answer';
+  if (soft.kind !== 'at_most') return 'the error control: a tighter tolerance is needed to reach the answer';
+  let text = 'its loosest tolerance already reaches the answer: the steps resolve the contacts (a soft contact must resolve each ' +
+    'impact and each contact period, whatever the tolerance), not the error';
+  if (soft.limited && soft.tend > 0) {
+    const rate = (n) => num(n / soft.tend);
+    text += `. ${rate(soft.steps)} steps per simulated second` +
+      (other && other.steps !== null && other.tend > 0 ? ` (the rigid engine: ${num(other.steps / other.tend)})` : '') +
+      (soft.derivatives !== null ? `, ${rate(soft.derivatives)} derivative evaluations` : '') +
+      `; their size set by ${limitShares(soft.limited)}`;
+  }
+  if (other && other.kind === 'at_most' && other.setting === 'step')
+    text += '; the rigid engine’s coarsest step reaches it too (a rigid contact resolves an impact within one step)';
+  return text;
 }
 
 export default {
@@ -102,11 +132,12 @@ export default {
       data: { unit, summary, experiments: perExperiment.map((x) => ({ experiment: x.experiment, soft: x.soft,
         ratios: Object.fromEntries(others.map((ev) => [ev, x.ratios[ev] ? x.ratios[ev].ratio : null])) })) },
       csv: [{ name: 'against', header: ['experiment', 'unit', ...others.map((ev) => `ratio_${ev.replace(' ', '_')}`), 'soft_cost',
-        'soft_to_tolerance', 'soft_setting_value', 'soft_steps'],
+        'soft_to_tolerance', 'soft_setting_value', 'soft_steps', 'soft_derivatives', ...STEP_LIMITS.map((l) => `soft_steps_${l}`)],
       rows: [
-        ...summary.map((s) => [`median over ${s.both} (${s.ev})`, unit, ...others.map((ev) => (ev === s.ev ? s.median_ratio : '')), '', '', '', '']),
+        ...summary.map((s) => [`median over ${s.both} (${s.ev})`, unit, ...others.map((ev) => (ev === s.ev ? s.median_ratio : '')), '', '', '', '',
+          '', ...STEP_LIMITS.map(() => '')]),
         ...perExperiment.map((x) => [x.experiment, unit, ...others.map((ev) => (x.ratios[ev] ? x.ratios[ev].ratio : '')), x.soft.cost,
-          x.soft.kind, x.soft.value, x.soft.steps]),
+          x.soft.kind, x.soft.value, x.soft.steps, x.soft.derivatives, ...STEP_LIMITS.map((l) => (x.soft.limited ? x.soft.limited[l] : ''))]),
       ] }],
     };
   },
