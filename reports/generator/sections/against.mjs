@@ -31,7 +31,7 @@ function reach(e, ev, unit) {
   return best;
 }
 
-// What each step limit means, in the words of the per-experiment table.
+// What each step limit means, in the words of the per-experiment table, and why it costs steps where it dominates.
 const LIMIT_WORDS = {
   error: 'the error control',
   largest: 'the largest step (dtmax)',
@@ -40,31 +40,39 @@ const LIMIT_WORDS = {
   event: 'contact events (onsets located, stick–slip changes refined)',
   landing: 'sync times between islands',
 };
+const LIMIT_WHY = {
+  error: 'the error control sets the steps even at the loosest tolerance',
+  largest: 'the scene’s largest step, dtmax, holds its free flight to shorter steps than the rigid engine’s',
+  stability: 'a soft contact must resolve each contact period: an explicit step is stable only below ~2.8/ω',
+  travel: 'the tunnelling guard lets a touching pair move at most 2 δ_max (or a quarter of the thinner width) per step',
+  event: 'a soft contact must resolve each impact: its onset is located and the steps after it grow from the cut',
+  landing: 'the islands’ sync times end its steps',
+};
 
-// "38 % the contacts' stability bound, 21 % ...": the limits that set at least 5 % of the steps, largest first.
-function limitShares(limited) {
+// The limits that set at least 5 % of the steps, largest first.
+function mainLimits(limited) {
   const total = STEP_LIMITS.reduce((a, l) => a + limited[l], 0);
-  if (!(total > 0)) return '';
+  if (!(total > 0)) return [];
   return STEP_LIMITS.filter((l) => limited[l] >= 0.05 * total).sort((a, b) => limited[b] - limited[a])
-    .map((l) => `${Math.round((100 * limited[l]) / total)} % ${LIMIT_WORDS[l]}`).join(', ');
+    .map((l) => ({ limit: l, share: limited[l] / total }));
 }
 
 // Why polydyn's cost on an experiment is what it is, from where its curve reaches the tolerance and the other's, and
 // what set the size of its steps there (precision.csv's steps_* columns, where it has them).
 function bound(soft, other) {
   if (soft.kind !== 'at_most') return 'the error control: a tighter tolerance is needed to reach the answer';
-  let text = 'its loosest tolerance already reaches the answer: the steps resolve the contacts (a soft contact must resolve each ' +
-    'impact and each contact period, whatever the tolerance), not the error';
-  if (soft.limited && soft.tend > 0) {
-    const rate = (n) => num(n / soft.tend);
-    text += `. ${rate(soft.steps)} steps per simulated second` +
-      (other && other.steps !== null && other.tend > 0 ? ` (the rigid engine: ${num(other.steps / other.tend)})` : '') +
-      (soft.derivatives !== null ? `, ${rate(soft.derivatives)} derivative evaluations` : '') +
-      `; their size set by ${limitShares(soft.limited)}`;
-  }
-  if (other && other.kind === 'at_most' && other.setting === 'step')
-    text += '; the rigid engine’s coarsest step reaches it too (a rigid contact resolves an impact within one step)';
-  return text;
+  const rigid = other && other.kind === 'at_most' && other.setting === 'step'
+    ? '; the rigid engine’s coarsest step reaches it too (a rigid contact resolves an impact within one step)' : '';
+  const main = soft.limited && soft.tend > 0 ? mainLimits(soft.limited) : [];
+  if (!main.length)
+    return 'its loosest tolerance already reaches the answer: the steps resolve the contacts (a soft contact must resolve each ' +
+      'impact and each contact period, whatever the tolerance), not the error' + rigid;
+  const rate = (n) => num(n / soft.tend);
+  return `its loosest tolerance already reaches the answer, so the error control does not set the cost: ${rate(soft.steps)} steps ` +
+    'per simulated second' + (other && other.steps !== null && other.tend > 0 ? ` (the rigid engine: ${num(other.steps / other.tend)})` : '') +
+    (soft.derivatives !== null ? `, ${rate(soft.derivatives)} derivative evaluations` : '') +
+    `, their size set by ${main.map((m) => `${Math.round(100 * m.share)} % ${LIMIT_WORDS[m.limit]}`).join(', ')}: ` +
+    `${LIMIT_WHY[main[0].limit]}${rigid}`;
 }
 
 export default {
