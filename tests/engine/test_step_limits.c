@@ -46,11 +46,18 @@ static pdState* run_limits(const pdModel* m, bool explicitOnly) {
   return s;
 }
 
+// Runs m (run_limits) and checks that `limit` set more than half of its steps; returns
+// the final state (the caller frees it).
+static pdState* held_by(pdModel* m, bool explicitOnly, pdStepLimit limit) {
+  pdState* s = run_limits(m, explicitOnly);
+  assert_true(s->count.stepsLimited[limit] > s->count.accepted / 2);
+  return s;
+}
+
 static void test_a_free_fall_is_held_by_the_largest_step(void** state) {
   (void)state;
   pdModel* m = cube_on_floor("loc 0 0 2");
-  pdState* s = run_limits(m, false);
-  assert_true(s->count.stepsLimited[pd_limitLargest] > s->count.accepted / 2);
+  pdState* s = held_by(m, false, pd_limitLargest);
   assert_int_equal(s->count.stepsLimited[pd_limitStability], 0);
   assert_int_equal(s->count.stepsLimited[pd_limitTravel], 0);
   pd_state_free(s);
@@ -60,18 +67,14 @@ static void test_a_free_fall_is_held_by_the_largest_step(void** state) {
 static void test_a_resting_cube_is_held_by_the_stability_bound(void** state) {
   (void)state;
   pdModel* m = cube_on_floor("loc 0 0 0.05");
-  pdState* s = run_limits(m, true);
-  assert_true(s->count.stepsLimited[pd_limitStability] > s->count.accepted / 2);
-  pd_state_free(s);
+  pd_state_free(held_by(m, true, pd_limitStability));
   pd_model_free(m);
 }
 
 static void test_a_fast_sliding_cube_is_held_by_the_tunnelling_guard(void** state) {
   (void)state;
   pdModel* m = cube_on_floor("loc 0 0 0.05\nvel 4 0 0");
-  pdState* s = run_limits(m, false);
-  assert_true(s->count.stepsLimited[pd_limitTravel] > s->count.accepted / 2);
-  pd_state_free(s);
+  pd_state_free(held_by(m, false, pd_limitTravel));
   pd_model_free(m);
 }
 
