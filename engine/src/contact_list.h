@@ -84,7 +84,6 @@ typedef struct searchPart {
   pdContactGeom* found;
   int foundCount, foundCapacity;
   pdContactId* previous;  // (capacity) scratch: the ids of one pair's contacts of C0
-  pdContactId* broken;    // (capacity) scratch: those of them that no longer track
 } searchPart;
 
 // A contact of C1 that is not in C0.

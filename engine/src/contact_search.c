@@ -394,16 +394,11 @@ static void find_range(void* ctx, int part, int begin, int end) {
     set->pairFoundCount[p] = 0;
     if (set->certified[p]) continue;
     int a = set->pairs[p].a, b = set->pairs[p].b, first = set->pairPrevious[p], count = set->pairPreviousCount[p];
-    int brokenCount = 0;  // its contacts of C0 that no longer track: their successors are hand-overs
-    for (int k = 0; k < count; ++k) {
-      sp->previous[k] = set->items[first + k].id;
-      if (!set->eval[first + k].tracked) sp->broken[brokenCount++] = set->items[first + k].id;
-    }
+    for (int k = 0; k < count; ++k) sp->previous[k] = set->items[first + k].id;
     int n = 0;
     if (set->touching[p]) {
-      while ((n = pd_contacts_find_handover(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b],
-                                            sp->previous, count, sp->broken, brokenCount, sp->found + sp->foundCount,
-                                            sp->foundCapacity - sp->foundCount)) >
+      while ((n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous, count,
+                                   sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount)) >
              sp->foundCapacity - sp->foundCount) {
         sp->foundCapacity = 2 * (sp->foundCount + n);
         sp->found = pd_grow(sp->found, sp->foundCapacity, sizeof *sp->found);

@@ -69,10 +69,8 @@ void pd_contact_set_reserve_list(pdContactSet* set, int capacity) {
   set->bodyList = pd_grow(set->bodyList, 2 * c, sizeof *set->bodyList);
   if (set->broad) {  // a view (pd_contact_set_create_view) has no contact events or stability bound
     set->eval = pd_grow(set->eval, c, sizeof *set->eval);
-    for (int part = 0; part < 2; ++part) {
+    for (int part = 0; part < 2; ++part)
       set->search[part].previous = pd_grow(set->search[part].previous, c, sizeof *set->search[part].previous);
-      set->search[part].broken = pd_grow(set->search[part].broken, c, sizeof *set->search[part].broken);
-    }
     set->stability = pd_grow(set->stability, c, sizeof *set->stability);
   } else {
     set->captured = pd_grow(set->captured, c, sizeof *set->captured);
@@ -134,7 +132,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->next);
   free(set->captured);
   free(set->recordedY);
-  for (int part = 0; part < 2; ++part) free(set->search[part].previous), free(set->search[part].broken);
+  for (int part = 0; part < 2; ++part) free(set->search[part].previous);
   free(set->force);
   free(set->stability);
   free(set->bodyFirst);
