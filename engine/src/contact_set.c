@@ -452,7 +452,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   double* analysisSeconds = &s->stageSeconds[pd_stageContactAnalysis];
 
   // 0. no tunnelling: bodies that may meet must not pass through each other's thinnest width in one step
-  int pairCount = pd_contact_search_broad_phase(model, set, set->poses0, set->poses1);
+  int pairCount = pd_contact_search_broad_phase(model, set, s->y, y1, h, set->poses0, set->poses1);
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageBroadPhase]);
   if (pd_contact_search_travel_retry(model, set, pairCount, h, hRetry)) {
     ++s->count.travelRetries;
