@@ -99,7 +99,7 @@ bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const 
                              pdPairFrame* frame, pdContactGeom* out);
 void pd_contact_geometry_framed(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                                 pdPairFrame* frame, pdContactGeom* out);
-// A certificate of a pair's contact search (contact_analysis.c, "search certificates"): at any poses whose motion
+// A certificate of a pair's contact search (contact_certificate.c, its design note): at any poses whose motion
 // from the ones it was issued at (pd_search_motion) is below `margin`, pd_contacts_find reports no contact of the
 // pair (ia < ib) outside the exempt list it was issued with. margin 0: none.
 typedef struct pdSearchCertificate {

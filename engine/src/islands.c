@@ -682,8 +682,8 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
           if (s->t > set->ct0 && !free_advance(s, set, k, s->t, true)) return false;
           set->free[k] = false;
           // brought to T only: the interval is still to go (left marked advanced, an island that stays alone in the
-          // partition would keep T's numbers for T')
-          set->islands[set->islandOld[k]]->advanced = false;
+          // partition would keep T's numbers for T'); a body free since the run's start has no island yet
+          if (set->islandOld[k] >= 0) set->islands[set->islandOld[k]]->advanced = false;
           set_start(model, s, set, k, dt);
         }
     } while (set->sleep && wake_reached(model, s, set, dt));

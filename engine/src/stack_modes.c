@@ -294,10 +294,10 @@ static int compare_modes(const void* a, const void* b) {
   return (x->zeta > y->zeta) - (x->zeta < y->zeta);
 }
 
-int pd_state_stack_modes(const pdModel* model, const pdState* state, const int* stackOf, int stack,
-                         pdStackMode* modes, int capacity) {
-  PD_ASSERT(model != NULL && state != NULL && stackOf != NULL && capacity >= 0 && (modes != NULL || capacity == 0));
-  const pdContactSet* set = state->contacts;
+int pd_stack_modes(const pdModel* model, const pdContactSet* set, const pdBodyState* bodies, const int* stackOf,
+                   int stack, pdStackMode* modes, int capacity) {
+  PD_ASSERT(model != NULL && bodies != NULL && stackOf != NULL && capacity >= 0 &&
+            (modes != NULL || capacity == 0));
   int n = model->bodyCount, members = 0;
   int* local = pd_grow(NULL, (size_t)n, sizeof *local);
   for (int k = 0; k < n; ++k) local[k] = stackOf[k] == stack && stack >= 0 ? members++ : -1;
@@ -308,7 +308,7 @@ int pd_state_stack_modes(const pdModel* model, const pdState* state, const int* 
   massScale* scale = pd_grow(NULL, (size_t)members, sizeof *scale);
   for (int k = 0; k < n; ++k)
     if (local[k] >= 0) {
-      pdBodyState b = pd_state_body(model, state, k);
+      pdBodyState b = bodies[k];
       pdPose pose = pose_of(b.x, b.q);
       scale[local[k]] = mass_scale(&model->bodies[k], &pose);
     }

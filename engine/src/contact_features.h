@@ -1,0 +1,58 @@
+// polydyn — the feature geometry that the contact search (contact_analysis.c) and its search certificates
+// (contact_certificate.c) share: the tolerances both must agree on, since a certificate proves what the search
+// would find, and the small helpers both use. Private to engine/src.
+#ifndef POLYDYN_CONTACT_FEATURES_H
+#define POLYDYN_CONTACT_FEATURES_H
+
+#include "polydyn/model.h"
+#include "polydyn/vecmath.h"
+
+// Relative tolerance (× body size) of "on the boundary": a point this close outside a face plane or
+// a face polygon counts as on it, so roundoff neither breaks a vertex sliding exactly along an edge
+// nor loses a corner resting exactly on a corner.
+#define BOUNDARY_TOL_REL 1e-12
+
+// Tolerance of "flush", as a fraction of the pair's δ_max (pd_model_pair_delta_max): a face plane
+// of one body that the other body does not cross by more than this is a plane both bodies share (bricks
+// side by side, a box on a box of the same width): a vertex lying on it has crossed another face, not
+// that one, and edges crossing inside it have no depth. A contact on such a plane would carry at most
+// this fraction of the deflection an impact at vmax makes; the bodies rock by 1e-6 rad and more while
+// they settle (1e-7 m on a 0.1 m brick), which a roundoff-sized tolerance would not absorb.
+#define FLUSH_TOL_DEFLECTIONS 1e-3
+
+// Deepest a new EE contact may be beyond the bodies' own penetration, in the pair's δ_max: contacts are found as
+// they start (onsets are interpolated to 10⁻³ δ_max), so a deeper one is not where the bodies just met unless they
+// interpenetrate that deeply (find_ee: the pair's depth against their penetration depth).
+#define EE_NEW_DEPTH_MAX_DEFLECTIONS 3.0
+
+// Gauss-map arcs within this sine of meeting touch (the arcs test in contact_analysis.c says why).
+#define ARC_TOUCH_TOL 1e-9
+// Absolute rounding margin of a triple product of unit vectors: ~100 ulps of 1.
+#define ARC_TRIPLE_ROUNDING 1e-14
+
+// Body b's pose in body a's frame: rotation R_aᵀ R_b, offset R_aᵀ (x_b − x_a).
+static inline void pose_in_frame_of(const pdPose* a, const pdPose* b, pdMat3* rel, pdVec3* off) {
+  pdMat3 RaT = pd_mat3_transpose(&a->R);
+  *rel = pd_mat3_mul(&RaT, &b->R);
+  *off = pd_mat3_mulv(&RaT, pd_v3_sub(b->x, a->x));
+}
+
+// Depth of point q (body frame) below face f's plane (> 0 inside the half-space).
+static inline double face_depth(const pdPolyhedron* s, int f, pdVec3 q) { return s->faces[f].offset - pd_v3_dot(s->faces[f].normal, q); }
+
+// An arc (a, b) of the Gauss map with its great circle's normal b × a and that normal's squared length: the
+// search tests every edge of one body against every edge of the other, so each arc's are formed once.
+typedef struct gaussArc {
+  pdVec3 a, b, bxa;
+  double norm2;
+} gaussArc;
+static inline gaussArc gauss_arc(pdVec3 a, pdVec3 b) {
+  pdVec3 bxa = pd_v3_cross(b, a);
+  return (gaussArc){a, b, bxa, pd_v3_dot(bxa, bxa)};
+}
+
+// The least overlap of A and B along the face normals of both, m: an upper bound of their penetration depth (those
+// normals are among the separating-axis test's axes). B's pose in A's frame rel, off.
+double pd_least_face_overlap(const pdPolyhedron* sa, const pdPolyhedron* sb, const pdMat3* rel, pdVec3 off);
+
+#endif
