@@ -56,6 +56,8 @@ typedef struct gkPoint {
   gkPointStatus status;
   double measured, error, wall, cpu;
   long steps;
+  long derivatives;                 // soft: derivative evaluations of the last run (0 for the reference engines)
+  long limited[pd_limitCount];      // soft: its accepted steps by what set their size (pdStepLimit)
   char note[PD_GK_NOTE_MAX];
 } gkPoint;
 
@@ -64,6 +66,8 @@ typedef struct gkPointResult {
   int32_t unused;
   double measured, error, wall, cpu;
   int64_t steps;
+  int64_t derivatives;
+  int64_t limited[pd_limitCount];
   char note[PD_GK_NOTE_MAX];
 } gkPointResult;
 
@@ -124,6 +128,8 @@ static double error_of(const gkCase* c, double measured) {
 static void measure_point(const gkPrecision* s, gkPoint* p) {
   p->measured = p->error = p->wall = p->cpu = NAN;
   p->steps = 0;
+  p->derivatives = 0;
+  memset(p->limited, 0, sizeof p->limited);
   p->note[0] = '\0';
   const gkCase* c = p->c;
   int repeats = s->options->repeats;
@@ -158,6 +164,8 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
       walls[r] = gk_wall_seconds() - t0;
       cpus[r] = gk_cpu_seconds() - c0;
       p->steps = state->count.accepted;
+      p->derivatives = state->count.derivatives;
+      memcpy(p->limited, state->count.stepsLimited, sizeof p->limited);
       if (!completed) point_note(p, "the run stopped at t = %.6g s", state->t);
       pd_state_free(state);
     } else {
@@ -216,6 +224,8 @@ static void point_task(int task, pdBatchBuffer* result, void* user) {
   r.wall = p->wall;
   r.cpu = p->cpu;
   r.steps = p->steps;
+  r.derivatives = p->derivatives;
+  for (int k = 0; k < pd_limitCount; ++k) r.limited[k] = p->limited[k];
   memcpy(r.note, p->note, sizeof r.note);
   pd_batch_append(result, &r, sizeof r);
 }
@@ -231,6 +241,8 @@ static void take_point(gkPoint* p, const pdBatchBuffer* bytes) {
   p->wall = r.wall;
   p->cpu = r.cpu;
   p->steps = (long)r.steps;
+  p->derivatives = (long)r.derivatives;
+  for (int k = 0; k < pd_limitCount; ++k) p->limited[k] = (long)r.limited[k];
   memcpy(p->note, r.note, sizeof p->note);
 }
 
@@ -297,7 +309,8 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
   }
   fputs(
       "experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,"
-      "judged,status,wall_seconds,wall_per_sim_second,steps,repeats,cpu_seconds,cpu_per_sim_second,note\n",
+      "judged,status,wall_seconds,wall_per_sim_second,steps,repeats,cpu_seconds,cpu_per_sim_second,derivatives,"
+      "steps_error,steps_largest,steps_stability,steps_travel,steps_event,steps_landing,note\n",
       out);
   for (int i = 0; i < s->count; ++i) {
     const gkPoint* p = &s->points[i];
@@ -329,6 +342,14 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
     fputc(',', out);
     pdu_csv_number(out, p->cpu / c->model->settings.tend, 17);
     fputc(',', out);
+    // what polydyn's steps were spent on (docs/integration.md); the reference engines': empty
+    bool counted = p->engine == pd_gkSoft && p->status == gkPointOk;
+    if (counted) fprintf(out, "%ld", p->derivatives);
+    fputc(',', out);
+    for (int k = 0; k < pd_limitCount; ++k) {
+      if (counted && strcmp(p->variant, "fixed") != 0) fprintf(out, "%ld", p->limited[k]);
+      fputc(',', out);
+    }
     pdu_csv_text(out, p->note);
     fputc('\n', out);
   }

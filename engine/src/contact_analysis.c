@@ -99,6 +99,47 @@ static int previous_face(const pdContactId* previous, int count, int vertexBody,
   return -1;
 }
 
+// The face of jf an edge-edge contact of `previous` hands vertex `vertex` of vertexBody over to, or -1: where the
+// contact's edge on vertexBody ends at that vertex and the vertex (q, jf's frame) lies within `reach` of its edge e_F
+// on jf, the deeper of e_F's two faces below which q lies and over whose polygon it projects (§4.4's EE → VF, design
+// note "hand-overs"). Edge e_F's crossing with an edge ending at v has passed v, which now lies in the wedge of e_F's
+// faces, the pair's depth d from e_F: its depth below each face is d times the cosine between that face's normal
+// and the pair's normal, so the deeper face is the one nearer the predecessor's normal, and the force goes on along
+// it. The nearest face (the other side of the wedge, which v crossed in this step) turns the normal by up to the
+// wedge's angle and reads a fraction of the depth. A vertex farther from e_F than a new edge pair may be deep did
+// not come from that crossing, and takes its face by the rules below.
+// Distance from q to the segment a–b, m.
+static double segment_distance(pdVec3 a, pdVec3 b, pdVec3 q) {
+  pdVec3 u = pd_v3_sub(b, a);
+  double s = pd_v3_dot(pd_v3_sub(q, a), u) / pd_v3_dot(u, u);
+  s = s < 0.0 ? 0.0 : s > 1.0 ? 1.0 : s;
+  return pd_v3_norm(pd_v3_sub(q, pd_v3_muladd(a, s, u)));
+}
+
+static int face_after_edge_pair(const pdModel* m, const pdContactId* previous, int count, int vertexBody, int vertex,
+                                int faceBody, pdVec3 q, double tol, double over, double reach) {
+  const pdPolyhedron* sv = &m->bodies[vertexBody].shape;
+  const pdPolyhedron* sf = &m->bodies[faceBody].shape;
+  int face = -1;
+  double deepest = tol;
+  for (int i = 0; i < count; ++i) {
+    const pdContactId* c = &previous[i];
+    if (c->kind != pd_contactEE) continue;
+    int edgeV, edgeF;
+    if (c->body1 == vertexBody && c->body2 == faceBody) edgeV = c->feat1, edgeF = c->feat2;
+    else if (c->body2 == vertexBody && c->body1 == faceBody) edgeV = c->feat2, edgeF = c->feat1;
+    else continue;
+    if (sv->edges[edgeV].v[0] != vertex && sv->edges[edgeV].v[1] != vertex) continue;
+    const pdEdge* e = &sf->edges[edgeF];
+    if (segment_distance(sf->vertices[e->v[0]], sf->vertices[e->v[1]], q) > reach) continue;
+    for (int k = 0; k < 2; ++k) {
+      int f = sf->edges[edgeF].f[k];
+      double d = face_depth(sf, f, q);
+      if (d > deepest && projects_inside(sf, f, q, over)) deepest = d, face = f;
+    }
+  }
+  return face;
+}
 
 // The bodies' penetration depth at their poses (the separating-axis test's minimum overlap over the faces of their
 // Minkowski difference, 0 when apart), m.
@@ -261,6 +302,9 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
     // off it onto the next face is found there now, so that its contact hands over in this commit (a successor found
     // only at the next commit leaves the vertex without a contact for a step)
     if (face >= 0 && !projects_inside(sf, face, q, fmax(tol, flushTol))) face = -1;
+    // the successor of an edge pair whose crossing passed this vertex: the face that carries its normal on
+    if (face < 0) face = face_after_edge_pair(m, previous, previousCount, iv, i, jf, q, tol, fmax(tol, flushTol),
+                                             EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax);
     // a new contact: the face whose plane it crossed during the step. Depth alone misleads where the
     // vertex also lies just inside another plane (a brick's corner a roundoff inside the side plane of
     // the brick below, which it slides along, while it sinks into the top face).
@@ -502,17 +546,8 @@ static double least_face_overlap(const pdPolyhedron* sa, const pdPolyhedron* sb,
   return least;
 }
 
-// Does the edge pair (ea of A, eb of B) continue one of the contacts `broken` (contact_analysis.h)?
-static bool continues_broken(const pdModel* model, int ia, int ea, int ib, int eb, const pdContactId* broken,
-                             int brokenCount) {
-  pdContactId id = {ia, ib, pd_contactEE, ea, eb};
-  for (int k = 0; k < brokenCount; ++k)
-    if (pd_contact_continues(model, &broken[k], &id)) return true;
-  return false;
-}
-
-static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, const pdContactId* broken,
-                   int brokenCount, pdContactGeom* out, int capacity, int n) {
+static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
+                   int capacity, int n) {
   const pdPolyhedron* sa = &model->bodies[ia].shape;
   const pdPolyhedron* sb = &model->bodies[ib].shape;
   pdMat3 rel;  // B in A's frame
@@ -610,19 +645,20 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
       pdVec3 onB = pd_v3_add(g.point, pd_v3_scale(g.normal, 0.5 * g.depth));  // on B's edge
       pdVec3 onAinB = pd_mat3_tmulv(&rel, pd_v3_sub(onA, off));
       if (!inside_body(sa, onB, tolA) || !inside_body(sb, onAinB, tolB)) {
-        // (a pair deeper than the new-pair allowance, kept above for the bodies' penetration P, may have its points
-        // up to δ_max + P outside: a 1 cm hull entering a body 58 δ_max deep with no contact, soak seed 32 scene
-        // 733, had its edge pair refused here at δ_max)
-        // the successor of a hand-over (an edge pair that continues a contact of C0 that no longer tracks) gets the
-        // deep pair's slack at any depth: its predecessor carried the pair this deep (soak seed 3, scene 8454: a
-        // successor on the same edge was refused here at 2.5 δ_max and the pair sank 6.5 δ_max)
-        bool deep = g.depth > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax;
-        if (!deep && brokenCount > 0 && continues_broken(model, ia, i, ib, j, broken, brokenCount)) {
+        // Where the bodies interpenetrate by P, a pair deeper than δ_max may have its points up to δ_max + P outside
+        // (still within its depth): one slack for every depth, so that acceptance does not jump where the depth
+        // crosses the new-pair allowance. With δ_max alone below 3 δ_max and δ_max + P above it, an edge pair 1.3 and
+        // 2.7 δ_max deep was refused until no pair of features was left (soak campaign 43, scene 6651: 3.2 δ_max
+        // between samples), another was found only at 3.0 δ_max; a 1 cm hull entering a body 58 δ_max deep (seed 32,
+        // scene 733) and a hand-over's successor on the same edge at 2.5 δ_max (seed 3, scene 8454) were refused at
+        // δ_max. P is formed only for a pair whose points the δ_max slack leaves outside.
+        double slack = fmin(g.depth, deltaMax);
+        if (!inside_body(sa, onB, slack) || !inside_body(sb, onAinB, slack)) {
+          if (!(g.depth > deltaMax)) continue;
           if (isnan(penetration)) penetration = penetration_depth(sa, pa, sb, pb);
-          deep = true;
+          slack = fmin(g.depth, deltaMax + penetration);
+          if (!inside_body(sa, onB, slack) || !inside_body(sb, onAinB, slack)) continue;
         }
-        double slack = deep ? fmin(g.depth, deltaMax + penetration) : fmin(g.depth, deltaMax);
-        if (!inside_body(sa, onB, slack) || !inside_body(sb, onAinB, slack)) continue;
         pdVec3 u = pd_v3_scale(g.normal, -1.0);  // from A to B
         double overlap = fmin(overlap_along(sa, sb, &rel, off, u), overlap_along(sa, sb, &rel, off, g.normal));
         if (g.depth > overlap + tolA + tolB) continue;
@@ -686,12 +722,6 @@ static int drop_coincident(pdContactGeom* c, int count, int lowBody) {
 int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, const pdPose* pa0,
                      const pdPose* pb0, const pdContactId* previous, int previousCount, pdContactGeom* out,
                      int capacity) {
-  return pd_contacts_find_handover(model, ia, pa, ib, pb, pa0, pb0, previous, previousCount, NULL, 0, out, capacity);
-}
-
-int pd_contacts_find_handover(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
-                              const pdPose* pa0, const pdPose* pb0, const pdContactId* previous, int previousCount,
-                              const pdContactId* broken, int brokenCount, pdContactGeom* out, int capacity) {
   PD_ASSERT(ia != ib && ia >= 0 && ib >= 0 && ia < model->bodyCount && ib < model->bodyCount);
   PD_ASSERT((pa0 == NULL) == (pb0 == NULL));
   if (ia > ib) {
@@ -704,7 +734,7 @@ int pd_contacts_find_handover(const pdModel* model, int ia, const pdPose* pa, in
   int n = 0;
   n = find_vf(model, ia, pa, pa0, ib, pb, pb0, previous, previousCount, out, capacity, n);
   n = find_vf(model, ib, pb, pb0, ia, pa, pa0, previous, previousCount, out, capacity, n);
-  n = find_ee(model, ia, pa, ib, pb, broken, brokenCount, out, capacity, n);
+  n = find_ee(model, ia, pa, ib, pb, out, capacity, n);
   if (n > capacity) return n;
   n = drop_coincident(out, n, ia);
   // the contact state is kept sorted by id (§4.4): sort this pair's contacts (few: insertion sort)

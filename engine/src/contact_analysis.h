@@ -54,12 +54,6 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
                      const pdPose* pb0, const pdContactId* previous, int previousCount, pdContactGeom* out,
                      int capacity);
 
-// pd_contacts_find, told which of the pair's contacts of `previous` no longer track (`broken`, nullable): an edge pair
-// that continues one of them (pd_contact_continues) is its successor, the same touch on the next features, and gets
-// the slack of a pair as deep as the bodies' penetration (find_ee).
-int pd_contacts_find_handover(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb,
-                              const pdPose* pa0, const pdPose* pb0, const pdContactId* previous, int previousCount,
-                              const pdContactId* broken, int brokenCount, pdContactGeom* out, int capacity);
 
 // Does contact b continue contact a of the same pair (a hand-over): on one of the two bodies, a vertex or edge of each
 // that share a vertex, so the touch moved from one feature to the next over their common vertex (a vertex onto the

@@ -12,7 +12,7 @@
 //   its farthest face plane, less that tolerance. A vertex in the exempt list keeps its face while it is over the
 //   face's polygon (find_vf's face continuity): margin, how far its projection is inside the polygon.
 // - EE, edges ea of A and eb of B: each edge's closest point within max(tol, δ_max) + P of inside the other body
-//   (the slack find_ee allows; P, the bodies' penetration depth, only for a pair deeper than 3 δ_max), so neither
+//   (the slack find_ee allows; P, the bodies' penetration depth, for a pair deeper than δ_max), so neither
 //   edge may lie wholly beyond one face plane of the other body by more. A motion m moves the edge by at most m
 //   and raises P by at most m (below), so the margin is half of how far beyond that both ends of an edge lie
 //   (per edge).

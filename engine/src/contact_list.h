@@ -84,7 +84,6 @@ typedef struct searchPart {
   pdContactGeom* found;
   int foundCount, foundCapacity;
   pdContactId* previous;  // (capacity) scratch: the ids of one pair's contacts of C0
-  pdContactId* broken;    // (capacity) scratch: those of them that no longer track
 } searchPart;
 
 // A contact of C1 that is not in C0.
@@ -312,10 +311,10 @@ void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose*
 // with contact events, and their release.
 void pd_contact_search_create(const pdModel* model, pdContactSet* set, const bool* fixed);
 void pd_contact_search_free(pdContactSet* set);
-// Broad phase over the step from poses0 to poses1 (every moving body's box covers both ends): the pairs in
-// set->pairs; returns their number.
-int pd_contact_search_broad_phase(const pdModel* model, pdContactSet* set, const pdPose* poses0,
-                                  const pdPose* poses1);
+// Broad phase over the step of h from y0 (poses0) to y1 (poses1): every moving body's box covers both ends and how far
+// its turn may carry its points off their chords in between; the pairs in set->pairs; returns their number.
+int pd_contact_search_broad_phase(const pdModel* model, pdContactSet* set, const double* y0, const double* y1,
+                                  double h, const pdPose* poses0, const pdPose* poses1);
 // Tunnelling guard over the step of h just analysed: whether a listed pair moved too far relative to each other, and
 // then the shorter step to retry (*hRetry).
 bool pd_contact_search_travel_retry(const pdModel* model, pdContactSet* set, int pairCount, double h,

@@ -13,6 +13,7 @@
 #include "grow.h"
 #include "model_contact.h"
 #include "onsets.h"
+#include "state_layout.h"
 
 // Tunnelling guard: over one step, two bodies whose swept boxes overlap may move relative to each other by
 // at most this fraction of the thinner one's width. A quarter keeps a vertex that crossed a face within
@@ -98,15 +99,39 @@ static void add_candidate(pdContactSet* set, const candidate* c) {
   set->candidates[set->candidateCount++] = *c;
 }
 
-// Broad phase over the step: each moving body's box covers its boxes at both ends of the step, so a pair
-// that met and parted (or tunnelled) inside the step is listed too. Returns the number of pairs.
-int pd_contact_search_broad_phase(const pdModel* model, pdContactSet* set, const pdPose* poses0,
-                                  const pdPose* poses1) {
+// The rotation angle from pose p0 to pose p1, rad (0 … π).
+static double turn_angle(const pdPose* p0, const pdPose* p1) {
+  pdMat3 r0t = pd_mat3_transpose(&p0->R);
+  pdMat3 d = pd_mat3_mul(&p1->R, &r0t);
+  return acos(fmax(-1.0, fmin(1.0, 0.5 * (d.m[0][0] + d.m[1][1] + d.m[2][2] - 1.0))));
+}
+
+// How far a moving body's points may stray over a step of h from the chords between their end positions by its turn,
+// m (yb0, yb1 its numbers at the step's ends). Turning uniformly by φ about an axis, a point at ρ from it has
+// |p''| = ρ φ²/h², and its path strays from its chord by at most λ(1 − λ) h²/2 |p''| ≤ ρ φ²/8 (the interpolation
+// error in integral form, in norm): twice that for safety, as vertex_moves' sag, at ρ ≤ r, and at most 2r (a point
+// stays on its circle). φ = h |ω|, the larger of the ends', or the angle between the end poses if larger: a spin of more
+// than half a turn a step shows a smaller one. The end poses alone miss it: a 0.4 m bar turning 0.5 rad in a step swings
+// its end 6 mm beyond both. The velocities' change is left out, as in the guard's move bound: gravity bends a path by
+// g h²/8, 0.12 mm over the longest default step, and contact forces act on pairs that are listed already.
+static double sway(const double* yb0, const double* yb1, double h, double r, const pdPose* p0, const pdPose* p1) {
+  double turn = fmax(h * fmax(pd_v3_norm(pd_layout_w(yb0)), pd_v3_norm(pd_layout_w(yb1))), turn_angle(p0, p1));
+  return r * fmin(0.25 * turn * turn, 2.0);
+}
+
+// Broad phase over the step: each moving body's box covers its boxes at both ends of the step and how far its points
+// may stray from their chords in between (sway), so a pair that met and parted (or tunnelled) inside the step is
+// listed too, and the tunnelling guard sees it: a spinning body whose corner swings through the floor between two
+// steps' ends. Returns the number of pairs.
+int pd_contact_search_broad_phase(const pdModel* model, pdContactSet* set, const double* y0, const double* y1,
+                                  double h, const pdPose* poses0, const pdPose* poses1) {
   for (int k = 0; k < model->movingCount; ++k) {
     int i = model->movingBodies[k];
+    const double *yb0 = y0 + PD_BODY_STATE_SIZE * k, *yb1 = y1 + PD_BODY_STATE_SIZE * k;
+    double margin = sway(yb0, yb1, h, model->bodies[i].radius, &poses0[i], &poses1[i]);
     pdAabb a = pd_aabb_of(&model->bodies[i].shape, poses0[i].x, &poses0[i].R);
     pdAabb b = pd_aabb_of(&model->bodies[i].shape, poses1[i].x, &poses1[i].R);
-    for (int d = 0; d < 3; ++d) a.lo[d] = fmin(a.lo[d], b.lo[d]), a.hi[d] = fmax(a.hi[d], b.hi[d]);
+    for (int d = 0; d < 3; ++d) a.lo[d] = fmin(a.lo[d], b.lo[d]) - margin, a.hi[d] = fmax(a.hi[d], b.hi[d]) + margin;
     set->boxes[i] = a;
   }
   // grown between steps: the analysis runs after a step, outside the derivative
@@ -124,10 +149,7 @@ int pd_contact_search_broad_phase(const pdModel* model, pdContactSet* set, const
 // How far body i's points move at most between two poses, m: the centre's displacement plus the largest
 // vertex radius times the rotation angle.
 static double travel(const pdBody* b, const pdPose* p0, const pdPose* p1) {
-  pdMat3 r0t = pd_mat3_transpose(&p0->R);
-  pdMat3 d = pd_mat3_mul(&p1->R, &r0t);  // the rotation over the step
-  double cosAngle = fmax(-1.0, fmin(1.0, 0.5 * (d.m[0][0] + d.m[1][1] + d.m[2][2] - 1.0)));
-  return pd_v3_norm(pd_v3_sub(p1->x, p0->x)) + b->radius * acos(cosAngle);
+  return pd_v3_norm(pd_v3_sub(p1->x, p0->x)) + b->radius * turn_angle(p0, p1);
 }
 
 // The planes that bound where a point may end inside body i at the step's end (4 numbers a plane: normal, offset;
@@ -394,16 +416,11 @@ static void find_range(void* ctx, int part, int begin, int end) {
     set->pairFoundCount[p] = 0;
     if (set->certified[p]) continue;
     int a = set->pairs[p].a, b = set->pairs[p].b, first = set->pairPrevious[p], count = set->pairPreviousCount[p];
-    int brokenCount = 0;  // its contacts of C0 that no longer track: their successors are hand-overs
-    for (int k = 0; k < count; ++k) {
-      sp->previous[k] = set->items[first + k].id;
-      if (!set->eval[first + k].tracked) sp->broken[brokenCount++] = set->items[first + k].id;
-    }
+    for (int k = 0; k < count; ++k) sp->previous[k] = set->items[first + k].id;
     int n = 0;
     if (set->touching[p]) {
-      while ((n = pd_contacts_find_handover(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b],
-                                            sp->previous, count, sp->broken, brokenCount, sp->found + sp->foundCount,
-                                            sp->foundCapacity - sp->foundCount)) >
+      while ((n = pd_contacts_find(job->model, a, &poses1[a], b, &poses1[b], &poses0[a], &poses0[b], sp->previous, count,
+                                   sp->found + sp->foundCount, sp->foundCapacity - sp->foundCount)) >
              sp->foundCapacity - sp->foundCount) {
         sp->foundCapacity = 2 * (sp->foundCount + n);
         sp->found = pd_grow(sp->found, sp->foundCapacity, sizeof *sp->found);

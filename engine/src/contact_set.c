@@ -69,10 +69,8 @@ void pd_contact_set_reserve_list(pdContactSet* set, int capacity) {
   set->bodyList = pd_grow(set->bodyList, 2 * c, sizeof *set->bodyList);
   if (set->broad) {  // a view (pd_contact_set_create_view) has no contact events or stability bound
     set->eval = pd_grow(set->eval, c, sizeof *set->eval);
-    for (int part = 0; part < 2; ++part) {
+    for (int part = 0; part < 2; ++part)
       set->search[part].previous = pd_grow(set->search[part].previous, c, sizeof *set->search[part].previous);
-      set->search[part].broken = pd_grow(set->search[part].broken, c, sizeof *set->search[part].broken);
-    }
     set->stability = pd_grow(set->stability, c, sizeof *set->stability);
   } else {
     set->captured = pd_grow(set->captured, c, sizeof *set->captured);
@@ -134,7 +132,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->next);
   free(set->captured);
   free(set->recordedY);
-  for (int part = 0; part < 2; ++part) free(set->search[part].previous), free(set->search[part].broken);
+  for (int part = 0; part < 2; ++part) free(set->search[part].previous);
   free(set->force);
   free(set->stability);
   free(set->bodyFirst);
@@ -454,7 +452,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   double* analysisSeconds = &s->stageSeconds[pd_stageContactAnalysis];
 
   // 0. no tunnelling: bodies that may meet must not pass through each other's thinnest width in one step
-  int pairCount = pd_contact_search_broad_phase(model, set, set->poses0, set->poses1);
+  int pairCount = pd_contact_search_broad_phase(model, set, s->y, y1, h, set->poses0, set->poses1);
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageBroadPhase]);
   if (pd_contact_search_travel_retry(model, set, pairCount, h, hRetry)) {
     ++s->count.travelRetries;

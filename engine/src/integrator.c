@@ -282,6 +282,8 @@ typedef struct stepOutcome {
   double wanted;
   bool eventCut;
   bool gaveUp;  // a probation's trial at its floor was rejected (nothing taken, s->h unchanged)
+  pdStepLimit wantedLimit;  // what set `wanted`
+  pdStepLimit cutLimit;     // with eventCut: the event (pd_limitTravel or pd_limitEvent)
 } stepOutcome;
 
 // Dense output (dense_output.h): an accepted step that passes the time the state must next be presented at keeps
@@ -321,11 +323,13 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
   pd_contact_set_hold_modes(s->contacts, s->onsets == pd_onsetsHeld);
   derivative(model, s, s->t, s->y, w.k1);
   bool eventCut = false;
+  pdStepLimit cutLimit = pd_limitEvent;  // what cut the step, when eventCut
   for (;;) {
     // a step cut short to land on a time (one_step's `land`) says nothing about a longer one: s->h keeps the wanted
     // size
     bool cut = hMax < s->h;
     double h = cut ? hMax : s->h;
+    pdStepLimit limit = !cut ? s->hLimit : eventCut ? cutLimit : pd_limitLanding;
     bool atMinimum = h <= set->dtmin;
     // the trial, then the contact events and the commit, timed as consecutive laps
     pdStopwatch watch = pd_stopwatch_start();
@@ -343,6 +347,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
         return 0.0;
       }
       s->h = fmax(set->dtmin, NONFINITE_SHRINK * h);
+      s->hLimit = pd_limitError;
       continue;
     }
     double tolTrial = probation ? probation->tol : set->tol;
@@ -352,22 +357,25 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       if (probation && shrink * h < probation->floor) {
         // a trial at the floor itself was rejected: give up; else the next trial is the floor
         if (h <= probation->floor) {
-          if (outcome) *outcome = (stepOutcome){s->h, eventCut, true};
+          if (outcome) *outcome = (stepOutcome){s->h, eventCut, true, s->hLimit, cutLimit};
           return 0.0;
         }
         shrink = probation->floor / h;
       }
       s->h = fmax(set->dtmin, shrink * h);
+      s->hLimit = pd_limitError;
       continue;
     }
     // contact events (Fig. 8): a new contact's onset or a reversal inside the step may shorten it; a
     // virtual contact restarts it with the contact list grown
     double hRetry = h;
     const double* yMid = trial == trial_doubling ? w.half : NULL;  // the first half step's end
+    long travelRetries = s->count.travelRetries;
     pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, yMid, &hRetry, &watch);
     if (verdict == pd_eventRetry) {
       hMax = hRetry;
       eventCut = true;
+      cutLimit = s->count.travelRetries > travelRetries ? pd_limitTravel : pd_limitEvent;
       continue;
     }
     if (verdict == pd_eventRestart) {
@@ -380,24 +388,31 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     pd_contact_events_commit(model, s, w.trial, &watch);
     renormalise_quaternions(model, s->y);
     ++s->count.accepted;
+    ++s->count.stepsLimited[limit];
     if (!cut) {
       double grow = norm > 0.0 ? STEP_SAFETY * pow(set->tol / norm, 1.0 / order) : STEP_GROW_MAX;
       grow = fmin(STEP_GROW_MAX, fmax(STEP_SHRINK_MIN, grow));
       s->h = fmin(set->dtmax, fmax(set->dtmin, grow * h));
+      s->hLimit = grow * h >= set->dtmax ? pd_limitLargest : pd_limitError;
     } else if (eventCut) {
       // a step a contact event cut short grows from what it took, as any step does: tried again at the size the
       // event cut, the next step would meet the same contact (an onset whose interpolation came early, a tunnelling
       // guard) and be cut again, one whole trial lost each time
+      if (STEP_GROW_MAX * h < s->h) s->hLimit = cutLimit;
       s->h = fmin(s->h, STEP_GROW_MAX * h);
     }
     // the tunnelling guard's step for the motion as it goes on: a longer trial would only be cut back to it
-    s->h = fmax(set->dtmin, fmin(s->h, pd_contact_set_travel_step(s->contacts)));
-    if (outcome) *outcome = (stepOutcome){s->h, eventCut, false};
+    double travelStep = pd_contact_set_travel_step(s->contacts);
+    if (travelStep < s->h) s->hLimit = pd_limitTravel;
+    s->h = fmax(set->dtmin, fmin(s->h, travelStep));
+    if (outcome) *outcome = (stepOutcome){s->h, eventCut, false, s->hLimit, cutLimit};
     // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge (an implicit
     // trial has none: stableFraction INFINITY)
     if (stableFraction < INFINITY) {
       bool tightNeeded;
-      s->h = fmax(set->dtmin, pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction, &tightNeeded));
+      double stable = pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction, &tightNeeded);
+      if (stable < s->h) s->hLimit = pd_limitStability;
+      s->h = fmax(set->dtmin, stable);
       s->count.stabilityTight += tightNeeded;
     }
     return h;
@@ -417,12 +432,15 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
   }
   pdImplicit* im = s->implicit;
-  stepOutcome out = {0.0, false, false};
+  stepOutcome out = {0.0, false, false, pd_limitError, pd_limitEvent};
   if (!pd_implicit_active(im)) {
     double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, &out);
     // s->h is now the bound's step: on a switch the implicit method starts from the step the error control wanted
     bool held = !out.eventCut && out.wanted >= PD_IMPLICIT_HELD_RATIO * s->h;
-    if (taken > 0.0 && pd_implicit_note_explicit(im, held, s->h, s->t)) s->h = out.wanted;
+    if (taken > 0.0 && pd_implicit_note_explicit(im, held, s->h, s->t)) {
+      s->h = out.wanted;
+      s->hLimit = out.wantedLimit;
+    }
     return taken;
   }
   // on probation (implicit.h): the implicit step must reach PD_IMPLICIT_HELD_RATIO × the step the bound held step
@@ -434,15 +452,21 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
   // doubling takes it, from the bound's step, and the probation waits for the next
   if (onProbation && hMax < limits.floor) {
     double wanted = s->h;
+    pdStepLimit wantedLimit = s->hLimit;
     s->h = boundStep;
+    s->hLimit = pd_limitStability;
     double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
-    if (taken > 0.0) s->h = fmax(s->h, wanted);
+    if (taken > 0.0 && wanted > s->h) {
+      s->h = wanted;
+      s->hLimit = wantedLimit;
+    }
     return taken;
   }
   double taken = adaptive_step(model, s, hMax, trial_implicit, 3.0, INFINITY, onProbation ? &limits : NULL, &out);
   if (out.gaveUp) {
     // on probation and not paying: step doubling takes this step, from the bound's step it was held to
     s->h = boundStep;
+    s->hLimit = pd_limitStability;
     pd_implicit_deactivate(im, true, s->t);
     return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
   }
@@ -451,7 +475,10 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     s->count.implicitSteps += 1;
     // a step an event cut (a body sliding fast at its tunnelling guard) is the step the next one will meet too:
     // the implicit trial is dear, so it grows from there rather than from what its error control wants
-    if (out.eventCut) s->h = fmin(s->h, PD_IMPLICIT_GROWTH_AFTER_CUT * taken);
+    if (out.eventCut && PD_IMPLICIT_GROWTH_AFTER_CUT * taken < s->h) {
+      s->h = PD_IMPLICIT_GROWTH_AFTER_CUT * taken;
+      s->hLimit = out.cutLimit;
+    }
     // back to step doubling when its bound would allow 1/PD_IMPLICIT_HELD_RATIO of the implicit step: an implicit
     // trial costs about two explicit ones on a small system
     double worth = (out.eventCut ? fmin(out.wanted, taken) : out.wanted) / PD_IMPLICIT_HELD_RATIO;

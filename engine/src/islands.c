@@ -194,6 +194,7 @@ static void island_load(const pdModel* model, const pdState* s, struct pdIslandS
     h = fmin(h, set->h[k]);
   }
   sub->h = h;
+  sub->hLimit = pd_limitError;  // a first step: the error control rejects it down or grows it
   for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = l;
   pd_contact_set_scatter(model, s, contacts, count, &is->model, sub, set->toSub);
   for (int l = 0; l < is->model.bodyCount; ++l) set->toSub[is->toScene[l]] = -1;
@@ -291,6 +292,7 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->refinements += c->refinements;
   to->stabilityTight += c->stabilityTight;
   to->implicitSteps += c->implicitSteps;
+  for (int k = 0; k < pd_limitCount; ++k) to->stepsLimited[k] += c->stepsLimited[k];
   to->searchesSkipped += c->searchesSkipped;
   to->contactsMade += c->contactsMade;
   to->contactsVirtual += c->contactsVirtual;

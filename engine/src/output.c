@@ -660,6 +660,11 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
           pd_state_contact_count(state));
   if (!info->stepper) {  // the soft engine's own: what it located, what it corrected and what that may cost (docs/events.md)
     const pdCounters* c = &state->count;
+    // what set the accepted steps' sizes: what the step count was spent on (docs/integration.md)
+    fputs("  \"steps_limited_by\": {", out);
+    for (int k = 0; k < pd_limitCount; ++k)
+      fprintf(out, "%s\"%s\": %ld", k ? ", " : "", pd_step_limit_name((pdStepLimit)k), c->stepsLimited[k]);
+    fputs("},\n", out);
     fprintf(out,
             "  \"events\": {\"onsets_located\": %ld, \"onsets_corrected\": %ld, \"onset_bound_max\": ",
             c->contactsMade + c->contactsVirtual - c->onsetsInterpolated, c->onsetsInterpolated);

@@ -52,6 +52,7 @@ void pd_state_reset_own(const pdModel* model, pdState* s) {
   pd_dense_discard(s);  // first: a presented state's y and contacts are the presentation's
   s->t = 0.0;
   s->h = s->options.h > 0.0 ? s->options.h : set->dt;
+  s->hLimit = pd_limitError;
   s->n = PD_BODY_STATE_SIZE * model->movingCount;
   pd_contact_set_clear(s->contacts);
   s->stepper = s->options.stepper;
@@ -148,3 +149,9 @@ const char* pd_onsets_name(pdOnsets onsets) {
 }
 
 const char* pd_islands_name(pdIslands islands) { return islands == pd_islandsOn ? "on" : "off"; }
+
+const char* pd_step_limit_name(pdStepLimit limit) {
+  static const char* const names[pd_limitCount] = {"error", "largest", "stability", "travel", "event", "landing"};
+  PD_ASSERT(limit >= 0 && limit < pd_limitCount);
+  return names[limit];
+}

@@ -446,6 +446,22 @@ class PrecisionReport(ReportInDir):
         if any(r["engine"] == "bullet" and r["status"] == "ok" for r in self.rows):  # a build with Bullet
             self.assertGreater(checked, 0)
 
+    def test_what_set_polydyns_steps_is_read_from_the_point_it_reaches_at(self):
+        limits = ("error", "largest", "stability", "travel", "event", "landing")
+        checked = 0
+        for row in self.table("against"):
+            if row["experiment"].startswith("median") or row["soft_to_tolerance"] != "at_most":
+                continue
+            point = [r for r in self.rows if r["experiment"] == row["experiment"] and r["engine"] == "soft"
+                     and r["variant"] == "implicit" and float(r["value"]) == float(row["soft_setting_value"])]
+            self.assertEqual(len(point), 1, row["experiment"])
+            self.assertEqual(row["soft_derivatives"], point[0]["derivatives"], row["experiment"])
+            for limit in limits:
+                self.assertEqual(row["soft_steps_" + limit], point[0]["steps_" + limit], f'{row["experiment"]} {limit}')
+            self.assertEqual(sum(int(row["soft_steps_" + l]) for l in limits), int(row["soft_steps"]), row["experiment"])
+            checked += 1
+        self.assertGreater(checked, 0)
+
     def test_one_curve_per_experiment_and_engine_variant_with_the_cost_to_its_tolerance(self):
         got = {(r["experiment"], f'{r["engine"]} {r["variant"]}', r["setting"]): r for r in self.table("precision")}
         want = {(r["experiment"], f'{r["engine"]} {r["variant"]}', r["setting"]) for r in self.rows}

@@ -135,6 +135,21 @@ typedef enum pdIslands {
 // The island mode's name in summary.json: "on" or "off".
 PD_API const char* pd_islands_name(pdIslands islands);
 
+// What set the size of an accepted step of an error-controlled stepper (pdCounters.stepsLimited; docs/integration.md,
+// "What sets the steps"): what a run's step count is spent on.
+typedef enum pdStepLimit {
+  pd_limitError,      // the error control: its growth from the step before, or its shrink after a rejected trial
+  pd_limitLargest,    // the scene's largest step, dtmax
+  pd_limitStability,  // the contacts' stability bound (step doubling's steps; §3.3)
+  pd_limitTravel,     // the tunnelling guard: the step it allows the motion as it goes on, or a trial it cut back
+  pd_limitEvent,      // another contact event cut the step: an onset located, a stick–slip change refined
+  pd_limitLanding,    // cut to end on a time: a sync time between islands, the end of a call, a probation's floor
+  pd_limitCount
+} pdStepLimit;
+
+// The limit's name in summary.json ("error", "largest", "stability", "travel", "event", "landing").
+PD_API const char* pd_step_limit_name(pdStepLimit limit);
+
 typedef struct pdCounters {
   long accepted;     // accepted steps
   long rejected;     // rejected trial steps
@@ -147,6 +162,7 @@ typedef struct pdCounters {
   long stabilityTight;    // accepted steps whose limit needed the tight stability bound: the cheap bound allowed
                           // less than the step the error control wanted (docs/integration.md)
   long implicitSteps;     // accepted steps taken by the implicit method (pd_stepperImplicit; 0 with other steppers)
+  long stepsLimited[pd_limitCount];  // accepted steps by what set their size (pdStepLimit; the fixed stepper's: none)
   long searchesSkipped;   // pair searches (interference and contact search) a search certificate made needless
   long contactsMade;      // contacts added at the end of a step (found, approaching)
   long contactsVirtual;   // contacts added at the start of a step (onset within the first dt_min)
@@ -221,6 +237,7 @@ PD_API pdStateOptions pd_state_options_default(void);
 typedef struct pdState {
   double t;          // s
   double h;          // next step to try, s
+  pdStepLimit hLimit;  // what set h (counted in count.stepsLimited when a step of h is accepted)
   // The options the state was created with (pdStateOptions), as the steppers read them; read-only to the caller.
   pdStepper stepper;
   pdOnsets onsets;

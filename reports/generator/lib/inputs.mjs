@@ -16,11 +16,15 @@ export const SWEEP_HEADER_V1 = ['scene', 'engine', 'variant', 'setting', 'value'
   'wall_per_sim_second', 'steps', 'repeats', 'reference'];
 export const SWEEP_HEADER_V2 = [...SWEEP_HEADER_V1, 'self_error', 'self_reference', 'horizon_seconds'];
 export const SWEEP_HEADER = [...SWEEP_HEADER_V2, 'derivatives'];
+// what set the size of polydyn's accepted steps (pdStepLimit, docs/integration.md), one column each
+export const STEP_LIMITS = ['error', 'largest', 'stability', 'travel', 'event', 'landing'];
 export const PRECISION_HEADER = ['experiment', 'kind', 'engine', 'variant', 'setting', 'value', 'input', 'quantity', 'unit',
   'measured', 'expected', 'error', 'relative', 'tolerance', 'judged', 'status', 'wall_seconds', 'wall_per_sim_second', 'steps',
-  'repeats', 'cpu_seconds', 'cpu_per_sim_second', 'note'];
+  'repeats', 'cpu_seconds', 'cpu_per_sim_second', 'derivatives', ...STEP_LIMITS.map((l) => `steps_${l}`), 'note'];
+// before the derivative evaluations and the steps' limits were counted
+const PRECISION_HEADER_CPU = PRECISION_HEADER.filter((h) => h !== 'derivatives' && !STEP_LIMITS.some((l) => h === `steps_${l}`));
 // before the CPU time was measured
-const PRECISION_HEADER_WALL_ONLY = PRECISION_HEADER.filter((h) => !h.startsWith('cpu_'));
+const PRECISION_HEADER_WALL_ONLY = PRECISION_HEADER_CPU.filter((h) => !h.startsWith('cpu_'));
 export const PRECISION_STATUSES = ['ok', 'failed', 'no_measure', 'refused', 'not_built'];
 export const METRICS_HEADER = ['scene', 'engine', 'variant', 'reference', 'pos_err_final', 'pos_err_rms',
   'rot_err_final_rad', 'rot_err_rms_rad', 'energy_drift_rel', 'momentum_drift_rel', 'max_penetration_over_size',
@@ -264,7 +268,7 @@ export function readPrecision(dir) {
   const src = readText(dir, 'precision.csv');
   if (!src) return null;
   const rows = [];
-  for (const { line, f } of table(src, PRECISION_HEADER, [PRECISION_HEADER_WALL_ONLY])) {
+  for (const { line, f } of table(src, PRECISION_HEADER, [PRECISION_HEADER_CPU, PRECISION_HEADER_WALL_ONLY])) {
     if (f.experiment === '') throw new InputError(src.file, line, 'experiment: empty');
     const status = oneOf(f.status, PRECISION_STATUSES, 'status', src.file, line);
     if (status !== 'not_built' && !['tol', 'step', 'iterations'].includes(f.setting))
@@ -293,6 +297,11 @@ export function readPrecision(dir) {
       repeats: number(f.repeats, 'repeats', src.file, line, { integer: true }),
       cpu_seconds: number(f.cpu_seconds ?? '', 'cpu_seconds', src.file, line),
       cpu_per_sim_second: number(f.cpu_per_sim_second ?? '', 'cpu_per_sim_second', src.file, line),
+      derivatives: number(f.derivatives ?? '', 'derivatives', src.file, line, { integer: true }),
+      // null where not counted (the reference engines, polydyn's fixed step, files from before the counts)
+      steps_limited_by: STEP_LIMITS.every((l) => (f[`steps_${l}`] ?? '') !== '')
+        ? Object.fromEntries(STEP_LIMITS.map((l) => [l, number(f[`steps_${l}`], `steps_${l}`, src.file, line, { integer: true })]))
+        : null,
       note: f.note,
     };
     if (status === 'ok' && (row.error === null || row.wall_per_sim_second === null))

@@ -63,6 +63,7 @@ export function precision(prec, experiments) {
         label, ev, engine: pts[0].engine, variant: pts[0].variant, setting: pts[0].setting, judged,
         points: ordered.map((p) => ({ value: p.value, measured: p.measured, error: p.error, wall_seconds: p.wall_seconds,
           wall_per_sim_second: p.wall_per_sim_second, cpu_per_sim_second: p.cpu_per_sim_second ?? null, steps: p.steps,
+          derivatives: p.derivatives ?? null, steps_limited_by: p.steps_limited_by ?? null,
           status: p.status, note: p.note })),
         to_tolerance: to,
         // the same read on the CPU time, where every usable point has it (precision.csv before it: null)

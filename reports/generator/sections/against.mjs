@@ -6,6 +6,7 @@
 // one, so wall-time ratios drift with the load), else the wall time.
 import { esc, num, table } from '../lib/html.mjs';
 import { median } from '../lib/derive.mjs';
+import { STEP_LIMITS } from '../lib/inputs.mjs';
 
 const SOFT = 'soft implicit';
 // The project's targets for the median ratio (docs/validation.md, "Cost against the rigid engines").
@@ -21,20 +22,57 @@ function reach(e, ev, unit) {
     if (!best || t.wall_per_sim_second < best.cost) {
       const at = t.kind === 'at_most' ? c.points.find((p) => p.value === t.setting_value) : null;
       best = { cost: t.wall_per_sim_second, kind: t.kind, setting: c.setting, value: t.setting_value, loosest: c.points[0].value,
-        steps: at ? at.steps : null };
+        steps: at ? at.steps : null, derivatives: at ? at.derivatives ?? null : null,
+        limited: at ? at.steps_limited_by ?? null : null,
+        // simulated seconds of the run (the scene's tend), from the point's wall time and its rate
+        tend: at && at.wall_per_sim_second > 0 ? at.wall_seconds / at.wall_per_sim_second : null };
     }
   }
   return best;
 }
 
-// Why polydyn's cost on an experiment is what it is, from where its curve reaches the tolerance and the other's.
+// What each step limit means, in the words of the per-experiment table, and why it costs steps where it dominates.
+const LIMIT_WORDS = {
+  error: 'the error control',
+  largest: 'the largest step (dtmax)',
+  stability: 'the contacts’ stability bound',
+  travel: 'the tunnelling guard',
+  event: 'contact events (onsets located, stick–slip changes refined)',
+  landing: 'sync times between islands',
+};
+const LIMIT_WHY = {
+  error: 'the error control sets the steps even at the loosest tolerance',
+  largest: 'the scene’s largest step, dtmax, holds its free flight to shorter steps than the rigid engine’s',
+  stability: 'a soft contact must resolve each contact period: an explicit step is stable only below ~2.8/ω',
+  travel: 'the tunnelling guard lets a touching pair move at most 2 δ_max (or a quarter of the thinner width) per step',
+  event: 'a soft contact must resolve each impact: its onset is located and the steps after it grow from the cut',
+  landing: 'the islands’ sync times end its steps',
+};
+
+// The limits that set at least 5 % of the steps, largest first.
+function mainLimits(limited) {
+  const total = STEP_LIMITS.reduce((a, l) => a + limited[l], 0);
+  if (!(total > 0)) return [];
+  return STEP_LIMITS.filter((l) => limited[l] >= 0.05 * total).sort((a, b) => limited[b] - limited[a])
+    .map((l) => ({ limit: l, share: limited[l] / total }));
+}
+
+// Why polydyn's cost on an experiment is what it is, from where its curve reaches the tolerance and the other's, and
+// what set the size of its steps there (precision.csv's steps_* columns, where it has them).
 function bound(soft, other) {
-  if (soft.kind === 'at_most')
+  if (soft.kind !== 'at_most') return 'the error control: a tighter tolerance is needed to reach the answer';
+  const rigid = other && other.kind === 'at_most' && other.setting === 'step'
+    ? '; the rigid engine’s coarsest step reaches it too (a rigid contact resolves an impact within one step)' : '';
+  const main = soft.limited && soft.tend > 0 ? mainLimits(soft.limited) : [];
+  if (!main.length)
     return 'its loosest tolerance already reaches the answer: the steps resolve the contacts (a soft contact must resolve each ' +
-      'impact and each contact period, whatever the tolerance), not the error' +
-      (other && other.kind === 'at_most' && other.setting === 'step' ? '; the rigid engine’s coarsest step reaches it too (a rigid ' +
-        'contact resolves an impact within one step)' : '');
-  return 'the error control: a tighter tolerance is needed to reach the answer';
+      'impact and each contact period, whatever the tolerance), not the error' + rigid;
+  const rate = (n) => num(n / soft.tend);
+  return `its loosest tolerance already reaches the answer, so the error control does not set the cost: ${rate(soft.steps)} steps ` +
+    'per simulated second' + (other && other.steps !== null && other.tend > 0 ? ` (the rigid engine: ${num(other.steps / other.tend)})` : '') +
+    (soft.derivatives !== null ? `, ${rate(soft.derivatives)} derivative evaluations` : '') +
+    `, their size set by ${main.map((m) => `${Math.round(100 * m.share)} % ${LIMIT_WORDS[m.limit]}`).join(', ')}: ` +
+    `${LIMIT_WHY[main[0].limit]}${rigid}`;
 }
 
 export default {
@@ -102,11 +140,12 @@ export default {
       data: { unit, summary, experiments: perExperiment.map((x) => ({ experiment: x.experiment, soft: x.soft,
         ratios: Object.fromEntries(others.map((ev) => [ev, x.ratios[ev] ? x.ratios[ev].ratio : null])) })) },
       csv: [{ name: 'against', header: ['experiment', 'unit', ...others.map((ev) => `ratio_${ev.replace(' ', '_')}`), 'soft_cost',
-        'soft_to_tolerance', 'soft_setting_value', 'soft_steps'],
+        'soft_to_tolerance', 'soft_setting_value', 'soft_steps', 'soft_derivatives', ...STEP_LIMITS.map((l) => `soft_steps_${l}`)],
       rows: [
-        ...summary.map((s) => [`median over ${s.both} (${s.ev})`, unit, ...others.map((ev) => (ev === s.ev ? s.median_ratio : '')), '', '', '', '']),
+        ...summary.map((s) => [`median over ${s.both} (${s.ev})`, unit, ...others.map((ev) => (ev === s.ev ? s.median_ratio : '')), '', '', '', '',
+          '', ...STEP_LIMITS.map(() => '')]),
         ...perExperiment.map((x) => [x.experiment, unit, ...others.map((ev) => (x.ratios[ev] ? x.ratios[ev].ratio : '')), x.soft.cost,
-          x.soft.kind, x.soft.value, x.soft.steps]),
+          x.soft.kind, x.soft.value, x.soft.steps, x.soft.derivatives, ...STEP_LIMITS.map((l) => (x.soft.limited ? x.soft.limited[l] : ''))]),
       ] }],
     };
   },

@@ -1,0 +1,88 @@
+// What set each accepted step's size (pdCounters.stepsLimited, summary.json's `steps_limited_by`;
+// docs/integration.md, "What sets the steps"): every accepted step of an error-controlled stepper is counted under
+// exactly one limit, and the limit named is the one the scene is known to be held by. A 0.1 m cube and a fixed floor:
+// - falling free from rest for 0.3 s (no contact): the error control grows the step to the scene's dtmax, which then
+//   sets it (the parabola has no fifth derivative); no contact limit may appear;
+// - resting on the floor, step doubling alone (islands off: it does not fall asleep): the error control wants long steps and the contacts' stability bound
+//   (about 2.8/ω) sets them;
+// - sliding at 4 m/s on a nearly frictionless floor: the tunnelling guard lets a pair touching move at most 2 δ_max
+//   per step (0.5 ms at that speed), shorter than the stability bound allows.
+#include <setjmp.h>
+#include <stdbool.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "polydyn/model.h"
+#include "polydyn/state.h"
+#include "scene_run.h"
+
+static pdModel* cube_on_floor(const char* placement) {
+  char text[512];
+  snprintf(text, sizeof text,
+           "tend 0.3\nsample 100\n"
+           "cube floor grey 4 1 0.2\nfixed\nloc 1.5 0 -0.1\nmu 0.01\n"
+           "cube block red 0.1 0.1 0.1\n%s\nmu 0.01\n",
+           placement);
+  return compile_text(text);
+}
+
+// Runs m with the default stepper, or step doubling alone with islands off (no island falls asleep: `explicitOnly`);
+// checks that every accepted step is counted once and returns the final state.
+static pdState* run_limits(const pdModel* m, bool explicitOnly) {
+  pdState* s = NULL;
+  free(explicitOnly ? run_onsets_islands(m, PD_ONSETS_DEFAULT, pd_islandsOff, &s) : run(m, &s));
+  long sum = 0;
+  for (int k = 0; k < pd_limitCount; ++k) {
+    print_message("%-9s %ld\n", pd_step_limit_name((pdStepLimit)k), s->count.stepsLimited[k]);
+    sum += s->count.stepsLimited[k];
+  }
+  print_message("accepted  %ld\n", s->count.accepted);
+  assert_int_equal(sum, s->count.accepted);
+  return s;
+}
+
+// Runs m (run_limits) and checks that `limit` set more than half of its steps; returns
+// the final state (the caller frees it).
+static pdState* held_by(pdModel* m, bool explicitOnly, pdStepLimit limit) {
+  pdState* s = run_limits(m, explicitOnly);
+  assert_true(s->count.stepsLimited[limit] > s->count.accepted / 2);
+  return s;
+}
+
+static void test_a_free_fall_is_held_by_the_largest_step(void** state) {
+  (void)state;
+  pdModel* m = cube_on_floor("loc 0 0 2");
+  pdState* s = held_by(m, false, pd_limitLargest);
+  assert_int_equal(s->count.stepsLimited[pd_limitStability], 0);
+  assert_int_equal(s->count.stepsLimited[pd_limitTravel], 0);
+  pd_state_free(s);
+  pd_model_free(m);
+}
+
+static void test_a_resting_cube_is_held_by_the_stability_bound(void** state) {
+  (void)state;
+  pdModel* m = cube_on_floor("loc 0 0 0.05");
+  pd_state_free(held_by(m, true, pd_limitStability));
+  pd_model_free(m);
+}
+
+static void test_a_fast_sliding_cube_is_held_by_the_tunnelling_guard(void** state) {
+  (void)state;
+  pdModel* m = cube_on_floor("loc 0 0 0.05\nvel 4 0 0");
+  pd_state_free(held_by(m, false, pd_limitTravel));
+  pd_model_free(m);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_a_free_fall_is_held_by_the_largest_step),
+      cmocka_unit_test(test_a_resting_cube_is_held_by_the_stability_bound),
+      cmocka_unit_test(test_a_fast_sliding_cube_is_held_by_the_tunnelling_guard),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

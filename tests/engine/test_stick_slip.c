@@ -1,0 +1,107 @@
+// Stick–slip changes against closed forms (docs/events.md, "Stick–slip changes"): with bounded events and step
+// doubling (the paper's stepper) a change whose bound anywhere in its step (pd_transition_error_bound) is within the
+// tolerance's share stays inside its step, others are refined.
+// - stick to slip at a known time: a block at rest on a floor (μ 0.5) pushed by a horizontal force growing at r N/s
+//   sticks until r t = μ m g, t* = μ m g / r, then slides with m ẍ = r (t − t*): at tend it has slid
+//   x = μ g (tend − t*)³ / (6 t*) past where it stuck. It must slide that far within SLIDE_REL_TOL, keep every change
+//   it left inside a step within the tolerance's share, and agree with the paper's loop (every change refined,
+//   --events exact) at tol REFERENCE_TOL within AGREE_TOL of the slide;
+// - slip to stick: a block launched at v0 (0.3, 1, 2 m/s) on the floor stops after v0²/(2 μ g), with the same checks;
+//   from 1 m/s on its stop comes at a speed whose bound anywhere in the step exceeds the share, so it is refined
+//   (counted).
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "onset_bound.h"
+#include "polydyn/model.h"
+#include "polydyn/scene.h"
+#include "polydyn/state.h"
+#include "scene_run.h"
+
+#define G 9.81
+#define MU 0.5
+#define STICK_UNTIL 0.3  // s: t*, the force's ramp set from the block's mass
+#define TEND 0.5         // s
+// of the closed form's slide: the soft contact's own departures from the rigid closed form (its tangential springs'
+// deflection at the change, μ m g / k_t, and the block's settling on its normal springs at the start): measured up to
+// 2e-4 of it
+#define SLIDE_REL_TOL 2e-3
+// of the slide: bounded events against exact ones at tol REFERENCE_TOL. A change left inside its step adds at most
+// the tolerance's share to the error norm, tol × vmax in velocity, ~1e-7 m over the ~0.2 s that follow: a few 1e-6 of
+// these slides for the block's four contacts (measured: at most 1.0e-7 of the slide)
+#define AGREE_TOL 1e-5
+#define REFERENCE_TOL 1e-10
+
+// The block's x at tend and the run's counters; `pushed`: the ramped force from rest, else launched at v0.
+static double final_x(bool pushed, double v0, pdOnsets onsets, double tol, pdCounters* counters) {
+  char text[640];
+  const char* shape = "cube floor grey 3 3 0.2\nfixed\nloc 0 0 -0.1\nmu 0.5\ncube block red 0.2 0.15 0.1\n";
+  snprintf(text, sizeof text, "tend %g\nsample 100\ntol %g\n%sloc -1 0 0.05\nmu %g\n", TEND, tol, shape, MU);
+  pdModel* probe = compile_text(text);
+  double mass = probe->bodies[body_index(probe, "block")].mass;
+  pd_model_free(probe);
+  if (pushed)
+    snprintf(text, sizeof text, "tend %g\nsample 100\ntol %g\n%sloc -1 0 0.05\nmu %g\nforce 0 0 0 ramp %.17g 0 0\n",
+             TEND, tol, shape, MU, MU * mass * G / STICK_UNTIL);
+  else
+    snprintf(text, sizeof text, "tend %g\nsample 100\ntol %g\n%sloc -1 0 0.05\nmu %g\nvel %g 0 0\n", TEND, tol, shape,
+             MU, v0);
+  pdModel* m = compile_text(text);
+  pdState* s = NULL;
+  record* r = run_onsets(m, pd_stepperRK4Adaptive, onsets, &s);
+  double x = r->body[0][r->count - 1].x.x - (-1.0);
+  if (counters) *counters = s->count;
+  free(r);
+  pd_state_free(s);
+  pd_model_free(m);
+  return x;
+}
+
+// `refined`: the run must have refined a change (a fast one), else left its changes inside their steps (changes at
+// nearly no slip, whose bound anywhere in the step allows them).
+static void check(const char* what, bool pushed, double v0, double expected, bool refined) {
+  pdCounters c;
+  double x = final_x(pushed, v0, pd_onsetsBounded, 1e-6, &c);
+  double exact = final_x(pushed, v0, pd_onsetsExact, REFERENCE_TOL, NULL);
+  print_message("%s: slid %.7f m, closed form %.7f m, exact events at tol %g %.7f m; changes left in their step %ld "
+                "(largest bound %.2e), halvings %ld; |x - exact| %.1e of the slide\n",
+                what, x, expected, REFERENCE_TOL, exact, c.transitionsUnlocated, c.transitionBoundMax,
+                c.refinements, fabs(x - exact) / expected);
+  assert_true(fabs(x - expected) <= SLIDE_REL_TOL * expected);
+  assert_true(fabs(x - exact) <= AGREE_TOL * expected);
+  assert_true(c.transitionBoundMax <= PD_ONSET_TOL_SHARE * 1e-6);
+  assert_true(c.transitionsUnlocated > 0);
+  if (refined) assert_true(c.refinements > 0);
+}
+
+static void test_a_pushed_block_starts_to_slide_when_the_cone_is_reached(void** state) {
+  (void)state;
+  double slide = MU * G * pow(TEND - STICK_UNTIL, 3) / (6.0 * STICK_UNTIL);
+  check("block pushed from rest", true, 0.0, slide, false);
+}
+
+static void test_a_launched_block_stops_where_it_should(void** state) {
+  (void)state;
+  const double v0s[] = {0.3, 1.0, 2.0};
+  for (size_t k = 0; k < sizeof v0s / sizeof v0s[0]; ++k) {
+    char what[64];
+    snprintf(what, sizeof what, "block launched at %g m/s", v0s[k]);
+    check(what, false, v0s[k], v0s[k] * v0s[k] / (2.0 * MU * G), v0s[k] >= 1.0);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_a_pushed_block_starts_to_slide_when_the_cone_is_reached),
+      cmocka_unit_test(test_a_launched_block_stops_where_it_should),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
