@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "grow.h"
+#include "model_contact.h"
 
 typedef struct trace {
   pdContactId id;
@@ -80,6 +81,28 @@ bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const p
     return true;
   }
   return false;
+}
+
+static double tangential_energy(const pdContactParams* p, const pdSprings* s) {
+  return 0.5 * (p->k1t * pd_v3_dot(s->s1t, s->s1t) + p->k2t * pd_v3_dot(s->s2t, s->s2t));
+}
+
+double pd_history_spring_energy(const pdModel* model, const pdContactHistory* h) {
+  double e = 0.0;
+  for (int i = 0; i < h->count; ++i) {
+    const trace* t = &h->items[i];
+    if (t->taken) continue;
+    pdContactParams p = pd_model_contact_params(model, t->id.body1, t->id.body2);
+    e += tangential_energy(&p, &t->springs);
+  }
+  for (int i = 0; i < h->handovers.count; ++i) {
+    const trace* t = &h->handovers.items[i];
+    if (t->taken) continue;
+    pdContactParams p = pd_model_contact_params(model, t->id.body1, t->id.body2);
+    e += tangential_energy(&p, &t->springs) +
+         0.5 * (p.k1n * t->springs.s1n * t->springs.s1n + p.k2n * t->springs.s2n * t->springs.s2n);
+  }
+  return e;
 }
 
 static int compare_traces(const void* a, const void* b) {

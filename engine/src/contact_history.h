@@ -47,6 +47,11 @@ void pd_history_leave_handover(pdContactHistory* h, const pdContactId* id, const
 // *springs; the trace is forgotten; true. Else false.
 bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const pdContactId* id, pdVec3 normal,
                               const pdContactParams* params, pdSprings* springs);
+// The energy the kept traces will bring back, J: ½ k s² of the tangential springs of each trace left by force (its
+// normal springs start at zero on return) and of every spring of each hand-over trace. A contact that breaks with
+// springs kept moves their energy here rather than losing it, so a state's energy (pd_state_energy) does not jump up
+// when a successor takes them (realigned, or held within a cone: never more).
+double pd_history_spring_energy(const pdModel* model, const pdContactHistory* h);
 // After a commit, at the bodies' new poses (indexed by model body): forgets every trace whose features no longer
 // track or are apart by more than the gap tolerance, and every trace left before this call and taken since.
 void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* poses);

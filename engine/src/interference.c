@@ -126,6 +126,8 @@ struct pdSatIndex {
   double inradius;      // distance from it to the nearest face plane, m
   double circumradius;  // to the farthest vertex, m
   bool acuteEdge;       // two faces meet at less than 90° (pd_polyhedron_has_acute_edge)
+  bool cuboid;          // the vertices are the 8 corners of the body-frame box [lo, hi] (pd_polyhedron_cuboid)
+  pdVec3 lo, hi;        // that box, m (set when cuboid)
   // Polyhedra with PD_SAT_INDEX_MIN_EDGES edges or more, else NULL (small ones: edge_record on the fly):
   satEdge* edge;        // (E)
   int* neighbourFirst;  // (V + 1) vertex v's neighbours are neighbours[neighbourFirst[v] .. neighbourFirst[v+1])
@@ -179,6 +181,39 @@ static bool acute_edge(const pdPolyhedron* p) {
 
 bool pd_polyhedron_has_acute_edge(const pdPolyhedron* p) { return p->satIndex ? p->satIndex->acuteEdge : acute_edge(p); }
 
+// Are p's vertices the 8 corners of its body-frame box, each coordinate exactly its low or its high value (a cube
+// primitive, translated to its centre of mass)? Sets x->lo and x->hi then.
+static void find_cuboid(const pdPolyhedron* p, struct pdSatIndex* x) {
+  x->cuboid = false;
+  if (p->vertexCount != 8) return;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int v = 0; v < 8; ++v) {
+    const double c[3] = {p->vertices[v].x, p->vertices[v].y, p->vertices[v].z};
+    for (int k = 0; k < 3; ++k) lo[k] = fmin(lo[k], c[k]), hi[k] = fmax(hi[k], c[k]);
+  }
+  unsigned corners = 0;  // bit (corner index) set for each corner met
+  for (int v = 0; v < 8; ++v) {
+    const double c[3] = {p->vertices[v].x, p->vertices[v].y, p->vertices[v].z};
+    int corner = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (c[k] != lo[k] && c[k] != hi[k]) return;
+      corner |= (c[k] == hi[k]) << k;
+    }
+    corners |= 1u << corner;
+  }
+  if (corners != 0xffu || !(lo[0] < hi[0] && lo[1] < hi[1] && lo[2] < hi[2])) return;
+  x->cuboid = true;
+  x->lo = (pdVec3){lo[0], lo[1], lo[2]};
+  x->hi = (pdVec3){hi[0], hi[1], hi[2]};
+}
+
+bool pd_polyhedron_cuboid(const pdPolyhedron* p, pdVec3* lo, pdVec3* hi) {
+  if (!p->satIndex || !p->satIndex->cuboid) return false;
+  *lo = p->satIndex->lo;
+  *hi = p->satIndex->hi;
+  return true;
+}
+
 void pd_sat_index_build(pdPolyhedron* p) {
   struct pdSatIndex* x = pd_zeroed(1, sizeof *x);
   p->satIndex = x;
@@ -192,6 +227,7 @@ void pd_sat_index_build(pdPolyhedron* p) {
   x->inradius = fmax(0.0, x->inradius);
   for (int v = 0; v < V; ++v) x->circumradius = fmax(x->circumradius, pd_v3_norm(pd_v3_sub(p->vertices[v], c)));
   x->acuteEdge = acute_edge(p);
+  find_cuboid(p, x);
   if (E < PD_SAT_INDEX_MIN_EDGES) return;
   x->edge = pd_zeroed((size_t)E, sizeof *x->edge);
   for (int e = 0; e < E; ++e) x->edge[e] = edge_record(p, e);

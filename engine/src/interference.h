@@ -127,6 +127,9 @@ void pd_sat_index_build(pdPolyhedron* p);
 // Where it has none, the contact search meets only the paper's contacts (contact_analysis.c, "a vertex beyond an
 // acute edge").
 bool pd_polyhedron_has_acute_edge(const pdPolyhedron* p);
+// Are p's vertices the 8 corners of a box aligned with its body frame (kept with the index; false without one)?
+// Sets *lo and *hi, the box's corners, then. pd_aabb_of takes its bounds from two corners instead of 8 vertices.
+bool pd_polyhedron_cuboid(const pdPolyhedron* p, pdVec3* lo, pdVec3* hi);
 void pd_sat_index_free(struct pdSatIndex* index);
 
 // Do A (at xA, RA) and B (at xB, RB) interfere? Fills *out and returns !out->separated. Equal-depth

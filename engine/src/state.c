@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "contact_list.h"
 #include "contact_set.h"
 #include "grow.h"
 #include "dense_output.h"
@@ -115,7 +116,10 @@ double pd_state_energy(const pdModel* model, const pdState* s) {
     pdBodyState bs = pd_state_body(model, s, i);
     e += pd_body_kinetic_energy(b, bs.v, bs.w, bs.q) - b->mass * pd_v3_dot(model->settings.gravity, bs.x);
   }
-  return e + pd_contact_spring_energy(s->contacts, s->y, PD_BODY_STATE_SIZE * model->movingCount);
+  e += pd_contact_spring_energy(s->contacts, s->y, PD_BODY_STATE_SIZE * model->movingCount);
+  // the springs that broken contacts keep for a return (contact_history.h) are energy the state still holds
+  if (s->contacts && s->contacts->history) e += pd_history_spring_energy(model, s->contacts->history);
+  return e;
 }
 
 const char* pd_stepper_name(pdStepper stepper) {

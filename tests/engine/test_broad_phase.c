@@ -19,6 +19,7 @@
 #include "test_random.h"
 
 #include "broad_phase.h"
+#include "interference.h"
 #include "polydyn/polyhedron.h"
 #include "polydyn/vecmath.h"
 
@@ -668,19 +669,29 @@ static void test_aabb_of_is_the_exact_box_of_the_rotated_vertices(void** state) 
   assert_true(fabs(b.lo[0] - (10 - h)) < 1e-14 && fabs(b.hi[0] - (10 + h)) < 1e-14);
   assert_true(fabs(b.lo[1] - (-5 - h)) < 1e-14 && fabs(b.hi[1] - (-5 + h)) < 1e-14);
   assert_true(fabs(b.lo[2] - 0.5) < 1e-15 && fabs(b.hi[2] - 1.5) < 1e-15);
-  // random poses of a geodesic sphere: equal, bit for bit, to min/max over x + R·p, and attained
-  pdPolyhedron s;
+  // random poses of a geodesic sphere (every vertex visited) and of cuboids (two corners: pd_polyhedron_cuboid), one off
+  // its centre, and the quarter turns whose matrices hold zeros of either sign: equal, bit for bit, to min/max over
+  // x + R·p, and attained
+  pdPolyhedron s, offset;
   assert_true(pd_polyhedron_sphere(&s, 1, (const double[3]){1, 2, 3}, &why));
+  assert_true(pd_polyhedron_cube(&offset, (const double[3]){0.2, 0.15, 0.1}, &why));
+  pd_polyhedron_translate(&offset, pd_v3(0.013, -0.0071, 0.3));
+  pdVec3 lo, hi;
+  assert_true(pd_polyhedron_cuboid(&cube, &lo, &hi) && pd_polyhedron_cuboid(&offset, &lo, &hi));
+  assert_false(pd_polyhedron_cuboid(&s, &lo, &hi));
+  const pdPolyhedron* shapes[3] = {&s, &cube, &offset};
   lcg g = {5};
-  for (int trial = 0; trial < 100; ++trial) {
+  for (int trial = 0; trial < 300; ++trial) {
     pdQuat q = pd_quat_normalize(
         (pdQuat){lcg_range(&g, -1, 1), lcg_range(&g, -1, 1), lcg_range(&g, -1, 1), lcg_range(&g, -1, 1)});
+    if (trial % 10 == 0) q = pd_quat_from_axis_angle(trial % 20 ? pd_v3(1, 0, 0) : pd_v3(0, -1, 0), PI / 2 * (trial / 20));
     pdMat3 Rq = pd_quat_to_mat3(q);
     pdVec3 x = pd_v3(lcg_range(&g, -10, 10), lcg_range(&g, -10, 10), lcg_range(&g, -10, 10));
-    pdAabb box = pd_aabb_of(&s, x, &Rq);
+    const pdPolyhedron* p = shapes[trial % 3];
+    pdAabb box = pd_aabb_of(p, x, &Rq);
     bool hitLo[3] = {false, false, false}, hitHi[3] = {false, false, false};
-    for (int v = 0; v < s.vertexCount; ++v) {
-      pdVec3 w = pd_v3_add(x, pd_mat3_mulv(&Rq, s.vertices[v]));
+    for (int v = 0; v < p->vertexCount; ++v) {
+      pdVec3 w = pd_v3_add(x, pd_mat3_mulv(&Rq, p->vertices[v]));
       for (int k = 0; k < 3; ++k) {
         double c = pd_v3_get(w, k);
         assert_true(box.lo[k] <= c && c <= box.hi[k]);
@@ -690,6 +701,7 @@ static void test_aabb_of_is_the_exact_box_of_the_rotated_vertices(void** state) 
     }
     for (int k = 0; k < 3; ++k) assert_true(hitLo[k] && hitHi[k]);
   }
+  pd_polyhedron_free(&offset);
   pd_polyhedron_free(&cube);
   pd_polyhedron_free(&s);
 }

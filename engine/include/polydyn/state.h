@@ -289,7 +289,8 @@ PD_API void pd_state_free(pdState* state);
 PD_API pdBodyState pd_state_body(const pdModel* model, const pdState* state, int bodyIndex);
 
 // Kinetic + gravitational potential energy of all moving bodies plus the energy stored in the contact
-// springs (½ k s² each), J (gravitational potential zero at the origin).
+// springs (½ k s² each), those that broken contacts keep for their return included, J (gravitational potential zero
+// at the origin).
 PD_API double pd_state_energy(const pdModel* model, const pdState* state);
 
 // One active contact at the state's time, for output (docs/outputs.md, contacts.csv).
