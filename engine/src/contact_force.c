@@ -349,6 +349,11 @@ static void rebalance(double k1, double k2, double* s1, double* s2) {
   *s2 = d * k1 / k;
 }
 
+double pd_springs_energy(const pdContactParams* p, const pdSprings* s) {
+  return 0.5 * (p->k1n * s->s1n * s->s1n + p->k2n * s->s2n * s->s2n + p->k1t * pd_v3_dot(s->s1t, s->s1t) +
+                p->k2t * pd_v3_dot(s->s2t, s->s2t));
+}
+
 void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const pdContactParams* p, double fn) {
   PD_ASSERT(mu >= 0.0);
   minRotation m = min_rotation(nOld, nNew);

@@ -102,3 +102,5 @@ void pd_springs_realign(pdSprings* s, pdVec3 nOld, pdVec3 nNew, double mu, const
 // Shortens each tangential spring along itself so that its force stays within `limit` (N): |k_it s_it| <= limit (a
 // spring with k_it = 0 carries no force and is left alone). What a successor of a hand-over inherits (contact_set.c).
 void pd_springs_clip_to_cone(pdSprings* s, const pdContactParams* p, double limit);
+// The energy the springs store, ½ k s² over the four of them, J.
+double pd_springs_energy(const pdContactParams* p, const pdSprings* s);

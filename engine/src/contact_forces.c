@@ -208,8 +208,7 @@ double pd_contact_spring_energy(const pdContactSet* set, const double* y, int sp
   for (int i = 0; i < set->count; ++i) {
     const pdContactParams* p = &set->items[i].params;
     pdSprings s = springs_load(y + springBase + PD_CONTACT_STATE_SIZE * i);
-    e += 0.5 * (p->k1n * s.s1n * s.s1n + p->k2n * s.s2n * s.s2n + p->k1t * pd_v3_dot(s.s1t, s.s1t) +
-                p->k2t * pd_v3_dot(s.s2t, s.s2t));
+    e += pd_springs_energy(p, &s);
   }
   return e;
 }

@@ -83,25 +83,21 @@ bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const p
   return false;
 }
 
-static double tangential_energy(const pdContactParams* p, const pdSprings* s) {
-  return 0.5 * (p->k1t * pd_v3_dot(s->s1t, s->s1t) + p->k2t * pd_v3_dot(s->s2t, s->s2t));
+// The energy of the springs a trace will give back: a trace left by force returns its tangential springs only
+// (pd_history_take), a hand-over trace all of them.
+static double trace_energy(const pdModel* model, const trace* t, bool normalReturns) {
+  pdContactParams p = pd_model_contact_params(model, t->id.body1, t->id.body2);
+  pdSprings s = t->springs;
+  if (!normalReturns) s.s1n = s.s2n = 0.0;
+  return pd_springs_energy(&p, &s);
 }
 
 double pd_history_spring_energy(const pdModel* model, const pdContactHistory* h) {
   double e = 0.0;
-  for (int i = 0; i < h->count; ++i) {
-    const trace* t = &h->items[i];
-    if (t->taken) continue;
-    pdContactParams p = pd_model_contact_params(model, t->id.body1, t->id.body2);
-    e += tangential_energy(&p, &t->springs);
-  }
-  for (int i = 0; i < h->handovers.count; ++i) {
-    const trace* t = &h->handovers.items[i];
-    if (t->taken) continue;
-    pdContactParams p = pd_model_contact_params(model, t->id.body1, t->id.body2);
-    e += tangential_energy(&p, &t->springs) +
-         0.5 * (p.k1n * t->springs.s1n * t->springs.s1n + p.k2n * t->springs.s2n * t->springs.s2n);
-  }
+  for (int i = 0; i < h->count; ++i)
+    if (!h->items[i].taken) e += trace_energy(model, &h->items[i], false);
+  for (int i = 0; i < h->handovers.count; ++i)
+    if (!h->handovers.items[i].taken) e += trace_energy(model, &h->handovers.items[i], true);
   return e;
 }
 

@@ -46,12 +46,20 @@ static pdSoakResult run(const pdSoakScene* scene, const char* engine, bool every
   return r;
 }
 
+// run(), its result printed: engine, what was checked, status, the deepest overlap, the energy gained, the message.
+static pdSoakResult run_told(const pdSoakScene* scene, const char* engine, bool everyStep) {
+  pdSoakResult r = run(scene, engine, everyStep);
+  print_message("%s, %s: %s, penetration %.3g delta_max, energy gain %.3g of E(0) %s\n", engine,
+                everyStep ? "every step" : "samples", pdSoakStatusNames[r.status], r.penetration, r.energyGain,
+                r.message);
+  return r;
+}
+
 static void test_an_impact_between_samples_is_caught_at_the_steps(void** state) {
   (void)state;
   pdSoakScene scene = scene_file("tests/validation/soak/impact_between_samples.scene", pd_soakDrop, 2);
   for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e) {
-    pdSoakResult steps = run(&scene, softEngines[e], true);
-    print_message("%s, every step: %s, %s\n", softEngines[e], pdSoakStatusNames[steps.status], steps.message);
+    pdSoakResult steps = run_told(&scene, softEngines[e], true);
     assert_int_equal(steps.status, pd_soakFailed);
     // 15 m/s on springs that store ½ m vmax² at δ_max for vmax = 1 m/s: 15 δ_max undamped, about 5 with the
     // dampers of restitution 0.5 in series with the springs (measured 5.3 at 20 kHz output)
@@ -70,8 +78,7 @@ static void test_energy_gained_between_samples_is_caught_at_the_steps(void** sta
   (void)state;
   pdSoakScene scene = scene_file("tests/validation/soak/energy_pulse.scene", pd_soakDrop, 2);
   for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e) {
-    pdSoakResult steps = run(&scene, softEngines[e], true);
-    print_message("%s, every step: %s, %s\n", softEngines[e], pdSoakStatusNames[steps.status], steps.message);
+    pdSoakResult steps = run_told(&scene, softEngines[e], true);
     assert_int_equal(steps.status, pd_soakFailed);
     // the peak at 5 ms: (f T / 4m)² / u² = (0.01 / 0.1)² = 0.01 of E(0); the steps of this smooth motion are ms
     // long, so a step ends where the rise is above half its peak (measured 0.0092), five times the limit
@@ -89,9 +96,7 @@ static void test_a_light_body_under_a_heavy_one_is_judged_by_the_load(void** sta
   (void)state;
   pdSoakScene scene = scene_file("cases/hard/heavy_block_on_chip.scene", pd_soakDrop, 3);
   for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e) {
-    pdSoakResult r = run(&scene, softEngines[e], true);
-    print_message("%s: %s, penetration %.3g delta_max %s\n", softEngines[e], pdSoakStatusNames[r.status], r.penetration,
-                  r.message);
+    pdSoakResult r = run_told(&scene, softEngines[e], true);
     // beyond the plain limit (measured 3.7 δ_max), below the closed form without dampers (4.9,
     // tests/engine/test_hard_cases.c); the pair's limit is the chain's, 3 √(20 kg / 16 g) = 106
     assert_true(r.penetration > PD_SOAK_PENETRATION_LIMIT && r.penetration < 4.9);
@@ -108,9 +113,7 @@ static void test_springs_kept_by_a_broken_contact_bring_no_energy_back(void** st
   (void)state;
   pdSoakScene scene = scene_file("cases/hard/plate_thrown_at_wall.scene", pd_soakThrow, 2);
   for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e) {
-    pdSoakResult r = run(&scene, softEngines[e], true);
-    print_message("%s: %s, energy gain %.3g of E(0) %s\n", softEngines[e], pdSoakStatusNames[r.status], r.energyGain,
-                  r.message);
+    pdSoakResult r = run_told(&scene, softEngines[e], true);
     assert_int_equal(r.status, pd_soakOk);
     assert_true(r.energyGain < KEPT_SPRINGS_ENERGY_TOL);
   }
