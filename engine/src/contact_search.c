@@ -62,14 +62,16 @@ void pd_contact_search_create(const pdModel* model, pdContactSet* set, const boo
   set->cacheNext = pd_grow(NULL, set->cacheCapacity, sizeof *set->cacheNext);
   set->touching = pd_grow(NULL, set->cacheCapacity, sizeof *set->touching);
   grow_pair_lists(set);
-  // reaching_fraction's scratch: two bodies' vertex moves and their bounding planes (a box's 6 or a fixed body's faces)
+  // reaching_fraction's scratch: two bodies' vertex moves and their bounding planes (a box's 6 or a fixed body's faces),
+  // and two numbers a vertex for plane_reach
   set->reachVertexMax = 1, set->reachFaceMax = 6;
   for (int i = 0; i < n; ++i) {
     const pdPolyhedron* shape = &model->bodies[i].shape;
     if (shape->vertexCount > set->reachVertexMax) set->reachVertexMax = shape->vertexCount;
     if (shape->faceCount > set->reachFaceMax) set->reachFaceMax = shape->faceCount;
   }
-  set->reachScratch = pd_grow(NULL, 2 * (PD_REACH_VERTEX_SIZE * set->reachVertexMax + 4 * set->reachFaceMax),
+  set->reachScratch = pd_grow(NULL, 2 * (PD_REACH_VERTEX_SIZE * set->reachVertexMax + 4 * set->reachFaceMax) +
+                                        2 * set->reachVertexMax,
                               sizeof *set->reachScratch);
 }
 
@@ -232,22 +234,23 @@ static double vertex_move(const double* at, double lambda, const double* toward,
 // distance outside it (inside ones all count), and where an edge crosses from such a vertex to one that cannot.
 // Between vertices the bound is taken as their barycentric mix, which is at least the convex bound's value there.
 static double plane_reach(const pdPolyhedron* shape, const double* moves, const double* plane, double lambda,
-                          bool alongNormal, double sagAlong, double stopAbove) {
+                          bool alongNormal, double sagAlong, double stopAbove, double* scratch) {
   const double* toward = alongNormal ? plane : NULL;
   double most = 0.0;
+  // each vertex's move bound and by how much it exceeds its distance outside the plane, for its edges below
+  double *move = scratch, *over = scratch + shape->vertexCount;
   for (int v = 0; v < shape->vertexCount; ++v) {
     const double* at = moves + PD_REACH_VERTEX_SIZE * v;
-    double move = vertex_move(at, lambda, toward, sagAlong);
-    if (move > beyond(plane, at)) most = fmax(most, move);
+    move[v] = vertex_move(at, lambda, toward, sagAlong);
+    over[v] = move[v] - beyond(plane, at);
+    if (over[v] > 0.0) most = fmax(most, move[v]);
   }
   for (int e = 0; e < shape->edgeCount && most < stopAbove; ++e) {
-    const double* u = moves + PD_REACH_VERTEX_SIZE * shape->edges[e].v[0];
-    const double* w = moves + PD_REACH_VERTEX_SIZE * shape->edges[e].v[1];
-    double mu = vertex_move(u, lambda, toward, sagAlong), mw = vertex_move(w, lambda, toward, sagAlong);
-    double fu = mu - beyond(plane, u), fw = mw - beyond(plane, w);
+    int u = shape->edges[e].v[0], w = shape->edges[e].v[1];
+    double fu = over[u], fw = over[w];
     if ((fu > 0.0) == (fw > 0.0)) continue;  // in or out as a whole: its vertices tell
     double t = fu / (fu - fw);                 // where it crosses out
-    most = fmax(most, (1.0 - t) * mu + t * mw);
+    most = fmax(most, (1.0 - t) * move[u] + t * move[w]);
   }
   return most;
 }
@@ -261,11 +264,16 @@ static double plane_reach(const pdPolyhedron* shape, const double* moves, const 
 // move over it is at one of those; each plane gives a bound, the smallest is kept. A spinning or rolling body's far
 // points move fast but cannot reach the other body: only the ones that can count (a top spinning on its tip, a wheel
 // on its rim).
+//
+// Where only whether it is within `enough` (> 0) matters (one moving body against a fixed one), the first plane whose
+// bound is within it answers, and a plane's search stops once above it; with `enough` 0, the bound itself.
 static double reaching_move(const pdPolyhedron* shape, const double* moves, const double* planes, int planeCount,
-                            double lambda) {
+                            double lambda, double enough, double* scratch) {
   double best = INFINITY;
-  for (int k = 0; k < planeCount && best > 0.0; ++k)
-    best = fmin(best, plane_reach(shape, moves, planes + 4 * k, lambda, false, 1.0, best));
+  // past this a plane's bound is out: past the best so far, and, with `enough`, past it
+  double out = enough > 0.0 ? nextafter(enough, INFINITY) : INFINITY;
+  for (int k = 0; k < planeCount && best > enough; ++k)
+    best = fmin(best, plane_reach(shape, moves, planes + 4 * k, lambda, false, 1.0, fmin(best, out), scratch));
   return best;
 }
 
@@ -282,6 +290,7 @@ typedef struct reachSide {
   int entryFace;  // -1: none
   double sagAlong;
   double entryHolds, entryFails;
+  double* scratch;  // plane_reach's
 } reachSide;
 
 // The candidate for a fixed body's sole entry face (entry_holds) for a moving body: the plane that the moving body's
@@ -341,14 +350,15 @@ static bool entry_holds(reachSide* side, double lambda) {
 // bound the same points; the face's, which needs one plane where reaching_move takes every plane, is tried first and
 // is enough when within `allowed`). Each grows with lambda, and the face holds up to some fraction: the result, as
 // compared with `allowed`, grows with lambda too (reaching_fraction bisects it).
-static double side_reach(reachSide* side, double lambda, double allowed) {
+static double side_reach(reachSide* side, double lambda, double allowed, double enough) {
   double inward = INFINITY;
   if (entry_holds(side, lambda)) {
     inward = plane_reach(side->shape, side->moves, side->planes + 4 * side->entryFace, lambda, true,
-                         side->sagAlong, INFINITY);
+                         side->sagAlong, INFINITY, side->scratch);
     if (inward <= allowed) return inward;
   }
-  return fmin(inward, reaching_move(side->shape, side->moves, side->planes, side->planeCount, lambda));
+  return fmin(inward, reaching_move(side->shape, side->moves, side->planes, side->planeCount, lambda, enough,
+                                    side->scratch));
 }
 
 // Bisections of the step fraction a pair's reaching travel allows: the fraction is then known to ~1e-3 of the
@@ -366,27 +376,30 @@ static double reaching_fraction(const pdModel* model, pdContactSet* set, int a, 
   double* movesB = movesA + PD_REACH_VERTEX_SIZE * set->reachVertexMax;
   double* planesA = movesB + PD_REACH_VERTEX_SIZE * set->reachVertexMax;  // bounding body a: for b's points
   double* planesB = planesA + 4 * set->reachFaceMax;
+  double* planeScratch = planesB + 4 * set->reachFaceMax;
   reachSide sides[2];
   int sideCount = 0;
   if (!ba->fixed) {
     pdVec3 axis = vertex_moves(ba, &set->poses0[a], &set->poses1[a], movesA);
     int count = bounding_planes(model, set, b, planesB);
-    sides[sideCount++] = (reachSide){&ba->shape, movesA, axis, planesB, count, -1, 1.0, 0.0, 0.0};
+    sides[sideCount++] = (reachSide){&ba->shape, movesA, axis, planesB, count, -1, 1.0, 0.0, 0.0, planeScratch};
   }
   if (!bb->fixed) {
     pdVec3 axis = vertex_moves(bb, &set->poses0[b], &set->poses1[b], movesB);
     int count = bounding_planes(model, set, a, planesA);
-    sides[sideCount++] = (reachSide){&bb->shape, movesB, axis, planesA, count, -1, 1.0, 0.0, 0.0};
+    sides[sideCount++] = (reachSide){&bb->shape, movesB, axis, planesA, count, -1, 1.0, 0.0, 0.0, planeScratch};
   }
   // a moving body touching a fixed one may have a sole entry face, where only its points' moves into it count. Not
   // before it touches: a landing's steps stay held by its whole move, and with them how long before a step's end its
   // onset may be, which the correction of an onset found inside a step is bounded for (onset_bound.h)
   if (sideCount == 1 && touching) entry_face(&sides[0]);
+  // alone, a side's bound only needs comparing with `allowed`; two are summed
+  double enough = sideCount == 1 ? allowed : 0.0;
   double lo = floor, hi = most;
   for (int k = -1; k < PD_TRAVEL_BISECTIONS; ++k) {
     double lambda = k < 0 ? most : 0.5 * (lo + hi);
     double moved = 0.0;
-    for (int k2 = 0; k2 < sideCount; ++k2) moved += side_reach(&sides[k2], lambda, allowed);
+    for (int k2 = 0; k2 < sideCount; ++k2) moved += side_reach(&sides[k2], lambda, allowed, enough);
     if (moved <= allowed) {
       if (k < 0) return most;
       lo = lambda;
