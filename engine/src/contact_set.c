@@ -561,6 +561,10 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   return verdict;
 }
 
+// A listed contact takes a broken one's normal springs (handover_to_listed) only while their normals are within this
+// cosine (25°): the springs' force then goes on about along the line it had.
+#define PD_HANDOVER_LISTED_COS 0.9
+
 // The normal deflection of springs sp, m: how far they are pressed together (s2n − s1n, the depth they carry).
 static double normal_deflection(const pdSprings* sp) { return sp->s2n - sp->s1n; }
 
@@ -582,12 +586,19 @@ static void handover_to_listed(const pdModel* model, pdContactSet* set, const do
     double deflection = normal_deflection(&left);
     for (int k = 0; k < count; ++k) {
       contactSlot* s = &set->next[k];
-      if (normal_deflection(&s->springs) >= deflection || !pd_contact_continues(model, &c->id, &s->id)) continue;
+      // the survivor presses where the broken one did: its normal near the broken one's, and deep enough to take the
+      // deflection (more would push it back beyond its own surface)
+      double carried = fmin(deflection, s->depth);
+      double cosine = pd_v3_dot(s->normal, e->geom.normal) * (s->id.body1 == c->id.body1 ? 1.0 : -1.0);
+      if (normal_deflection(&s->springs) >= carried || cosine < PD_HANDOVER_LISTED_COS ||
+          !pd_contact_continues(model, &c->id, &s->id))
+        continue;
       if (best < 0 || normal_deflection(&s->springs) < normal_deflection(&set->next[best].springs)) best = k;
     }
     if (best < 0) continue;
-    set->next[best].springs.s1n = left.s1n;
-    set->next[best].springs.s2n = left.s2n;
+    double scale = fmin(1.0, set->next[best].depth / deflection);
+    set->next[best].springs.s1n = scale * left.s1n;
+    set->next[best].springs.s2n = scale * left.s2n;
     set->eval[i].transferred = true;  // no hand-over trace: its normal springs went on
   }
 }
