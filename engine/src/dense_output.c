@@ -17,6 +17,7 @@ struct pdDense {
   // the captured step [t0, t0 + h], in its contact list's layout (n numbers)
   bool captured;
   bool quartic;  // step doubling's nodes; else the cubic's
+  bool dopri;    // Dormand–Prince's: the cubic's nodes and its extension's term d in NODE_YHALF
   double t0, h;
   int n, capacity;
   double* node[NODE_COUNT];  // (capacity) each
@@ -71,6 +72,7 @@ void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* 
   reserve(d, n);
   size_t bytes = (size_t)n * sizeof(double);
   d->quartic = yHalf != NULL;
+  d->dopri = false;
   memcpy(d->node[NODE_Y0], s->y, bytes);
   memcpy(d->node[NODE_F0], f0, bytes);
   memcpy(d->node[NODE_Y1], y1, bytes);
@@ -86,6 +88,13 @@ void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* 
   d->h = h;
   d->n = n;
   d->captured = true;
+}
+
+void pd_dense_capture_dopri(const pdModel* model, pdState* s, double h, const double* f0, const double* y1,
+                            const double* f1, const double* d) {
+  pd_dense_capture(model, s, h, f0, NULL, NULL, y1, f1);
+  memcpy(s->dense->node[NODE_YHALF], d, (size_t)s->n * sizeof(double));
+  s->dense->dopri = true;
 }
 
 // The interpolant at θ into out (d->n numbers).
@@ -107,6 +116,14 @@ static void interpolate(const pdDense* d, double theta, double* out) {
     return;
   }
   const double* f1 = d->node[NODE_F1];
+  if (d->dopri) {
+    const double* ext = d->node[NODE_YHALF];
+    for (int i = 0; i < d->n; ++i) {
+      double dy = y1[i] - y0[i], r3 = h * f0[i] - dy, r4 = dy - h * f1[i] - r3;
+      out[i] = y0[i] + theta * (dy + (1.0 - theta) * (r3 + theta * (r4 + (1.0 - theta) * ext[i])));
+    }
+    return;
+  }
   for (int i = 0; i < d->n; ++i) {
     double dy = y1[i] - y0[i];
     double c2 = 3.0 * dy - h * (2.0 * f0[i] + f1[i]);
