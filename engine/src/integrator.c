@@ -510,9 +510,13 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
 // where the implicit method's steps are limited by its own error estimate alone (reports/bench/implicit: 3× fewer
 // steps on a resting pile). The switch (implicit.h, PD_IMPLICIT_SWITCH_STEPS) looks only at the state's own
 // numbers, so it is the same on every run. Systems of more than PD_IMPLICIT_BODIES_MAX moving bodies stay explicit.
-static double switching_step(const pdModel* model, pdState* s, double hMax) {
-  if (model->movingCount > PD_IMPLICIT_BODIES_MAX)
-    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
+// `explicitTrial`: step doubling (pd_stepperImplicit) or Dormand–Prince (pd_stepperImplicitDopri), with its bound.
+static double explicit_step(const pdModel* model, pdState* s, double hMax, trialFcn* explicitTrial, stepOutcome* out) {
+  return adaptive_step(model, s, hMax, explicitTrial, 5.0, explicitTrial == trial_dopri ? NAN : 1.0, NULL, out);
+}
+
+static double switching_step(const pdModel* model, pdState* s, double hMax, trialFcn* explicitTrial) {
+  if (model->movingCount > PD_IMPLICIT_BODIES_MAX) return explicit_step(model, s, hMax, explicitTrial, NULL);
   if (!s->implicit) {
     s->implicit = pd_implicit_create();
     pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
@@ -520,7 +524,7 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
   pdImplicit* im = s->implicit;
   stepOutcome out = {0.0, false, false, pd_limitError, pd_limitEvent};
   if (!pd_implicit_active(im)) {
-    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, &out);
+    double taken = explicit_step(model, s, hMax, explicitTrial, &out);
     // s->h is now the bound's step: on a switch the implicit method starts from the step the error control wanted
     bool held = !out.eventCut && out.wanted >= PD_IMPLICIT_HELD_RATIO * s->h;
     if (taken > 0.0 && pd_implicit_note_explicit(im, held, s->h, s->t)) {
@@ -541,7 +545,7 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     pdStepLimit wantedLimit = s->hLimit;
     s->h = boundStep;
     s->hLimit = pd_limitStability;
-    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
+    double taken = explicit_step(model, s, hMax, explicitTrial, NULL);
     if (taken > 0.0 && wanted > s->h) {
       s->h = wanted;
       s->hLimit = wantedLimit;
@@ -554,7 +558,7 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     s->h = boundStep;
     s->hLimit = pd_limitStability;
     pd_implicit_deactivate(im, true, s->t);
-    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
+    return explicit_step(model, s, hMax, explicitTrial, NULL);
   }
   if (taken > 0.0) {
     if (onProbation) pd_implicit_paid(im);
@@ -569,7 +573,8 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     // trial costs about two explicit ones on a small system
     double worth = (out.eventCut ? fmin(out.wanted, taken) : out.wanted) / PD_IMPLICIT_HELD_RATIO;
     bool tightNeeded;
-    if (pd_contact_set_limit_step(model, s->contacts, worth, 1.0, &tightNeeded) >= worth) {
+    double fraction = explicitTrial == trial_dopri ? pd_contact_set_dopri_fraction(s->contacts) : 1.0;
+    if (pd_contact_set_limit_step(model, s->contacts, worth, fraction, &tightNeeded) >= worth) {
       pd_implicit_deactivate(im, false, s->t);
       s->count.stabilityTight += tightNeeded;
     }
@@ -621,7 +626,9 @@ static double one_step(const pdModel* model, pdState* s, double target, bool lan
     case pd_stepperRK43Embedded:
       return adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, NULL, NULL);
     case pd_stepperImplicit:
-      return switching_step(model, s, hMax);
+      return switching_step(model, s, hMax, trial_doubling);
+    case pd_stepperImplicitDopri:
+      return switching_step(model, s, hMax, trial_dopri);
     case pd_stepperDopri54:
       return adaptive_step(model, s, hMax, trial_dopri, 5.0, NAN, NULL, NULL);
     case pd_stepperRK4Adaptive:
