@@ -497,29 +497,31 @@ static void test_dt_equal_to_dtmin_and_dtmax_takes_exactly_1000_steps(void** sta
   assert_int_equal(c.rejected, 0);
 }
 
+// A thrown, spinning box at tol 1e-10 from a first step of 0.01 s (far too long: some trials are rejected): every
+// accepted step costs `perAccepted` derivative evaluations and every rejected trial `perRejected`.
+static void check_evaluations_per_step(pdStepper stepper, long perAccepted, long perRejected) {
+  pdCounters c = run_counts_with(
+      "gravity 0 0 -9.81\ntend 1\ntol 1e-10\ndt 0.01\nsample 100\n"
+      "cube box red 0.1 0.2 0.3\nvel 1 0 2  720 1 3 0.2\n",
+      stepper);
+  printf("  %s counts: %ld accepted, %ld rejected, %ld derivatives\n", pd_stepper_name(stepper), c.accepted,
+         c.rejected, c.derivatives);
+  assert_true(c.rejected > 0);
+  assert_int_equal(c.derivatives, perAccepted * c.accepted + perRejected * c.rejected);
+}
+
 static void test_adaptive_step_costs_11_evaluations_and_a_rejection_10(void** state) {
   (void)state;
   // integrator.c: k1 is evaluated once per accepted step and reused by every trial from that point;
   // a trial is a full step (3 more), two half steps (3 + 1 + 3): 10 evaluations
-  pdCounters c = run_counts(
-      "gravity 0 0 -9.81\ntend 1\ntol 1e-10\ndt 0.01\nsample 100\n"
-      "cube box red 0.1 0.2 0.3\nvel 1 0 2  720 1 3 0.2\n");
-  printf("  counts: %ld accepted, %ld rejected, %ld derivatives\n", c.accepted, c.rejected, c.derivatives);
-  assert_true(c.rejected > 0);  // the first step (0.01 s) is far too long for 1e-10
-  assert_int_equal(c.derivatives, 11 * c.accepted + 10 * c.rejected);
+  check_evaluations_per_step(pd_stepperRK4Adaptive, 11, 10);
 }
 
 static void test_embedded_step_costs_5_evaluations_and_a_rejection_4(void** state) {
   (void)state;
   // integrator.c: k1 once per accepted step; a trial is the RK4 step (3 more) and f(t + h, y1) for the
   // error estimate: 4 evaluations
-  pdCounters c = run_counts_with(
-      "gravity 0 0 -9.81\ntend 1\ntol 1e-10\ndt 0.01\nsample 100\n"
-      "cube box red 0.1 0.2 0.3\nvel 1 0 2  720 1 3 0.2\n",
-      pd_stepperRK43Embedded);
-  printf("  counts: %ld accepted, %ld rejected, %ld derivatives\n", c.accepted, c.rejected, c.derivatives);
-  assert_true(c.rejected > 0);
-  assert_int_equal(c.derivatives, 5 * c.accepted + 4 * c.rejected);
+  check_evaluations_per_step(pd_stepperRK43Embedded, 5, 4);
 }
 
 static void test_embedded_pair_keeps_the_parabola_and_steps_as_tol_to_the_quarter(void** state) {
@@ -551,13 +553,7 @@ static void test_dopri_step_costs_7_evaluations_and_a_rejection_6(void** state) 
   (void)state;
   // integrator.c, trial_dopri: k1 once per accepted step; a trial is 6 more stages, the last f(t + h, y1), which the
   // next step cannot reuse (its commit realigns the springs)
-  pdCounters c = run_counts_with(
-      "gravity 0 0 -9.81\ntend 1\ntol 1e-10\ndt 0.01\nsample 100\n"
-      "cube box red 0.1 0.2 0.3\nvel 1 0 2  720 1 3 0.2\n",
-      pd_stepperDopri54);
-  printf("  counts: %ld accepted, %ld rejected, %ld derivatives\n", c.accepted, c.rejected, c.derivatives);
-  assert_true(c.rejected > 0);
-  assert_int_equal(c.derivatives, 7 * c.accepted + 6 * c.rejected);
+  check_evaluations_per_step(pd_stepperDopri54, 7, 6);
 }
 
 // A box spinning about no principal axis (Euler's equations, torque-free: smooth, no contacts), run with the
