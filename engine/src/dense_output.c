@@ -17,6 +17,7 @@ struct pdDense {
   // the captured step [t0, t0 + h], in its contact list's layout (n numbers)
   bool captured;
   bool quartic;  // step doubling's nodes; else the cubic's
+  bool dopri;    // Dormand–Prince's: the cubic's nodes and its extension's term d in NODE_YHALF
   double t0, h;
   int n, capacity;
   double* node[NODE_COUNT];  // (capacity) each
@@ -63,29 +64,61 @@ double* pd_dense_slope_scratch(pdDense* d, int n) {
   return d->node[NODE_F1];
 }
 
-void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* f0, const double* yHalf,
-                      const double* fHalf, const double* y1, const double* f1) {
+// What every capture keeps: y0, f0, y1 and the step's contact list.
+static pdDense* capture_ends(const pdModel* model, pdState* s, double h, const double* f0, const double* y1) {
   pdDense* d = s->dense;
   PD_ASSERT(d != NULL && !d->presenting);
   int n = s->n;
   reserve(d, n);
   size_t bytes = (size_t)n * sizeof(double);
-  d->quartic = yHalf != NULL;
   memcpy(d->node[NODE_Y0], s->y, bytes);
   memcpy(d->node[NODE_F0], f0, bytes);
   memcpy(d->node[NODE_Y1], y1, bytes);
-  if (d->quartic) {
-    memcpy(d->node[NODE_YHALF], yHalf, bytes);
-    memcpy(d->node[NODE_FHALF], fHalf, bytes);
-  } else if (f1 != d->node[NODE_F1]) {  // the implicit method's f(y1) is already there (pd_dense_slope_scratch)
-    memcpy(d->node[NODE_F1], f1, bytes);
-  }
   if (!d->view) d->view = pd_contact_set_create_view(model);
   pd_contact_set_capture(s->contacts, d->view);
   d->t0 = s->t;
   d->h = h;
   d->n = n;
   d->captured = true;
+  return d;
+}
+
+void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* f0, const double* yHalf,
+                      const double* fHalf, const double* y1, const double* f1) {
+  pdDense* d = capture_ends(model, s, h, f0, y1);
+  size_t bytes = (size_t)d->n * sizeof(double);
+  d->quartic = yHalf != NULL;
+  d->dopri = false;
+  if (yHalf) {
+    memcpy(d->node[NODE_YHALF], yHalf, bytes);
+    memcpy(d->node[NODE_FHALF], fHalf, bytes);
+  } else if (f1 != d->node[NODE_F1]) {  // the implicit method's f(y1) is already there (pd_dense_slope_scratch)
+    memcpy(d->node[NODE_F1], f1, bytes);
+  }
+}
+
+void pd_dense_capture_dopri(const pdModel* model, pdState* s, double h, const double* f0, const double* y1,
+                            const double* f1, const double* ext) {
+  pdDense* d = capture_ends(model, s, h, f0, y1);
+  size_t bytes = (size_t)d->n * sizeof(double);
+  d->quartic = false;
+  d->dopri = true;
+  memcpy(d->node[NODE_F1], f1, bytes);
+  memcpy(d->node[NODE_YHALF], ext, bytes);
+}
+
+void pd_dense_quartic(int n, double h, double theta, const double* y0, const double* f0, const double* yHalf,
+                      const double* fHalf, const double* y1, double* out) {
+  // p(θ) = y0 + h f0 θ + a θ² + b θ³ + c θ⁴ through p(½) = y½, p'(½) = h f½, p(1) = y1 (derivation: the three
+  // conditions solved for a, b, c with D½ = y½ − y0 − h f0/2, Df = h (f½ − f0), D1 = y1 − y0 − h f0)
+  for (int i = 0; i < n; ++i) {
+    double slope = h * f0[i];
+    double dHalf = yHalf[i] - y0[i] - 0.5 * slope, dSlope = h * (fHalf[i] - f0[i]), dEnd = y1[i] - y0[i] - slope;
+    double a = dEnd - 4.0 * dSlope + 16.0 * dHalf;
+    double b = -4.0 * dEnd + 12.0 * dSlope - 32.0 * dHalf;
+    double c = 4.0 * dEnd - 8.0 * dSlope + 16.0 * dHalf;
+    out[i] = y0[i] + theta * (slope + theta * (a + theta * (b + theta * c)));
+  }
 }
 
 // The interpolant at θ into out (d->n numbers).
@@ -93,20 +126,18 @@ static void interpolate(const pdDense* d, double theta, double* out) {
   const double *y0 = d->node[NODE_Y0], *f0 = d->node[NODE_F0], *y1 = d->node[NODE_Y1];
   double h = d->h;
   if (d->quartic) {
-    // p(θ) = y0 + h f0 θ + a θ² + b θ³ + c θ⁴ through p(½) = y½, p'(½) = h f½, p(1) = y1 (derivation: the three
-    // conditions solved for a, b, c with D½ = y½ − y0 − h f0/2, Df = h (f½ − f0), D1 = y1 − y0 − h f0)
-    const double *yh = d->node[NODE_YHALF], *fh = d->node[NODE_FHALF];
-    for (int i = 0; i < d->n; ++i) {
-      double slope = h * f0[i];
-      double dHalf = yh[i] - y0[i] - 0.5 * slope, dSlope = h * (fh[i] - f0[i]), dEnd = y1[i] - y0[i] - slope;
-      double a = dEnd - 4.0 * dSlope + 16.0 * dHalf;
-      double b = -4.0 * dEnd + 12.0 * dSlope - 32.0 * dHalf;
-      double c = 4.0 * dEnd - 8.0 * dSlope + 16.0 * dHalf;
-      out[i] = y0[i] + theta * (slope + theta * (a + theta * (b + theta * c)));
-    }
+    pd_dense_quartic(d->n, h, theta, y0, f0, d->node[NODE_YHALF], d->node[NODE_FHALF], y1, out);
     return;
   }
   const double* f1 = d->node[NODE_F1];
+  if (d->dopri) {
+    const double* ext = d->node[NODE_YHALF];
+    for (int i = 0; i < d->n; ++i) {
+      double dy = y1[i] - y0[i], r3 = h * f0[i] - dy, r4 = dy - h * f1[i] - r3;
+      out[i] = y0[i] + theta * (dy + (1.0 - theta) * (r3 + theta * (r4 + (1.0 - theta) * ext[i])));
+    }
+    return;
+  }
   for (int i = 0; i < d->n; ++i) {
     double dy = y1[i] - y0[i];
     double c2 = 3.0 * dy - h * (2.0 * f0[i] + f1[i]);
