@@ -805,7 +805,15 @@ static bool edge_points_inside(const pdModel* model, const pdContactId* id, cons
   double sharp = fmin(fmax(g->depth, 0.0), deepest);
   double tol1 = fmax(TRACK_INSIDE_TOL_REL * model->settings.deflection * b1->size, sharp);
   double tol2 = fmax(TRACK_INSIDE_TOL_REL * model->settings.deflection * b2->size, sharp);
-  return inside_body(&b1->shape, to_local(p1, on2), tol1) && inside_body(&b2->shape, to_local(p2, on1), tol2);
+  pdVec3 on2in1 = to_local(p1, on2), on1in2 = to_local(p2, on1);
+  if (inside_body(&b1->shape, on2in1, tol1) && inside_body(&b2->shape, on1in2, tol2)) return true;
+  // and as find_ee accepts a pair deeper than δ_max where the bodies interpenetrate by P: its points within δ_max + P
+  // (at most its depth) of inside. Held to less, a deep pair the search finds broke at every commit and was found
+  // again at the next, with springs from a hand-over trace while it approached and none once it turned away
+  double deltaMax = pd_model_pair_delta_max(model, id->body1, id->body2);
+  if (!(g->depth > deltaMax)) return false;
+  double slack = fmin(g->depth, deltaMax + penetration_depth(&b1->shape, p1, &b2->shape, p2));
+  return inside_body(&b1->shape, on2in1, slack) && inside_body(&b2->shape, on1in2, slack);
 }
 
 // Do the Gauss-map arcs of a known edge pair meet at the given poses (see arcs_meet)?

@@ -561,6 +561,48 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   return verdict;
 }
 
+// A listed contact takes a broken one's normal springs (handover_to_listed) only while their normals are within this
+// cosine (25°): the springs' force then goes on about along the line it had.
+#define PD_HANDOVER_LISTED_COS 0.9
+
+// The normal deflection of springs sp, m: how far they are pressed together (s2n − s1n, the depth they carry).
+static double normal_deflection(const pdSprings* sp) { return sp->s2n - sp->s1n; }
+
+// Contacts of C0 broken geometrically with no successor among the new contacts (not transferred) may be continued
+// by a contact already listed: two edge pairs at one corner, or an edge pair and the vertex's face contact. The
+// corner's depth is then carried by the survivor, whose springs may have started at zero when it was found
+// already deep; without the broken contact's springs the depth they carried is met by no force, and the pair
+// sinks by it. So the survivor among next[0 .. count) whose features continue the broken one's and whose normal
+// springs carry less takes the broken one's normal springs (never more energy than the two held). The
+// tangential springs stay the survivor's: they are its own sliding history.
+static void handover_to_listed(const pdModel* model, pdContactSet* set, const double* y1, int count) {
+  int base = spring_base(model);
+  for (int i = 0; i < set->count; ++i) {
+    const contactEval* e = &set->eval[i];
+    if (e->tracked || e->transferred) continue;
+    const contactSlot* c = &set->items[i];
+    pdSprings left = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
+    int best = -1;
+    double deflection = normal_deflection(&left);
+    for (int k = 0; k < count; ++k) {
+      contactSlot* s = &set->next[k];
+      // the survivor presses where the broken one did: its normal near the broken one's, and deep enough to take the
+      // deflection (more would push it back beyond its own surface)
+      double carried = fmin(deflection, s->depth);
+      double cosine = pd_v3_dot(s->normal, e->geom.normal) * (s->id.body1 == c->id.body1 ? 1.0 : -1.0);
+      if (normal_deflection(&s->springs) >= carried || cosine < PD_HANDOVER_LISTED_COS ||
+          !pd_contact_continues(model, &c->id, &s->id))
+        continue;
+      if (best < 0 || normal_deflection(&s->springs) < normal_deflection(&set->next[best].springs)) best = k;
+    }
+    if (best < 0) continue;
+    double scale = fmin(1.0, set->next[best].depth / deflection);
+    set->next[best].springs.s1n = scale * left.s1n;
+    set->next[best].springs.s2n = scale * left.s2n;
+    set->eval[i].transferred = true;  // no hand-over trace: its normal springs went on
+  }
+}
+
 void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1, pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
   int base = spring_base(model);
@@ -576,14 +618,8 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       s->count.releaseBoundSum += e->modeBound;
     }
     if (!e->tracked) {
-      if (!e->transferred) {
-        ++s->count.breaksGeometry;
-        if (set->history) {
-          pdSprings left = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
-          pd_history_leave_handover(set->history, &c->id, &left, e->geom.normal, e->force.fn);
-        }
-      }
-      continue;
+      if (!e->transferred) ++s->count.breaksGeometry;
+      continue;  // its springs go on in a listed contact, or into a hand-over trace, below
     }
     if (pd_contact_force_pulls(&e->force)) {
       ++s->count.breaksForce;
@@ -608,6 +644,13 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
     k->point = e->geom.point;
     k->depth = e->geom.depth;
     k->geometryCurrent = true;  // tracked at y1's poses, which the commit keeps (record_range)
+  }
+  handover_to_listed(model, set, y1, count);
+  for (int i = 0; i < set->count && set->history; ++i) {
+    const contactEval* e = &set->eval[i];
+    if (e->tracked || e->transferred) continue;
+    pdSprings left = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
+    pd_history_leave_handover(set->history, &set->items[i].id, &left, e->geom.normal, e->force.fn);
   }
   for (int j = 0; j < set->candidateCount; ++j) {
     const candidate* cand = &set->candidates[j];
