@@ -16,7 +16,8 @@
 
 static const char* const help =
     "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
-    "                         [--stepper implicit|adaptive|fixed|embedded] [--variant native|matched]\n"
+    "                         [--stepper implicit|adaptive|fixed|embedded|dopri]\n"
+    "                         [--variant native|matched]\n"
     "                         [--events bounded|exact|held] [--onsets pair|exact|auto|bounded] [--islands on|off]\n"
     "                         [--sleep on|off] [--threads N] [--step H] [--ode-friction pyramid|aligned]\n"
     "\n"
@@ -34,7 +35,8 @@ static const char* const help =
     "                   sliding contact, islands of up to 32 bodies (docs/integration.md);\n"
     "                   adaptive: RK4 with step-doubling error control alone (the paper's);\n"
     "                   fixed: RK4 with the scene's dt, no error control;\n"
-    "                   embedded: RK4 with its embedded third-order error estimate\n"
+    "                   embedded: RK4 with its embedded third-order error estimate; dopri: DOPRI5(4);\n"
+    "                   implicit-dopri: implicit with DOPRI5(4) for step doubling\n"
     "  --events MODE    soft engine: bounded (default) corrects a contact onset inside a step where its\n"
     "                   error bound is within the tolerance's share and locates the others; exact locates\n"
     "                   every onset, the paper's loop (docs/events.md; the same as --onsets bounded|exact);\n"
@@ -119,9 +121,9 @@ static bool accept_events(const char* cmd, const char* v, void* target) {
 }
 
 static const char* const onOff[] = {"on", "off", NULL};
-static const char* const stepperWords[] = {"adaptive", "fixed", "embedded", "implicit", NULL};
+static const char* const stepperWords[] = {"adaptive", "fixed", "embedded", "implicit", "dopri", "implicit-dopri", NULL};
 static const int stepperValues[] = {pd_stepperRK4Adaptive, pd_stepperRK4Fixed, pd_stepperRK43Embedded,
-                                    pd_stepperImplicit};
+                                    pd_stepperImplicit, pd_stepperDopri54, pd_stepperImplicitDopri};
 static const int islandsValues[] = {pd_islandsOn, pd_islandsOff};
 static const int sleepValues[] = {1, -1};  // pdCliOverrides.sleep
 static const char* const variantWords[] = {"native", "matched", NULL};
@@ -150,7 +152,7 @@ int pd_cmd_run(int argc, char** argv) {
       {.name = "--sample", .kind = pd_optPositive, .target = &overrides.sample,
        .message = "--sample needs a number > 0"},
       {.name = "--stepper", .kind = pd_optChoice, .target = &stepper,
-       .message = "--stepper must be adaptive, fixed, embedded or implicit", .words = stepperWords,
+       .message = "--stepper must be adaptive, fixed, embedded, implicit, dopri or implicit-dopri", .words = stepperWords,
        .values = stepperValues, .given = &softOptionGiven},
       {.name = "--onsets", .kind = pd_optAccept, .target = &onsets, .accept = pd_cli_accept_onsets, .given = &softOptionGiven},
       {.name = "--events", .kind = pd_optAccept, .target = &onsets, .accept = accept_events, .given = &softOptionGiven},

@@ -11,7 +11,7 @@ static const char* const usage =
     "Rigid convex polyhedra in frictional contact (Goyal, Pinson & Sinden 1994).\n"
     "\n"
     "commands:\n"
-    "  run SCENE [--out DIR] [--tend T] [--sample HZ] [--stepper implicit|adaptive|fixed|embedded]\n"
+    "  run SCENE [--out DIR] [--tend T] [--sample HZ] [--stepper implicit|adaptive|fixed|embedded|dopri]\n"
     "                 simulate a scene, write trajectory.csv and summary.json into DIR\n"
     "  check SCENE    parse and compile a scene; print masses, inertias, polyhedra, settings\n"
     "  compare SCENE --out DIR [--engines soft,ode,bullet]\n"

@@ -32,7 +32,7 @@ enum {
   REFERENCE_STEP_COUNT = sizeof referenceSteps / sizeof referenceSteps[0],
   BULLET_ITERATION_COUNT = sizeof bulletIterations / sizeof bulletIterations[0],
   MAX_REPEATS = 21,
-  SOFT_TOL_VARIANTS = 4,
+  SOFT_TOL_VARIANTS = 6,
 };
 
 int pd_gk_precision_input(const pdGkExperiment* e) { return (e->inputCount - 1) / 2; }
@@ -49,7 +49,8 @@ static const char* const pointStatusNames[] = {"ok", "failed", "no_measure", "re
 typedef struct gkPoint {
   const gkCase* c;
   pdGkEngine engine;
-  const char* variant;  // "adaptive", "fixed", "embedded", "implicit", "exact-events", "native", "matched"
+  const char* variant;  // "adaptive", "fixed", "embedded", "implicit", "exact-events", "dopri", "implicit-dopri",
+                        // "native", "matched"
   const char* setting;  // "tol", "step", "iterations"; "" for a not_built row
   double value;
   // measured (travels between processes as gkPointResult)
@@ -155,6 +156,8 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
                         : strcmp(p->variant, "embedded") == 0     ? pd_stepperRK43Embedded
                         : strcmp(p->variant, "implicit") == 0     ? pd_stepperImplicit
                         : strcmp(p->variant, "exact-events") == 0 ? pd_stepperImplicit
+                        : strcmp(p->variant, "dopri") == 0        ? pd_stepperDopri54
+                        : strcmp(p->variant, "implicit-dopri") == 0 ? pd_stepperImplicitDopri
                                                                   : pd_stepperRK4Adaptive;
       // the reference variant of the contact events: every onset located (docs/events.md)
       if (strcmp(p->variant, "exact-events") == 0) options.onsets = pd_onsetsExact;
@@ -276,6 +279,10 @@ static void add_case_points(gkPrecision* s, const gkCase* c) {
     for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "implicit", "tol", softTolerances[k]);
     // the reference variant of the contact events: the default stepper with every onset located (docs/events.md)
     for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "exact-events", "tol", softTolerances[k]);
+    // the Dormand–Prince 5(4) pair, step doubling's explicit alternative, alone and as the implicit stepper's explicit
+    // part (docs/integration.md, "Steppers")
+    for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "dopri", "tol", softTolerances[k]);
+    for (int k = 0; k < SOFT_TOL_COUNT; ++k) add(s, c, pd_gkSoft, "implicit-dopri", "tol", softTolerances[k]);
   }
   for (int engine = pd_gkOde; engine < pd_gkEngineCount; ++engine) {
     if (!o->engines[engine]) continue;
@@ -361,8 +368,8 @@ static bool write_precision(const gkPrecision* s, const char* root, pdError* err
 
 bool gk_precision_run(const pdGkOptions* options, const gkCase* cases, int caseCount, const char* root, pdError* err) {
   PD_ASSERT(options->repeats >= 1 && options->repeats <= MAX_REPEATS);
-  // add_case_points: four soft variants over the tolerances (adaptive, embedded, implicit, exact-events) and one over
-  // the fixed steps; each reference engine native and matched over the steps, Bullet also over its iterations
+  // add_case_points: six soft variants over the tolerances (adaptive, embedded, implicit, exact-events, dopri,
+  // implicit-dopri), one over the fixed steps; each reference engine native and matched over the steps, Bullet also over its iterations
   int perCase = SOFT_TOL_VARIANTS * SOFT_TOL_COUNT + SOFT_FIXED_COUNT +
                 2 * (pd_gkEngineCount - 1) * REFERENCE_STEP_COUNT + 2 * BULLET_ITERATION_COUNT;
   gkPrecision s = {.options = options, .points = calloc((size_t)caseCount * (size_t)perCase + 1, sizeof(gkPoint))};

@@ -167,6 +167,7 @@ struct pdContactSet {
   const pdPose* stablePoses;   // the poses of the list's pd_stability_prepare (unchanged until the step's limit)
   double overdamp;         // the largest over-damping factor of the list's contacts (stabilityTerms)
   double stackTau;         // s: the largest c/k along n of contacts whose dampers a stack sized (0: none; step_of)
+  double dampingMin;       // the smallest damping ratio of the list's modes (ζ_n; ζ_t where a contact sticks), ≤ 1
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)

@@ -90,6 +90,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
   set->stackScratch = pd_stack_scratch_create();
   set->stableStep = set->stableCheap = INFINITY;
+  set->dampingMin = 1.0;
   set->stableKnown = true;
   set->travelStep = INFINITY;
   set->bodyRowsK = pd_grow(NULL, n, sizeof *set->bodyRowsK);
@@ -158,6 +159,7 @@ void pd_contact_set_clear(pdContactSet* set) {
   set->bodyListValid = false;
   set->recordedValid = false;
   set->stableStep = set->stableCheap = INFINITY;
+  set->dampingMin = 1.0;
   set->stableKnown = true;
   set->candidateCount = 0;
   set->cacheCount = 0;

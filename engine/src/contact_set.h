@@ -83,6 +83,11 @@ void pd_contact_events_commit(const pdModel* model, pdState* state, const double
 // does not let h through; *tightNeeded says whether it was needed.
 double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double h, double fraction, bool* tightNeeded);
 
+// The fraction of that step (pd_contact_set_limit_step's `fraction`) within which one Dormand–Prince 5(4) step is
+// stable for the committed list: its stability region's radius along the rays of modes damped at least as much as
+// the list's least damped contact (stability_bound.c, PD_DOPRI_STABLE_RADIUS), against step doubling's 2 × 2.5.
+double pd_contact_set_dopri_fraction(const pdContactSet* set);
+
 // The step the tunnelling guard (contact_search.c) lets the step after the last analysed one take if the bodies'
 // motion goes on, s (INFINITY: no pair near its travel limit). The adaptive steppers start their next trial from at
 // most this, rather than from what their error control wants, each time to be cut back by the guard.

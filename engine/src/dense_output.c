@@ -19,6 +19,7 @@ struct pdDense {
   // the captured step [t0, t0 + h], in its contact list's layout (n numbers)
   bool captured;
   bool quartic;  // step doubling's nodes; else the cubic's
+  bool dopri;    // Dormand–Prince's: the cubic's nodes and its extension's term d in NODE_YHALF
   double t0, h;
   int n, capacity;
   double* node[NODE_COUNT];  // (capacity) each
@@ -66,23 +67,16 @@ double* pd_dense_slope_scratch(pdDense* d, int n) {
   return d->node[NODE_F1];
 }
 
-void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* f0, const double* yHalf,
-                      const double* fHalf, const double* y1, const double* f1) {
+// What every capture keeps: y0, f0, y1 and the step's contact list.
+static pdDense* capture_ends(const pdModel* model, pdState* s, double h, const double* f0, const double* y1) {
   pdDense* d = s->dense;
   PD_ASSERT(d != NULL && !d->presenting);
   int n = s->n;
   reserve(d, n);
   size_t bytes = (size_t)n * sizeof(double);
-  d->quartic = yHalf != NULL;
   memcpy(d->node[NODE_Y0], s->y, bytes);
   memcpy(d->node[NODE_F0], f0, bytes);
   memcpy(d->node[NODE_Y1], y1, bytes);
-  if (d->quartic) {
-    memcpy(d->node[NODE_YHALF], yHalf, bytes);
-    memcpy(d->node[NODE_FHALF], fHalf, bytes);
-  } else if (f1 != d->node[NODE_F1]) {  // the implicit method's f(y1) is already there (pd_dense_slope_scratch)
-    memcpy(d->node[NODE_F1], f1, bytes);
-  }
   if (!d->view) d->view = pd_contact_set_create_view(model);
   pd_contact_set_capture(s->contacts, d->view);
   // the history changes only at commits: what it keeps at the step's start it keeps until its end
@@ -91,6 +85,31 @@ void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* 
   d->h = h;
   d->n = n;
   d->captured = true;
+  return d;
+}
+
+void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* f0, const double* yHalf,
+                      const double* fHalf, const double* y1, const double* f1) {
+  pdDense* d = capture_ends(model, s, h, f0, y1);
+  size_t bytes = (size_t)d->n * sizeof(double);
+  d->quartic = yHalf != NULL;
+  d->dopri = false;
+  if (yHalf) {
+    memcpy(d->node[NODE_YHALF], yHalf, bytes);
+    memcpy(d->node[NODE_FHALF], fHalf, bytes);
+  } else if (f1 != d->node[NODE_F1]) {  // the implicit method's f(y1) is already there (pd_dense_slope_scratch)
+    memcpy(d->node[NODE_F1], f1, bytes);
+  }
+}
+
+void pd_dense_capture_dopri(const pdModel* model, pdState* s, double h, const double* f0, const double* y1,
+                            const double* f1, const double* ext) {
+  pdDense* d = capture_ends(model, s, h, f0, y1);
+  size_t bytes = (size_t)d->n * sizeof(double);
+  d->quartic = false;
+  d->dopri = true;
+  memcpy(d->node[NODE_F1], f1, bytes);
+  memcpy(d->node[NODE_YHALF], ext, bytes);
 }
 
 // The interpolant at θ into out (d->n numbers).
@@ -112,6 +131,14 @@ static void interpolate(const pdDense* d, double theta, double* out) {
     return;
   }
   const double* f1 = d->node[NODE_F1];
+  if (d->dopri) {
+    const double* ext = d->node[NODE_YHALF];
+    for (int i = 0; i < d->n; ++i) {
+      double dy = y1[i] - y0[i], r3 = h * f0[i] - dy, r4 = dy - h * f1[i] - r3;
+      out[i] = y0[i] + theta * (dy + (1.0 - theta) * (r3 + theta * (r4 + (1.0 - theta) * ext[i])));
+    }
+    return;
+  }
   for (int i = 0; i < d->n; ++i) {
     double dy = y1[i] - y0[i];
     double c2 = 3.0 * dy - h * (2.0 * f0[i] + f1[i]);

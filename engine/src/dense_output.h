@@ -12,7 +12,10 @@
 // - step doubling: the quartic through y0 with slope f(y0), the first half step's result y½ with slope f(y½), and
 //   the kept result y1: every number it uses is the step's own (no evaluation), error O(h⁵) like the half steps';
 // - the embedded pair and the implicit method: the cubic Hermite interpolant of y0, f(y0), y1, f(y1) (the embedded
-//   pair has f(y1) already; the implicit method evaluates it once per step that needs it), error O(h⁴).
+//   pair has f(y1) already; the implicit method evaluates it once per step that needs it), error O(h⁴);
+// - Dormand–Prince 5(4): its fourth-order continuous extension (Hairer, Nørsett & Wanner I, II.6; their DOPRI5's
+//   CONTD5) y0 + θ (Δ + (1 − θ)(h f0 − Δ + θ (2Δ − h f0 − h f1 + (1 − θ) d))), Δ = y1 − y0, d = h Σ d_i k_i: the
+//   cubic Hermite interpolant plus θ²(1 − θ)² d, error O(h⁵), from the step's own stages (no evaluation).
 // Quaternions are normalised after interpolation.
 #pragma once
 
@@ -37,6 +40,10 @@ bool pd_dense_wanted(const pdDense* d, double t0, double h);
 // list. May grow the record (the first steps of a state, or a longer state vector).
 void pd_dense_capture(const pdModel* model, pdState* s, double h, const double* f0, const double* yHalf,
                       const double* fHalf, const double* y1, const double* f1);
+// The accepted Dormand–Prince step of h from (state->t, state->y), before its commit: f0 = k1, y1, f1 = k7 = f(y1)
+// and d = h Σ d_i k_i, its continuous extension's last term (integrator.c, DOPRI_D). As pd_dense_capture.
+void pd_dense_capture_dopri(const pdModel* model, pdState* s, double h, const double* f0, const double* y1,
+                            const double* f1, const double* d);
 // Where the implicit method evaluates f(y1) for its capture (state->n numbers; pd_dense_capture takes it as is).
 double* pd_dense_slope_scratch(pdDense* d, int n);
 

@@ -19,6 +19,9 @@
 // analysed once per accepted step — so it wins on impacts and free flight and loses on resting and sliding
 // contacts (docs/integration.md); step doubling, not this pair, is the default's explicit part. Both run through
 // adaptive_step, which takes the trial, the order of its estimate (the controller's exponents) and the bound's share.
+// The Dormand–Prince pair (pd_stepperDopri54, trial_dopri) keeps a fifth-order result with an O(h⁵) estimate, as step
+// doubling does, at 7 evaluations per step; its stability region holds little of the imaginary axis, so its bound
+// depends on the contacts' damping (pd_contact_set_dopri_fraction) and is below step doubling's two half steps'.
 // The implicit stepper (pd_stepperImplicit, switching_step) runs step doubling until the contacts' stability bound
 // holds it well below what its error control wants (resting contact), then ROS34PW2, a linearly implicit method
 // with no stability bound (trial_implicit; its matrices in implicit.c), until step doubling could take about its
@@ -216,6 +219,79 @@ static double trial_embedded(const pdModel* model, pdState* s, stepperWork* w, d
   return norm;
 }
 
+// Dormand–Prince 5(4) (J. R. Dormand & P. J. Prince, "A family of embedded Runge–Kutta formulae", J. Comput. Appl.
+// Math. 6 (1980) 19–26; the tableau as printed in Hairer, Nørsett & Wanner, Solving ODEs I, 2nd ed., Table II.5.2):
+// 7 stages, the fifth-order result kept (local extrapolation), error y1 − ŷ1 = h Σ e_i k_i with ŷ1 the embedded
+// fourth-order one, O(h⁵) as step doubling's. The seventh stage is f(t + h, y1) (FSAL), but it cannot serve as the
+// next step's k1: committing a step realigns the springs and may change the contact list (as for the embedded
+// pair), so 7 evaluations per accepted step and 6 per rejected retry. Checked on y' = y²: local error O(h⁶).
+static const double DOPRI_C[7] = {0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0};
+static const double DOPRI_A[6][5] = {
+    {1.0 / 5.0},
+    {3.0 / 40.0, 9.0 / 40.0},
+    {44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0},
+    {19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0},
+    {9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0},
+    {35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, /* 11/84: DOPRI_B[5] */}};
+static const double DOPRI_B[6] = {35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0};
+static const double DOPRI_E[7] = {71.0 / 57600.0,      0.0,           -71.0 / 16695.0, 71.0 / 1920.0,
+                                  -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0};
+// The fourth-order continuous extension's last coefficients (Hairer, Nørsett & Wanner I, II.6, and their DOPRI5 code,
+// CONTD5): with d = h Σ d_i k_i, the interpolant is dense_output.c's (b2 = d2 = 0). Checked on y' = y²: O(h⁵) at θ = ½.
+static const double DOPRI_D[7] = {-12715105075.0 / 11282082432.0, 0.0,
+                                  87487479700.0 / 32700410799.0,  -10690763975.0 / 1880347072.0,
+                                  701980252875.0 / 199316789632.0, -1453857185.0 / 822651844.0,
+                                  69997945.0 / 29380423.0};
+
+// The stages' slopes in the scratch: k2's vector takes k7 (k2's weights in y1, the error and the extension are 0).
+static void dopri_slopes(stepperWork* w, double* k[7]) {
+  double* slopes[7] = {w->k1, w->ktmp, w->acc, w->full, w->half, w->k1half, w->ktmp};
+  memcpy(k, slopes, sizeof slopes);
+}
+
+// out = y + h Σ_{j<count} a_j k_j, elementwise (so a split loop computes the same numbers: help_desk.h).
+typedef struct dopriLoop {
+  const double* y;
+  double* const* k;
+  const double* a;
+  int count;
+  double h;
+  double* out;
+} dopriLoop;
+
+static void dopri_range(void* ctx, int part, int begin, int end) {
+  (void)part;
+  const dopriLoop* job = ctx;
+  for (int i = begin; i < end; ++i) {
+    double acc = 0.0;
+    for (int j = 0; j < job->count; ++j) acc += job->a[j] * job->k[j][i];
+    job->out[i] = job->y[i] + job->h * acc;
+  }
+}
+
+// The Dormand–Prince trial (pd_stepperDopri54): y1 into w->trial, the error norm returned; k1 … k7 left in the
+// scratch for the dense output (dopri_slopes).
+static double trial_dopri(const pdModel* model, pdState* s, stepperWork* w, double h) {
+  w->halfStep = 0.0;
+  pdHelpDesk* desk = pd_contact_set_help_desk(s->contacts);
+  double* k[7];
+  dopri_slopes(w, k);
+  for (int i = 1; i < 7; ++i) {
+    // stage i's point; the last is y1 itself
+    double* point = i < 6 ? w->ytmp : w->trial;
+    dopriLoop job = {s->y, k, i < 6 ? DOPRI_A[i - 1] : DOPRI_B, i, h, point};
+    pd_help_for(desk, s->n, PD_HELP_MIN_COMPONENTS, dopri_range, &job);
+    derivative(model, s, s->t + DOPRI_C[i] * h, point, k[i]);
+  }
+  double norm = 0.0;
+  for (int i = 0; i < s->n; ++i) {
+    double e = 0.0;
+    for (int j = 0; j < 7; ++j) e += DOPRI_E[j] * k[j][i];
+    norm = max_skipping_nan(norm, fabs(h * e) / s->weight[i]);
+  }
+  return norm;
+}
+
 // ROS34PW2 (Rang & Angermann, BIT 45 (2005) 761–787): a Rosenbrock-W method of 4 stages, order 3 for any
 // matrix W, with an embedded order-2 solution, L-stable and stiffly accurate. In the transformed form (Hairer &
 // Wanner II, IV.7), with M = I/(hγ) − W:
@@ -288,13 +364,22 @@ typedef struct stepOutcome {
 
 // Dense output (dense_output.h): an accepted step that passes the time the state must next be presented at keeps
 // its interpolant, from the trial's own numbers (step doubling: the first half step and its slope; the embedded pair:
-// f(y1), its k5; the implicit method: f(y1), evaluated here). Before the commit, which may change the contact list.
+// f(y1), its k5; Dormand–Prince: its stages; the implicit method: f(y1), evaluated here). Before the commit, which may change the contact list.
 static void capture_step(const pdModel* model, pdState* s, stepperWork* w, trialFcn* trial, double h) {
   if (!s->dense || !pd_dense_wanted(s->dense, s->t, h)) return;
   if (trial == trial_doubling) {
     pd_dense_capture(model, s, h, w->k1, w->half, w->k1half, w->trial, NULL);
   } else if (trial == trial_embedded) {
     pd_dense_capture(model, s, h, w->k1, NULL, NULL, w->trial, w->k1half);
+  } else if (trial == trial_dopri) {
+    double* k[7];
+    dopri_slopes(w, k);
+    for (int i = 0; i < s->n; ++i) {
+      double d = 0.0;
+      for (int j = 0; j < 7; ++j) d += DOPRI_D[j] * k[j][i];
+      w->ytmp[i] = h * d;
+    }
+    pd_dense_capture_dopri(model, s, h, w->k1, w->trial, k[6], w->ytmp);
   } else {
     double* f1 = pd_dense_slope_scratch(s->dense, s->n);
     derivative(model, s, s->t + h, w->trial, f1);
@@ -312,7 +397,7 @@ typedef struct probationLimits {
 // Takes one accepted step of at most `hMax` from state->t with error control. Returns the step taken (0 on
 // failure). `order` is the order of the error estimate's leading term in h (5 for step doubling, 4 for the
 // embedded pair, 3 for ROS34PW2); `stableFraction` the part of the contacts' stability bound (a bound for half
-// steps) the whole trial step may use (INFINITY: none); `probation` (nullable): a trial must meet its tol, a rejection
+// steps) the whole trial step may use (INFINITY: none; NAN: Dormand–Prince's, from the committed list); `probation` (nullable): a trial must meet its tol, a rejection
 // below its floor retries at the floor once, and a trial at the floor rejected returns 0 with outcome->gaveUp set and
 // nothing taken; `outcome` (nullable) receives the accepted step's outcome.
 static double adaptive_step(const pdModel* model, pdState* s, double hMax, trialFcn* trial, double order,
@@ -408,9 +493,10 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     if (outcome) *outcome = (stepOutcome){s->h, eventCut, false, s->hLimit, cutLimit};
     // the contacts' stability bound (§3.3): the error control alone would walk the step to the edge (an implicit
     // trial has none: stableFraction INFINITY)
-    if (stableFraction < INFINITY) {
+    if (stableFraction != INFINITY) {
       bool tightNeeded;
-      double stable = pd_contact_set_limit_step(model, s->contacts, s->h, stableFraction, &tightNeeded);
+      double fraction = isnan(stableFraction) ? pd_contact_set_dopri_fraction(s->contacts) : stableFraction;
+      double stable = pd_contact_set_limit_step(model, s->contacts, s->h, fraction, &tightNeeded);
       if (stable < s->h) s->hLimit = pd_limitStability;
       s->h = fmax(set->dtmin, stable);
       s->count.stabilityTight += tightNeeded;
@@ -424,9 +510,13 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
 // where the implicit method's steps are limited by its own error estimate alone (reports/bench/implicit: 3× fewer
 // steps on a resting pile). The switch (implicit.h, PD_IMPLICIT_SWITCH_STEPS) looks only at the state's own
 // numbers, so it is the same on every run. Systems of more than PD_IMPLICIT_BODIES_MAX moving bodies stay explicit.
-static double switching_step(const pdModel* model, pdState* s, double hMax) {
-  if (model->movingCount > PD_IMPLICIT_BODIES_MAX)
-    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
+// `explicitTrial`: step doubling (pd_stepperImplicit) or Dormand–Prince (pd_stepperImplicitDopri), with its bound.
+static double explicit_step(const pdModel* model, pdState* s, double hMax, trialFcn* explicitTrial, stepOutcome* out) {
+  return adaptive_step(model, s, hMax, explicitTrial, 5.0, explicitTrial == trial_dopri ? NAN : 1.0, NULL, out);
+}
+
+static double switching_step(const pdModel* model, pdState* s, double hMax, trialFcn* explicitTrial) {
+  if (model->movingCount > PD_IMPLICIT_BODIES_MAX) return explicit_step(model, s, hMax, explicitTrial, NULL);
   if (!s->implicit) {
     s->implicit = pd_implicit_create();
     pd_implicit_reserve(s->implicit, model->movingCount, pd_state_contact_room(model, s));
@@ -434,7 +524,7 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
   pdImplicit* im = s->implicit;
   stepOutcome out = {0.0, false, false, pd_limitError, pd_limitEvent};
   if (!pd_implicit_active(im)) {
-    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, &out);
+    double taken = explicit_step(model, s, hMax, explicitTrial, &out);
     // s->h is now the bound's step: on a switch the implicit method starts from the step the error control wanted
     bool held = !out.eventCut && out.wanted >= PD_IMPLICIT_HELD_RATIO * s->h;
     if (taken > 0.0 && pd_implicit_note_explicit(im, held, s->h, s->t)) {
@@ -455,7 +545,7 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     pdStepLimit wantedLimit = s->hLimit;
     s->h = boundStep;
     s->hLimit = pd_limitStability;
-    double taken = adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
+    double taken = explicit_step(model, s, hMax, explicitTrial, NULL);
     if (taken > 0.0 && wanted > s->h) {
       s->h = wanted;
       s->hLimit = wantedLimit;
@@ -468,7 +558,7 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     s->h = boundStep;
     s->hLimit = pd_limitStability;
     pd_implicit_deactivate(im, true, s->t);
-    return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);
+    return explicit_step(model, s, hMax, explicitTrial, NULL);
   }
   if (taken > 0.0) {
     if (onProbation) pd_implicit_paid(im);
@@ -483,7 +573,8 @@ static double switching_step(const pdModel* model, pdState* s, double hMax) {
     // trial costs about two explicit ones on a small system
     double worth = (out.eventCut ? fmin(out.wanted, taken) : out.wanted) / PD_IMPLICIT_HELD_RATIO;
     bool tightNeeded;
-    if (pd_contact_set_limit_step(model, s->contacts, worth, 1.0, &tightNeeded) >= worth) {
+    double fraction = explicitTrial == trial_dopri ? pd_contact_set_dopri_fraction(s->contacts) : 1.0;
+    if (pd_contact_set_limit_step(model, s->contacts, worth, fraction, &tightNeeded) >= worth) {
       pd_implicit_deactivate(im, false, s->t);
       s->count.stabilityTight += tightNeeded;
     }
@@ -535,7 +626,11 @@ static double one_step(const pdModel* model, pdState* s, double target, bool lan
     case pd_stepperRK43Embedded:
       return adaptive_step(model, s, hMax, trial_embedded, 4.0, 0.5, NULL, NULL);
     case pd_stepperImplicit:
-      return switching_step(model, s, hMax);
+      return switching_step(model, s, hMax, trial_doubling);
+    case pd_stepperImplicitDopri:
+      return switching_step(model, s, hMax, trial_dopri);
+    case pd_stepperDopri54:
+      return adaptive_step(model, s, hMax, trial_dopri, 5.0, NAN, NULL, NULL);
     case pd_stepperRK4Adaptive:
     default:
       return adaptive_step(model, s, hMax, trial_doubling, 5.0, 1.0, NULL, NULL);

@@ -24,6 +24,20 @@
 // the bound the error control walks the step up to the stability edge, where round-off grows until a
 // step is rejected: a block at rest then jitters at the tolerance (µm/s) instead of round-off.
 #define PD_STABLE_STEP_OMEGA 2.5
+// Stability bound of a Dormand–Prince 5(4) step (pd_contact_set_dopri_fraction). Its kept fifth-order result has the
+// stability function R(z) = Σ_{k≤5} z^k/k! + z⁶/600 (the seventh stage has weight 0). A contact mode of frequency ω
+// and damping ratio ζ ≤ 1 has λ = ω(−ζ ± i√(1 − ζ²)), so the step is stable for hω ≤ r(ζ), the distance from 0 to
+// where the ray at that angle leaves |R| ≤ 1. Unlike RK4's, R's region barely holds the imaginary axis (|R(iy)| > 1
+// from y = 0.997): an undamped mode is stable only to hω ≈ 1, a damped one far further. Each entry is a damping
+// ratio ζ₀ and min r(ζ) over ζ ∈ [ζ₀, 1] (bisection on |R| = 1 along 1 001 rays); a list's least damped contact picks
+// the last entry at or below its ζ, and the step is 0.95 r (the margin 2.5 leaves below RK4's own 2.62). The joint
+// modes of several contacts are damped at least as much as the least damped of them (docs/integration.md).
+// Overdamped modes enter through ω's overdamp factor (step_of), as RK4's do: along the negative real axis r = 3.307.
+static const double PD_DOPRI_STABLE_RADIUS[][2] = {
+    {0.0, 0.9972},  {0.01, 1.8721}, {0.02, 2.0791}, {0.03, 2.2153}, {0.04, 2.3187}, {0.05, 2.4026},
+    {0.075, 2.5623}, {0.1, 2.6814}, {0.15, 2.8608}, {0.2, 3.0007}, {0.25, 3.1179}, {0.3, 3.2160},
+    {0.35, 3.2811}, {0.8, 3.2848}, {0.85, 3.3050}, {0.9, 3.3066}};
+#define PD_DOPRI_STABLE_MARGIN 0.95
 // Relative margin on the stability bounds (pd_stability_prepare, stability_tight) against the rounding of their
 // sums (~1e-15 relative): where a Gershgorin bound is exact (a single contact), rounding must not take it below
 // ω_max².
@@ -360,12 +374,14 @@ void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose*
   if (set->count == 0) {
     set->stableStep = set->stableCheap = INFINITY;
     set->cheapOmega2 = 0.0;
+    set->dampingMin = 1.0;
     set->stableKnown = true;
     return;
   }
   pd_contact_set_list_bodies(model, set);
   set->stablePoses = poses;
   set->stackTau = 0.0;
+  set->dampingMin = 1.0;
   int bodies = model->bodyCount;
   for (int k = 0; k < bodies; ++k) set->bodyRowsK[k] = set->bodyRowsRight[k] = (pdVec3){0, 0, 0};
   for (int i = 0; i < set->count; ++i) {
@@ -385,6 +401,7 @@ void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose*
       if (ks > 0.0) set->stackTau = fmax(set->stackTau, pd_series(p->c1n, p->c2n) / ks);
     }
     t->overdamp = fmax(overdamp_factor(zn), overdamp_factor(zt));
+    set->dampingMin = fmin(set->dampingMin, sticks ? fmin(zn, zt) : zn);
     int ends[2] = {c->id.body1, c->id.body2};
     for (int e = 0; e < 2; ++e) {
       const pdBody* b = &model->bodies[ends[e]];
@@ -433,4 +450,10 @@ double pd_contact_set_limit_step(const pdModel* model, pdContactSet* set, double
     set->stableKnown = true;
   }
   return fmin(h, fraction * set->stableStep);
+}
+
+double pd_contact_set_dopri_fraction(const pdContactSet* set) {
+  int count = (int)(sizeof PD_DOPRI_STABLE_RADIUS / sizeof PD_DOPRI_STABLE_RADIUS[0]), entry = 0;
+  while (entry + 1 < count && PD_DOPRI_STABLE_RADIUS[entry + 1][0] <= set->dampingMin) ++entry;
+  return PD_DOPRI_STABLE_MARGIN * PD_DOPRI_STABLE_RADIUS[entry][1] / (2.0 * PD_STABLE_STEP_OMEGA);
 }

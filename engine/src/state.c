@@ -35,7 +35,7 @@ pdStateOptions pd_state_options_default(void) {
 pdState* pd_state_create(const pdModel* model, const pdStateOptions* options) {
   pdStateOptions o = options ? *options : pd_state_options_default();
   PD_ASSERT(o.valid == OPTIONS_VALID);  // made by pd_state_options_default
-  PD_ASSERT(o.stepper >= pd_stepperRK4Adaptive && o.stepper <= pd_stepperImplicit);
+  PD_ASSERT(o.stepper >= pd_stepperRK4Adaptive && o.stepper <= pd_stepperImplicitDopri);
   PD_ASSERT(o.onsets >= pd_onsetsExact && o.onsets <= pd_onsetsHeld);
   PD_ASSERT(o.islands == pd_islandsOff || o.islands == pd_islandsOn);
   PD_ASSERT(o.threads >= 1 && o.threads <= PD_THREADS_MAX);
@@ -132,6 +132,10 @@ const char* pd_stepper_name(pdStepper stepper) {
       return "rk43-embedded";
     case pd_stepperImplicit:
       return "ros34pw2";
+    case pd_stepperDopri54:
+      return "dopri54";
+    case pd_stepperImplicitDopri:
+      return "ros34pw2-dopri54";
     case pd_stepperRK4Adaptive:
       break;
   }

@@ -145,7 +145,7 @@ def run(scene, engine="soft", *, variant=None, tend=None, sample=None, stepper=N
     scene: a Scene, a Model, or a scene file's path. engine: "soft" (polydyn's), "ode" or "bullet" (the same
     compiled model in a reference engine: variant "native" or "matched", step in s). tend (s), sample (Hz): override
     the scene's, as `polydyn run --tend --sample`. Soft engine only: stepper ("implicit", "adaptive", "fixed",
-    "embedded"), onsets ("bounded", the default, "auto", "pair", "exact": docs/events.md), islands ("on", "off"),
+    "embedded", "dopri", "implicit-dopri"), onsets ("bounded", the default, "auto", "pair", "exact": docs/events.md), islands ("on", "off"),
     threads (with islands on). contacts: record
     every sample's contacts (soft engine; the reference engines report none). callback(state): called at every
     output sample with a read-only State; returning False stops the run. out: also write the run directory there,

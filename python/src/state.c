@@ -180,13 +180,14 @@ static pdPyState* state_alloc(PyObject* modelObject, const pdModel* model, pdSta
 static bool parse_stepper(const char* name, pdStepper* out) {
   static const struct { const char* name; pdStepper stepper; } steppers[] = {
       {"implicit", pd_stepperImplicit}, {"adaptive", pd_stepperRK4Adaptive},
-      {"fixed", pd_stepperRK4Fixed},    {"embedded", pd_stepperRK43Embedded}};
+      {"fixed", pd_stepperRK4Fixed},    {"embedded", pd_stepperRK43Embedded},
+      {"dopri", pd_stepperDopri54},     {"implicit-dopri", pd_stepperImplicitDopri}};
   for (size_t i = 0; i < sizeof steppers / sizeof steppers[0]; ++i)
     if (strcmp(name, steppers[i].name) == 0) {
       *out = steppers[i].stepper;
       return true;
     }
-  PyErr_Format(PyExc_ValueError, "stepper must be implicit, adaptive, fixed or embedded, not '%s'", name);
+  PyErr_Format(PyExc_ValueError, "stepper must be implicit, adaptive, fixed, embedded, dopri or implicit-dopri, not '%s'", name);
   return false;
 }
 

@@ -497,29 +497,31 @@ static void test_dt_equal_to_dtmin_and_dtmax_takes_exactly_1000_steps(void** sta
   assert_int_equal(c.rejected, 0);
 }
 
+// A thrown, spinning box at tol 1e-10 from a first step of 0.01 s (far too long: some trials are rejected): every
+// accepted step costs `perAccepted` derivative evaluations and every rejected trial `perRejected`.
+static void check_evaluations_per_step(pdStepper stepper, long perAccepted, long perRejected) {
+  pdCounters c = run_counts_with(
+      "gravity 0 0 -9.81\ntend 1\ntol 1e-10\ndt 0.01\nsample 100\n"
+      "cube box red 0.1 0.2 0.3\nvel 1 0 2  720 1 3 0.2\n",
+      stepper);
+  printf("  %s counts: %ld accepted, %ld rejected, %ld derivatives\n", pd_stepper_name(stepper), c.accepted,
+         c.rejected, c.derivatives);
+  assert_true(c.rejected > 0);
+  assert_int_equal(c.derivatives, perAccepted * c.accepted + perRejected * c.rejected);
+}
+
 static void test_adaptive_step_costs_11_evaluations_and_a_rejection_10(void** state) {
   (void)state;
   // integrator.c: k1 is evaluated once per accepted step and reused by every trial from that point;
   // a trial is a full step (3 more), two half steps (3 + 1 + 3): 10 evaluations
-  pdCounters c = run_counts(
-      "gravity 0 0 -9.81\ntend 1\ntol 1e-10\ndt 0.01\nsample 100\n"
-      "cube box red 0.1 0.2 0.3\nvel 1 0 2  720 1 3 0.2\n");
-  printf("  counts: %ld accepted, %ld rejected, %ld derivatives\n", c.accepted, c.rejected, c.derivatives);
-  assert_true(c.rejected > 0);  // the first step (0.01 s) is far too long for 1e-10
-  assert_int_equal(c.derivatives, 11 * c.accepted + 10 * c.rejected);
+  check_evaluations_per_step(pd_stepperRK4Adaptive, 11, 10);
 }
 
 static void test_embedded_step_costs_5_evaluations_and_a_rejection_4(void** state) {
   (void)state;
   // integrator.c: k1 once per accepted step; a trial is the RK4 step (3 more) and f(t + h, y1) for the
   // error estimate: 4 evaluations
-  pdCounters c = run_counts_with(
-      "gravity 0 0 -9.81\ntend 1\ntol 1e-10\ndt 0.01\nsample 100\n"
-      "cube box red 0.1 0.2 0.3\nvel 1 0 2  720 1 3 0.2\n",
-      pd_stepperRK43Embedded);
-  printf("  counts: %ld accepted, %ld rejected, %ld derivatives\n", c.accepted, c.rejected, c.derivatives);
-  assert_true(c.rejected > 0);
-  assert_int_equal(c.derivatives, 5 * c.accepted + 4 * c.rejected);
+  check_evaluations_per_step(pd_stepperRK43Embedded, 5, 4);
 }
 
 static void test_embedded_pair_keeps_the_parabola_and_steps_as_tol_to_the_quarter(void** state) {
@@ -545,6 +547,59 @@ static void test_embedded_pair_keeps_the_parabola_and_steps_as_tol_to_the_quarte
   printf("  spinning box: %ld steps at tol 1e-7, %ld at 1e-8 (ratio %.2f, 10^(1/4) = 1.78)\n", steps[0], steps[1],
          ratio);
   assert_true(ratio > 1.68 && ratio < 1.9);
+}
+
+static void test_dopri_step_costs_7_evaluations_and_a_rejection_6(void** state) {
+  (void)state;
+  // integrator.c, trial_dopri: k1 once per accepted step; a trial is 6 more stages, the last f(t + h, y1), which the
+  // next step cannot reuse (its commit realigns the springs)
+  check_evaluations_per_step(pd_stepperDopri54, 7, 6);
+}
+
+// A box spinning about no principal axis (Euler's equations, torque-free: smooth, no contacts), run with the
+// Dormand–Prince pair at fixed steps (dtmin = dtmax, tol 0.9 loose enough to accept every step) of 10 and 5 ms (ωh
+// 0.13 and 0.06) and compared at t = 1 s with a run at tol 1e-13: the kept result is of fifth order, so halving the
+// step divides the global error by 2⁵ = 32 (a fourth-order result kept: 16; sixth: 64). The estimated order
+// log₂(e_h/e_h/2) within 4.5 … 5.6 (at 20 and 10 ms, not yet asymptotic, it is 5.8).
+#define DOPRI_ORDER_MIN 4.5
+#define DOPRI_ORDER_MAX 5.6
+
+static const char* const spinningBox = "gravity 0 0 0\ntend 1\nsample 10\ncube box red 0.1 0.2 0.3\nvel 0 0 0  720 1 3 0.2\n";
+
+static pdBodyState spin_run(const char* settings, long* steps) {
+  char text[512];
+  snprintf(text, sizeof text, "%s%s", settings, spinningBox);
+  pdModel* m = compile_text(text);
+  pdStateOptions options = pd_state_options_default();
+  options.stepper = pd_stepperDopri54;
+  pdState* s = pd_state_create(m, &options);
+  assert_true(pd_advance(m, s, m->settings.tend, NULL, NULL));
+  pdBodyState b = pd_state_body(m, s, 0);
+  *steps = s->count.accepted;
+  pd_state_free(s);
+  pd_model_free(m);
+  return b;
+}
+
+static void test_dopri_converges_at_fifth_order(void** state) {
+  (void)state;
+  long refSteps, steps[2];
+  pdBodyState ref = spin_run("tol 1e-13\ndtmax 1\n", &refSteps);
+  static const char* const fixedSteps[2] = {"tol 0.9\ndt 0.01\ndtmin 0.01\ndtmax 0.01\n",
+                                            "tol 0.9\ndt 0.005\ndtmin 0.005\ndtmax 0.005\n"};
+  double err[2];
+  for (int i = 0; i < 2; ++i) {
+    pdBodyState b = spin_run(fixedSteps[i], &steps[i]);
+    double dq = fabs(b.q.w - ref.q.w) + fabs(b.q.x - ref.q.x) + fabs(b.q.y - ref.q.y) + fabs(b.q.z - ref.q.z);
+    err[i] = fmax(pd_v3_norm(pd_v3_sub(b.w, ref.w)) / pd_v3_norm(ref.w), dq);
+  }
+  double order = log2(err[0] / err[1]);
+  printf("  spinning box, dopri54: h 0.01 s (%ld steps) error %.3g, h 0.005 s (%ld steps) error %.3g: order %.2f "
+         "(reference %ld steps)\n",
+         steps[0], err[0], steps[1], err[1], order, refSteps);
+  assert_int_equal(steps[0], 100);
+  assert_int_equal(steps[1], 200);
+  assert_true(order >= DOPRI_ORDER_MIN && order <= DOPRI_ORDER_MAX);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -718,6 +773,8 @@ int main(void) {
       cmocka_unit_test(test_adaptive_step_costs_11_evaluations_and_a_rejection_10),
       cmocka_unit_test(test_embedded_step_costs_5_evaluations_and_a_rejection_4),
       cmocka_unit_test(test_embedded_pair_keeps_the_parabola_and_steps_as_tol_to_the_quarter),
+      cmocka_unit_test(test_dopri_step_costs_7_evaluations_and_a_rejection_6),
+      cmocka_unit_test(test_dopri_converges_at_fifth_order),
       cmocka_unit_test(test_quaternion_stays_unit_at_every_sample),
       cmocka_unit_test(test_constant_force_at_centre_of_mass_gives_x_equal_f_t2_over_2m),
       cmocka_unit_test(test_ramp_force_gives_x_equal_rate_t3_over_6m),

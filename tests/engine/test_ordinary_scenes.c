@@ -327,5 +327,7 @@ int main(void) {
   failed += cmocka_run_group_tests_name("embedded stepper (rk43-embedded)", tests, NULL, NULL);
   stepper = pd_stepperImplicit;
   failed += cmocka_run_group_tests_name("implicit stepper (ros34pw2 where contacts rest)", tests, NULL, NULL);
+  stepper = pd_stepperDopri54;
+  failed += cmocka_run_group_tests_name("Dormand-Prince stepper (dopri54)", tests, NULL, NULL);
   return failed;
 }

@@ -69,6 +69,10 @@ typedef enum pdStepper {
                            // order 3 with an order-2 estimate and no stability bound) where the contacts' stability
                            // bound holds step doubling: resting contact. Systems of more than 32 moving bodies
                            // (PD_IMPLICIT_BODIES_MAX) keep step doubling (docs/integration.md)
+  pd_stepperDopri54,       // Dormand–Prince 5(4): 7 stages, the fifth-order result kept, error = |y1 − ŷ1| of the
+                           // embedded fourth-order one, dense output by its fourth-order continuous extension; its own
+                           // stability bound (docs/integration.md, "Steppers")
+  pd_stepperImplicitDopri,  // as pd_stepperImplicit with Dormand–Prince 5(4) in step doubling's place, for measurement
 } pdStepper;
 
 // The stepper of pd_state_options_default() and the one `polydyn run` uses unless told: it takes step doubling's
@@ -76,7 +80,8 @@ typedef enum pdStepper {
 // would hold step doubling to a fraction of them (docs/integration.md).
 #define PD_STEPPER_DEFAULT pd_stepperImplicit
 
-// The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed", "rk43-embedded" or "ros34pw2".
+// The stepper's name in summary.json: "rk4-adaptive", "rk4-fixed", "rk43-embedded", "ros34pw2", "dopri54" or
+// "ros34pw2-dopri54".
 PD_API const char* pd_stepper_name(pdStepper stepper);
 
 // How a contact that began inside a step joins the list (paper App. C; docs/contact-model.md).
