@@ -112,22 +112,26 @@ void pd_dense_capture_dopri(const pdModel* model, pdState* s, double h, const do
   memcpy(d->node[NODE_YHALF], ext, bytes);
 }
 
+void pd_dense_quartic(int n, double h, double theta, const double* y0, const double* f0, const double* yHalf,
+                      const double* fHalf, const double* y1, double* out) {
+  // p(θ) = y0 + h f0 θ + a θ² + b θ³ + c θ⁴ through p(½) = y½, p'(½) = h f½, p(1) = y1 (derivation: the three
+  // conditions solved for a, b, c with D½ = y½ − y0 − h f0/2, Df = h (f½ − f0), D1 = y1 − y0 − h f0)
+  for (int i = 0; i < n; ++i) {
+    double slope = h * f0[i];
+    double dHalf = yHalf[i] - y0[i] - 0.5 * slope, dSlope = h * (fHalf[i] - f0[i]), dEnd = y1[i] - y0[i] - slope;
+    double a = dEnd - 4.0 * dSlope + 16.0 * dHalf;
+    double b = -4.0 * dEnd + 12.0 * dSlope - 32.0 * dHalf;
+    double c = 4.0 * dEnd - 8.0 * dSlope + 16.0 * dHalf;
+    out[i] = y0[i] + theta * (slope + theta * (a + theta * (b + theta * c)));
+  }
+}
+
 // The interpolant at θ into out (d->n numbers).
 static void interpolate(const pdDense* d, double theta, double* out) {
   const double *y0 = d->node[NODE_Y0], *f0 = d->node[NODE_F0], *y1 = d->node[NODE_Y1];
   double h = d->h;
   if (d->quartic) {
-    // p(θ) = y0 + h f0 θ + a θ² + b θ³ + c θ⁴ through p(½) = y½, p'(½) = h f½, p(1) = y1 (derivation: the three
-    // conditions solved for a, b, c with D½ = y½ − y0 − h f0/2, Df = h (f½ − f0), D1 = y1 − y0 − h f0)
-    const double *yh = d->node[NODE_YHALF], *fh = d->node[NODE_FHALF];
-    for (int i = 0; i < d->n; ++i) {
-      double slope = h * f0[i];
-      double dHalf = yh[i] - y0[i] - 0.5 * slope, dSlope = h * (fh[i] - f0[i]), dEnd = y1[i] - y0[i] - slope;
-      double a = dEnd - 4.0 * dSlope + 16.0 * dHalf;
-      double b = -4.0 * dEnd + 12.0 * dSlope - 32.0 * dHalf;
-      double c = 4.0 * dEnd - 8.0 * dSlope + 16.0 * dHalf;
-      out[i] = y0[i] + theta * (slope + theta * (a + theta * (b + theta * c)));
-    }
+    pd_dense_quartic(d->n, h, theta, y0, f0, d->node[NODE_YHALF], d->node[NODE_FHALF], y1, out);
     return;
   }
   const double* f1 = d->node[NODE_F1];

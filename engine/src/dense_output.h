@@ -57,3 +57,8 @@ double pd_dense_presented_kept_energy(const pdDense* d);
 bool pd_dense_resume(pdState* s);
 // Forgets the captured step (the state is set up anew: islands.c's island_load, pd_state_reset).
 void pd_dense_discard(pdState* s);
+
+// Step doubling's quartic (above) at θ of the step of h from y0, f0 = f(y0), through yHalf, fHalf = f(yHalf) and y1,
+// into out (n numbers; quaternions left as interpolated). Also where a located onset's step is cut (integrator.c).
+void pd_dense_quartic(int n, double h, double theta, const double* y0, const double* f0, const double* yHalf,
+                      const double* fHalf, const double* y1, double* out);

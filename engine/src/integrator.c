@@ -387,6 +387,21 @@ static void capture_step(const pdModel* model, pdState* s, stepperWork* w, trial
   }
 }
 
+// A located onset's step (bounded events) is cut on the accepted trial's own interpolant rather than retried: step
+// doubling's quartic through its nodes (dense_output.h), whose error inside the step is within the kept result's,
+// which the error control held to tol (on y' = λy, hλ from −1 to 1: at most 0.92 of the error at the step's end,
+// anywhere inside it). Up to the onset the trial integrated what a retried step would (the new contact has no force
+// before it), and past it both leave the contact to the correction at the cut. The paper's loop (exact events) retries, as do held modes (their changes are found from the
+// first half step's end, which a cut step does not have) and the other steppers (their interpolant is a cubic).
+static bool cuts_on_interpolant(const pdModel* model, const pdState* s, trialFcn* trial) {
+  return trial == trial_doubling && pd_onsets_effective(s->onsets, model->movingCount) == pd_onsetsBounded;
+}
+
+// The state at hCut of the accepted trial of h into w->full (its full-step result is no longer needed).
+static void onset_cut_state(const pdState* s, stepperWork* w, double h, double hCut) {
+  pd_dense_quartic(s->n, h, hCut / h, s->y, w->k1, w->half, w->k1half, w->trial, w->full);
+}
+
 // The limits of a trial on probation (an implicit switch, implicit.h): the step below which the error control does not
 // retry, and the error norm a trial must meet instead of tol.
 typedef struct probationLimits {
@@ -455,8 +470,25 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     // virtual contact restarts it with the contact list grown
     double hRetry = h;
     const double* yMid = trial == trial_doubling ? w.half : NULL;  // the first half step's end
-    long travelRetries = s->count.travelRetries;
+    long travelRetries = s->count.travelRetries, onsetRetries = s->count.eventRetries;
     pdEventVerdict verdict = pd_contact_events(model, s, h, w.trial, yMid, &hRetry, &watch);
+    // the step's end and length as accepted: the trial's, or a located onset's cut on the trial's interpolant
+    const double* yEnd = w.trial;
+    double hTaken = h;
+    if (verdict == pd_eventRetry && s->count.eventRetries > onsetRetries && cuts_on_interpolant(model, s, trial)) {
+      // an onset to locate: the trial up to it is the retried step's, as accurate (onset_cut_state); a retried trial
+      // is needed only if the contact events at the cut ask for one again
+      double hCut = hRetry;
+      onset_cut_state(s, &w, h, hCut);
+      verdict = pd_contact_events(model, s, hCut, w.full, NULL, &hRetry, &watch);
+      if (verdict == pd_eventAccept) {
+        ++s->count.onsetCuts;
+        yEnd = w.full;
+        hTaken = hCut;
+        cut = eventCut = true;
+        cutLimit = limit = pd_limitEvent;
+      }
+    }
     if (verdict == pd_eventRetry) {
       hMax = hRetry;
       eventCut = true;
@@ -469,8 +501,9 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
       continue;
     }
     if (norm > set->tol) ++s->warnings[pd_warnStepAtMinimum];
-    capture_step(model, s, &w, trial, h);
-    pd_contact_events_commit(model, s, w.trial, &watch);
+    capture_step(model, s, &w, trial, h);  // the whole trial's: a cut step presents its samples from the same curve
+    pd_contact_events_commit(model, s, yEnd, &watch);
+    h = hTaken;
     renormalise_quaternions(model, s->y);
     ++s->count.accepted;
     ++s->count.stepsLimited[limit];

@@ -287,6 +287,7 @@ static void add_counters(pdCounters* to, const pdCounters* c) {
   to->rejected += c->rejected;
   to->derivatives += c->derivatives;
   to->eventRetries += c->eventRetries;
+  to->onsetCuts += c->onsetCuts;
   to->onsetsInterpolated += c->onsetsInterpolated;
   to->travelRetries += c->travelRetries;
   to->refinements += c->refinements;

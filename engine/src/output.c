@@ -647,13 +647,15 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
           pd_model_adjustments_dropped(model));
   fprintf(out,
           "  \"counts\": {\"accepted_steps\": %ld, \"rejected_steps\": %ld, \"derivative_evaluations\": %ld, "
-          "\"samples\": %ld, \"travel_retries\": %ld, \"onset_retries\": %ld, \"onsets_interpolated\": %ld, "
+          "\"samples\": %ld, \"travel_retries\": %ld, \"onset_retries\": %ld, \"onset_cuts\": %ld, "
+          "\"onsets_interpolated\": %ld, "
           "\"refinements\": %ld, \"stability_tight\": %ld, \"implicit_steps\": %ld, \"searches_skipped\": %ld, "
           "\"contacts_made\": %ld, "
           "\"contacts_virtual\": %ld, \"contacts_transferred\": %ld, \"breaks_force\": %ld, "
           "\"breaks_geometry\": %ld, \"contacts_at_end\": %d},\n",
           state->count.accepted, state->count.rejected, state->count.derivatives, state->count.samples,
-          state->count.travelRetries, state->count.eventRetries, state->count.onsetsInterpolated,
+          state->count.travelRetries, state->count.eventRetries, state->count.onsetCuts,
+          state->count.onsetsInterpolated,
           state->count.refinements, state->count.stabilityTight, state->count.implicitSteps,
           state->count.searchesSkipped, state->count.contactsMade, state->count.contactsVirtual,
           state->count.contactsTransferred, state->count.breaksForce, state->count.breaksGeometry,

@@ -161,6 +161,7 @@ typedef struct pdCounters {
   long derivatives;  // evaluations of the state derivative
   long samples;      // output samples delivered to the observer
   long eventRetries;      // trial steps cut short to land on a contact onset (App. C)
+  long onsetCuts;         // of those, the steps ended on the accepted trial's interpolant, no trial retaken
   long onsetsInterpolated;  // contacts that joined at a step's end from an onset inside it (pd_onsetsPair)
   long travelRetries;     // trial steps cut short because two bodies that may meet moved too far (tunnelling)
   long refinements;       // trial steps halved around a reversal or a stick/slip change (§3.4)
