@@ -30,9 +30,9 @@
 // How far past the step just taken the guard looks for the next one (travelStep): the error control grows a step by at
 // most 5×; twice is enough to keep a step the guard holds from being tried too long and retried, every step.
 #define PD_TRAVEL_ROOM_MAX 2.0
-// Numbers per vertex in reaching_fraction's scratch: its point at the step's start (3), its chord over the step, and
-// how far the arc it follows may stray from that chord.
-#define PD_REACH_VERTEX_SIZE 5
+// Numbers per vertex in reaching_fraction's scratch: its point at the step's start (3), its chord over the step (3)
+// and the chord's length, and how far the arc it follows may stray from that chord.
+#define PD_REACH_VERTEX_SIZE 8
 
 // The contact search's per-pair lists, to cacheCapacity.
 static void grow_pair_lists(pdContactSet* set) {
@@ -62,14 +62,16 @@ void pd_contact_search_create(const pdModel* model, pdContactSet* set, const boo
   set->cacheNext = pd_grow(NULL, set->cacheCapacity, sizeof *set->cacheNext);
   set->touching = pd_grow(NULL, set->cacheCapacity, sizeof *set->touching);
   grow_pair_lists(set);
-  // reaching_fraction's scratch: two bodies' vertex moves and their bounding planes (a box's 6 or a fixed body's faces)
+  // reaching_fraction's scratch: two bodies' vertex moves and their bounding planes (a box's 6 or a fixed body's faces),
+  // and two numbers a vertex for plane_reach
   set->reachVertexMax = 1, set->reachFaceMax = 6;
   for (int i = 0; i < n; ++i) {
     const pdPolyhedron* shape = &model->bodies[i].shape;
     if (shape->vertexCount > set->reachVertexMax) set->reachVertexMax = shape->vertexCount;
     if (shape->faceCount > set->reachFaceMax) set->reachFaceMax = shape->faceCount;
   }
-  set->reachScratch = pd_grow(NULL, 2 * (PD_REACH_VERTEX_SIZE * set->reachVertexMax + 4 * set->reachFaceMax),
+  set->reachScratch = pd_grow(NULL, 2 * (PD_REACH_VERTEX_SIZE * set->reachVertexMax + 4 * set->reachFaceMax) +
+                                        2 * set->reachVertexMax,
                               sizeof *set->reachScratch);
 }
 
@@ -184,11 +186,13 @@ static double beyond(const double* plane, const double* p) {
 
 // Each vertex of body i at the step's start and how far a fraction λ of the step may move it, into scratch
 // (PD_REACH_VERTEX_SIZE numbers a vertex): along the step's screw motion (rotation by φ about u, the centre moving
-// uniformly) a point w from the centre of mass is at most λ c + ρ φ²/4 from its start, c the chord of the whole step
+// uniformly) a point w from the centre of mass is at most λ |c| + ρ φ²/4 from its start, c the chord of the whole step
 // and ρ = |u × w| (the arc strays from the chord by at most λ(1 − λ)/2 of its second derivative, ρφ², per
-// component). Both terms are convex over the body. A rolling wheel's rim point on the ground has a short chord where
-// |Δx| + φ ρ, the arc's length, would be twice its speed times the step.
-static void vertex_moves(const pdBody* body, const pdPose* p0, const pdPose* p1, double* scratch) {
+// component). Both terms are convex over the body, and so is the chord's part along a direction, max(0, n·c): c is
+// affine in the point; and the arc strays from its chord only across the axis u, so along a direction n by at most
+// |n × u| of it. A rolling wheel's rim point on the ground has a short chord where |Δx| + φ ρ, the arc's length, would
+// be twice its speed times the step. Returns u, or 0 where it is ill-defined.
+static pdVec3 vertex_moves(const pdBody* body, const pdPose* p0, const pdPose* p1, double* scratch) {
   pdMat3 r0t = pd_mat3_transpose(&p0->R);
   pdMat3 d = pd_mat3_mul(&p1->R, &r0t);
   double cosAngle = fmax(-1.0, fmin(1.0, 0.5 * (d.m[0][0] + d.m[1][1] + d.m[2][2] - 1.0)));
@@ -201,12 +205,54 @@ static void vertex_moves(const pdBody* body, const pdPose* p0, const pdPose* p1,
     pdVec3 w = pd_mat3_mulv(&p0->R, body->shape.vertices[v]);
     pdVec3 start = pd_v3_add(p0->x, w);
     pdVec3 end = pd_v3_add(p1->x, pd_mat3_mulv(&p1->R, body->shape.vertices[v]));
+    pdVec3 chord = pd_v3_sub(end, start);
     double lever = axisKnown ? pd_v3_norm(pd_v3_cross(sinAxis, w)) / sinAngle : pd_v3_norm(w);
     double* at = scratch + PD_REACH_VERTEX_SIZE * v;
     at[0] = start.x, at[1] = start.y, at[2] = start.z;
-    at[3] = pd_v3_norm(pd_v3_sub(end, start));
-    at[4] = 0.25 * lever * angle * angle;
+    at[3] = chord.x, at[4] = chord.y, at[5] = chord.z;
+    at[6] = pd_v3_norm(chord);
+    at[7] = 0.25 * lever * angle * angle;
   }
+  return axisKnown ? pd_v3_scale(sinAxis, 1.0 / sinAngle) : (pdVec3){0.0, 0.0, 0.0};
+}
+
+// Where the step's move bounds are evaluated at a fraction λ of the step, they stand for a step λ times as long, the
+// motion going on as it went: its chord λ c and its sag λ² times this step's (the turn is λ φ). At λ = 1 they are this
+// step's bounds, which the retry checks on every step taken; below and above they predict the step to try.
+//
+// A vertex's move bound over a fraction lambda of the step (vertex_moves): all of it, or, with `toward` (a plane,
+// bounding_planes), only how far it may go past that plane along its inward normal: the chord's part that way and
+// `sagAlong` (|n × u|, sole_entry_face) of the sag.
+static double vertex_move(const double* at, double lambda, const double* toward, double sagAlong) {
+  if (!toward) return lambda * at[6] + at[7];
+  double inward = -(toward[0] * at[3] + toward[1] * at[4] + toward[2] * at[5]);
+  return lambda * fmax(0.0, inward) + sagAlong * at[7];
+}
+
+// The largest move bound (vertex_move, all of it or toward `plane` alone) over the points of a body (its vertices in
+// `moves`) that may get beyond `plane` over a fraction lambda of the step: the vertices whose bound exceeds their
+// distance outside it (inside ones all count), and where an edge crosses from such a vertex to one that cannot.
+// Between vertices the bound is taken as their barycentric mix, which is at least the convex bound's value there.
+static double plane_reach(const pdPolyhedron* shape, const double* moves, const double* plane, double lambda,
+                          bool alongNormal, double sagAlong, double stopAbove, double* scratch) {
+  const double* toward = alongNormal ? plane : NULL;
+  double most = 0.0;
+  // each vertex's move bound and by how much it exceeds its distance outside the plane, for its edges below
+  double *move = scratch, *over = scratch + shape->vertexCount;
+  for (int v = 0; v < shape->vertexCount; ++v) {
+    const double* at = moves + PD_REACH_VERTEX_SIZE * v;
+    move[v] = vertex_move(at, lambda, toward, sagAlong);
+    over[v] = move[v] - beyond(plane, at);
+    if (over[v] > 0.0) most = fmax(most, move[v]);
+  }
+  for (int e = 0; e < shape->edgeCount && most < stopAbove; ++e) {
+    int u = shape->edges[e].v[0], w = shape->edges[e].v[1];
+    double fu = over[u], fw = over[w];
+    if ((fu > 0.0) == (fw > 0.0)) continue;  // in or out as a whole: its vertices tell
+    double t = fu / (fu - fw);                 // where it crosses out
+    most = fmax(most, (1.0 - t) * move[u] + t * move[w]);
+  }
+  return most;
 }
 
 // The largest move, over a fraction lambda of the step, of the points of a body (its vertices in `moves`:
@@ -218,29 +264,101 @@ static void vertex_moves(const pdBody* body, const pdPose* p0, const pdPose* p1,
 // move over it is at one of those; each plane gives a bound, the smallest is kept. A spinning or rolling body's far
 // points move fast but cannot reach the other body: only the ones that can count (a top spinning on its tip, a wheel
 // on its rim).
+//
+// Where only whether it is within `enough` (> 0) matters (one moving body against a fixed one), the first plane whose
+// bound is within it answers, and a plane's search stops once above it; with `enough` 0, the bound itself.
 static double reaching_move(const pdPolyhedron* shape, const double* moves, const double* planes, int planeCount,
-                            double lambda) {
+                            double lambda, double enough, double* scratch) {
   double best = INFINITY;
-  for (int k = 0; k < planeCount && best > 0.0; ++k) {
-    const double* plane = planes + 4 * k;
-    double most = 0.0;
-    for (int v = 0; v < shape->vertexCount; ++v) {
-      const double* at = moves + PD_REACH_VERTEX_SIZE * v;
-      double move = lambda * at[3] + at[4];
-      if (move > beyond(plane, at)) most = fmax(most, move);
-    }
-    for (int e = 0; e < shape->edgeCount && most < best; ++e) {
-      const double* u = moves + PD_REACH_VERTEX_SIZE * shape->edges[e].v[0];
-      const double* w = moves + PD_REACH_VERTEX_SIZE * shape->edges[e].v[1];
-      double mu = lambda * u[3] + u[4], mw = lambda * w[3] + w[4];
-      double fu = mu - beyond(plane, u), fw = mw - beyond(plane, w);
-      if ((fu > 0.0) == (fw > 0.0)) continue;  // in or out as a whole: its vertices tell
-      double t = fu / (fu - fw);                 // where it crosses out
-      most = fmax(most, (1.0 - t) * mu + t * mw);
-    }
-    best = fmin(best, most);
-  }
+  // past this a plane's bound is out: past the best so far, and, with `enough`, past it
+  double out = enough > 0.0 ? nextafter(enough, INFINITY) : INFINITY;
+  for (int k = 0; k < planeCount && best > enough; ++k)
+    best = fmin(best, plane_reach(shape, moves, planes + 4 * k, lambda, false, 1.0, fmin(best, out), scratch));
   return best;
+}
+
+// One moving body's side of a pair in the guard's measure: its vertices' moves (vertex_moves) and turn axis, the
+// other body's bounding planes, and, where the other body is fixed, the candidate for its face that is the moving
+// body's only way in (entry_face) with the part of the sag that can point along that face's normal, and the fractions
+// at which that face is known to hold (entryHolds) and to fail (entryFails).
+typedef struct reachSide {
+  const pdPolyhedron* shape;
+  const double* moves;
+  pdVec3 axis;
+  const double* planes;
+  int planeCount;
+  int entryFace;  // -1: none
+  double sagAlong;
+  double entryHolds, entryFails;
+  double* scratch;  // plane_reach's
+} reachSide;
+
+// The candidate for a fixed body's sole entry face (entry_holds) for a moving body: the plane that the moving body's
+// most inside vertex is least inside (its nearest face), into side->entryFace, with side->sagAlong: |n × u| for its
+// normal n and the turn's axis u (1 where the axis is ill-defined: no turn, or half a turn).
+static void entry_face(reachSide* side) {
+  side->entryFace = -1, side->sagAlong = 1.0, side->entryHolds = 0.0, side->entryFails = INFINITY;
+  double deepest = INFINITY;
+  for (int v = 0; v < side->shape->vertexCount; ++v) {
+    const double* at = side->moves + PD_REACH_VERTEX_SIZE * v;
+    int nearest = 0;
+    double outside = -INFINITY;
+    for (int k = 0; k < side->planeCount; ++k) {
+      double g = beyond(side->planes + 4 * k, at);
+      if (g > outside) outside = g, nearest = k;
+    }
+    if (outside < deepest) deepest = outside, side->entryFace = nearest;
+  }
+  if (side->entryFace < 0 || pd_v3_norm(side->axis) == 0.0) return;
+  const double* n = side->planes + 4 * side->entryFace;
+  side->sagAlong = fmin(1.0, pd_v3_norm(pd_v3_cross((pdVec3){n[0], n[1], n[2]}, side->axis)));
+}
+
+// Is the candidate face F (entry_face) of a fixed body (its planes) the only way into it for every point of a moving
+// body over a fraction lambda of the step? It is when every vertex v, for every other face j, ends the fraction
+// farther inside j's plane than it can be past F's:
+//     −g_j(v) − (λ|c_v| + s_v) > −g_F(v) + (λ max(0, −n_F·c_v) + |n_F × u| s_v)
+// (g signed distances beyond the planes at the start, c the chord, s the sag, u the turn's axis: vertex_moves). Each
+// side is a convex bound and an affine part, so it holds over the whole body once it holds at the vertices. Then, all
+// through the fraction, a point of the body that is inside the fixed one is deeper behind every other face than
+// behind F: F is the face it is found against, and it cannot pass through and out of another; how deep it is behind F
+// grows by at most its move along F's inward normal. That, not its whole move, is what the guard bounds for it: a
+// block sliding on the floor, or a top spinning on its tip, moves its touching points along the face, not into it, and
+// such a move can neither sink them nor carry them through. The bounds grow with λ, so the condition holds up to some
+// fraction and fails above it: each answer is kept for the bisection's later fractions.
+static bool entry_holds(reachSide* side, double lambda) {
+  if (side->entryFace < 0 || lambda >= side->entryFails) return false;
+  if (lambda <= side->entryHolds) return true;
+  const double* entry = side->planes + 4 * side->entryFace;
+  for (int v = 0; v < side->shape->vertexCount; ++v) {
+    const double* at = side->moves + PD_REACH_VERTEX_SIZE * v;
+    double behindEntry = -beyond(entry, at) + vertex_move(at, lambda, entry, side->sagAlong);
+    double move = vertex_move(at, lambda, NULL, 1.0);
+    for (int k = 0; k < side->planeCount; ++k)
+      if (k != side->entryFace && -beyond(side->planes + 4 * k, at) - move <= behindEntry) {
+        side->entryFails = lambda;
+        return false;
+      }
+  }
+  side->entryHolds = lambda;
+  return true;
+}
+
+// One moving body's share of a pair's reaching move over a fraction lambda of the step, as far as the guard's test
+// against `allowed` needs it: reaching_move, or, where the other body is fixed and its entry face holds at lambda
+// (entry_holds), the smaller of that and the largest move into the face of the points that may get past it (both
+// bound the same points; the face's, which needs one plane where reaching_move takes every plane, is tried first and
+// is enough when within `allowed`). Each grows with lambda, and the face holds up to some fraction: the result, as
+// compared with `allowed`, grows with lambda too (reaching_fraction bisects it).
+static double side_reach(reachSide* side, double lambda, double allowed, double enough) {
+  double inward = INFINITY;
+  if (entry_holds(side, lambda)) {
+    inward = plane_reach(side->shape, side->moves, side->planes + 4 * side->entryFace, lambda, true,
+                         side->sagAlong, INFINITY, side->scratch);
+    if (inward <= allowed) return inward;
+  }
+  return fmin(inward, reaching_move(side->shape, side->moves, side->planes, side->planeCount, lambda, enough,
+                                    side->scratch));
 }
 
 // Bisections of the step fraction a pair's reaching travel allows: the fraction is then known to ~1e-3 of the
@@ -248,29 +366,40 @@ static double reaching_move(const pdPolyhedron* shape, const double* moves, cons
 #define PD_TRAVEL_BISECTIONS 10
 
 // The largest fraction of the step, between `floor` (known to hold) and `most`, over which pair (a, b)'s reaching
-// travel (reaching_move of each body against the other, summed) stays within `allowed`; `most` when all of it does.
-// Fractions above 1 extrapolate the step's motion: what the next step may take if the motion goes on.
-static double reaching_fraction(const pdModel* model, pdContactSet* set, int a, int b, double allowed, double floor,
-                                double most) {
+// travel (side_reach of each moving body against the other, summed) stays within `allowed`; `most` when all of it
+// does. `touching`: the pair has contacts at the step's start. Fractions above 1 extrapolate the step's motion: what
+// the next step may take if the motion goes on.
+static double reaching_fraction(const pdModel* model, pdContactSet* set, int a, int b, bool touching, double allowed,
+                                double floor, double most) {
   const pdBody *ba = &model->bodies[a], *bb = &model->bodies[b];
   double* movesA = set->reachScratch;
   double* movesB = movesA + PD_REACH_VERTEX_SIZE * set->reachVertexMax;
   double* planesA = movesB + PD_REACH_VERTEX_SIZE * set->reachVertexMax;  // bounding body a: for b's points
   double* planesB = planesA + 4 * set->reachFaceMax;
-  int countA = 0, countB = 0;
+  double* planeScratch = planesB + 4 * set->reachFaceMax;
+  reachSide sides[2];
+  int sideCount = 0;
   if (!ba->fixed) {
-    vertex_moves(ba, &set->poses0[a], &set->poses1[a], movesA);
-    countB = bounding_planes(model, set, b, planesB);
+    pdVec3 axis = vertex_moves(ba, &set->poses0[a], &set->poses1[a], movesA);
+    int count = bounding_planes(model, set, b, planesB);
+    sides[sideCount++] = (reachSide){&ba->shape, movesA, axis, planesB, count, -1, 1.0, 0.0, 0.0, planeScratch};
   }
   if (!bb->fixed) {
-    vertex_moves(bb, &set->poses0[b], &set->poses1[b], movesB);
-    countA = bounding_planes(model, set, a, planesA);
+    pdVec3 axis = vertex_moves(bb, &set->poses0[b], &set->poses1[b], movesB);
+    int count = bounding_planes(model, set, a, planesA);
+    sides[sideCount++] = (reachSide){&bb->shape, movesB, axis, planesA, count, -1, 1.0, 0.0, 0.0, planeScratch};
   }
+  // a moving body touching a fixed one may have a sole entry face, where only its points' moves into it count. Not
+  // before it touches: a landing's steps stay held by its whole move, and with them how long before a step's end its
+  // onset may be, which the correction of an onset found inside a step is bounded for (onset_bound.h)
+  if (sideCount == 1 && touching) entry_face(&sides[0]);
+  // alone, a side's bound only needs comparing with `allowed`; two are summed
+  double enough = sideCount == 1 ? allowed : 0.0;
   double lo = floor, hi = most;
   for (int k = -1; k < PD_TRAVEL_BISECTIONS; ++k) {
     double lambda = k < 0 ? most : 0.5 * (lo + hi);
-    double moved = (ba->fixed ? 0.0 : reaching_move(&ba->shape, movesA, planesB, countB, lambda)) +
-                   (bb->fixed ? 0.0 : reaching_move(&bb->shape, movesB, planesA, countA, lambda));
+    double moved = 0.0;
+    for (int k2 = 0; k2 < sideCount; ++k2) moved += side_reach(&sides[k2], lambda, allowed, enough);
     if (moved <= allowed) {
       if (k < 0) return most;
       lo = lambda;
@@ -291,12 +420,15 @@ static double travel_room(const pdModel* model, pdContactSet* set, int pairCount
     set->travel[i] = travel(&model->bodies[i], &set->poses0[i], &set->poses1[i]);
   }
   double room = PD_TRAVEL_ROOM_MAX;
+  int listed = 0;  // the contact list's cursor: it is sorted by the unordered body pair, as the pairs are
   for (int p = 0; p < pairCount; ++p) {
     int a = set->pairs[p].a, b = set->pairs[p].b;
+    while (listed < set->count && compare_to_pair(&set->items[listed].id, a, b) < 0) ++listed;
+    bool touching = listed < set->count && compare_to_pair(&set->items[listed].id, a, b) == 0;
     double moved = set->travel[a] + set->travel[b];
     double allowed = fmin(PD_TRAVEL_WIDTH_FRACTION * fmin(model->bodies[a].width, model->bodies[b].width),
                           PD_TRAVEL_DEFLECTIONS * pd_model_pair_delta_max(model, a, b));
-    if (room * moved > allowed) room = reaching_fraction(model, set, a, b, allowed, allowed / moved, room);
+    if (room * moved > allowed) room = reaching_fraction(model, set, a, b, touching, allowed, allowed / moved, room);
   }
   return room;
 }

@@ -148,6 +148,8 @@ static const char* const sweptCases[] = {
     "spinning_baton.scene",      // a body turning through its collision with the floor
     "baton_past_block.scene",    // ... through a corner of a free body
     "vertex_past_edge_plate.scene",  // a spinning plate among free bodies whose corner met another with no contact
+    "slide_off_slab_spinning.scene",  // a fast cube whose steps only its move into a fixed slab's top face held, off its edge
+    "fast_cube_thin_slab.scene",      // a cube at 20 m/s onto a fixed 2 cm slab: the move into its top face is all
 };
 
 int main(void) {
