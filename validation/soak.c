@@ -296,6 +296,7 @@ typedef struct watch {
   double e0, momentumScale;
   pdVec3 p0;
   double stretchE0;  // the energy of the system stepped where its stretch began (observe_step)
+  pdVec3 stretchP0;  // and its momentum
   pdSoakResult* out;
   char broke[240];  // the first invariant that broke (soft), empty while all hold
   bool soft;          // the soft engine: overlaps judged against the pair's limit (pair_limit)
@@ -317,40 +318,91 @@ static pdVec3 momentum(const pdModel* m, const pdState* s, double* scale) {
   return p;
 }
 
-// 1 / mass, 0 for a fixed body.
-static double inverse_mass(const pdModel* m, int i) { return m->bodies[i].fixed ? 0.0 : 1.0 / m->bodies[i].mass; }
+// A fixed body pressing on one of a pair stands in for this many times the pressed body's mass: immovable for the
+// limit (the mass moving with the pressed body then grows as 1 / sin²θ, or without bound while held, below).
+#define PRESSING_FIXED_MASS_FACTOR 1e6
 
-// The overlap pair (i, j) may reach, in δ_max: PD_SOAK_PENETRATION_LIMIT, as eq. (11) sizes the pair's springs for
-// an impact at vmax of its reduced mass — unless the pair is the light link of a chain: a third body k pressing on
-// one of them (in contact with i or j at this state) against the other makes the pair's springs stop the reduced
-// mass of k and the other body, not the pair's own. A light body between a heavy one and the floor, or between two
-// heavy ones, cannot get out of the way: its springs store ½ m_chain v², and an impact at vmax deflects them by
-// δ_max √(m_chain / m_pair). The limit grows by that factor only while the pair's own contacts carry the overlap
-// (their largest normal force at least k_n times the overlap beyond the plain limit): an overlap that no contact
-// resists, or one a contact reads at a fraction of its depth, is a fault of the contact search whatever the load.
+// The mass that moves with body b of a pair when b moves at unit speed along `into` (towards the pair's other
+// body), given pushes[k], the net contact force of each third body k on b, and whether the pair's contact holds b
+// from sliding across (it sticks): pair_limit's derivation. Infinite for a fixed b.
+static double mass_moving_with(const pdModel* m, int b, pdVec3 into, const pdVec3* pushes, bool held) {
+  if (m->bodies[b].fixed) return INFINITY;
+  double mb = m->bodies[b].mass, along = mb, a[3][3] = {{mb, 0, 0}, {0, mb, 0}, {0, 0, mb}};
+  for (int k = 0; k < m->bodyCount; ++k) {
+    double f = pd_v3_norm(pushes[k]), c = f > 0.0 ? pd_v3_dot(pushes[k], into) / f : 0.0;
+    if (!(c > 0.0)) continue;  // not pressing b towards the other body
+    pdVec3 u = pd_v3_scale(pushes[k], 1.0 / f);
+    double mk = m->bodies[k].fixed ? PRESSING_FIXED_MASS_FACTOR * mb : m->bodies[k].mass;
+    along += mk * c * c;
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 3; ++q) a[r][q] += mk * pd_v3_get(u, r) * pd_v3_get(u, q);
+  }
+  if (held) return along;
+  // 1 / (into · A⁻¹ into) by Cramer's rule: A is symmetric positive definite (mb 1 plus positive semidefinite terms)
+  pdVec3 r0 = pd_v3(a[0][0], a[0][1], a[0][2]), r1 = pd_v3(a[1][0], a[1][1], a[1][2]),
+         r2 = pd_v3(a[2][0], a[2][1], a[2][2]);
+  double det = pd_v3_dot(r0, pd_v3_cross(r1, r2));
+  pdVec3 x = pd_v3(pd_v3_dot(into, pd_v3_cross(r1, r2)), pd_v3_dot(r0, pd_v3_cross(into, r2)),
+                   pd_v3_dot(r0, pd_v3_cross(r1, into)));
+  return det / pd_v3_dot(into, x);
+}
+
+// The overlap pair (i, j) may reach, in δ_max. Eq. (11) sizes the pair's springs, k_s = m_pair vmax² / δ_max², so
+// that the pair's bodies alone, closing at vmax, stop at δ_max: PD_SOAK_PENETRATION_LIMIT is that with the margin
+// for the scene's vmax estimate (hard cases). Third bodies pressing on the pair make its springs stop more mass: they
+// store the kinetic energy of the closing motion along the pair's normal n of all that moves with either side,
+// ½ M v² with M = M_i M_j / (M_i + M_j), and deflect by δ_max √(M / m_pair) v / vmax. So the limit is
+// PD_SOAK_PENETRATION_LIMIT √(M / m_pair), with M_i (M_j alike) the mass moving with i when i closes on j along −n
+// at unit speed:
+// - a third body k presses on i with F_k, the net force of its contacts on i (springs and friction). A contact
+//   transmits force along F_k only, so k has to follow i along u_k = F_k / |F_k| alone (it slides freely across it),
+//   and only if F_k presses i towards j (cos θ_k = −u_k · n > 0): a body pulling away or pressing sideways stores
+//   nothing in the pair's springs;
+// - while the pair's contact sticks, i moves along −n (relative to j) and k follows at cos θ_k: M_i = m_i +
+//   Σ_k m_k cos²θ_k, the pushing force projected on the pair's normal;
+// - while it slides, i may also slide out sideways, and by Kelvin's theorem (an impulsive motion under constraints
+//   has the least kinetic energy they allow) M_i is the least of wᵀ A w over i's velocities w with −w · n = 1,
+//   A = m_i 1 + Σ_k m_k u_k u_kᵀ: 1 / (nᵀ A⁻¹ n). One pusher gives m_i + m_k cos²θ m_i / (m_i + m_k sin²θ): m_i +
+//   m_k pressing along the normal, m_i pressing sideways, m_i / sin²θ for an immovable one (i squeezed out).
+// Bodies are taken as points (leaving their turning out can only raise the least energy: a generous bound), and
+// only the direct pushers count (a pusher's own pushers are not followed: a strict bound). The limit grows only
+// while the pair's own contacts carry the overlap (their largest normal force at least k_n times the overlap beyond
+// the plain limit), and n and stick are that contact's: an overlap that no contact resists, or one a contact reads
+// at a fraction of its depth, is a fault of the contact search whatever the load.
 static double pair_limit(const pdModel* m, const pdState* s, int i, int j, double depthOverDelta) {
   if (!(depthOverDelta > PD_SOAK_PENETRATION_LIMIT)) return PD_SOAK_PENETRATION_LIMIT;
   pdPairContact pair = pd_model_pair_contact(m, i, j);
-  double invI = inverse_mass(m, i), invJ = inverse_mass(m, j);
-  double chain = pair.massPair, pushed = 0.0;
+  double pushed = 0.0;
+  pdVec3 outOfJ = {0, 0, 0};  // the carrying contact's normal, from j into i
+  bool held = false;          // and whether it sticks
   int n = pd_state_contact_count(s);
+  pdVec3* onI = calloc((size_t)m->bodyCount * 2, sizeof *onI);  // each third body's net force on i, then on j
+  if (!onI) abort();
+  pdVec3* onJ = onI + m->bodyCount;
   for (int c = 0; c < n; ++c) {
     pdContactReport r = pd_state_contact(s, c);
+    pdVec3 onA = pd_v3_muladd(r.ft, r.fn, r.normal);
     if ((r.bodyA == i && r.bodyB == j) || (r.bodyA == j && r.bodyB == i)) {
-      pushed = fmax(pushed, r.fn);
+      if (r.fn > pushed) pushed = r.fn, outOfJ = r.bodyA == i ? r.normal : pd_v3_scale(r.normal, -1.0), held = !r.slip;
       continue;
     }
     for (int side = 0; side < 2; ++side) {
       int on = side ? r.bodyB : r.bodyA, k = side ? r.bodyA : r.bodyB;
-      double invOther = on == i ? invJ : on == j ? invI : -1.0;  // the pair's body across from the one k presses
-      if (invOther < 0.0 || k == i || k == j) continue;
-      double inv = invOther + inverse_mass(m, k);
-      if (inv > 0.0) chain = fmax(chain, 1.0 / inv);
+      pdVec3 force = side ? pd_v3_scale(onA, -1.0) : onA;
+      if (on == i) onI[k] = pd_v3_add(onI[k], force);
+      if (on == j) onJ[k] = pd_v3_add(onJ[k], force);
     }
   }
   double beyond = (depthOverDelta - PD_SOAK_PENETRATION_LIMIT) * pair.deltaMax;
-  if (!(chain > pair.massPair) || !(pushed >= pair.kn * beyond)) return PD_SOAK_PENETRATION_LIMIT;
-  return PD_SOAK_PENETRATION_LIMIT * sqrt(chain / pair.massPair);
+  double limit = PD_SOAK_PENETRATION_LIMIT;
+  if (pushed > 0.0 && pushed >= pair.kn * beyond) {
+    double mi = mass_moving_with(m, i, pd_v3_scale(outOfJ, -1.0), onI, held);
+    double mj = mass_moving_with(m, j, outOfJ, onJ, held);
+    double moving = isinf(mi) ? mj : isinf(mj) ? mi : mi * mj / (mi + mj);
+    if (moving > pair.massPair) limit *= sqrt(moving / pair.massPair);
+  }
+  free(onI);
+  return limit;
 }
 
 // Deepest overlap of any two bodies over the pair's δ_max. With w->soft, each pair's overlap is also judged against
@@ -416,8 +468,9 @@ static bool observe(const pdModel* m, const pdState* s, void* user) {
   return true;
 }
 
-// The step observer (polydyn/state.h): the overlap and the energy of the system stepped (the scene, or one
-// island over a sync interval) at every accepted step; its bodies' names and δ_max are the scene's.
+// The step observer (polydyn/state.h): the overlap, the energy and (free scenes) the momentum of the system stepped
+// (the scene, or one island over a sync interval) at every accepted step; its bodies' names and δ_max are the
+// scene's. The energy and momentum are compared with the stretch's start (the samples compare the scene's with t = 0).
 static void observe_step(const pdModel* m, const pdState* s, bool start, void* user) {
   watch* w = user;
   pdSoakResult* o = w->out;
@@ -426,11 +479,17 @@ static void observe_step(const pdModel* m, const pdState* s, bool start, void* u
     return;
   }
   double e = pd_state_energy(m, s);
+  bool free = w->scene->kind == pd_soakFree;
   if (start) {
     w->stretchE0 = e;
+    if (free) w->stretchP0 = momentum(m, s, NULL);
     return;
   }
   if (w->e0 > 0.0) o->energyGain = fmax(o->energyGain, (e - w->stretchE0) / w->e0);
+  // an island touches no other within its sync interval: its own momentum holds over the stretch
+  if (free && w->momentumScale > 0.0)
+    o->momentumError =
+        fmax(o->momentumError, pd_v3_norm(pd_v3_sub(momentum(m, s, NULL), w->stretchP0)) / w->momentumScale);
   o->penetration = fmax(o->penetration, deepest_overlap(m, s, w, " (an accepted step)"));
 }
 

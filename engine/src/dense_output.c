@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "contact_history.h"
+#include "contact_list.h"
 #include "contact_set.h"
 #include "grow.h"
 #include "polydyn/error.h"
@@ -23,6 +25,7 @@ struct pdDense {
   double* node[NODE_COUNT];  // (capacity) each
   // the presentation
   pdContactSet* view;  // the captured contact list, presented (NULL until the first capture)
+  double keptEnergy;   // J: the springs the history keeps for broken contacts over the step (the view has none)
   double* yView;       // (capacity)
   bool presenting;
   double tOwn;  // the integration's own time, state vector, its length and contact list, put aside
@@ -76,6 +79,8 @@ static pdDense* capture_ends(const pdModel* model, pdState* s, double h, const d
   memcpy(d->node[NODE_Y1], y1, bytes);
   if (!d->view) d->view = pd_contact_set_create_view(model);
   pd_contact_set_capture(s->contacts, d->view);
+  // the history changes only at commits: what it keeps at the step's start it keeps until its end
+  d->keptEnergy = s->contacts->history ? pd_history_spring_energy(model, s->contacts->history) : 0.0;
   d->t0 = s->t;
   d->h = h;
   d->n = n;
@@ -170,6 +175,8 @@ void pd_dense_present(const pdModel* model, pdState* s, double t) {
   s->contacts = d->view;
   d->presenting = true;
 }
+
+double pd_dense_presented_kept_energy(const pdDense* d) { return d && d->presenting ? d->keptEnergy : 0.0; }
 
 bool pd_dense_resume(pdState* s) {
   pdDense* d = s->dense;

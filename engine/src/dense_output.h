@@ -50,6 +50,9 @@ double* pd_dense_slope_scratch(pdDense* d, int n);
 // Presents the state at t, inside the last captured step (t0 < t < t0 + h, asserted). A state already presented
 // is presented anew.
 void pd_dense_present(const pdModel* model, pdState* s, double t);
+// The energy of the springs the contact history kept over the presented step (J), 0 when not presenting: the
+// presented contact list has no history of its own (pd_state_energy).
+double pd_dense_presented_kept_energy(const pdDense* d);
 // Puts the integration's own state back; returns whether the state was presented.
 bool pd_dense_resume(pdState* s);
 // Forgets the captured step (the state is set up anew: islands.c's island_load, pd_state_reset).

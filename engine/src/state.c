@@ -118,7 +118,9 @@ double pd_state_energy(const pdModel* model, const pdState* s) {
   }
   e += pd_contact_spring_energy(s->contacts, s->y, PD_BODY_STATE_SIZE * model->movingCount);
   // the springs that broken contacts keep for a return (contact_history.h) are energy the state still holds
+  // (a presented state's contact list is the dense output's view, without a history: the step's, kept aside)
   if (s->contacts && s->contacts->history) e += pd_history_spring_energy(model, s->contacts->history);
+  else e += pd_dense_presented_kept_energy(s->dense);
   return e;
 }
 

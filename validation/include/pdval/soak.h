@@ -90,7 +90,8 @@ typedef struct pdSoakResult {
   double penetrationSampled; // the same at the output samples only
   double energyGain;         // max (E(t) − E(0)) / E(0), kinetic + gravitational (+ springs: soft); when
                              // everyStep also every stretch's rise within itself (pdSoakRunOptions)
-  double momentumError;      // max |P(t) − P(0)| / Σ m|v(0)| (free scenes), else 0
+  double momentumError;      // max |P(t) − P(0)| / Σ m|v(0)| at the samples, and of each stretch's change at
+                             // the accepted steps (--check steps) (free scenes), else 0
 } pdSoakResult;
 
 // Whether `engine` is the soft engine: "soft" (islands as the engine's default) or "soft-islands-off"
