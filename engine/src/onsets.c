@@ -147,12 +147,10 @@ typedef struct onsetMotion {
 } onsetMotion;
 
 static onsetMotion onset_motion(const onsetElement* e, double v0, double tau);
-static double point_mass_at(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
-                            pdVec3 point, pdVec3 normal);
-static pdVec3 point_response(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
-                             pdVec3 point, pdVec3 impulse);
-static void slip_element(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
-                         pdVec3 point, pdVec3 normal, pdVec3 du, onsetElement* e, pdVec3* along);
+static pdVec3 point_response(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point,
+                             pdVec3 impulse);
+static void slip_element(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point, pdVec3 normal,
+                         pdVec3 du, onsetElement* e, pdVec3* along);
 
 // What the error bound (onset_bound.h) of joining new contact g (found at y1, poses in set->poses1) as a corrected
 // onset is formed from, apart from its age and depth.
@@ -174,7 +172,8 @@ static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, con
   onsetTerms t = {.omega = sqrt(pd_series(p.k1n, p.k2n) / p.massMin), .approach = -pd_v3_dot(du, g->normal),
                   .size = INFINITY, .deltaMax = pd_model_pair_delta_max(model, a, b)};
   onsetElement* e = &t.element;
-  e->mass = point_mass_at(model, set, set->poses1, &g->id, g->point, g->normal);
+  double inverseMass = pd_v3_dot(g->normal, point_response(model, set->poses1, &g->id, g->point, g->normal));
+  e->mass = inverseMass > 0.0 ? 1.0 / inverseMass : INFINITY;
   e->mu = p.mu;
   if (isfinite(e->mass)) {
     e->omega2 = pd_series(p.k1n, p.k2n) / e->mass;
@@ -182,7 +181,7 @@ static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, con
     e->kt = pd_series(p.k1t, p.k2t);
     e->ct = pd_series(p.c1t, p.c2t);
     pdVec3 along;
-    slip_element(model, set, set->poses1, &g->id, g->point, g->normal, du, e, &along);
+    slip_element(model, set->poses1, &g->id, g->point, g->normal, du, e, &along);
   }
   pdVec3 spin = {0.0, 0.0, 0.0};
   double reach = 0.0;
@@ -332,17 +331,25 @@ static onsetMotion onset_motion(const onsetElement* e, double v0, double tau) {
                        .drift1 = s[M_I1], .drift2 = s[M_I2], .approach1 = s[M_N1], .approach2 = s[M_N2]};
 }
 
+// A body's inverse inertia in the world frame at `pose`, R I⁻¹ Rᵀ: computed here, since the set's copy is the last
+// installed list's (a step's start, and zero before the first), and an onset's bound is formed at the step's end.
+static pdMat3 inverse_inertia_at(const pdBody* body, const pdPose* pose) {
+  pdMat3 rt = pd_mat3_transpose(&pose->R), tmp = pd_mat3_mul(&body->invInertia, &rt);
+  return pd_mat3_mul(&pose->R, &tmp);
+}
+
 // K·j at a contact point: how the relative velocity Δu there changes under impulse j on body 1 (−j on body 2), 1/kg
 // times the impulse.
-static pdVec3 point_response(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
-                             pdVec3 point, pdVec3 impulse) {
+static pdVec3 point_response(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point,
+                             pdVec3 impulse) {
   pdVec3 out = {0.0, 0.0, 0.0};
   for (int side = 0; side < 2; ++side) {
     int b = side == 0 ? id->body1 : id->body2;
     const pdBody* body = &model->bodies[b];
     if (body->fixed) continue;
     pdVec3 r = pd_v3_sub(point, poses[b].x);
-    pdVec3 turn = pd_mat3_mulv(&set->invInertiaWorld[b], pd_v3_cross(r, impulse));
+    pdMat3 invInertia = inverse_inertia_at(body, &poses[b]);
+    pdVec3 turn = pd_mat3_mulv(&invInertia, pd_v3_cross(r, impulse));
     out = pd_v3_add(out, pd_v3_add(pd_v3_scale(impulse, body->invMass), pd_v3_cross(turn, r)));
   }
   return out;
@@ -350,8 +357,8 @@ static pdVec3 point_response(const pdModel* model, const pdContactSet* set, cons
 
 // The tangential part of a correction's element at a contact point whose relative velocity is du: the slip, its
 // direction *along (any tangent where there is none), and how the impulses change it (K the point's inverse mass).
-static void slip_element(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
-                         pdVec3 point, pdVec3 normal, pdVec3 du, onsetElement* e, pdVec3* along) {
+static void slip_element(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point, pdVec3 normal,
+                         pdVec3 du, onsetElement* e, pdVec3* along) {
   pdVec3 slip = pd_v3_sub(du, pd_v3_scale(normal, pd_v3_dot(du, normal)));
   double speed = pd_v3_norm(slip);
   if (!(e->mu > 0.0) || speed <= PD_ONSET_PAIR_SLIP_REL * pd_v3_norm(du)) speed = 0.0;  // rounding, not slip
@@ -364,8 +371,8 @@ static void slip_element(const pdModel* model, const pdContactSet* set, const pd
                                                                                         : pd_v3(0, 0, 1);
     *along = pd_v3_normalize(pd_v3_cross(normal, axis));
   }
-  pdVec3 ks = point_response(model, set, poses, id, point, *along);
-  pdVec3 kn = point_response(model, set, poses, id, point, normal);
+  pdVec3 ks = point_response(model, poses, id, point, *along);
+  pdVec3 kn = point_response(model, poses, id, point, normal);
   e->slipInvMass = pd_v3_dot(*along, ks);
   pdVec3 off = pd_v3_sub(ks, pd_v3_add(pd_v3_scale(*along, e->slipInvMass), pd_v3_scale(normal, pd_v3_dot(normal, ks))));
   e->driftPerJt = pd_v3_norm(off);
@@ -417,7 +424,12 @@ int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, con
       onsetElement e = {.omega2 = k / mass, .damping = damper / mass, .mass = mass, .mu = p->mu,
                         .kt = pd_series(p->k1t, p->k2t), .ct = pd_series(p->c1t, p->c2t)};
       pdVec3 along;
-      slip_element(model, set, poses, &c->id, c->point, n, du, &e, &along);
+      slip_element(model, poses, &c->id, c->point, n, du, &e, &along);
+      // the pair's contacts that join together slow the slip together, as they do the approach (the modal mass): each
+      // contact's element slows it by the ratio of its normal's modal to point inverse mass more, so that several
+      // contacts, each stopping the slip alone, do not reverse it
+      double pointMass = point_mass(model, set, poses, c);
+      if (isfinite(pointMass) && mass < pointMass) e.slipInvMass *= pointMass / mass;
       onsetMotion m = onset_motion(&e, approach, c->onsetAge);
       double x = fmin(fmax(m.x, 0.0), fmax(c->depth, 0.0));
       pdSprings sp = springs_load(y + base + PD_CONTACT_STATE_SIZE * i);
