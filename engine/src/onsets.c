@@ -179,18 +179,23 @@ static void applied_at(const pdModel* model, const pdPose* poses, const pdContac
     int b = side == 0 ? id->body1 : id->body2;
     const pdBody* body = &model->bodies[b];
     if (body->fixed) continue;
-    pdVec3 r = pd_v3_sub(point, poses[b].x), force = pd_body_applied_force(body, t);
-    pdMat3 invInertia = inverse_inertia_at(body, &poses[b]);
-    pdVec3 alpha = pd_mat3_mulv(&invInertia, pd_body_applied_torque(body, &poses[b].R, force));
-    pdVec3 alphaRate = pd_mat3_mulv(&invInertia, pd_body_applied_torque(body, &poses[b].R, body->forceRate));
-    pdVec3 a = pd_v3_add(model->settings.gravity, pd_v3_scale(force, body->invMass));
-    pdVec3 aRate = body->hasForce ? pd_v3_scale(body->forceRate, body->invMass) : (pdVec3){0.0, 0.0, 0.0};
-    if (body->planar) {  // the plane's reaction, as in the derivative
-      a.y = aRate.y = 0.0;
-      alpha.x = alpha.z = alphaRate.x = alphaRate.z = 0.0;
+    pdVec3 a = model->settings.gravity, aRate = {0.0, 0.0, 0.0};
+    if (body->planar) a.y = 0.0;  // the plane's reaction, as in the derivative
+    if (body->hasForce) {
+      pdVec3 force = pd_body_applied_force(body, t);
+      pdMat3 invInertia = inverse_inertia_at(body, &poses[b]);
+      pdVec3 alpha = pd_mat3_mulv(&invInertia, pd_body_applied_torque(body, &poses[b].R, force));
+      pdVec3 alphaRate = pd_mat3_mulv(&invInertia, pd_body_applied_torque(body, &poses[b].R, body->forceRate));
+      pdVec3 linear = pd_v3_scale(force, body->invMass);
+      aRate = pd_v3_scale(body->forceRate, body->invMass);
+      if (body->planar) {
+        linear.y = aRate.y = 0.0;
+        alpha.x = alpha.z = alphaRate.x = alphaRate.z = 0.0;
+      }
+      pdVec3 r = pd_v3_sub(point, poses[b].x);
+      a = pd_v3_add(a, pd_v3_add(linear, pd_v3_cross(alpha, r)));
+      aRate = pd_v3_add(aRate, pd_v3_cross(alphaRate, r));
     }
-    a = pd_v3_add(a, pd_v3_cross(alpha, r));
-    aRate = pd_v3_add(aRate, pd_v3_cross(alphaRate, r));
     *acceleration = side == 0 ? pd_v3_add(*acceleration, a) : pd_v3_sub(*acceleration, a);
     *rate = side == 0 ? pd_v3_add(*rate, aRate) : pd_v3_sub(*rate, aRate);
   }
