@@ -623,6 +623,10 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
       continue;
     }
     double settle = pd_sleep_settle_time(&is->model, is->state);
+    // The acceleration threshold guards the frozen velocity until the scene's end, not one settle time: a body
+    // accelerating steadily (a block sliding down an incline under a loose tol) stays below the speed threshold
+    // over a settle time and would leave it long before the end.
+    double horizon = fmax(settle, model->settings.tend - tNext);
     for (int m = 0; m < is->bodyCount; ++m) sleep->inContact[is->bodies[m]] = false;
     for (int c = 0; c < pd_state_contact_count(is->state); ++c) {
       int b[2];
@@ -635,7 +639,7 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
     for (int m = 0; m < is->bodyCount; ++m) {
       int k = is->bodies[m];
       const pdBody* b = &model->bodies[model->movingBodies[k]];
-      bool bodyQuiet = pd_sleep_quiet(sleep, b, k, s->y + PD_BODY_STATE_SIZE * k, set->t0, tNext, settle);
+      bool bodyQuiet = pd_sleep_quiet(sleep, b, k, s->y + PD_BODY_STATE_SIZE * k, set->t0, tNext, horizon);
       if (!bodyQuiet || !sleep->inContact[k]) {
         sleep->quietSince[k] = NAN;
         quiet = false;
@@ -646,7 +650,7 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
     if (!quiet || tNext - since < settle) continue;
     is->asleep = true;
     ++sleep->sleeps;
-    for (int m = 0; m < is->bodyCount; ++m) pd_sleep_fall_asleep(sleep, is->bodies[m], tNext, settle);
+    for (int m = 0; m < is->bodyCount; ++m) pd_sleep_fall_asleep(sleep, is->bodies[m], tNext, horizon);
   }
 }
 
