@@ -357,7 +357,9 @@ static bool line_closest(pdVec3 P, pdVec3 u, pdVec3 Q, pdVec3 v, double* s, doub
 // arcs that only touch — an endpoint shared (two faces parallel and in contact, such as a cube turned
 // 45° on another) or lying on the other arc (an edge lying on a face) — meet too, because the crossings
 // of the edges bounding those faces are real contact points (the corners of the overlap polygon).
-// Strict crossing (the SAT's Minkowski-face test) would miss them.
+// Strict crossing (the SAT's Minkowski-face test) would miss them. The callers allow a slack beyond that
+// (EE_ARC_SLACK, contact_features.h): an edge lying within it of a face is pressed into the face at both of its
+// crossings with the face's edges.
 // A touching pair is a contact only where those faces press on each other: its depth (the gap of the two
 // face planes) must not exceed the bodies' overlap along the faces around the two edges; otherwise the
 // faces are far apart across an overlap that is shallow along another axis (see edge_contact_is_shallow).
@@ -597,7 +599,7 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
         if (i < FIND_EE_CACHED) arcsA[i] = arcA, arcFormed |= 1ull << i;
       }
       if (!arcBFormed) arcB = gauss_arc(c, d), arcBFormed = true;
-      arcMeeting meet = arcs_meet_formed(&arcA, &arcB, ARC_TOUCH_TOL);
+      arcMeeting meet = arcs_meet_formed(&arcA, &arcB, EE_ARC_SLACK);
       if (meet == arcsApart) continue;
       edgeGeom g;
       if (!edge_pair_geometry(sa, i, b0, b1, true, &g) || !(g.depth > 0.0)) continue;
@@ -784,10 +786,6 @@ static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPo
   return true;
 }
 
-// A tracked EE contact keeps its edges while their Gauss-map arcs meet within this angle (rad): bodies
-// resting face on face (a 45° stack) rock by far less, so their edge crossings, whose arcs only touch,
-// persist; an edge pair that slid past a corner (arcs apart by the angle between faces) breaks.
-#define EE_TRACK_ARC_SLACK 1e-2
 // A tracked contact keeps its features while its vertex (VF) or each edge's closest point (EE) lies inside the other body, to this
 // fraction of that body's δ_max (deflection × size): a crossing that ends with the springs still loaded
 // (elastic contacts end where they began, up to the onset interpolation's error) stays; an edge pair whose
@@ -825,7 +823,7 @@ static bool edge_arcs_meet(const pdModel* model, const pdContactId* id, const pd
   pdVec3 a = pd_mat3_mulv(&p1->R, s1->faces[e1->f[0]].normal), b = pd_mat3_mulv(&p1->R, s1->faces[e1->f[1]].normal);
   pdVec3 c = pd_v3_scale(pd_mat3_mulv(&p2->R, s2->faces[e2->f[0]].normal), -1.0);
   pdVec3 d = pd_v3_scale(pd_mat3_mulv(&p2->R, s2->faces[e2->f[1]].normal), -1.0);
-  return arcs_meet(a, b, c, d, EE_TRACK_ARC_SLACK) != arcsApart;
+  return arcs_meet(a, b, c, d, EE_ARC_SLACK) != arcsApart;
 }
 
 void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,

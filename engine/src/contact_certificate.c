@@ -17,8 +17,8 @@
 //   and raises P by at most m (below), so the margin is half of how far beyond that both ends of an edge lie
 //   (per edge).
 // - EE: the Gauss arcs meet (find_ee's first test). Margin: the sine by which both ends of one arc lie on one
-//   side of the other's great circle, beyond arcs_meet's own slack; a rotation of B by ‖ΔR‖ moves its normals by
-//   at most that much.
+//   side of the other's great circle, beyond the slack find_ee allows (EE_ARC_SLACK); a rotation of B by ‖ΔR‖
+//   moves its normals by at most that much.
 // - EE: the closest points lie inside both edges and at most 3 δ_max plus the bodies' penetration depth P apart
 //   (EE_NEW_DEPTH_MAX_DEFLECTIONS; for lines whose sine is at least CERT_SINE_MIN the computed closest points are
 //   the true ones to ~1e-12 of the size, so the depth is their distance), so the segments are that close. A
@@ -225,7 +225,7 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
       // each pair needs one condition whose margin is at least the least so far (cheapest first)
       double margin = fmax(beyondA[i], beyondB[j]);
       if (margin >= least || exempt_listed(exempt, exemptCount, pd_contactEE, ia, i, j)) continue;
-      margin = fmax(margin, arcs_apart_margin(&arcA, &arcB[j], ARC_TOUCH_TOL) * cert.reach);
+      margin = fmax(margin, arcs_apart_margin(&arcA, &arcB[j], EE_ARC_SLACK) * cert.reach);
       if (margin >= least) continue;
       pdVec3 v = pd_v3_sub(b1[j], b0[j]);
       double sine = pd_v3_norm(pd_v3_cross(u, v)) / sqrt(pd_v3_dot(u, u) * pd_v3_dot(v, v));

@@ -97,6 +97,12 @@ static const hardCase hardCases[] = {
     // chip's two faces, in series, store ½ M v² at a total x = (v / vmax) δ_max √(M / 2 m_pair) = 9.8 δ_max, 4.9 at
     // each face without dampers; the dampers keep the peak below that (measured 3.7)
     {"heavy_block_on_chip.scene", NULL, NULL, 4.9, true},
+    // a cube's edge lying along a 15:1 plate's rim face, held at both ends where it crosses the rim's edges; at its
+    // deepest the light plate (0.4 g) is pressed between two cubes (11 g, 165 g), a pile-up beyond the springs' sizing
+    // as the two above: bound 5
+    {"cube_edge_along_plate_rim.scene", NULL, NULL, 5.0, true},
+    // the same along a frustum's side face between two spinning frusta
+    {"frustum_edge_along_frustum_face.scene", NULL, NULL, 0.0, true},
 };
 
 // What the observer saw over all samples.
