@@ -84,11 +84,20 @@ bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const p
 }
 
 // The energy of the springs a trace will give back: a trace left by force returns its tangential springs only
-// (pd_history_take), a hand-over trace all of them.
+// (pd_history_take), a hand-over trace all of them as its successor takes them (pd_history_take_handover: realigned,
+// which clamps the normal springs out of tension, and held within the cone). A contact that broke with its springs
+// stretched in tension (its force pulling at the step's end: the paper's contact ended where its force reached zero)
+// gives a successor none of that tension, and the state's energy must not count it: it rose by the tension's energy
+// at the commit and fell back when the trace expired (soak campaign 48, scene 1728: 5.1e-3 of E(0)).
 static double trace_energy(const pdModel* model, const trace* t, bool normalReturns) {
   pdContactParams p = pd_model_contact_params(model, t->id.body1, t->id.body2);
   pdSprings s = t->springs;
-  if (!normalReturns) s.s1n = s.s2n = 0.0;
+  if (!normalReturns) {
+    s.s1n = s.s2n = 0.0;
+  } else {
+    pd_springs_realign(&s, t->normal, t->normal, p.mu, &p, t->fn);
+    pd_springs_clip_to_cone(&s, &p, p.mu * fmax(t->fn, 0.0));
+  }
   return pd_springs_energy(&p, &s);
 }
 

@@ -178,6 +178,16 @@ static void test_kept_springs_count_at_a_presented_state(void** state) {
   assert_no_energy_gained("cases/hard/prism_off_wall_kept_springs_at_sync.scene", pd_soakThrow, 3);
 }
 
+// Nine bodies colliding in the air (cases/hard/free_pile_energy_after_dropped_contact.scene): an edge pair whose
+// springs were stretched in tension over its last step (its force pulling) broke geometrically with no successor, and
+// the hand-over trace it left counted the tension springs' energy, which no successor gets back (a successor's springs
+// are clamped out of tension): 5.1e-3 of E(0) gained at the commit, islands on, and lost again when the trace expired.
+// No energy is gained beyond the integration's error, islands on and off.
+static void test_a_pulling_contact_leaves_no_energy_for_a_successor(void** state) {
+  (void)state;
+  assert_no_energy_gained("cases/hard/free_pile_energy_after_dropped_contact.scene", pd_soakFree, 9);
+}
+
 // Scene 371 of campaign 3 of the first generator is the file committed with the campaign 3 rerun (after its two
 // header lines: what happened and how to replay it).
 static void test_the_first_generator_replays_committed_campaigns(void** state) {
@@ -252,6 +262,7 @@ int main(void) {
       cmocka_unit_test(test_a_body_pressing_sideways_does_not_raise_the_limit),
       cmocka_unit_test(test_springs_kept_by_a_broken_contact_bring_no_energy_back),
       cmocka_unit_test(test_kept_springs_count_at_a_presented_state),
+      cmocka_unit_test(test_a_pulling_contact_leaves_no_energy_for_a_successor),
       cmocka_unit_test(test_the_first_generator_replays_committed_campaigns),
       cmocka_unit_test(test_the_second_generator_draws_plates),
   };
