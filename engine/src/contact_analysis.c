@@ -251,6 +251,59 @@ __attribute__((noinline)) static int vf_beyond_acute_edge(const pdModel* m, int 
   return n + 1;
 }
 
+// The faces of jf other than `face` that an edge of vertex i of body iv leaves through (q: the vertex in jf's frame,
+// inside jf), each appended to out (find_vf's) as a contact of the vertex with that face: n or more. The VF/EE model
+// carries an edge pressed into a face by the VF contact of its end inside; when that end came in through a
+// neighbouring face (a cube's corner entering a thin plate's rim, then its edge tipping down into the plate's
+// cap), the vertex keeps the face it crossed (§4.4.3) and the edge's pair with the rim edge is not interior (its
+// crossing lies just past the vertex), so the edge sank into the cap with no contact (soak seed 42, scene 2187:
+// 5.7 δ_max against a corner 0.3 δ_max in the rim). The vertex then presses on that face as well, from the
+// moment its edge crosses it inside the face's polygon: found within δ_max of that face's plane (the slack of a new
+// sharp-edge pair), then kept by tracking. A vertex already deeper below it when first seen is carried by its body's
+// other pairs: made a contact there with springs at zero, a sphere's vertex 2.3 δ_max below a cube's next face took
+// over from the edge pairs that held it (cases/hard/vertex_past_edge_plate.scene, islands off: 0.77 → 3.6 δ_max).
+__attribute__((noinline)) static int vf_edge_leaves_through(const pdModel* m, int iv, int jf, const pdPose* pf, int i,
+                                                            int face, pdVec3 p, pdVec3 q, const pdMat3* rel, pdVec3 off,
+                                                            pdContactGeom* out, int capacity, int n) {
+  const pdPolyhedron* sv = &m->bodies[iv].shape;
+  const pdPolyhedron* sf = &m->bodies[jf].shape;
+  double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
+  double deltaMax = pd_model_pair_delta_max(m, iv, jf);
+  double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
+  for (int f = 0; f < sf->faceCount; ++f) {
+    double d = face_depth(sf, f, q);
+    // deeper below f than below its own face (a corner that slides along a side plane a roundoff inside it, its edge
+    // leaving through it, is pressed into its own face: the sliver across the side plane is no contact), and over f's
+    // polygon, as tracking keeps a VF contact (else it would break at once and be found again)
+    if (f == face || !(d > fmax(tol, flushTol)) || !(d > face_depth(sf, face, q)) ||
+        !projects_inside(sf, f, q, fmax(tol, flushTol)))
+      continue;
+    // a face beside the vertex's own, across the edge the vertex came in by (a vertex deep in the body, far from f,
+    // is no corner at f's edge: its edges leaving through f are the body's overlap, which its other pairs carry)
+    bool beside = false;
+    for (int e = 0; e < sf->edgeCount && !beside; ++e) {
+      const pdEdge* edge = &sf->edges[e];
+      beside = (edge->f[0] == face && edge->f[1] == f) || (edge->f[0] == f && edge->f[1] == face);
+    }
+    if (!beside) continue;
+    bool leaves = false;
+    for (int e = 0; e < sv->edgeCount && !leaves; ++e) {
+      const pdEdge* edge = &sv->edges[e];
+      if (edge->v[0] != i && edge->v[1] != i) continue;
+      pdVec3 qk = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[edge->v[0] == i ? edge->v[1] : edge->v[0]]));
+      double dk = face_depth(sf, f, qk);
+      if (!(dk < -tol)) continue;
+      pdVec3 exit = pd_v3_add(q, pd_v3_scale(pd_v3_sub(qk, q), d / (d - dk)));
+      leaves = projects_inside(sf, f, exit, fmax(tol, flushTol));
+    }
+    if (!leaves || d > deltaMax) continue;
+    if (n < capacity)
+      out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, f}, p, pd_mat3_mulv(&pf->R, sf->faces[f].normal), d};
+    ++n;
+  }
+  return n;
+}
+
 // VF contacts of the vertices of body iv inside body jf.
 // (Formed twice, for a face body with an acute edge and for one without (find_vf): without, the loop is the paper's
 // alone, as fast as it was before vertices beyond acute edges were looked at.)
@@ -328,6 +381,9 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
       out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, face}, p, pd_mat3_mulv(&pf->R, sf->faces[face].normal),
                                face_depth(sf, face, q)};
     ++n;
+    // only a vertex that keeps its face by continuity: a vertex new here takes the face it crossed or the nearest
+    if (face >= 0 && face == previous_face(previous, previousCount, iv, i, jf))
+      n = vf_edge_leaves_through(m, iv, jf, pf, i, face, p, q, &rel, off, out, capacity, n);
   }
   return n;
 }

@@ -145,8 +145,37 @@ static double over_face_margin(const pdPolyhedron* s, int f, pdVec3 q, double ov
 
 // The least margin of the vertices of sv (given in sf's frame by rel, off) against sf, vertices listed as VF
 // contacts of body iv in `exempt` left out; stops at `bound` (no lower margin needed).
+// How far vertex i of sv (q, in sf's frame), in contact, may move before an edge of it leaves through a face of sf
+// other than its listed ones with the vertex below that face's plane by more than `over` (find_vf then makes it a
+// contact on that face too, vf_edge_leaves_through), m: per face, the larger of the vertex's distance above that depth
+// and the least depth of its edges' other ends below the plane (either keeps the condition false), less `guard`.
+static double edge_exit_margin(const pdPolyhedron* sv, int iv, int i, const pdMat3* rel, pdVec3 off,
+                               const pdPolyhedron* sf, pdVec3 q, double over, double guard, const pdContactId* exempt,
+                               int exemptCount) {
+  double least = INFINITY;
+  for (int f = 0; f < sf->faceCount; ++f) {
+    bool listed = false;
+    for (int k = 0; k < exemptCount && !listed; ++k)
+      listed = exempt[k].kind == pd_contactVF && exempt[k].body1 == iv && exempt[k].feat1 == i && exempt[k].feat2 == f;
+    if (listed) continue;
+    double ends = INFINITY;
+    for (int e = 0; e < sv->edgeCount; ++e) {
+      const pdEdge* edge = &sv->edges[e];
+      if (edge->v[0] != i && edge->v[1] != i) continue;
+      pdVec3 qk = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[edge->v[0] == i ? edge->v[1] : edge->v[0]]));
+      double dk = face_depth(sf, f, qk);
+      ends = dk < ends ? dk : ends;
+    }
+    double above = over - face_depth(sf, f, q);
+    double margin = (above > ends ? above : ends) - guard;
+    least = margin < least ? margin : least;
+  }
+  return least;
+}
+
 static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf,
-                              double tolerance, double over, const pdContactId* exempt, int exemptCount, double bound) {
+                              double tolerance, double over, double guard, const pdContactId* exempt, int exemptCount,
+                              double bound) {
   double least = bound;
   for (int i = 0; i < sv->vertexCount && least > 0.0; ++i) {
     pdVec3 q = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[i]));
@@ -154,6 +183,8 @@ static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel,
     if (listed >= 0) {
       // a vertex in contact keeps its face while it is over it (find_vf), and takes another once it is not
       double margin = over_face_margin(sf, exempt[listed].feat2, q, over);
+      if (margin > 0.0)
+        margin = fmin(margin, edge_exit_margin(sv, iv, i, rel, off, sf, q, over, guard, exempt, exemptCount));
       least = margin < least ? margin : least;
       continue;
     }
@@ -185,8 +216,9 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   double onA = pd_polyhedron_has_acute_edge(sa) ? fmax(deltaMax, tolA) : fmax(tolA, flushTol);
   double onB = pd_polyhedron_has_acute_edge(sb) ? fmax(deltaMax, tolB) : fmax(tolB, flushTol);
   double overA = fmax(tolA, flushTol) - guard, overB = fmax(tolB, flushTol) - guard;  // find_vf's "over its face"
-  double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, exempt, exemptCount, INFINITY);
-  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, exempt, exemptCount, least);
+  double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, guard, exempt, exemptCount,
+                                 INFINITY);
+  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, guard, exempt, exemptCount, least);
   if (!(least > 0.0)) return cert;
   // EE: per edge, how far it lies beyond one face plane of the other body (then any pair with it is certified)
   enum { EDGES_MAX = 64 };
