@@ -155,3 +155,16 @@ bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, 
   t->taken = true;
   return true;
 }
+
+bool pd_history_vertex_trace(const pdContactHistory* h, int vertexBody, int vertex, int faceBody, int face,
+                             pdContactId* id) {
+  for (int i = 0; i < h->sortedCount; ++i) {
+    const trace* t = &h->items[i];
+    if (t->taken || t->id.kind != pd_contactVF || t->id.body1 != vertexBody || t->id.feat1 != vertex ||
+        t->id.body2 != faceBody || t->id.feat2 == face)
+      continue;
+    *id = t->id;
+    return true;
+  }
+  return false;
+}
