@@ -188,15 +188,20 @@ static void test_a_pulling_contact_leaves_no_energy_for_a_successor(void** state
   assert_no_energy_gained("cases/hard/free_pile_energy_after_dropped_contact.scene", pd_soakFree, 9);
 }
 
+// The scene `name` passes the soak's checks at every step, islands on and off.
+static void assert_passes_at_every_step(const char* name, pdSoakKind kind, int objects) {
+  pdSoakScene scene = scene_file(name, kind, objects);
+  for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e)
+    assert_int_equal(run_told(&scene, softEngines[e], true).status, pd_soakOk);
+  pd_soak_scene_free(&scene);
+}
+
 // A plate's corner in a prism (cases/hard/plate_corner_into_prism_next_face.scene, nine bodies in the air) keeps the
 // face it entered by while its edge tips into the next face: 5.27 delta_max at a step, islands on, while the corner's
 // contact on that face was found only once the corner left its first one. Passes the soak's checks, islands on and off.
 static void test_a_corner_presses_on_the_next_face_its_edge_enters(void** state) {
   (void)state;
-  pdSoakScene scene = scene_file("cases/hard/plate_corner_into_prism_next_face.scene", pd_soakFree, 9);
-  for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e)
-    assert_int_equal(run_told(&scene, softEngines[e], true).status, pd_soakOk);
-  pd_soak_scene_free(&scene);
+  assert_passes_at_every_step("cases/hard/plate_corner_into_prism_next_face.scene", pd_soakFree, 9);
 }
 
 // A geodesic sphere's vertex released by force 2.75 delta_max inside a 100:1 blade
@@ -205,10 +210,7 @@ static void test_a_corner_presses_on_the_next_face_its_edge_enters(void** state)
 // islands on and off.
 static void test_a_vertex_released_inside_a_blade_keeps_its_face(void** state) {
   (void)state;
-  pdSoakScene scene = scene_file("cases/hard/vertex_released_in_blade_far_face.scene", pd_soakFree, 10);
-  for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e)
-    assert_int_equal(run_told(&scene, softEngines[e], true).status, pd_soakOk);
-  pd_soak_scene_free(&scene);
+  assert_passes_at_every_step("cases/hard/vertex_released_in_blade_far_face.scene", pd_soakFree, 10);
 }
 
 // Scene 371 of campaign 3 of the first generator is the file committed with the campaign 3 rerun (after its two
