@@ -585,7 +585,7 @@ static void find_range(void* ctx, int part, int begin, int end) {
 // pushed on through the blade (soak campaign 48, scene 4069: 11.4 δ_max). Candidate *c (a new contact at y1) then
 // becomes the trace's contact at its tracked geometry when it approaches F (c->released), and is no contact when it
 // recedes from F onto a face turned away from F, where its contact ended (false: drop it). Dropped on a face beside F
-// too, a vertex that slid from F into that face met nothing there (soak campaign 62, scene 265: 0.38 -> 6.5 δ_max).
+// too, a vertex that slid from F into that face was not held there (soak campaign 62, scene 265: 0.38 -> 6.5 δ_max).
 static bool keep_released_face(const pdModel* model, const pdContactSet* set, const double* y1, const pdPose* poses1,
                                candidate* c) {
   const pdContactId* id = &c->geom.id;
