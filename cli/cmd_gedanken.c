@@ -35,7 +35,7 @@ static const char* const help =
     "  --tolerance-scale F  multiply every tolerance by F > 0 (default 1: the catalogue's); only to check that\n"
     "                       failures are reported, the verdicts are then not the catalogue's\n"
     "  --precision          also work-precision against the closed form: every quantitative experiment, on its\n"
-    "                       middle input, at soft tol 1e-2 ... 1e-10 and fixed-step RK4 dt 1e-3 ... 1e-5 s, ODE\n"
+    "                       middle input, at soft tol 1e-1 ... 1e-10 and fixed-step RK4 dt 1e-3 ... 1e-5 s, ODE\n"
     "                       and Bullet (native, matched) at steps 1/60 ... 1/16000 s, Bullet also at 5 ... 200\n"
     "                       solver iterations; writes DIR/precision.csv\n"
     "                       (error against the closed form and wall time per point)\n"

@@ -139,8 +139,8 @@ static bool soft_run(const pdModel* model, pdStepper stepper, pdTrajectory* traj
   pdStateOptions options = pd_state_options_default();
   options.stepper = stepper;
   options.onsets = sweepOnsets;
+  double t0 = pd_cli_wall_seconds();  // the span of a reference engine's run (pd_ref_run): created, then run
   pdState* state = pd_state_create(model, &options);
-  double t0 = pd_cli_wall_seconds();
   bool ok = pd_advance(model, state, model->settings.tend, observe, trajectory);
   *wall = pd_cli_wall_seconds() - t0;
   *steps = state->count.accepted;

@@ -20,7 +20,9 @@
 #include "pdutil/csv.h"
 
 // The knobs, loosest first (the header lists them; docs/validation.md).
-static const double softTolerances[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
+// The soft tolerances start above 1e-2 so that an experiment reached at every setting gets a measured crossing,
+// not only a bound: several experiments' closed forms are met at 1e-2 already.
+static const double softTolerances[] = {1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
 static const double softFixedSteps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};                              // s
 static const double referenceSteps[] = {1.0 / 60, 1.0 / 250, 1.0 / 1000, 1.0 / 4000, 1.0 / 16000};  // s
 // Bullet's sequential-impulse solver iterations per step, at the default step (ODE's dWorldStep solves its LCP
@@ -161,8 +163,9 @@ static void measure_point(const gkPrecision* s, gkPoint* p) {
                                                                   : pd_stepperRK4Adaptive;
       // the reference variant of the contact events: every onset located (docs/events.md)
       if (strcmp(p->variant, "exact-events") == 0) options.onsets = pd_onsetsExact;
-      pdState* state = pd_state_create(model, &options);
+      // the span of a reference engine's run (pd_ref_run): the engine's state created, then run to the end
       double t0 = gk_wall_seconds(), c0 = gk_cpu_seconds();
+      pdState* state = pd_state_create(model, &options);
       completed = pd_advance(model, state, model->settings.tend, observe, &observer);
       walls[r] = gk_wall_seconds() - t0;
       cpus[r] = gk_cpu_seconds() - c0;

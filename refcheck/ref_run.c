@@ -100,15 +100,19 @@ bool pd_ref_run(const pdModel* model, const pdRefAdapter* adapter, const pdRefOp
   PD_ASSERT(model && adapter && options && stats && options->step > 0.0);
   memset(stats, 0, sizeof *stats);
   sampling plan = plan_sampling(options->step, model->settings.sampleRate);
+  // The harness's own state (the samples handed to the observer) is made before the clock starts: the span is
+  // the engine's, from its world created out of the compiled model to the last sample, as a soft run's from
+  // pd_state_create to the end of pd_advance (docs/validation.md, "The cost's span").
+  pdState* state = pd_state_create(model, NULL);
+  double energyStart = pd_state_energy(model, state);
   double wall0 = pd_wall_seconds(), cpu0 = pd_thread_cpu_seconds();
   pdRefWorld* world = adapter->create(model, options, err);
   if (!world) {
+    pd_state_free(state);
     stats->refused = true;
     if (writer) pd_run_abort(writer);
     return false;
   }
-  pdState* state = pd_state_create(model, NULL);
-  double energyStart = pd_state_energy(model, state);
   double tend = model->settings.tend;
   long sampleCount = (long)floor(tend / plan.sampleInterval * (1.0 + 1e-12));
   bool ok = true, stopped = false;

@@ -221,9 +221,10 @@ pdTrajectory* pd_toss_simulate(const pdToss* toss, const pdTossParams* params, c
   bool ok;
   double cpu0 = pd_process_cpu_seconds();
   if (soft) {
+    double t0 = pd_wall_seconds();  // the span of a reference engine's run (pd_ref_run): created, then run
     pdState* state = pd_state_create(model, NULL);
     softObserver o = {writer, trajectory};
-    double e0 = pd_state_energy(model, state), t0 = pd_wall_seconds();
+    double e0 = pd_state_energy(model, state);
     bool completed = pd_advance(model, state, model->settings.tend, observe_soft, &o);
     if (writer) pd_run_drain(writer);  // the samples printed by the writer thread count too (engine/src/output.c)
     r->wallSeconds = pd_wall_seconds() - t0;

@@ -251,59 +251,6 @@ __attribute__((noinline)) static int vf_beyond_acute_edge(const pdModel* m, int 
   return n + 1;
 }
 
-// The faces of jf other than `face` that an edge of vertex i of body iv leaves through (q: the vertex in jf's frame,
-// inside jf), each appended to out (find_vf's) as a contact of the vertex with that face: n or more. The VF/EE model
-// carries an edge pressed into a face by the VF contact of its end inside; when that end came in through a
-// neighbouring face (a cube's corner entering a thin plate's rim, then its edge tipping down into the plate's
-// cap), the vertex keeps the face it crossed (§4.4.3) and the edge's pair with the rim edge is not interior (its
-// crossing lies just past the vertex), so the edge sank into the cap with no contact (soak seed 42, scene 2187:
-// 5.7 δ_max against a corner 0.3 δ_max in the rim). The vertex then presses on that face as well, from the
-// moment its edge crosses it inside the face's polygon: found within δ_max of that face's plane (the slack of a new
-// sharp-edge pair), then kept by tracking. A vertex already deeper below it when first seen is carried by its body's
-// other pairs: made a contact there with springs at zero, a sphere's vertex 2.3 δ_max below a cube's next face took
-// over from the edge pairs that held it (cases/hard/vertex_past_edge_plate.scene, islands off: 0.77 → 3.6 δ_max).
-__attribute__((noinline)) static int vf_edge_leaves_through(const pdModel* m, int iv, int jf, const pdPose* pf, int i,
-                                                            int face, pdVec3 p, pdVec3 q, const pdMat3* rel, pdVec3 off,
-                                                            pdContactGeom* out, int capacity, int n) {
-  const pdPolyhedron* sv = &m->bodies[iv].shape;
-  const pdPolyhedron* sf = &m->bodies[jf].shape;
-  double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
-  double deltaMax = pd_model_pair_delta_max(m, iv, jf);
-  double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
-  for (int f = 0; f < sf->faceCount; ++f) {
-    double d = face_depth(sf, f, q);
-    // deeper below f than below its own face (a corner that slides along a side plane a roundoff inside it, its edge
-    // leaving through it, is pressed into its own face: the sliver across the side plane is no contact), and over f's
-    // polygon, as tracking keeps a VF contact (else it would break at once and be found again)
-    if (f == face || !(d > fmax(tol, flushTol)) || !(d > face_depth(sf, face, q)) ||
-        !projects_inside(sf, f, q, fmax(tol, flushTol)))
-      continue;
-    // a face beside the vertex's own, across the edge the vertex came in by (a vertex deep in the body, far from f,
-    // is no corner at f's edge: its edges leaving through f are the body's overlap, which its other pairs carry)
-    bool beside = false;
-    for (int e = 0; e < sf->edgeCount && !beside; ++e) {
-      const pdEdge* edge = &sf->edges[e];
-      beside = (edge->f[0] == face && edge->f[1] == f) || (edge->f[0] == f && edge->f[1] == face);
-    }
-    if (!beside) continue;
-    bool leaves = false;
-    for (int e = 0; e < sv->edgeCount && !leaves; ++e) {
-      const pdEdge* edge = &sv->edges[e];
-      if (edge->v[0] != i && edge->v[1] != i) continue;
-      pdVec3 qk = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[edge->v[0] == i ? edge->v[1] : edge->v[0]]));
-      double dk = face_depth(sf, f, qk);
-      if (!(dk < -tol)) continue;
-      pdVec3 exit = pd_v3_add(q, pd_v3_scale(pd_v3_sub(qk, q), d / (d - dk)));
-      leaves = projects_inside(sf, f, exit, fmax(tol, flushTol));
-    }
-    if (!leaves || d > deltaMax) continue;
-    if (n < capacity)
-      out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, f}, p, pd_mat3_mulv(&pf->R, sf->faces[f].normal), d};
-    ++n;
-  }
-  return n;
-}
-
 // VF contacts of the vertices of body iv inside body jf.
 // (Formed twice, for a face body with an acute edge and for one without (find_vf): without, the loop is the paper's
 // alone, as fast as it was before vertices beyond acute edges were looked at.)
@@ -381,9 +328,6 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
       out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, face}, p, pd_mat3_mulv(&pf->R, sf->faces[face].normal),
                                face_depth(sf, face, q)};
     ++n;
-    // only a vertex that keeps its face by continuity: a vertex new here takes the face it crossed or the nearest
-    if (face >= 0 && face == previous_face(previous, previousCount, iv, i, jf))
-      n = vf_edge_leaves_through(m, iv, jf, pf, i, face, p, q, &rel, off, out, capacity, n);
   }
   return n;
 }
@@ -413,7 +357,9 @@ static bool line_closest(pdVec3 P, pdVec3 u, pdVec3 Q, pdVec3 v, double* s, doub
 // arcs that only touch — an endpoint shared (two faces parallel and in contact, such as a cube turned
 // 45° on another) or lying on the other arc (an edge lying on a face) — meet too, because the crossings
 // of the edges bounding those faces are real contact points (the corners of the overlap polygon).
-// Strict crossing (the SAT's Minkowski-face test) would miss them.
+// Strict crossing (the SAT's Minkowski-face test) would miss them. The callers allow a slack beyond that
+// (EE_ARC_SLACK, contact_features.h): an edge lying within it of a face is pressed into the face at both of its
+// crossings with the face's edges.
 // A touching pair is a contact only where those faces press on each other: its depth (the gap of the two
 // face planes) must not exceed the bodies' overlap along the faces around the two edges; otherwise the
 // faces are far apart across an overlap that is shallow along another axis (see edge_contact_is_shallow).
@@ -653,7 +599,7 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
         if (i < FIND_EE_CACHED) arcsA[i] = arcA, arcFormed |= 1ull << i;
       }
       if (!arcBFormed) arcB = gauss_arc(c, d), arcBFormed = true;
-      arcMeeting meet = arcs_meet_formed(&arcA, &arcB, ARC_TOUCH_TOL);
+      arcMeeting meet = arcs_meet_formed(&arcA, &arcB, EE_ARC_SLACK);
       if (meet == arcsApart) continue;
       edgeGeom g;
       if (!edge_pair_geometry(sa, i, b0, b1, true, &g) || !(g.depth > 0.0)) continue;
@@ -840,10 +786,6 @@ static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPo
   return true;
 }
 
-// A tracked EE contact keeps its edges while their Gauss-map arcs meet within this angle (rad): bodies
-// resting face on face (a 45° stack) rock by far less, so their edge crossings, whose arcs only touch,
-// persist; an edge pair that slid past a corner (arcs apart by the angle between faces) breaks.
-#define EE_TRACK_ARC_SLACK 1e-2
 // A tracked contact keeps its features while its vertex (VF) or each edge's closest point (EE) lies inside the other body, to this
 // fraction of that body's δ_max (deflection × size): a crossing that ends with the springs still loaded
 // (elastic contacts end where they began, up to the onset interpolation's error) stays; an edge pair whose
@@ -881,7 +823,7 @@ static bool edge_arcs_meet(const pdModel* model, const pdContactId* id, const pd
   pdVec3 a = pd_mat3_mulv(&p1->R, s1->faces[e1->f[0]].normal), b = pd_mat3_mulv(&p1->R, s1->faces[e1->f[1]].normal);
   pdVec3 c = pd_v3_scale(pd_mat3_mulv(&p2->R, s2->faces[e2->f[0]].normal), -1.0);
   pdVec3 d = pd_v3_scale(pd_mat3_mulv(&p2->R, s2->faces[e2->f[1]].normal), -1.0);
-  return arcs_meet(a, b, c, d, EE_TRACK_ARC_SLACK) != arcsApart;
+  return arcs_meet(a, b, c, d, EE_ARC_SLACK) != arcsApart;
 }
 
 void pd_contact_geometry(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,

@@ -17,8 +17,8 @@
 //   and raises P by at most m (below), so the margin is half of how far beyond that both ends of an edge lie
 //   (per edge).
 // - EE: the Gauss arcs meet (find_ee's first test). Margin: the sine by which both ends of one arc lie on one
-//   side of the other's great circle, beyond arcs_meet's own slack; a rotation of B by ‖ΔR‖ moves its normals by
-//   at most that much.
+//   side of the other's great circle, beyond the slack find_ee allows (EE_ARC_SLACK); a rotation of B by ‖ΔR‖
+//   moves its normals by at most that much.
 // - EE: the closest points lie inside both edges and at most 3 δ_max plus the bodies' penetration depth P apart
 //   (EE_NEW_DEPTH_MAX_DEFLECTIONS; for lines whose sine is at least CERT_SINE_MIN the computed closest points are
 //   the true ones to ~1e-12 of the size, so the depth is their distance), so the segments are that close. A
@@ -145,37 +145,8 @@ static double over_face_margin(const pdPolyhedron* s, int f, pdVec3 q, double ov
 
 // The least margin of the vertices of sv (given in sf's frame by rel, off) against sf, vertices listed as VF
 // contacts of body iv in `exempt` left out; stops at `bound` (no lower margin needed).
-// How far vertex i of sv (q, in sf's frame), in contact, may move before an edge of it leaves through a face of sf
-// other than its listed ones with the vertex below that face's plane by more than `over` (find_vf then makes it a
-// contact on that face too, vf_edge_leaves_through), m: per face, the larger of the vertex's distance above that depth
-// and the least depth of its edges' other ends below the plane (either keeps the condition false), less `guard`.
-static double edge_exit_margin(const pdPolyhedron* sv, int iv, int i, const pdMat3* rel, pdVec3 off,
-                               const pdPolyhedron* sf, pdVec3 q, double over, double guard, const pdContactId* exempt,
-                               int exemptCount) {
-  double least = INFINITY;
-  for (int f = 0; f < sf->faceCount; ++f) {
-    bool listed = false;
-    for (int k = 0; k < exemptCount && !listed; ++k)
-      listed = exempt[k].kind == pd_contactVF && exempt[k].body1 == iv && exempt[k].feat1 == i && exempt[k].feat2 == f;
-    if (listed) continue;
-    double ends = INFINITY;
-    for (int e = 0; e < sv->edgeCount; ++e) {
-      const pdEdge* edge = &sv->edges[e];
-      if (edge->v[0] != i && edge->v[1] != i) continue;
-      pdVec3 qk = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[edge->v[0] == i ? edge->v[1] : edge->v[0]]));
-      double dk = face_depth(sf, f, qk);
-      ends = dk < ends ? dk : ends;
-    }
-    double above = over - face_depth(sf, f, q);
-    double margin = (above > ends ? above : ends) - guard;
-    least = margin < least ? margin : least;
-  }
-  return least;
-}
-
 static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf,
-                              double tolerance, double over, double guard, const pdContactId* exempt, int exemptCount,
-                              double bound) {
+                              double tolerance, double over, const pdContactId* exempt, int exemptCount, double bound) {
   double least = bound;
   for (int i = 0; i < sv->vertexCount && least > 0.0; ++i) {
     pdVec3 q = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[i]));
@@ -183,8 +154,6 @@ static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel,
     if (listed >= 0) {
       // a vertex in contact keeps its face while it is over it (find_vf), and takes another once it is not
       double margin = over_face_margin(sf, exempt[listed].feat2, q, over);
-      if (margin > 0.0)
-        margin = fmin(margin, edge_exit_margin(sv, iv, i, rel, off, sf, q, over, guard, exempt, exemptCount));
       least = margin < least ? margin : least;
       continue;
     }
@@ -216,9 +185,8 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   double onA = pd_polyhedron_has_acute_edge(sa) ? fmax(deltaMax, tolA) : fmax(tolA, flushTol);
   double onB = pd_polyhedron_has_acute_edge(sb) ? fmax(deltaMax, tolB) : fmax(tolB, flushTol);
   double overA = fmax(tolA, flushTol) - guard, overB = fmax(tolB, flushTol) - guard;  // find_vf's "over its face"
-  double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, guard, exempt, exemptCount,
-                                 INFINITY);
-  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, guard, exempt, exemptCount, least);
+  double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, exempt, exemptCount, INFINITY);
+  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, exempt, exemptCount, least);
   if (!(least > 0.0)) return cert;
   // EE: per edge, how far it lies beyond one face plane of the other body (then any pair with it is certified)
   enum { EDGES_MAX = 64 };
@@ -257,7 +225,7 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
       // each pair needs one condition whose margin is at least the least so far (cheapest first)
       double margin = fmax(beyondA[i], beyondB[j]);
       if (margin >= least || exempt_listed(exempt, exemptCount, pd_contactEE, ia, i, j)) continue;
-      margin = fmax(margin, arcs_apart_margin(&arcA, &arcB[j], ARC_TOUCH_TOL) * cert.reach);
+      margin = fmax(margin, arcs_apart_margin(&arcA, &arcB[j], EE_ARC_SLACK) * cert.reach);
       if (margin >= least) continue;
       pdVec3 v = pd_v3_sub(b1[j], b0[j]);
       double sine = pd_v3_norm(pd_v3_cross(u, v)) / sqrt(pd_v3_dot(u, u) * pd_v3_dot(v, v));

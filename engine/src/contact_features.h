@@ -27,6 +27,17 @@
 
 // Gauss-map arcs within this sine of meeting touch (the arcs test in contact_analysis.c says why).
 #define ARC_TOUCH_TOL 1e-9
+// An edge pair is a contact while its Gauss-map arcs meet within this angle (rad), for the search (find_ee) and for
+// tracking alike, so that tracking keeps what the search finds and the search finds what tracking would keep. Arcs
+// that only just miss are an edge lying nearly along a face of the other body (the pair's normal within about this
+// angle of the face's), pressed into it along a segment whose two ends, where it crosses the face's edges, both carry
+// the touch; the Minkowski-face test alone admits one end at a time, whichever the face's rocking tips deeper. So an
+// edge lying along a thin body's rim face was held at one end at a time, each end found anew at the depth the two
+// shared with its springs at zero (soak campaign 49, scene 439: 6.2 δ_max; docs/contact-model.md, "An edge along a
+// face"). 1e-2 for both leaves that scene at 4.2 δ_max, 3e-2 at 3.6 (the plate then pressed between two cubes),
+// 5e-2 and 1e-1 no lower. Bodies resting face on face rock by far less, so their edge crossings, whose arcs only
+// touch, persist; an edge pair that slid past a corner (arcs apart by the angle between faces) breaks.
+#define EE_ARC_SLACK 3e-2
 // Absolute rounding margin of a triple product of unit vectors: ~100 ulps of 1.
 #define ARC_TRIPLE_ROUNDING 1e-14
 

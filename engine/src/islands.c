@@ -623,6 +623,10 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
       continue;
     }
     double settle = pd_sleep_settle_time(&is->model, is->state);
+    // The acceleration threshold guards the frozen velocity until the scene's end, not one settle time: a body
+    // accelerating steadily (a block sliding down an incline under a loose tol) stays below the speed threshold
+    // over a settle time and would leave it long before the end.
+    double horizon = fmax(settle, model->settings.tend - tNext);
     for (int m = 0; m < is->bodyCount; ++m) sleep->inContact[is->bodies[m]] = false;
     for (int c = 0; c < pd_state_contact_count(is->state); ++c) {
       int b[2];
@@ -635,7 +639,7 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
     for (int m = 0; m < is->bodyCount; ++m) {
       int k = is->bodies[m];
       const pdBody* b = &model->bodies[model->movingBodies[k]];
-      bool bodyQuiet = pd_sleep_quiet(sleep, b, k, s->y + PD_BODY_STATE_SIZE * k, set->t0, tNext, settle);
+      bool bodyQuiet = pd_sleep_quiet(sleep, b, k, s->y + PD_BODY_STATE_SIZE * k, set->t0, tNext, horizon);
       if (!bodyQuiet || !sleep->inContact[k]) {
         sleep->quietSince[k] = NAN;
         quiet = false;
@@ -646,7 +650,7 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
     if (!quiet || tNext - since < settle) continue;
     is->asleep = true;
     ++sleep->sleeps;
-    for (int m = 0; m < is->bodyCount; ++m) pd_sleep_fall_asleep(sleep, is->bodies[m], tNext, settle);
+    for (int m = 0; m < is->bodyCount; ++m) pd_sleep_fall_asleep(sleep, is->bodies[m], tNext, horizon);
   }
 }
 
@@ -670,9 +674,13 @@ static bool free_advance(pdState* s, struct pdIslandSet* set, int k, double tNex
 static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSet* set, double tNext, bool last) {
   double dt = tNext - s->t;
   set->t0 = s->t;
-  mark_touching(model, s, set);
-  for (int k = 0; k < set->movingCount; ++k)
-    if (!set->free[k]) set_start(model, s, set, k, dt);
+  // a sample interval gone through in one (a stack, a pile at rest) has its starts from find_free: the same numbers
+  if (!(set->startsFormed && set->startsT == s->t && set->startsDt == dt)) {
+    mark_touching(model, s, set);
+    for (int k = 0; k < set->movingCount; ++k)
+      if (!set->free[k]) set_start(model, s, set, k, dt);
+  }
+  set->startsFormed = false;  // the rounds below grow bounds and start activated bodies
   for (int j = 0; j < set->islandCount; ++j) set->islands[j]->advanced = false;
   if (set->sleep) wake_pushed(model, s, set, dt);
   for (int round = 0;; ++round) {
@@ -760,6 +768,7 @@ static void find_free(const pdModel* model, const pdState* s, struct pdIslandSet
     set->cbound[k] = set->bound[k];
     set->ctravel[k] = 0.0;
   }
+  set->startsFormed = true, set->startsT = s->t, set->startsDt = dt;
   pd_island_partition(model, s, set, dt, false);
   for (int j = 0; j < set->partCount; ++j) {
     if (set->first[j + 1] - set->first[j] != 1) continue;
@@ -780,6 +789,7 @@ static bool cuts_split_islands(const pdModel* model, const pdState* s, struct pd
   mark_touching(model, s, set);
   for (int k = 0; k < set->movingCount; ++k)
     if (!set->free[k]) set_start(model, s, set, k, dt);
+  set->startsFormed = true, set->startsT = s->t, set->startsDt = dt;
   int activations = pd_island_partition(model, s, set, dt, true);
   return activations > 0 || set->partCount > whole;
 }

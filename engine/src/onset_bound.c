@@ -4,11 +4,11 @@
 #include <math.h>
 
 double pd_onset_error_bound(double omega, double tau, double depth, double approach, double vmax, double size,
-                            double friction) {
+                            double friction, double spring) {
   double wt = omega * tau;
   double velocity = (PD_ONSET_BOUND_C * wt * wt * wt * fabs(approach) + friction) / vmax;
   double position = fmax(depth, 0.0) * wt * wt / (6.0 * size);
-  return fmax(velocity, position);
+  return fmax(fmax(velocity, position), spring);
 }
 
 double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, double slide, double approach, double h,

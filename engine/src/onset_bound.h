@@ -5,19 +5,23 @@
 // deflection x of a Kelvin–Voigt element at the pair's modal mass, the bodies given the impulse that element took).
 // Along the normal of one point mass that is the exact motion; what it misses is the rest of the system over τ: the
 // bodies' turning under the impulse (a modal mass, not the motion of every contact of the pair), the other contacts,
-// and the interpolated onset time. Two numbers bound it, both in the units of the stepper's error norm (state.c's
+// and the interpolated onset time. These terms bound it, all in the units of the stepper's error norm (state.c's
 // weights), so they compare with tol:
 //   velocity: |δe| v_n / vmax, with |δe| <= PD_ONSET_BOUND_C (ωτ)³, the restitution error of a corrected onset
 //             (C measured: tests/engine/test_events.c, the drops whose onsets are forced to be corrected);
 //   position: (d − x) / L <= d (ωτ)² / (6 L), how much deeper the contact's rest point sits than a located onset's,
 //             L the smaller moving body's size;
-//   friction: added to the velocity term where the pair slides at the onset: the correction gives the tangential
-//             impulse J_t of springs loaded by the slip, within the cone (onsets.c, onset_motion), as if the slip
-//             stayed what it was; it changes over τ by the impulse's own effect, so J_t is off by at most
-//             PD_ONSET_FRICTION_C ωτ of it, times how far a tangential impulse moves the point and turns the bodies
-//             (onsets.c, onset_terms),
-// with ω = √(k_s / m_min) the pair's fastest undamped frequency. An onset is corrected only where the larger of the
-// two is at most PD_ONSET_TOL_SHARE × tol, and ωτ and d stay within the ranges the correction holds in (contact_set.c,
+//   friction: added to the velocity term where the pair has friction: the correction follows the slip along its
+//             direction ŝ under its own friction, within the cone (onsets.c, onset_motion); what it leaves out is the
+//             slip's change off that element, D(t) <= |P K ŝ| J_t(t) + |P_t K n| J_n(t) (K the point's inverse mass
+//             matrix, P the projection off n and ŝ, P_t off n: the tangential impulse turning the slip, the normal
+//             impulse making slip). The force law is Lipschitz in the slip (c_t, k_t on its integral, 1 for the cone's
+//             projection), so the tangential impulse is off by at most c_t ∫D + k_t ∫∫D (at most 2 μ J_n), plus μ times
+//             the normal impulse's own error, times how far a tangential impulse moves the point and turns the bodies;
+//   spring:   the tangential springs' stretch is off by at most ∫D, over δ_max (their weight in the error norm);
+//   turning:  added to the velocity term: PD_ONSET_TURNING_C Ω² r τ ωτ (onsets.c, correction_bound),
+// with ω = √(k_s / m_min) the pair's fastest undamped frequency. An onset is corrected only where the largest of the
+// three is at most PD_ONSET_TOL_SHARE × tol, and ωτ and d stay within the ranges the correction holds in (contact_set.c,
 // PD_ONSET_PAIR_OMEGA_TAU, PD_ONSET_PAIR_DEPTH_REL); others are located, as the paper does with every one.
 #pragma once
 
@@ -30,13 +34,9 @@
 // 1e-10): at most 1.1e-4 (ωτ)³, so 0.004 keeps a factor of ~36 for what no test isolates (a crowd's other contacts
 // over τ). The 1-D spring–dashpot figure of the cruder impulse (c v_n + ½ k δ₀) τ is 0.08.
 #define PD_ONSET_BOUND_C 0.04
-// The friction term's coefficient: the correction's tangential impulse is off by at most this × ωτ of it. Calibrated
-// (tests/engine/test_events.c): grazing corner, edge and face landings, sliding and sticking, stiff and soft ones
-// stay within 1 % of the bound; a bar 0.6 m long landing on its edge while turning at 4 rad/s, sliding, within 41 %
-// (at 1 it was 4× over: the turning changes the slip over τ faster than the slip's own impulse does).
-#define PD_ONSET_FRICTION_C 10.0
 // The turning term's coefficient (onsets.c, correction_bound): a body turning at Ω as it lands changes its point's
-// approach by Ω² r τ over the τ the correction stands in for; calibrated with the friction term's, on the same bar.
+// approach by Ω² r τ over the τ the correction stands in for; calibrated on a bar 0.6 m long landing on its edge while
+// turning at 4 rad/s (tests/engine/test_events.c).
 #define PD_ONSET_TURNING_C 10.0
 // The share of tol one corrected onset may spend: the size of one accepted step's own local error. An onset joined
 // within it changes the result no more than one more step would; beyond it the onset is located (a retried step).
@@ -45,10 +45,11 @@
 // The error bound of joining, corrected, an onset of a contact whose pair's fastest frequency is omega (1/s), that
 // began tau seconds before the step's end, found at depth (m) approaching at approach (m/s, > 0), in a scene whose
 // velocity scale is vmax (m/s) and whose smaller moving body of the pair is size (m) across, with `friction` (m/s) the
-// friction term: the larger of the two terms above, friction / vmax added to the velocity one (dimensionless, the
+// friction and turning terms and `spring` the spring term (error norm units): the largest of the velocity term,
+// friction / vmax added to it, the position term and the spring term (dimensionless, the
 // error norm's units).
 double pd_onset_error_bound(double omega, double tau, double depth, double approach, double vmax, double size,
-                            double friction);
+                            double friction, double spring);
 
 // Whether an onset of that bound may be corrected at tolerance tol (else it is located).
 static inline bool pd_onset_bound_allows(double bound, double tol) { return bound <= PD_ONSET_TOL_SHARE * tol; }

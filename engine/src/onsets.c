@@ -120,26 +120,49 @@ static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double a
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
 
-static void onset_motion(double omega2, double damping, double v0, double tau, double mu, double slipDamp,
-                         double slipRate, double* xOut, double* uOut, double* wOut);
-static double point_mass_at(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
-                            pdVec3 point, pdVec3 normal);
+// The pair's motion over the τ since an onset, alone (onset_motion): a Kelvin–Voigt element along the normal and one
+// along the slip, coupled by the cone.
+typedef struct onsetElement {
+  double omega2;        // 1/s²: k_n / m, the normal element's (m its mass along the normal)
+  double damping;       // 1/s: c_n / m
+  double mass;          // kg: m
+  double mu;
+  double kt, ct;        // N/m, N·s/m: the tangential spring and damper (series)
+  double slipInvMass;   // 1/kg: ŝᵀKŝ, the slip's change per unit tangential impulse along it (K the point's)
+  double slip;          // m/s: the slip speed at the onset (0: none)
+  double driftPerJt;    // 1/kg: |(I − n nᵀ − ŝ ŝᵀ) K ŝ|, the slip's turn off ŝ per unit tangential impulse
+  double driftPerJn;    // 1/kg: |(I − n nᵀ) K n|, the slip the normal impulse makes, per unit of it
+  double approachPerJt; // 1/kg: |nᵀ K ŝ|, the approach the tangential impulse changes, per unit of it
+} onsetElement;
+
+typedef struct onsetMotion {
+  double x, u;          // m, m/s: the normal deflection and approach speed at τ
+  double jn, jt;        // N·s: the normal and tangential impulses over τ (jt against the slip)
+  double spring;        // m: the tangential spring's stretch since the onset (∫ slip in stick)
+  double cone;          // N: μ F_n at τ
+  double drift1;        // m: ∫₀^τ D(t) dt, D the slip's change that the element leaves out (onset_bound.h)
+  double drift2;        // m·s: ∫₀^τ ∫₀^t D
+  double approach1;     // m: ∫₀^τ D_n(t) dt, D_n the approach's change that the element leaves out
+  double approach2;     // m·s: ∫₀^τ ∫₀^t D_n
+} onsetMotion;
+
+static onsetMotion onset_motion(const onsetElement* e, double v0, double tau);
+static pdVec3 point_response(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point,
+                             pdVec3 impulse);
+static void slip_element(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point, pdVec3 normal,
+                         pdVec3 du, onsetElement* e, pdVec3* along);
 
 // What the error bound (onset_bound.h) of joining new contact g (found at y1, poses in set->poses1) as a corrected
 // onset is formed from, apart from its age and depth.
 typedef struct onsetTerms {
-  double omega;      // 1/s: the pair's fastest undamped frequency, √(k_s / m_min)
-  double approach;   // m/s: its approach speed now
-  double size;       // m: the smaller moving body's
-  double mass;       // kg: the effective mass at the point along the normal (the correction's element)
-  double stiffness;  // 1/s²: k_s / mass
-  double damping;    // 1/s: c_s / mass
-  double mu;
-  double slip;       // m/s: the slip speed at the point (0: none)
-  double slipDamp;   // m/s²: c_t × slip / mass, the tangential damper's force per unit mass
-  double slipRate;   // m/s³: k_t × slip / mass, how fast the tangential springs load
-  double lever;      // 1/kg: how far a tangential impulse there may move the state, per kg·m/s (0: no slip)
-  double turning;    // m/s²: Ω² r, the bodies' turning's acceleration of the point (Ω their relative rate)
+  double omega;         // 1/s: the pair's fastest undamped frequency, √(k_s / m_min)
+  double approach;      // m/s: its approach speed now
+  double size;          // m: the smaller moving body's
+  double deltaMax;      // m: the pair's δ_max, the error norm's weight of a contact spring
+  onsetElement element; // the correction's element at the point's effective mass (its friction: the model's dampers,
+                        // which the modal ones never exceed)
+  double lever;         // 1/kg: how far a tangential impulse there may move the state, per kg·m/s
+  double turning;       // m/s²: Ω² r, the bodies' turning's acceleration of the point (Ω their relative rate)
 } onsetTerms;
 
 static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, const double* y1, const pdContactGeom* g) {
@@ -147,15 +170,18 @@ static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, con
   pdContactParams p = pd_model_contact_params(model, a, b);
   pdVec3 du = relative_velocity(model, y1, set->poses1, &g->id, g->point);
   onsetTerms t = {.omega = sqrt(pd_series(p.k1n, p.k2n) / p.massMin), .approach = -pd_v3_dot(du, g->normal),
-                  .size = INFINITY, .mu = p.mu};
-  t.mass = point_mass_at(model, set, set->poses1, &g->id, g->point, g->normal);
-  t.slip = pd_v3_norm(pd_v3_sub(du, pd_v3_scale(g->normal, -t.approach)));
-  if (!(p.mu > 0.0) || t.slip <= PD_ONSET_PAIR_SLIP_REL * pd_v3_norm(du)) t.slip = 0.0;
-  if (isfinite(t.mass)) {
-    t.stiffness = pd_series(p.k1n, p.k2n) / t.mass;
-    t.damping = pd_series(p.c1n, p.c2n) / t.mass;
-    t.slipDamp = pd_series(p.c1t, p.c2t) * t.slip / t.mass;
-    t.slipRate = pd_series(p.k1t, p.k2t) * t.slip / t.mass;
+                  .size = INFINITY, .deltaMax = pd_model_pair_delta_max(model, a, b)};
+  onsetElement* e = &t.element;
+  double inverseMass = pd_v3_dot(g->normal, point_response(model, set->poses1, &g->id, g->point, g->normal));
+  e->mass = inverseMass > 0.0 ? 1.0 / inverseMass : INFINITY;
+  e->mu = p.mu;
+  if (isfinite(e->mass)) {
+    e->omega2 = pd_series(p.k1n, p.k2n) / e->mass;
+    e->damping = pd_series(p.c1n, p.c2n) / e->mass;
+    e->kt = pd_series(p.k1t, p.k2t);
+    e->ct = pd_series(p.c1t, p.c2t);
+    pdVec3 along;
+    slip_element(model, set->poses1, &g->id, g->point, g->normal, du, e, &along);
   }
   pdVec3 spin = {0.0, 0.0, 0.0};
   double reach = 0.0;
@@ -177,20 +203,29 @@ static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, con
   return t;
 }
 
-// The bound of joining the contact `age` seconds after its onset at `depth`. Its friction term: the tangential
-// impulse the correction gives (onset_motion's, as if the slip stayed what it is now) is off by what the slip's own
-// change over the age makes of it, at most ωτ of it (PD_ONSET_FRICTION_C), times what such an impulse moves. Its
-// turning term: the correction starts the element at the approach speed found at the step's end, which the bodies'
-// turning changed over the age by up to Ω² r τ without the contact; the element's response to that is at most ωτ of
-// it (PD_ONSET_TURNING_C).
+// The bound of joining the contact `age` seconds after its onset at `depth` (onset_bound.h). Its friction terms: the
+// correction follows the slip along ŝ under its own friction and the normal element under its own force
+// (onset_motion); what it leaves out are the slip's change off that element, D(t) <= driftPerJt J_t(t) +
+// driftPerJn J_n(t) (the tangential impulse turning the slip, the normal impulse making slip), and the approach's,
+// D_n(t) <= approachPerJt J_t(t) (the tangential impulse pressing or lifting the point). Each force law is Lipschitz in
+// its velocity (the damper by c, the spring by k on its integral, the cone's projection by 1, the clamp of F_n by 1),
+// so the tangential impulse is off by at most c_t ∫D + k_t ∫∫D (never more than both cones' impulses, 2 μ J_n), the
+// normal impulse by c_n ∫D_n + k_n ∫∫D_n, and the cone's radius, μ F_n, by μ times the normal impulse's error: that
+// and the velocity term's (PD_ONSET_BOUND_C). Those impulses move the state by at most `lever` each; the tangential
+// springs' stretch is off by at most ∫D. Its turning term: the correction starts the element at the approach speed
+// found at the step's end, which the bodies' turning changed over the age by up to Ω² r τ without the contact; the
+// element's response to that is at most ωτ of it (PD_ONSET_TURNING_C).
 static double correction_bound(const pdModel* model, const onsetTerms* t, double age, double depth) {
-  double frictionVelocity = PD_ONSET_TURNING_C * t->turning * age * t->omega * age;
-  if (t->slip > 0.0 && isfinite(t->mass) && t->approach > 0.0) {
-    double x, u, w;
-    onset_motion(t->stiffness, t->damping, t->approach, age, t->mu, t->slipDamp, t->slipRate, &x, &u, &w);
-    frictionVelocity += PD_ONSET_FRICTION_C * t->omega * age * t->lever * t->mass * fmin(w, t->slip);
+  double wt = t->omega * age, velocity = PD_ONSET_TURNING_C * t->turning * age * wt, spring = 0.0;
+  const onsetElement* e = &t->element;
+  if (e->mu > 0.0 && isfinite(e->mass) && t->approach > 0.0) {
+    onsetMotion m = onset_motion(e, t->approach, age);
+    double normal = e->mass * (e->omega2 * m.approach2 + e->damping * m.approach1);  // N·s
+    double tangential = fmin(e->ct * m.drift1 + e->kt * m.drift2, 2.0 * e->mu * m.jn);
+    velocity += t->lever * (tangential + (1.0 + e->mu) * normal) + e->mu * PD_ONSET_BOUND_C * wt * wt * wt * t->approach;
+    spring = m.drift1 / t->deltaMax;
   }
-  return pd_onset_error_bound(t->omega, age, depth, t->approach, model->settings.vmax, t->size, frictionVelocity);
+  return pd_onset_error_bound(t->omega, age, depth, t->approach, model->settings.vmax, t->size, velocity, spring);
 }
 
 // Bisections of the age a retried step aims at (retry_target): to ~1e-3 of the range, far finer than its share.
@@ -250,33 +285,99 @@ bool pd_onsets_may_retry(const pdContactSet* set) { return set->onsetRetries < P
 
 // ---------------------------------------------------------------- pair onsets at commit
 
-// The normal motion of one contact over the τ since its onset, alone at the effective mass m, undamped
-// frequency² k/m and damping c/m (a Kelvin–Voigt element, force never pulling): from deflection 0 at
-// approach speed v0 to its deflection *x and approach speed *u at τ. Linear and short
-// (ω τ <= PD_ONSET_PAIR_OMEGA_TAU): a few classic RK4 substeps are exact to ~(ωτ/8)⁵. With it, the friction over τ
-// per unit mass, *w (m/s): the tangential spring and damper under the slip, slipDamp + slipRate t (c_t × slip / m and
-// k_t × slip / m), within the cone μ F_n / m, the force at each time the smaller of the two. A slow slip's springs
-// take a while to reach the cone, which the normal damper makes large at once: the cone's impulse μ J_n alone would
-// be first order in τ there, where the springs give second.
+// The motion of one contact over the τ since its onset, alone (onsetElement): along the normal a Kelvin–Voigt element at
+// mass m that never pulls, from deflection 0 at approach speed v0; along the slip ŝ a Kelvin–Voigt element (k_t, c_t)
+// from stretch 0 at the slip speed, within the cone μ F_n, that slows the slip at ŝᵀKŝ per unit impulse. Linear and
+// short (ω τ <= PD_ONSET_PAIR_OMEGA_TAU): a few classic RK4 substeps are exact to ~(ωτ/8)⁵ away from the cone's and
+// the clamp's kinks. With the slip's own slowing, the tangential impulse is second order in τ where the slip is slow
+// (the springs take a while to reach the cone, which the normal damper makes large at once) and the slip stopping
+// within τ is followed, not capped afterwards. Also the integrals of D = driftPerJt J_t + driftPerJn J_n, what the
+// element leaves out of the slip (correction_bound).
 #define PD_ONSET_PAIR_SUBSTEPS 8
-static void onset_motion(double omega2, double damping, double v0, double tau, double mu, double slipDamp,
-                         double slipRate, double* xOut, double* uOut, double* wOut) {
-  double x = 0.0, u = v0, w = 0.0, dt = tau / PD_ONSET_PAIR_SUBSTEPS;
+enum { M_X, M_U, M_VT, M_Q, M_JN, M_JT, M_I1, M_I2, M_N1, M_N2, M_STATE };
+static void motion_rate(const onsetElement* e, const double s[M_STATE], double r[M_STATE]) {
+  double fn = e->mass * fmax(0.0, e->omega2 * s[M_X] + e->damping * s[M_U]);  // N
+  // the tangential law (contact_force.h): the spring and damper in stick, on the cone in slip with the spring's stretch
+  // relaxing towards it through the damper, k_t q + c_t q̇ = ±μ F_n
+  double cone = e->mu * fn, trial = e->kt * s[M_Q] + e->ct * s[M_VT], ft = fmin(cone, fmax(-cone, trial));
+  r[M_X] = s[M_U];
+  r[M_U] = -fn / e->mass;
+  r[M_VT] = -e->slipInvMass * ft;
+  r[M_Q] = ft == trial || !(e->ct > 0.0) ? s[M_VT] : (ft - e->kt * s[M_Q]) / e->ct;
+  r[M_JN] = fn;
+  r[M_JT] = ft;
+  r[M_I1] = e->driftPerJt * fabs(s[M_JT]) + e->driftPerJn * s[M_JN];
+  r[M_I2] = s[M_I1];
+  r[M_N1] = e->approachPerJt * fabs(s[M_JT]);
+  r[M_N2] = s[M_N1];
+}
+
+static onsetMotion onset_motion(const onsetElement* e, double v0, double tau) {
+  double s[M_STATE] = {0.0}, k[4][M_STATE], tmp[M_STATE], dt = tau / PD_ONSET_PAIR_SUBSTEPS;
+  s[M_U] = v0;
+  s[M_VT] = e->slip;
   for (int i = 0; i < PD_ONSET_PAIR_SUBSTEPS; ++i) {
-    double t = i * dt;
-    double a1 = fmax(0.0, omega2 * x + damping * u);
-    double x2 = x + 0.5 * dt * u, u2 = u - 0.5 * dt * a1, a2 = fmax(0.0, omega2 * x2 + damping * u2);
-    double x3 = x + 0.5 * dt * u2, u3 = u - 0.5 * dt * a2, a3 = fmax(0.0, omega2 * x3 + damping * u3);
-    double x4 = x + dt * u3, u4 = u - dt * a3, a4 = fmax(0.0, omega2 * x4 + damping * u4);
-    double f1 = fmin(mu * a1, slipDamp + slipRate * t), f2 = fmin(mu * a2, slipDamp + slipRate * (t + 0.5 * dt));
-    double f3 = fmin(mu * a3, slipDamp + slipRate * (t + 0.5 * dt)), f4 = fmin(mu * a4, slipDamp + slipRate * (t + dt));
-    x += dt / 6.0 * (u + 2.0 * u2 + 2.0 * u3 + u4);
-    u -= dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
-    w += dt / 6.0 * (f1 + 2.0 * f2 + 2.0 * f3 + f4);
+    motion_rate(e, s, k[0]);
+    for (int j = 0; j < M_STATE; ++j) tmp[j] = s[j] + 0.5 * dt * k[0][j];
+    motion_rate(e, tmp, k[1]);
+    for (int j = 0; j < M_STATE; ++j) tmp[j] = s[j] + 0.5 * dt * k[1][j];
+    motion_rate(e, tmp, k[2]);
+    for (int j = 0; j < M_STATE; ++j) tmp[j] = s[j] + dt * k[2][j];
+    motion_rate(e, tmp, k[3]);
+    for (int j = 0; j < M_STATE; ++j) s[j] += dt / 6.0 * (k[0][j] + 2.0 * k[1][j] + 2.0 * k[2][j] + k[3][j]);
   }
-  *xOut = x;
-  *uOut = u;
-  *wOut = w;
+  double fn = e->mass * fmax(0.0, e->omega2 * s[M_X] + e->damping * s[M_U]);
+  return (onsetMotion){.x = s[M_X], .u = s[M_U], .jn = s[M_JN], .jt = s[M_JT], .spring = s[M_Q], .cone = e->mu * fn,
+                       .drift1 = s[M_I1], .drift2 = s[M_I2], .approach1 = s[M_N1], .approach2 = s[M_N2]};
+}
+
+// A body's inverse inertia in the world frame at `pose`, R I⁻¹ Rᵀ: computed here, since the set's copy is the last
+// installed list's (a step's start, and zero before the first), and an onset's bound is formed at the step's end.
+static pdMat3 inverse_inertia_at(const pdBody* body, const pdPose* pose) {
+  pdMat3 rt = pd_mat3_transpose(&pose->R), tmp = pd_mat3_mul(&body->invInertia, &rt);
+  return pd_mat3_mul(&pose->R, &tmp);
+}
+
+// K·j at a contact point: how the relative velocity Δu there changes under impulse j on body 1 (−j on body 2), 1/kg
+// times the impulse.
+static pdVec3 point_response(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point,
+                             pdVec3 impulse) {
+  pdVec3 out = {0.0, 0.0, 0.0};
+  for (int side = 0; side < 2; ++side) {
+    int b = side == 0 ? id->body1 : id->body2;
+    const pdBody* body = &model->bodies[b];
+    if (body->fixed) continue;
+    pdVec3 r = pd_v3_sub(point, poses[b].x);
+    pdMat3 invInertia = inverse_inertia_at(body, &poses[b]);
+    pdVec3 turn = pd_mat3_mulv(&invInertia, pd_v3_cross(r, impulse));
+    out = pd_v3_add(out, pd_v3_add(pd_v3_scale(impulse, body->invMass), pd_v3_cross(turn, r)));
+  }
+  return out;
+}
+
+// The tangential part of a correction's element at a contact point whose relative velocity is du: the slip, its
+// direction *along (any tangent where there is none), and how the impulses change it (K the point's inverse mass).
+static void slip_element(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point, pdVec3 normal,
+                         pdVec3 du, onsetElement* e, pdVec3* along) {
+  pdVec3 slip = pd_v3_sub(du, pd_v3_scale(normal, pd_v3_dot(du, normal)));
+  double speed = pd_v3_norm(slip);
+  if (!(e->mu > 0.0) || speed <= PD_ONSET_PAIR_SLIP_REL * pd_v3_norm(du)) speed = 0.0;  // rounding, not slip
+  e->slip = speed;
+  if (speed > 0.0) {
+    *along = pd_v3_scale(slip, 1.0 / speed);
+  } else {  // a tangent: the axis least along the normal, crossed with it
+    pdVec3 axis = fabs(normal.x) <= fabs(normal.y) && fabs(normal.x) <= fabs(normal.z) ? pd_v3(1, 0, 0)
+                  : fabs(normal.y) <= fabs(normal.z)                                    ? pd_v3(0, 1, 0)
+                                                                                        : pd_v3(0, 0, 1);
+    *along = pd_v3_normalize(pd_v3_cross(normal, axis));
+  }
+  pdVec3 ks = point_response(model, poses, id, point, *along);
+  pdVec3 kn = point_response(model, poses, id, point, normal);
+  e->slipInvMass = pd_v3_dot(*along, ks);
+  pdVec3 off = pd_v3_sub(ks, pd_v3_add(pd_v3_scale(*along, e->slipInvMass), pd_v3_scale(normal, pd_v3_dot(normal, ks))));
+  e->driftPerJt = pd_v3_norm(off);
+  e->approachPerJt = fabs(pd_v3_dot(normal, ks));
+  e->driftPerJn = pd_v3_norm(pd_v3_sub(kn, pd_v3_scale(normal, pd_v3_dot(normal, kn))));
 }
 
 // The effective mass of the bodies of contact `id` along `normal` at `point`, kg (INFINITY if neither moves).
@@ -317,29 +418,31 @@ int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, con
     pdVec3 n = c->normal;
     pdVec3 du = relative_velocity(model, y, poses, &c->id, c->point);
     double approach = -pd_v3_dot(du, n);
-    pdVec3 slip = pd_v3_sub(du, pd_v3_scale(n, -approach));  // tangential relative velocity
-    double slipSpeed = pd_v3_norm(slip);
-    if (slipSpeed <= PD_ONSET_PAIR_SLIP_REL * pd_v3_norm(du)) slipSpeed = 0.0;  // rounding, not slip
     c->onsetImpulse = (pdVec3){0, 0, 0};
     double mass = c->modalMass > 0.0 && isfinite(c->modalMass) ? c->modalMass : point_mass(model, set, poses, c);
     if (isfinite(mass) && approach > 0.0 && k > 0.0) {
-      double kt = pd_series(p->k1t, p->k2t), ct = pd_series(p->c1t, p->c2t), x, u, w;
-      onset_motion(k / mass, damper / mass, approach, c->onsetAge, p->mu, ct * slipSpeed / mass, kt * slipSpeed / mass,
-                   &x, &u, &w);
-      x = fmin(fmax(x, 0.0), fmax(c->depth, 0.0));
+      onsetElement e = {.omega2 = k / mass, .damping = damper / mass, .mass = mass, .mu = p->mu,
+                        .kt = pd_series(p->k1t, p->k2t), .ct = pd_series(p->c1t, p->c2t)};
+      pdVec3 along;
+      slip_element(model, poses, &c->id, c->point, n, du, &e, &along);
+      // the pair's contacts that join together slow the slip together, as they do the approach (the modal mass): each
+      // contact's element slows it by the ratio of its normal's modal to point inverse mass more, so that several
+      // contacts, each stopping the slip alone, do not reverse it
+      double pointMass = point_mass(model, set, poses, c);
+      if (isfinite(pointMass) && mass < pointMass) e.slipInvMass *= pointMass / mass;
+      onsetMotion m = onset_motion(&e, approach, c->onsetAge);
+      double x = fmin(fmax(m.x, 0.0), fmax(c->depth, 0.0));
       pdSprings sp = springs_load(y + base + PD_CONTACT_STATE_SIZE * i);
       sp.s1n = -k * x / p->k1n;
       sp.s2n = k * x / p->k2n;
-      double normalImpulse = mass * fmax(0.0, approach - fmax(u, 0.0));  // the pair's contacts together slow it so
+      double normalImpulse = mass * fmax(0.0, approach - fmax(m.u, 0.0));  // the pair's contacts together slow it so
       c->onsetImpulse = pd_v3_scale(n, normalImpulse);
-      // friction over τ: sliding, the springs' impulse against the slip, within the cone (onset_motion; at most what
-      // stops it), and the tangential springs loaded to the cone (or to the slip since the onset, if less) against it
-      if (p->mu > 0.0 && kt > 0.0 && slipSpeed > 0.0) {
-        pdVec3 along = pd_v3_scale(slip, 1.0 / slipSpeed);
-        double frictionImpulse = fmin(mass * w, mass * slipSpeed);
-        c->onsetImpulse = pd_v3_sub(c->onsetImpulse, pd_v3_scale(along, frictionImpulse));
-        double ft = fmin(p->mu * k * x, kt * slipSpeed * c->onsetAge);  // |F_t| on body 1, against the slip
-        sp.s1t = pd_v3_scale(along, ft / p->k1t);                       // F_t = −k1t s1t = k2t s2t = −ft · along
+      // friction over τ: sliding, the element's impulse against the slip (within the cone, the slip slowing under it),
+      // and the tangential springs loaded by the slip since the onset, capped by the cone
+      if (p->mu > 0.0 && e.kt > 0.0 && e.slip > 0.0) {
+        c->onsetImpulse = pd_v3_sub(c->onsetImpulse, pd_v3_scale(along, fmax(m.jt, 0.0)));
+        double ft = fmin(m.cone, e.kt * fmax(m.spring, 0.0));  // the spring's |F_t| on body 1, against the slip
+        sp.s1t = pd_v3_scale(along, ft / p->k1t);                     // F_t = −k1t s1t = k2t s2t = −ft · along
         sp.s2t = pd_v3_scale(along, -ft / p->k2t);
       }
       springs_store(y + base + PD_CONTACT_STATE_SIZE * i, &sp);

@@ -75,11 +75,11 @@ bool pd_sleep_slow(const pdSleepSet* set, const pdBody* body, int k, const doubl
 }
 
 bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb, double t0, double t1,
-                    double settle) {
+                    double horizon) {
   double dt = t1 - t0;
   pdVec3 dv = pd_v3_sub(pd_layout_v(yb), set->v0[k]), dw = pd_v3_sub(pd_layout_w(yb), set->w0[k]);
   double accel = dt > 0.0 ? (pd_v3_norm(dv) + pd_v3_norm(dw) * body->radius) / dt : 0.0;
-  bool quiet = isfinite(settle) && pd_sleep_slow(set, body, k, yb) && accel * settle < set->speedMax;
+  bool quiet = isfinite(horizon) && pd_sleep_slow(set, body, k, yb) && accel * horizon < set->speedMax;
   if (!quiet)
     set->quietSince[k] = NAN;
   else if (isnan(set->quietSince[k]))
@@ -87,10 +87,10 @@ bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb
   return quiet;
 }
 
-void pd_sleep_fall_asleep(pdSleepSet* set, int k, double t, double settle) {
+void pd_sleep_fall_asleep(pdSleepSet* set, int k, double t, double horizon) {
   set->asleep[k] = true;
   set->asleepSince[k] = t;
-  set->settle[k] = settle;
+  set->settle[k] = horizon;
 }
 
 bool pd_sleep_force_changed(const pdSleepSet* set, const pdBody* body, int k, double t) {

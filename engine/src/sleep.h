@@ -5,8 +5,8 @@
 // - speed: |v| + |ω| r (r the body's radius: the fastest surface point), peak over every step end of the
 //   interval under way and its start, below PD_SLEEP_SPEED of the velocity scale the error control uses;
 // - acceleration: the same measure of the change of v and ω over a sync interval, divided by its length,
-//   below the speed threshold over the island's settle time (a body that accelerated faster would leave the
-//   speed threshold within one settle time);
+//   below the speed threshold over the horizon: the time left to the scene's end, at least the island's settle
+//   time (a body that accelerated faster would leave the speed threshold before the end);
 // - contact: every body of the island touches something (a body in free flight is never at rest);
 // - both held since quietSince for the island's settle time: PD_SLEEP_SETTLE_PERIODS of the slowest period
 //   of its contacts (pd_sleep_settle_time).
@@ -39,7 +39,7 @@ typedef struct pdSleepSet {
   double* quietSince;   // (movingCount) s: start of the quiet intervals leading here (NAN: the last was not quiet)
   bool* asleep;         // (movingCount)
   double* asleepSince;  // (movingCount) s: when it fell asleep
-  double* settle;       // (movingCount) s: its island's settle time then
+  double* settle;       // (movingCount) s: the horizon of its acceleration threshold when it fell asleep
   bool* inContact;      // (movingCount) scratch: the body has a contact
   long sleeps, wakes;   // islands that fell asleep, islands woken
   double bodySeconds;   // body-seconds spent asleep
@@ -70,14 +70,14 @@ double pd_sleep_settle_time(const pdModel* sub, const pdState* state);
 bool pd_sleep_slow(const pdSleepSet* set, const pdBody* body, int k, const double* yb);
 
 // At the end of the interval [t0, t1] with body k's numbers yb there: whether the body was quiet over it (speed
-// peak and mean acceleration below the thresholds for the settle time `settle`), and quietSince updated
+// peak below the speed threshold, mean acceleration below it over `horizon`), and quietSince updated
 // (set to t0 when the body turns quiet, NAN when it is not).
 bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb, double t0, double t1,
-                    double settle);
+                    double horizon);
 
-// Body k falls asleep at t in an island of settle time `settle`.
-void pd_sleep_fall_asleep(pdSleepSet* set, int k, double t, double settle);
+// Body k falls asleep at t, its acceleration threshold that of `horizon` (pd_sleep_quiet).
+void pd_sleep_fall_asleep(pdSleepSet* set, int k, double t, double horizon);
 
 // Whether the applied force on sleeping body k at t differs from the one it fell asleep under by more than would
-// give its surface the acceleration threshold of its island's settle time (speedMax / settle).
+// give its surface the acceleration threshold it fell asleep under (speedMax / horizon).
 bool pd_sleep_force_changed(const pdSleepSet* set, const pdBody* body, int k, double t);

@@ -63,6 +63,12 @@ for sc in 3:1931:free:steps 3:2429:free:steps 3:2707:free:steps 3:8264:free:step
     '[ $rc -eq 0 ] && grep -q "^$seed,$scene,$kind,.*,soft,ok," "$SCRATCH/thin-$seed-$scene/summary.csv"'
 done
 
+# an edge lying along a plate's rim face, held at one end at a time (campaign 49, checked at every step:
+# cases/hard/cube_edge_along_plate_rim.scene is this scene reduced)
+run_pd "$SCRATCH/rim.out" "$SCRATCH/rim.err" soak --seed 49 --first 439 --scenes 1 --budget "$BUDGET" --out "$SCRATCH/rim"
+check "regression: seed 49 scene 439 (an edge along a plate's rim face) passes" \
+  '[ $rc -eq 0 ] && grep -q "^49,439,free,.*,soft,ok," "$SCRATCH/rim/summary.csv"'
+
 run_pd "$SCRATCH/budget.out" "$SCRATCH/budget.err" soak --generator 1 --seed 1 --first 13 --scenes 1 --budget 0.001 --out "$SCRATCH/budget"
 check "over budget: exit 0 (a cost finding, not a failure)" '[ $rc -eq 0 ]'
 check "over budget: counted" 'grep -q ",over-budget," "$SCRATCH/budget/summary.csv"'

@@ -441,6 +441,43 @@ static void test_a_deep_edge_pair_the_search_finds_is_tracked(void** state) {
   pd_model_free(m);
 }
 
+// An edge lying nearly along a thin plate's rim face, pressed into it, crosses both of the face's long edges: both
+// crossings carry the touch. Body 0: a bar (cube a turned 45° about x) whose top edge runs along x at height h;
+// body 1: a plate 0.1 × 0.01 × 0.05 m whose bottom face, its rim, is turned 30° about z across that edge (so the
+// edge crosses the rim's two long edges at x = ±0.01) and tilted 0.3° about y, pressed down until the edge lies
+// `deep` below the rim at its middle: deep ± 5.2e-5 at the two crossings. The Gauss-map arcs of the bar's edge cross
+// those of one rim edge only (the tilt turns the pair's normal 0.6° off the rim's), so the Minkowski-face test alone
+// gives one crossing at a time, and a rocking rim's other end is found anew at the depth the two share, its springs
+// at zero (soak campaign 49, scene 439). Within EE_ARC_SLACK both are found, and tracked.
+static void test_edge_along_a_rim_face_gives_both_crossings(void** state) {
+  (void)state;
+  pdModel* m = compile("cube bar grey 0.3 0.1 0.1\ncube plate orange 0.1 0.01 0.05\n");
+  const double deep = 2e-4, tilt = 0.3 * PI / 180.0, turn = 30.0 * PI / 180.0;
+  double h = SIDE / sqrt(2.0);
+  pdPose bar = pose(0, 0, 0, 45, pd_v3(1, 0, 0));
+  pdQuat q = pd_quat_mul(pd_quat_from_axis_angle(pd_v3(0, 1, 0), tilt), pd_quat_from_axis_angle(pd_v3(0, 0, 1), turn));
+  pdMat3 R = pd_quat_to_mat3(q);
+  // the plate's bottom face centre (0, 0, −0.025 in its frame) at the edge's height less `deep`
+  pdVec3 bottom = pd_mat3_mulv(&R, pd_v3(0, 0, -0.025));
+  pdPose plate = {pd_v3(-bottom.x, -bottom.y, h - deep - bottom.z), R};
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &bar, 1, &plate, NULL, NULL, NULL, 0, c, CAPACITY);
+  int crossings = 0;
+  for (int i = 0; i < n; ++i) {
+    print_message("contact %d: kind %d features %d/%d depth %.6g at x %.4f\n", i, c[i].id.kind, c[i].id.feat1,
+                  c[i].id.feat2, c[i].depth, c[i].point.x);
+    if (c[i].id.kind != pd_contactEE) continue;
+    ++crossings;
+    // the rim's long edges cross the bar's at x = ±0.005 / sin 30°, where the tilt lowers or raises the rim by x tan 0.3°
+    assert_true(fabs(fabs(c[i].point.x) - 0.005 / sin(turn)) < 1e-4);
+    expect_near(c[i].depth, deep + c[i].point.x * tan(tilt), 2e-6, "crossing depth");
+    pdContactGeom g;
+    assert_true(pd_contact_track(m, &c[i].id, &bar, &plate, &g));
+  }
+  assert_int_equal(crossings, 2);
+  pd_model_free(m);
+}
+
 static void test_small_capacity_reports_the_needed_count(void** state) {
   (void)state;
   pdModel* m = compile(cubeOnFloor);
@@ -468,6 +505,7 @@ int main(void) {
       cmocka_unit_test(test_contact_geometry_is_the_tracked_geometry),
       cmocka_unit_test(test_sharp_edge_pair_is_not_pruned_before_the_inside_test),
       cmocka_unit_test(test_a_deep_edge_pair_the_search_finds_is_tracked),
+      cmocka_unit_test(test_edge_along_a_rim_face_gives_both_crossings),
       cmocka_unit_test(test_small_capacity_reports_the_needed_count),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -11,6 +11,12 @@
 //   tolerance's share (the others were located, their steps cut on the accepted trial's interpolant) and the exit
 //   velocity is the exact run's to 0.005 of the approach speed; a loose pile of 12 boxes (slow re-landings) corrects some of its onsets, each within the tolerance's
 //   share, gains no energy, and counts its breaks and its body-seconds asleep (within bodies × tend).
+// - oblique drops at 0.3 m/s (a face, a corner and an edge landing with the block sliding at 0.3, 1 and 3 times its
+//   approach speed, μ 0.3 and 0.8), their onsets forced to be corrected at tol 1e-10: the normal and the tangential
+//   exit velocities are the located run's within the bound the engine computed for the run's corrected onsets (their
+//   sum, times vmax, plus the comparison's scatter); with the default events at the default tolerance some of those
+//   sliding onsets are corrected (the corner landings') and the exit velocity is the located run's to 0.005 of the
+//   approach speed (a restitution and a tangential exit within 0.005);
 // Every case asserts first that what it checks happened (corrected onsets in the forced runs and in the pile).
 #include <math.h>
 #include <setjmp.h>
@@ -263,12 +269,78 @@ static void test_bounded_events_correct_slow_onsets_in_a_pile(void** state) {
   pd_model_free(m);
 }
 
+// The oblique drops: an impact's landing with the block sliding at `slide` times the approach speed.
+static const double SLIDES[] = {0.3, 1.0, 3.0};
+static const double FRICTIONS[] = {0.3, 0.8};
+static const char* const OBLIQUE_TURNS[][2] = {
+    {"face", "0 0 0 1"}, {"corner", "54.7356 0.7071068 -0.7071068 0"}, {"edge", "45 1 0 0"}};
+#define OBLIQUE_DROPS 6
+
+static void test_oblique_corrections_keep_restitution_and_slip_within_their_bound(void** state) {
+  (void)state;
+  long correctedDefault = 0;
+  for (size_t l = 0; l < sizeof OBLIQUE_TURNS / sizeof OBLIQUE_TURNS[0]; ++l)
+    for (size_t f = 0; f < sizeof FRICTIONS / sizeof FRICTIONS[0]; ++f) {
+      long corrected = 0, correctedBounded = 0;
+      double worstNormal = 0.0, worstRatio = 0.0, worstBounded = 0.0;
+      for (size_t k = 0; k < sizeof SLIDES / sizeof SLIDES[0]; ++k)
+        for (int i = 0; i < OBLIQUE_DROPS; ++i) {
+          impact im = {OBLIQUE_TURNS[l][0], OBLIQUE_TURNS[l][1], 0.3, SLIDES[k], 0.01, FRICTIONS[f], 0.0,
+                       "0.1 0.1 0.1"};
+          double gap = 0.004 + 0.00137 * i * im.speed;
+          pdModel* m = impact_model(&im, gap, FORCED_TOL);
+          pdState *sp = NULL, *se = NULL;
+          pdVec3 vp = final_velocity(m, pd_onsetsPair, &sp), ve = final_velocity(m, pd_onsetsExact, &se);
+          double normal = fabs(vp.z - ve.z) / im.speed;
+          double tangential = hypot(vp.x - ve.x, vp.y - ve.y);
+          double allowed = (sp->count.onsetBoundSum + COMPARISON_NOISE) * m->settings.vmax;
+          corrected += sp->count.onsetsInterpolated;
+          worstNormal = fmax(worstNormal, normal);
+          if (sp->count.onsetsInterpolated > 0) worstRatio = fmax(worstRatio, tangential / allowed);
+          if (sp->count.onsetsInterpolated > 0 && normal * im.speed > allowed)
+            fail_msg("oblique %s landing, mu %g, slide %g, drop %d: normal exit velocity off by %.3e m/s, beyond its "
+                     "bound %.3e m/s",
+                     im.name, im.mu, im.slide, i, normal * im.speed, allowed);
+          if (sp->count.onsetsInterpolated > 0 && tangential > allowed)
+            fail_msg("oblique %s landing, mu %g, slide %g, drop %d: tangential exit velocity off by %.3e m/s, beyond "
+                     "its bound %.3e m/s",
+                     im.name, im.mu, im.slide, i, tangential, allowed);
+          pd_state_free(sp);
+          pd_state_free(se);
+          pd_model_free(m);
+          // the default events at the default tolerance, against the same drop with every onset located
+          m = impact_model(&im, gap, DEFAULT_TOL);
+          pdVec3 vb = final_velocity(m, pd_onsetsBounded, &sp), vx = final_velocity(m, pd_onsetsExact, &se);
+          correctedBounded += sp->count.onsetsInterpolated;
+          assert_true(sp->count.onsetBoundMax <= PD_ONSET_TOL_SHARE * m->settings.tol);
+          double off = pd_v3_norm(pd_v3_sub(vb, vx)) / im.speed;
+          worstBounded = fmax(worstBounded, off);
+          if (off > RESTITUTION_TOL)
+            fail_msg("oblique %s landing, mu %g, slide %g, drop %d, default events: exit velocity off the located "
+                     "run's by %.3e v_n",
+                     im.name, im.mu, im.slide, i, off);
+          pd_state_free(sp);
+          pd_state_free(se);
+          pd_model_free(m);
+        }
+      print_message("oblique %s landings, mu %g: %ld corrected onsets (forced), normal exit off by at most %.2e v_n, "
+                    "tangential at most %.2e of its bound; default events: %ld corrected, exit off by %.2e v_n\n",
+                    OBLIQUE_TURNS[l][0], FRICTIONS[f], corrected, worstNormal, worstRatio, correctedBounded,
+                    worstBounded);
+      assert_true(corrected > 0);
+      assert_true(worstBounded <= RESTITUTION_TOL);
+      correctedDefault += correctedBounded;
+    }
+  assert_true(correctedDefault > 0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_forced_corrections_keep_restitution_within_their_bound),
       cmocka_unit_test(test_onset_bound_holds_over_impacts),
       cmocka_unit_test(test_bounded_events_locate_fast_landings),
       cmocka_unit_test(test_bounded_events_correct_slow_onsets_in_a_pile),
+      cmocka_unit_test(test_oblique_corrections_keep_restitution_and_slip_within_their_bound),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -93,13 +93,19 @@ static const hardCase hardCases[] = {
     // none (9.9 δ_max at a step when its springs went into a trace no new contact took)
     {"sliver_rim_into_ball.scene", NULL, NULL, 0.0, true},
     // a corner in a thin plate's rim whose edge tips down into the plate's cap: the corner keeps the rim's face and the
-    // edge's pair with the rim edge is not interior (6.5 δ_max at a step before the corner pressed on the cap too)
+    // edge's pair with the rim edge is not interior (6.5 δ_max at a step before its edge pairs held both crossings)
     {"cube_edge_into_plate_cap.scene", NULL, NULL, 0.0, true},
     // a light body between a heavy one and the floor: its springs, sized for its own mass, stop the heavy one's. The
     // block (20 kg) lands at v = 0.63 m/s (vmax 1.6) on the chip (16 g): four contacts in parallel at each of the
     // chip's two faces, in series, store ½ M v² at a total x = (v / vmax) δ_max √(M / 2 m_pair) = 9.8 δ_max, 4.9 at
     // each face without dampers; the dampers keep the peak below that (measured 3.7)
     {"heavy_block_on_chip.scene", NULL, NULL, 4.9, true},
+    // a cube's edge lying along a 15:1 plate's rim face, held at both ends where it crosses the rim's edges; at its
+    // deepest the light plate (0.4 g) is pressed between two cubes (11 g, 165 g), a pile-up beyond the springs' sizing
+    // as the two above: bound 5
+    {"cube_edge_along_plate_rim.scene", NULL, NULL, 5.0, true},
+    // the same along a frustum's side face between two spinning frusta
+    {"frustum_edge_along_frustum_face.scene", NULL, NULL, 0.0, true},
 };
 
 // What the observer saw over all samples.

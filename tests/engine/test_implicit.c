@@ -189,7 +189,10 @@ static void test_resting_boxes_stick_in_a_fraction_of_the_steps(void** state) {
 // (17 rejected of 853 accepted) and 6 686 against 16 709. The rejected trials are counted against the steps step
 // doubling takes, the cost a switch must not add: since its dampers are sized for the stack (docs/contact-model.md,
 // "Stacks": its boxes' masses differ several-fold) the stirred stack settles, the switch pays (3 371 evaluations against
-// 9 786) and takes 336 steps, 23 of its trials rejected (26 of 595 before).
+// 9 786) and takes 336 steps, 23 of its trials rejected (26 of 595 before). The rejected trials a switch adds are those
+// beyond step doubling's own: with a corrected onset's friction following the slip (docs/events.md) the stirred stack
+// sets down on another path, on which step doubling itself has 279 of 1 204 trials rejected and the default stepper
+// never switches (287 rejected, the same evaluations to 0.2 %).
 #define NOT_PAYING_EVALUATIONS_RATIO_MAX 1.05
 #define NOT_PAYING_REJECTED_SHARE_MAX 0.05  // of step doubling's accepted steps
 
@@ -210,7 +213,7 @@ static void a_switch_that_does_not_pay_costs_nothing(const char* path) {
   pdModel* m = compile_file(path);
   pdCounters c[2];
   run_both(m, c);
-  assert_true((double)c[1].rejected <= NOT_PAYING_REJECTED_SHARE_MAX * (double)c[0].accepted);
+  assert_true((double)(c[1].rejected - c[0].rejected) <= NOT_PAYING_REJECTED_SHARE_MAX * (double)c[0].accepted);
   assert_true((double)c[1].derivatives <= NOT_PAYING_EVALUATIONS_RATIO_MAX * (double)c[0].derivatives);
   pd_model_free(m);
 }

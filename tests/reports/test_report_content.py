@@ -395,7 +395,9 @@ class PrecisionReport(ReportInDir):
     def expected_cost(self, experiment, ev, setting=None, column="wall_per_sim_second"):
         """(kind, cost, smallest error) of one curve (one knob of an engine-variant; None: the cheapest that reaches
         the tolerance): the first setting, loosest first (largest tol or step, fewest iterations), whose error is
-        within the tolerance, the cost (`column`) interpolated log-log from the setting before it."""
+        within the tolerance and the next finer setting's too (a run with no answer is outside it), the cost
+        (`column`) interpolated log-log from the setting before it unless that one gave no answer or its error falls
+        faster than cost^-8 (then at most the cost of the setting that reaches it)."""
         if setting is None:
             curves = [self.expected_cost(experiment, ev, k, column) for k in {r["setting"] for r in self.rows
                       if r["experiment"] == experiment and f'{r["engine"]} {r["variant"]}' == ev}]
@@ -405,15 +407,19 @@ class PrecisionReport(ReportInDir):
                and (r["setting"] == setting or r["status"] == "not_built")]
         if all(r["status"] == "not_built" for r in pts):
             return "not_built", None, None
-        ok = sorted(([float(r["value"]), float(r["error"]), float(r[column])] for r in pts if r["status"] == "ok"),
-                    reverse=setting != "iterations")
+        answered = sorted(([float(r["value"]), float(r["error"]), float(r[column])] if r["status"] == "ok"
+                           else [float(r["value"]), math.inf, None] for r in pts if r["status"] != "refused"),
+                          reverse=setting != "iterations")
         tol = float(pts[0]["tolerance"])
+        ok = [p for p in answered if p[1] < math.inf]
         smallest = min(e for _, e, _ in ok) if ok else None
-        for k, (_, e, w) in enumerate(ok):
-            if e <= tol:
-                if k == 0 or e <= 0:
+        for k, (_, e, w) in enumerate(answered):
+            if e <= tol and (k + 1 == len(answered) or answered[k + 1][1] <= tol):
+                if k == 0 or e <= 0 or answered[k - 1][1] == math.inf:
                     return "at_most", w, smallest
-                e0, w0 = ok[k - 1][1], ok[k - 1][2]
+                e0, w0 = answered[k - 1][1], answered[k - 1][2]
+                if w == w0 or not 0 <= math.log(e0 / e) / math.log(w / w0) <= 8:
+                    return "at_most", w, smallest
                 s = (math.log(tol) - math.log(e0)) / (math.log(e) - math.log(e0))
                 return "interpolated", math.exp(math.log(w0) + s * (math.log(w) - math.log(w0))), smallest
         return "never", None, smallest

@@ -297,3 +297,25 @@ test('the committed reports load: reports/sweep, reports/gedanken, reports/cubet
   assert.ok(readPrecision(path.join(root, 'gedanken')).rows.length > 0);
   assert.ok(readCubetoss(path.join(root, 'cubetoss')) !== null);
 });
+
+test('costToReach: a point within the target between two outside it is luck; a setting that gave no answer is outside it', () => {
+  // 3e-2 within, 1e-2 outside, 1e-3 and finer within: the crossing is between 1e-2 and 1e-3, not at 3e-2
+  const lucky = [{ value: 1e-1, error: 4, wall_per_sim_second: 1 }, { value: 3e-2, error: 0.4, wall_per_sim_second: 1 },
+    { value: 1e-2, error: 4, wall_per_sim_second: 1 }, { value: 1e-3, error: 0.1, wall_per_sim_second: 10 },
+    { value: 1e-4, error: 0.1, wall_per_sim_second: 20 }];
+  const c = costToReach(lucky, 1);
+  assert.equal(c.kind, 'interpolated');
+  assert.ok(c.wall_per_sim_second > 1 && c.wall_per_sim_second < 10);
+  // a frozen run (error 200 at cost 0.1) before an exact one must not pull the crossing down to ~0.15: no answer
+  // (Infinity) is not interpolated from, and a wrong answer only bounds it
+  const noAnswer = [{ value: 1e-1, error: Infinity, wall_per_sim_second: null }, { value: 3e-2, error: 1e-13, wall_per_sim_second: 1 },
+    { value: 1e-2, error: 1e-13, wall_per_sim_second: 1.1 }];
+  assert.deepEqual(costToReach(noAnswer, 1e-2), { kind: 'at_most', wall_per_sim_second: 1, setting_value: 3e-2 });
+  const frozen = [{ value: 1e-1, error: 2, wall_per_sim_second: 0.1 }, ...noAnswer.slice(1)];
+  assert.deepEqual(costToReach(frozen, 1e-2), { kind: 'at_most', wall_per_sim_second: 1, setting_value: 3e-2 });
+  // the finest point within the target counts (nothing finer to contradict it)
+  assert.equal(costToReach([{ value: 1e-2, error: 2, wall_per_sim_second: 1 }, { value: 1e-3, error: 0.5, wall_per_sim_second: 4 }], 1).kind,
+    'interpolated');
+  assert.equal(costToReach([{ value: 1e-2, error: 0.5, wall_per_sim_second: 1 }, { value: 1e-3, error: Infinity, wall_per_sim_second: null }], 1).kind,
+    'never');
+});

@@ -204,7 +204,7 @@ typedef struct pdGkExperiment {
 // Work-precision: each quantitative experiment also runs at every setting of each engine's
 // accuracy knob, on one input (the middle one of its inputs, listed first when there are two), and its error
 // against the closed form is written with the wall time (out/precision.csv). The knobs, loosest first:
-//   soft adaptive: tol 1e-2 … 1e-10 (decades); soft fixed-step RK4: dt 1e-3, 3e-4, 1e-4, 3e-5, 1e-5 s;
+//   soft adaptive: tol 1e-1, 3e-2, then 1e-2 … 1e-10 (decades); soft fixed-step RK4: dt 1e-3, 3e-4, 1e-4, 3e-5, 1e-5 s;
 //   ODE and Bullet, native and matched: step 1/60, 1/250, 1/1000, 1/4000, 1/16000 s; Bullet also its solver's
 //   iterations 5 … 200 at the 1 ms default step (ODE's dWorldStep solves its LCP exactly: no iterations).
 int pd_gk_precision_input(const pdGkExperiment* e);  // index into e->inputs

@@ -93,7 +93,7 @@ typedef struct pdRefRunStats {
   long steps;
   long contactSteps;     // steps with at least one contact
   long maxContacts;      // most contacts in one step
-  double wallSeconds;    // time spent in create + step
+  double wallSeconds;    // the engine's world created from the model, then stepped and sampled to the end
   double cpuSeconds;     // the same span in the calling thread's CPU time (what a loaded machine does not inflate)
   bool completed;        // reached tend with finite numbers
   bool refused;          // create() refused the scene (a feature the engine cannot represent)

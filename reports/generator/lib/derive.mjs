@@ -214,19 +214,32 @@ function formatG(x) {
   return String(Number(x.toPrecision(6)));
 }
 
-// Cost (wall seconds per simulated second) at which a curve first reaches `target`, walking from the
-// loosest setting to the tightest and interpolating linearly in log(error)–log(cost) between the
-// last point above the target and the first at or below it. {kind: "interpolated"|"at_most"|"never",
-// wall_per_sim_second, setting_value}: "at_most" when the loosest usable point already reaches it
-// (no extrapolation: the cost is at most that point's), "never" when no point reaches it.
+// Cost (wall seconds per simulated second) at which a curve reaches `target` and stays there, walking from the
+// loosest setting to the tightest: the first point at or below the target whose next finer point is too (a point
+// within the target between two outside it is luck — an error changing sign, an event rounded the right way —
+// not the engine's accuracy), interpolated linearly in log(error)–log(cost) between it and the point before it.
+// Where the error falls between the two points faster than cost^-MAX_INTERPOLATED_ORDER, the fall is a change of
+// regime (a body frozen asleep, an event missed), not convergence: the crossing could be anywhere between them,
+// and the cost is bounded by the point that reaches it. A point whose error is Infinity gave no answer (its run
+// failed or its measure found nothing): it is outside the target and nothing is interpolated from it; points with
+// no error at all are skipped. {kind: "interpolated"|"at_most"|"never", wall_per_sim_second, setting_value}:
+// "at_most" when the loosest point reaches it or nothing can be interpolated (no extrapolation: the cost is at most
+// that point's), "never" when no point reaches it.
+// Twice the order of the classical RK4 the soft steppers build on: no stepper swept converges faster.
+const MAX_INTERPOLATED_ORDER = 8;
+
 export function costToReach(points, target) {
-  const usable = points.filter((p) => Number.isFinite(p.error) && p.error >= 0 && Number.isFinite(p.wall_per_sim_second) && p.wall_per_sim_second > 0);
+  const usable = points.filter((p) => p.error === Infinity ||
+    (Number.isFinite(p.error) && p.error >= 0 && Number.isFinite(p.wall_per_sim_second) && p.wall_per_sim_second > 0));
+  const within = (p) => p.error <= target;
   for (let k = 0; k < usable.length; ++k) {
     const p = usable[k];
-    if (p.error <= target) {
+    if (within(p) && (k + 1 === usable.length || within(usable[k + 1]))) {
       if (k === 0) return { kind: 'at_most', wall_per_sim_second: p.wall_per_sim_second, setting_value: p.value };
       const q = usable[k - 1];
-      if (p.error <= 0) return { kind: 'at_most', wall_per_sim_second: p.wall_per_sim_second, setting_value: p.value };
+      const order = Math.log(q.error / p.error) / Math.log(p.wall_per_sim_second / q.wall_per_sim_second);
+      if (p.error <= 0 || q.error === Infinity || !(order >= 0 && order <= MAX_INTERPOLATED_ORDER))
+        return { kind: 'at_most', wall_per_sim_second: p.wall_per_sim_second, setting_value: p.value };
       const s = (Math.log(target) - Math.log(q.error)) / (Math.log(p.error) - Math.log(q.error));
       const w = Math.exp(Math.log(q.wall_per_sim_second) + s * (Math.log(p.wall_per_sim_second) - Math.log(q.wall_per_sim_second)));
       return { kind: 'interpolated', wall_per_sim_second: w, setting_value: null };

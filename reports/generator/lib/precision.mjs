@@ -57,8 +57,11 @@ export function precision(prec, experiments) {
       const ordered = [...pts].sort((a, b) => (setting === 'iterations' ? 1 : -1) * ((a.value ?? 0) - (b.value ?? 0)));
       const judged = pts[0].judged;
       const notBuilt = pts.every((p) => p.status === 'not_built');
+      // a run that gave no answer counts as outside the tolerance (costToReach: error Infinity)
+      const answered = ordered.filter((p) => p.status !== 'not_built' && p.status !== 'refused')
+        .map((p) => (usable(p) ? p : { ...p, error: Infinity }));
       const to = notBuilt ? { kind: 'not_built', wall_per_sim_second: null, setting_value: null }
-        : costToReach(ordered.filter(usable), first.tolerance);
+        : costToReach(answered, first.tolerance);
       const curve = {
         label, ev, engine: pts[0].engine, variant: pts[0].variant, setting: pts[0].setting, judged,
         points: ordered.map((p) => ({ value: p.value, measured: p.measured, error: p.error, wall_seconds: p.wall_seconds,
@@ -68,7 +71,7 @@ export function precision(prec, experiments) {
         to_tolerance: to,
         // the same read on the CPU time, where every usable point has it (precision.csv before it: null)
         to_tolerance_cpu: notBuilt || !ordered.filter(usable).every((p) => Number.isFinite(p.cpu_per_sim_second) && p.cpu_per_sim_second > 0)
-          ? null : costToReach(ordered.filter(usable).map((p) => ({ ...p, wall_per_sim_second: p.cpu_per_sim_second })), first.tolerance),
+          ? null : costToReach(answered.map((p) => ({ ...p, wall_per_sim_second: p.cpu_per_sim_second })), first.tolerance),
         floor: null,
         never: null,
       };

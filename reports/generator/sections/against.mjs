@@ -61,9 +61,14 @@ function mainLimits(limited) {
 // what set the size of its steps there (precision.csv's steps_* columns, where it has them).
 function bound(soft, other) {
   if (soft.kind !== 'at_most') return 'the error control: a tighter tolerance is needed to reach the answer';
-  const rigid = other && other.kind === 'at_most' && other.setting === 'step'
+  // "at most" is read at the loosest setting, or at the first that reaches the answer and stays (costToReach)
+  const rigid = other && other.kind === 'at_most' && other.setting === 'step' && other.value === other.loosest
     ? '; the rigid engine’s coarsest step reaches it too (a rigid contact resolves an impact within one step)' : '';
   const main = soft.limited && soft.tend > 0 ? mainLimits(soft.limited) : [];
+  if (soft.value !== soft.loosest) {
+    const from = `it reaches the answer and stays within it from tol ${num(soft.value)} (looser ones miss it, or meet it by chance)`;
+    return main.length ? `${from}; there its steps are set by ${main.map((m) => `${Math.round(100 * m.share)} % ${LIMIT_WORDS[m.limit]}`).join(', ')}${rigid}` : from + rigid;
+  }
   if (!main.length)
     return 'its loosest tolerance already reaches the answer: the steps resolve the contacts (a soft contact must resolve each ' +
       'impact and each contact period, whatever the tolerance), not the error' + rigid;

@@ -32,7 +32,7 @@ export default {
     html += `<p class="legend">Wall times are those the runs measured on the machine that ran them. The cost to reach error ${num(c.target)} is read on ` +
       (anySelf ? 'the self-convergence curve (each engine against its own finest run; the error against the reference where a sweep has no ' +
         'self-convergence column), ' : 'the work-precision curve, ') +
-      'interpolated linearly in log error–log cost between the settings on either side; "≤" when the loosest ' +
+      'read where the curve reaches it and stays (one setting within it between two outside is luck), interpolated linearly in log error–log cost between the settings on either side; "≤" when the loosest ' +
       'setting swept is already accurate enough; "never" when no setting swept gets there; the cheapest curve of an engine-variant counts.</p>';
     return {
       html,

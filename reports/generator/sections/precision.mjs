@@ -28,7 +28,7 @@ export function costCell(e, c) {
   }
   const atMost = t.kind === 'at_most';
   return { html: (atMost ? '≤ ' : '') + num(t.wall_per_sim_second), cls: 'n',
-    title: atMost ? `already within the tolerance at the loosest setting (${settingText(c)} ${num(t.setting_value)})` : 'interpolated log–log between the settings on either side',
+    title: atMost ? `within the tolerance from ${settingText(c)} ${num(t.setting_value)}: the loosest setting, or the one before gave no answer` : 'interpolated log–log between the settings on either side',
     text: `${atMost ? '<= ' : ''}${t.wall_per_sim_second}` };
 }
 
@@ -79,8 +79,9 @@ export default {
     ]);
     html += table(['experiment', 'kind', 'tolerance', ...labels.map(esc)], rows, 'precision-cost');
     html += '<p class="legend">Bullet has two knobs: its step, and its solver’s iterations at the default 1 ms step (ODE’s ' +
-      'dWorldStep solves its LCP exactly: no iterations). “≤”: the loosest setting already reaches the tolerance; otherwise the cost is interpolated log–log between the ' +
-      'settings on either side of it. “never”: no setting reaches it; the floor is the smallest error any setting gave, “stalls” when the two ' +
+      'dWorldStep solves its LCP exactly: no iterations). The cost is where the curve reaches the tolerance and stays: the first setting within it whose next finer ' +
+      'setting is within it too (one setting within it between two outside is luck, not accuracy), interpolated log–log with the setting before it; ' +
+      '“≤”: the loosest setting already reaches it, or the one before gave no answer (a failed run, a measure that found nothing). “never”: no setting reaches it; the floor is the smallest error any setting gave, “stalls” when the two ' +
       'finest settings differ by less than 30 % (refining does not help), “still falling” when they do not. “n/a”: a prediction of the soft model ' +
       'that this variant does not have (measured anyway: hover).</p>';
     html += '<div class="charts multi wide">';

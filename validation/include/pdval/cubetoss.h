@@ -197,7 +197,7 @@ typedef struct pdTossResult {
   int samples;                    // samples compared (the record's)
   double posErrEnd, posErrRms;    // cube widths; NAN unless ok
   double rotErrEnd, rotErrRms;    // rad; NAN unless ok
-  double wallSeconds;             // the engine's run (soft: pd_advance; others: create + steps)
+  double wallSeconds;             // the engine's run: its state or world created, then run
   double cpuSeconds;              // CPU time of this process over the same span (a shared machine's wall
                                   // time counts other processes too)
   long steps;                     // accepted steps
