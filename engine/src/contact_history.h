@@ -55,6 +55,10 @@ double pd_history_spring_energy(const pdModel* model, const pdContactHistory* h)
 // After a commit, at the bodies' new poses (indexed by model body): forgets every trace whose features no longer
 // track or are apart by more than the gap tolerance, and every trace left before this call and taken since.
 void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* poses);
+// The id of the trace left by force by vertex `vertex` of body vertexBody on a face of faceBody other than `face`, into
+// *id: true when one is kept (not taken), else false.
+bool pd_history_vertex_trace(const pdContactHistory* h, int vertexBody, int vertex, int faceBody, int face,
+                             pdContactId* id);
 // A new contact `id` with normal `normal`: when a trace of the same features is kept, writes its tangential springs,
 // realigned from the trace's normal to `normal` (pd_springs_realign), into *springs, forgets the trace and returns
 // true; else false.

@@ -94,6 +94,7 @@ typedef struct candidate {
   double onsetAge;    // s since the interpolated onset when it joins as a pair onset (pd_onsetsPair), else 0
   int inherit;        // index in C0 of the contact whose springs it carries (face continuity), or -1
   double onsetBound;  // the error bound of joining it as a pair onset (onset_bound.h), when it does (else 0)
+  bool released;      // a vertex's contact on the face a release by force left it in (contact_search.c): no onset
 } candidate;
 
 // Contact i's share in the stiffness of the undamped contact modes. With K_i^½ = √k_t I + (√k_n − √k_t) n nᵀ

@@ -579,6 +579,38 @@ static void find_range(void* ctx, int part, int begin, int end) {
   }
 }
 
+// Face continuity (§4.4.3) through a release by force: a vertex whose contact on face F was released by its dampers
+// while still inside the other body, and that the search finds again on another face of that body, keeps F while the
+// history keeps its trace (its features still tracked, within the history's gap: contact_history.h). The search takes
+// the face the vertex crossed in the step or else the nearest, and a vertex past a thin plate's mid-plane is nearer
+// the far face: a sphere's vertex released 2.75 δ_max below a 100:1 blade's face was found again 1.25 δ_max below the
+// opposite face, "approaching" it only because it was on its way back out through F, with springs at zero, and was
+// pushed on through the blade (soak campaign 48, scene 4069: 11.4 δ_max). Candidate *c (a new contact at y1) then
+// becomes the trace's contact at its tracked geometry when it approaches F (c->released), and is no contact when it
+// recedes from F onto a face turned away from F, where its contact ended (false: drop it). Dropped on a face beside F
+// too, a vertex that slid from F into that face was not held there (soak campaign 62, scene 265: 0.38 -> 6.5 δ_max).
+static bool keep_released_face(const pdModel* model, const pdContactSet* set, const double* y1, const pdPose* poses1,
+                               candidate* c) {
+  const pdContactId* id = &c->geom.id;
+  pdContactId released;
+  if (!set->history || id->kind != pd_contactVF ||
+      !pd_history_vertex_trace(set->history, id->body1, id->feat1, id->body2, id->feat2, &released))
+    return true;
+  pdContactGeom kept;
+  if (!pd_contact_track(model, &released, &poses1[released.body1], &poses1[released.body2], &kept) ||
+      !(kept.depth > 0.0))
+    return true;
+  kept.id = released;
+  pdVec3 du = relative_velocity(model, y1, poses1, &released, kept.point);
+  // receding from F it is no contact on a face turned away from F (the far side of a plate, which it approaches only
+  // by leaving through F); on a face beside F it may have slid in, and is that face's as found
+  if (!(pd_v3_dot(du, kept.normal) < 0.0)) return !(pd_v3_dot(kept.normal, c->geom.normal) < 0.0);
+  c->geom = kept;
+  c->approaching = true;
+  c->released = true;
+  return true;
+}
+
 // Interference of the pairs at poses1 (the verdict only, PD_SAT_VERDICT: GJK's certificates, and touching where
 // they prove neither, within 1e-7 of the size; cache of the last separating feature or direction per pair, merged
 // by the sorted pair order), then the contact search of the touching ones, whose own depth tests find no contact
@@ -616,8 +648,13 @@ void pd_contact_search(const pdModel* model, pdState* s, const double* y1, int p
       const pdContactGeom* g = &found[f];
       while (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) < 0) ++j;
       if (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) == 0) continue;
-      candidate c = {*g, 1.0, false, 0.0, -1, 0.0};
+      candidate c = {*g, 1.0, false, 0.0, -1, 0.0, false};
       int b1 = g->id.body1, b2 = g->id.body2;
+      if (!keep_released_face(model, set, y1, poses1, &c)) continue;
+      if (c.released) {  // continues a contact released by force: no onset of its own, its springs from the trace
+        add_candidate(set, &c);
+        continue;
+      }
       pdVec3 du = relative_velocity(model, y1, poses1, &g->id, g->point);
       c.approaching = pd_v3_dot(du, g->normal) < 0.0;
       // a hand-over: the contact of C0 that no longer tracks and whose features this one continues carries on

@@ -539,7 +539,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
       int added = 0;
       for (int k = 0; k < set->candidateCount; ++k) {
         const candidate* c = &set->candidates[k];
-        if (!c->approaching || c->inherit >= 0 || c->onset * h > model->settings.dtmin) continue;
+        if (!c->approaching || c->inherit >= 0 || c->released || c->onset * h > model->settings.dtmin) continue;
         pdContactGeom g0;
         const pdContactId* id = &c->geom.id;
         pd_contact_track(model, id, &set->poses0[id->body1], &set->poses0[id->body2], &g0);

@@ -331,7 +331,7 @@ double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdO
   double earliest = 2.0;
   for (int k = 0; k < set->candidateCount; ++k) {
     candidate* c = &set->candidates[k];
-    if (!c->approaching || c->inherit >= 0) continue;
+    if (!c->approaching || c->inherit >= 0 || c->released) continue;
     double age = (1.0 - c->onset) * h;
     if (onsets != pd_onsetsExact && joins_as_pair(model, &c->geom, age)) {
       onsetTerms t = onset_terms(model, set, y1, t1, &c->geom);

@@ -178,6 +178,49 @@ static void test_kept_springs_count_at_a_presented_state(void** state) {
   assert_no_energy_gained("cases/hard/prism_off_wall_kept_springs_at_sync.scene", pd_soakThrow, 3);
 }
 
+// Nine bodies colliding in the air (cases/hard/free_pile_energy_after_dropped_contact.scene): an edge pair whose
+// springs were stretched in tension over its last step (its force pulling) broke geometrically with no successor, and
+// the hand-over trace it left counted the tension springs' energy, which no successor gets back (a successor's springs
+// are clamped out of tension): 5.1e-3 of E(0) gained at the commit, islands on, and lost again when the trace expired.
+// No energy is gained beyond the integration's error, islands on and off.
+static void test_a_pulling_contact_leaves_no_energy_for_a_successor(void** state) {
+  (void)state;
+  assert_no_energy_gained("cases/hard/free_pile_energy_after_dropped_contact.scene", pd_soakFree, 9);
+}
+
+// The scene `name` passes the soak's checks at every step, islands on and off.
+static void assert_passes_at_every_step(const char* name, pdSoakKind kind, int objects) {
+  pdSoakScene scene = scene_file(name, kind, objects);
+  for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e)
+    assert_int_equal(run_told(&scene, softEngines[e], true).status, pd_soakOk);
+  pd_soak_scene_free(&scene);
+}
+
+// A plate's corner in a prism (cases/hard/plate_corner_into_prism_next_face.scene, nine bodies in the air) keeps the
+// face it entered by while its edge tips into the next face: 5.27 delta_max at a step, islands on, while the corner's
+// contact on that face was found only once the corner left its first one. Passes the soak's checks, islands on and off.
+static void test_a_corner_presses_on_the_next_face_its_edge_enters(void** state) {
+  (void)state;
+  assert_passes_at_every_step("cases/hard/plate_corner_into_prism_next_face.scene", pd_soakFree, 9);
+}
+
+// A geodesic sphere's vertex released by force 2.75 delta_max inside a 100:1 blade
+// (cases/hard/vertex_released_in_blade_far_face.scene, ten bodies in the air) was found again on the blade's far face,
+// the nearest, and pushed through (11.4 delta_max). It keeps the face it was released from: the soak's checks pass,
+// islands on and off.
+static void test_a_vertex_released_inside_a_blade_keeps_its_face(void** state) {
+  (void)state;
+  assert_passes_at_every_step("cases/hard/vertex_released_in_blade_far_face.scene", pd_soakFree, 10);
+}
+
+// A sphere's vertex released by force from a 24:1 plate's face and sliding into the face beside it
+// (cases/hard/vertex_released_slides_to_next_face.scene) keeps the contact found there: the soak's checks pass, islands
+// on and off (6.48 delta_max when a receding vertex made no contact on any face but the released one).
+static void test_a_released_vertex_sliding_into_the_next_face_is_held_there(void** state) {
+  (void)state;
+  assert_passes_at_every_step("cases/hard/vertex_released_slides_to_next_face.scene", pd_soakFree, 3);
+}
+
 // Scene 371 of campaign 3 of the first generator is the file committed with the campaign 3 rerun (after its two
 // header lines: what happened and how to replay it).
 static void test_the_first_generator_replays_committed_campaigns(void** state) {
@@ -252,6 +295,10 @@ int main(void) {
       cmocka_unit_test(test_a_body_pressing_sideways_does_not_raise_the_limit),
       cmocka_unit_test(test_springs_kept_by_a_broken_contact_bring_no_energy_back),
       cmocka_unit_test(test_kept_springs_count_at_a_presented_state),
+      cmocka_unit_test(test_a_pulling_contact_leaves_no_energy_for_a_successor),
+      cmocka_unit_test(test_a_corner_presses_on_the_next_face_its_edge_enters),
+      cmocka_unit_test(test_a_vertex_released_inside_a_blade_keeps_its_face),
+      cmocka_unit_test(test_a_released_vertex_sliding_into_the_next_face_is_held_there),
       cmocka_unit_test(test_the_first_generator_replays_committed_campaigns),
       cmocka_unit_test(test_the_second_generator_draws_plates),
   };
