@@ -243,14 +243,17 @@ static double plane_reach(const pdPolyhedron* shape, const double* moves, const 
     const double* at = moves + PD_REACH_VERTEX_SIZE * v;
     move[v] = vertex_move(at, lambda, toward, sagAlong);
     over[v] = move[v] - beyond(plane, at);
-    if (over[v] > 0.0) most = fmax(most, move[v]);
+    // the larger inline, not fmax's libm call (1.8 M calls on cases/bench/pile_300.scene's first 0.2 s): the moves are
+    // finite and at least +0, so the same value
+    if (over[v] > 0.0 && move[v] > most) most = move[v];
   }
   for (int e = 0; e < shape->edgeCount && most < stopAbove; ++e) {
     int u = shape->edges[e].v[0], w = shape->edges[e].v[1];
     double fu = over[u], fw = over[w];
     if ((fu > 0.0) == (fw > 0.0)) continue;  // in or out as a whole: its vertices tell
     double t = fu / (fu - fw);                 // where it crosses out
-    most = fmax(most, (1.0 - t) * move[u] + t * move[w]);
+    double crossing = (1.0 - t) * move[u] + t * move[w];
+    if (crossing > most) most = crossing;
   }
   return most;
 }

@@ -88,7 +88,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   set->bodyFirst = pd_grow(NULL, n + 1, sizeof *set->bodyFirst);
   set->invInertiaWorld = pd_grow(NULL, n, sizeof *set->invInertiaWorld);
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
-  set->stackScratch = pd_stack_scratch_create();
+  set->stackScratch = NULL;  // made when a pair's modal dampers first need it (stack_mass)
   set->stableStep = set->stableCheap = INFINITY;
   set->dampingMin = 1.0;
   set->stableKnown = true;
@@ -763,14 +763,14 @@ static int remap_body(const int* map, int body) {
   return mapped;
 }
 
-// Contact i of `from` (a state of `fromModel`) as a slot of another model's list: its bodies renumbered by
-// `map` (fromModel body → the other's), its springs read from from->y.
-static contactSlot remapped_slot(const pdModel* fromModel, const pdState* from, int i, const int* map) {
-  contactSlot c = from->contacts->items[i];
-  c.id.body1 = remap_body(map, c.id.body1);
-  c.id.body2 = remap_body(map, c.id.body2);
-  c.springs = springs_load(from->y + spring_base(fromModel) + PD_CONTACT_STATE_SIZE * i);
-  return c;
+// Contact i of `from` (a state of `fromModel`) as a slot of another model's list, into *c: its bodies renumbered by
+// `map` (fromModel body → the other's), its springs read from from->y. Written in place: a slot is ~0.5 kB, and
+// one returned by value was copied twice for every contact at every sample (the islands' gather).
+static void remap_slot(contactSlot* c, const pdModel* fromModel, const pdState* from, int i, const int* map) {
+  *c = from->contacts->items[i];
+  c->id.body1 = remap_body(map, c->id.body1);
+  c->id.body2 = remap_body(map, c->id.body2);
+  c->springs = springs_load(from->y + spring_base(fromModel) + PD_CONTACT_STATE_SIZE * i);
 }
 
 // Installs next[0 .. count) as the list of `to` (a state of `model`), with no candidates or retries pending.
@@ -788,7 +788,7 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
   pd_contact_set_reserve_list(set, count);
   for (int k = 0; k < count; ++k) {
     PD_ASSERT(contacts[k] >= 0 && contacts[k] < from->contacts->count);
-    set->next[k] = remapped_slot(model, from, contacts[k], toSub);
+    remap_slot(&set->next[k], model, from, contacts[k], toSub);
   }
   install_moved(sub, to, count);
   // what prepare_list derives from the bodies' poses; the slots (modal dampers, forces) come as they were
@@ -807,7 +807,7 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
   int count = 0;
   for (int p = 0; p < parts; ++p)
     for (int i = 0; i < from[p]->contacts->count; ++i)
-      set->next[count++] = remapped_slot(subs[p], from[p], i, toModel[p]);
+      remap_slot(&set->next[count++], subs[p], from[p], i, toModel[p]);
   install_moved(model, to, count);
 }
 

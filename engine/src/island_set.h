@@ -39,6 +39,10 @@ struct pdIslandSet {
   pdMat3* r0;        // (movingCount) its rotation matrix (normalised)
   pdAabb* box0;      // (movingCount) box at T
   bool* touching;    // (movingCount) in a contact at T, or its box may reach a fixed body's
+  // x0 … touching of every body not free are set_start's at startsT over startsDt (find_free's or
+  // cuts_split_islands', which an interval of that length from there need not form again), while startsFormed
+  bool startsFormed;
+  double startsT, startsDt;  // s
   // the sample interval [T0, Ts] as a whole (free bodies: see the design note)
   double ct0;         // s: T0
   bool* free;         // (movingCount) alone and ballistic over the whole sample interval

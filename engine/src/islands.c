@@ -674,9 +674,13 @@ static bool free_advance(pdState* s, struct pdIslandSet* set, int k, double tNex
 static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSet* set, double tNext, bool last) {
   double dt = tNext - s->t;
   set->t0 = s->t;
-  mark_touching(model, s, set);
-  for (int k = 0; k < set->movingCount; ++k)
-    if (!set->free[k]) set_start(model, s, set, k, dt);
+  // a sample interval gone through in one (a stack, a pile at rest) has its starts from find_free: the same numbers
+  if (!(set->startsFormed && set->startsT == s->t && set->startsDt == dt)) {
+    mark_touching(model, s, set);
+    for (int k = 0; k < set->movingCount; ++k)
+      if (!set->free[k]) set_start(model, s, set, k, dt);
+  }
+  set->startsFormed = false;  // the rounds below grow bounds and start activated bodies
   for (int j = 0; j < set->islandCount; ++j) set->islands[j]->advanced = false;
   if (set->sleep) wake_pushed(model, s, set, dt);
   for (int round = 0;; ++round) {
@@ -764,6 +768,7 @@ static void find_free(const pdModel* model, const pdState* s, struct pdIslandSet
     set->cbound[k] = set->bound[k];
     set->ctravel[k] = 0.0;
   }
+  set->startsFormed = true, set->startsT = s->t, set->startsDt = dt;
   pd_island_partition(model, s, set, dt, false);
   for (int j = 0; j < set->partCount; ++j) {
     if (set->first[j + 1] - set->first[j] != 1) continue;
@@ -784,6 +789,7 @@ static bool cuts_split_islands(const pdModel* model, const pdState* s, struct pd
   mark_touching(model, s, set);
   for (int k = 0; k < set->movingCount; ++k)
     if (!set->free[k]) set_start(model, s, set, k, dt);
+  set->startsFormed = true, set->startsT = s->t, set->startsDt = dt;
   int activations = pd_island_partition(model, s, set, dt, true);
   return activations > 0 || set->partCount > whole;
 }

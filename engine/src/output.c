@@ -40,6 +40,10 @@
 #define PD_OUTPUT_RING_BYTES (1024 * 1024)
 #define PD_OUTPUT_BLOCKS_MIN 4
 #define PD_OUTPUT_BLOCKS_MAX 64
+// The stdio buffer of trajectory.csv and of contacts.csv: glibc ignores setvbuf's size when it is given no buffer and
+// writes in blocks of the file system's (4 KiB: 1 572 write calls for cases/hard/stack_10.scene's 6.4 MB), so the
+// buffers are ours.
+#define PD_OUTPUT_STREAM_BUFFER_BYTES (1 << 20)
 
 typedef struct outputBlock {
   unsigned char* data;
@@ -51,8 +55,10 @@ struct pdRunWriter {
   char* tmp;         // temporary directory being written
   FILE* trajectory;  // tmp/trajectory.csv
   FILE* contacts;    // tmp/contacts.csv
+  char* streamBuffers[2];  // trajectory's and contacts' stdio buffers (PD_OUTPUT_STREAM_BUFFER_BYTES each)
   atomic_bool ioError;  // a write failed (set by the writer thread)
   struct numberCache* numbers;  // the writer thread's (print_block)
+  struct rowText* rows;         // the model's names and the writer's line (print_block), with the model
   // the ring (design note): blocks filled = produced − consumed, in order
   const pdModel* model;  // the model of the samples (the same for every one; the writer reads its names)
   outputBlock blocks[PD_OUTPUT_BLOCKS_MAX];
@@ -107,7 +113,9 @@ static size_t append_number_cached(numberCache* cache, char* text, size_t n, dou
     cache->bits[slot] = bits;
     cache->length[slot] = (unsigned char)pd_format_g17(x, cache->text[slot]);
   }
-  memcpy(text + n, cache->text[slot], cache->length[slot]);
+  // the whole slot, whatever the number's length: a copy of constant size is two moves, one of the number's length a
+  // `rep movs` (text has PD_G17_MAX bytes of room after any number: rowText)
+  memcpy(text + n, cache->text[slot], PD_G17_MAX);
   return n + cache->length[slot];
 }
 
@@ -129,6 +137,47 @@ static size_t append_index(char* text, size_t n, int k) {
   text[n++] = ',';
   while (d > 0) text[n++] = digits[--d];
   return n;
+}
+
+// The CSV texts of the bodies' names (pdu_csv_text's bytes, formed once) and a line long enough for any row with them:
+// a row is assembled whole and written with one fwrite (printed in six stdio calls, two of them scanning a name for
+// characters to quote, the rows took a fifth of the writer's instructions on cases/hard/stack_10.scene).
+typedef struct rowText {
+  char** name;          // (bodyCount)
+  size_t* nameLength;   // (bodyCount)
+  char* line;           // (lineCapacity)
+  size_t lineCapacity;  // a time, two names, kind and features, 13 numbers, commas, the mode, and PD_G17_MAX spare
+} rowText;
+
+static void row_text_init(rowText* r, const pdModel* model) {
+  int n = model->bodyCount;
+  r->name = malloc((size_t)(n > 0 ? n : 1) * sizeof *r->name);
+  r->nameLength = malloc((size_t)(n > 0 ? n : 1) * sizeof *r->nameLength);
+  PD_ASSERT(r->name != NULL && r->nameLength != NULL);
+  size_t longest = 0;
+  for (int i = 0; i < n; ++i) {
+    FILE* text = open_memstream(&r->name[i], &r->nameLength[i]);
+    PD_ASSERT(text != NULL);
+    pdu_csv_text(text, model->bodies[i].name);
+    PD_ASSERT(fclose(text) == 0);
+    if (r->nameLength[i] > longest) longest = r->nameLength[i];
+  }
+  r->lineCapacity = PD_G17_MAX + 2 * longest + 2 * 12 + 16 + 13 * (PD_G17_MAX + 1) + PD_G17_MAX;
+  r->line = malloc(r->lineCapacity);
+  PD_ASSERT(r->line != NULL);
+}
+
+static void row_text_free(rowText* r, const pdModel* model) {
+  for (int i = 0; i < model->bodyCount; ++i) free(r->name[i]);
+  free(r->name);
+  free(r->nameLength);
+  free(r->line);
+}
+
+// Appends body i's name's CSV text to r->line at n; returns the new length.
+static size_t append_name(const rowText* r, size_t n, int i) {
+  memcpy(r->line + n, r->name[i], r->nameLength[i]);
+  return n + r->nameLength[i];
 }
 
 // A sample time's text, formatted once for all of the sample's rows.
@@ -162,18 +211,19 @@ static contactRecord contact_record(const pdContactReport* c) {
   return r;
 }
 
-static void write_contact_row(FILE* out, numberCache* cache, const pdModel* model, const timeText* t,
+static void write_contact_row(FILE* out, numberCache* cache, const rowText* r, const timeText* t,
                               const contactRecord* c) {
-  fwrite(t->text, 1, t->length, out);
-  fputc(',', out);
-  pdu_csv_text(out, model->bodies[c->bodyA].name);
-  fputc(',', out);
-  pdu_csv_text(out, model->bodies[c->bodyB].name);
-  // the rest of the row in one fwrite: ",EE,3,7" (kind, features), 10 numbers, ",slip\n"
-  char text[32 + 10 * (PD_G17_MAX + 1)];
+  // "t,a,b,EE,3,7" (time, names, kind, features), 10 numbers, ",slip\n"
   PD_ASSERT(c->featureA >= 0 && c->featureB >= 0);
-  memcpy(text, c->edgeEdge ? ",EE" : ",VF", 3);
-  size_t n = append_index(text, 3, (int)c->featureA);
+  char* text = r->line;
+  memcpy(text, t->text, t->length);
+  size_t n = t->length;
+  text[n++] = ',';
+  n = append_name(r, n, c->bodyA);
+  text[n++] = ',';
+  n = append_name(r, n, c->bodyB);
+  memcpy(text + n, c->edgeEdge ? ",EE" : ",VF", 3);
+  n = append_index(text, n + 3, (int)c->featureA);
   n = append_index(text, n, (int)c->featureB);
   n = append_numbers(cache, text, n, c->row, 10);
   const char* mode = c->slip ? ",slip\n" : ",stick\n";
@@ -185,11 +235,14 @@ static void write_contact_row(FILE* out, numberCache* cache, const pdModel* mode
 void pd_write_contact_rows(FILE* out, const pdModel* model, const pdState* state) {
   int count = pd_state_contact_count(state);
   timeText t = time_text(state->t);
+  rowText names;
+  row_text_init(&names, model);
   for (int i = 0; i < count; ++i) {
     pdContactReport c = pd_state_contact(state, i);
     contactRecord r = contact_record(&c);
-    write_contact_row(out, NULL, model, &t, &r);
+    write_contact_row(out, NULL, &names, &t, &r);
   }
+  row_text_free(&names, model);
 }
 
 void pd_write_trajectory_header(FILE* out) { fputs("t,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", out); }
@@ -201,25 +254,29 @@ static void body_row(const pdModel* model, const pdState* state, int i, double r
   memcpy(row, r, sizeof r);
 }
 
-static void write_trajectory_row(FILE* out, numberCache* cache, const pdModel* model, const timeText* t, int i,
+static void write_trajectory_row(FILE* out, numberCache* cache, const rowText* r, const timeText* t, int i,
                                  const double row[13]) {
-  fwrite(t->text, 1, t->length, out);
-  fputc(',', out);
-  pdu_csv_text(out, model->bodies[i].name);
-  char text[13 * (PD_G17_MAX + 1) + 1];
-  size_t n = append_numbers(cache, text, 0, row, 13);
+  char* text = r->line;
+  memcpy(text, t->text, t->length);
+  size_t n = t->length;
+  text[n++] = ',';
+  n = append_name(r, n, i);
+  n = append_numbers(cache, text, n, row, 13);
   text[n++] = '\n';
   fwrite(text, 1, n, out);
 }
 
 void pd_write_trajectory_rows(FILE* out, const pdModel* model, const pdState* state) {
   timeText t = time_text(state->t);
+  rowText names;
+  row_text_init(&names, model);
   for (int k = 0; k < model->movingCount; ++k) {
     int i = model->movingBodies[k];
     double row[13];
     body_row(model, state, i, row);
-    write_trajectory_row(out, NULL, model, &t, i, row);
+    write_trajectory_row(out, NULL, &names, &t, i, row);
   }
+  row_text_free(&names, model);
 }
 
 // ---------------------------------------------------------------- the writer thread (design note)
@@ -249,13 +306,13 @@ static bool print_block(pdRunWriter* run, const outputBlock* b) {
       double row[13];
       memcpy(row, b->data + at, sizeof row);
       at += sizeof row;
-      write_trajectory_row(run->trajectory, run->numbers, model, &t, model->movingBodies[k], row);
+      write_trajectory_row(run->trajectory, run->numbers, run->rows, &t, model->movingBodies[k], row);
     }
     for (int i = 0; i < h.contacts; ++i) {
       contactRecord c;
       memcpy(&c, b->data + at, sizeof c);
       at += sizeof c;
-      write_contact_row(run->contacts, run->numbers, model, &t, &c);
+      write_contact_row(run->contacts, run->numbers, run->rows, &t, &c);
     }
   }
   return !ferror(run->trajectory) && !ferror(run->contacts);
@@ -341,6 +398,11 @@ static void writer_stop(pdRunWriter* run, bool discard) {
   run->threadStarted = false;
   for (int k = 0; k < PD_OUTPUT_BLOCKS_MAX; ++k) free(run->blocks[k].data);
   free(run->numbers);
+  if (run->rows) {
+    row_text_free(run->rows, run->model);
+    free(run->rows);
+    run->rows = NULL;
+  }
 }
 
 pdRunWriter* pd_run_open(const char* dir, pdError* err) {
@@ -383,8 +445,12 @@ pdRunWriter* pd_run_open(const char* dir, pdError* err) {
     return NULL;
   }
   // large buffers: trajectory and contacts are the bulk of the output
-  setvbuf(run->trajectory, NULL, _IOFBF, 1 << 20);
-  setvbuf(run->contacts, NULL, _IOFBF, 1 << 20);
+  for (int k = 0; k < 2; ++k) {
+    run->streamBuffers[k] = malloc(PD_OUTPUT_STREAM_BUFFER_BYTES);
+    PD_ASSERT(run->streamBuffers[k] != NULL);
+  }
+  setvbuf(run->trajectory, run->streamBuffers[0], _IOFBF, PD_OUTPUT_STREAM_BUFFER_BYTES);
+  setvbuf(run->contacts, run->streamBuffers[1], _IOFBF, PD_OUTPUT_STREAM_BUFFER_BYTES);
   pd_write_trajectory_header(run->trajectory);
   pd_write_contacts_header(run->contacts);
   atomic_init(&run->ioError, false);
@@ -402,7 +468,12 @@ bool pd_run_observe(const pdModel* model, const pdState* state, void* user) {
   pdRunWriter* run = user;
   PD_ASSERT(run->model == NULL || run->model == model);  // one run directory holds one model's samples
   if (atomic_load(&run->ioError)) return false;
-  if (!run->model) run->model = model;  // set before the first block is handed over, read-only after
+  if (!run->model) {  // set before the first block is handed over, read-only after
+    run->model = model;
+    run->rows = malloc(sizeof *run->rows);
+    PD_ASSERT(run->rows != NULL);
+    row_text_init(run->rows, model);
+  }
   int contacts = pd_state_contact_count(state);
   outputBlock* b = block_with_room(run, sample_bytes(model, contacts));
   sampleHead h = {state->t, contacts, 0};
@@ -722,6 +793,14 @@ void pd_write_summary_json(FILE* out, const pdModel* model, const pdState* state
   fputs("}}\n}\n", out);
 }
 
+// After the streams are closed (a stream's buffer must outlive it).
+static void free_stream_buffers(pdRunWriter* run) {
+  for (int k = 0; k < 2; ++k) {
+    free(run->streamBuffers[k]);
+    run->streamBuffers[k] = NULL;
+  }
+}
+
 bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state, const pdRunInfo* info, pdError* err) {
   writer_stop(run, false);
   bool ok = !atomic_load(&run->ioError) && !ferror(run->trajectory) && !ferror(run->contacts);
@@ -729,6 +808,7 @@ bool pd_run_finish(pdRunWriter* run, const pdModel* model, const pdState* state,
   ok = (fclose(run->contacts) == 0) && ok;
   run->trajectory = NULL;
   run->contacts = NULL;
+  free_stream_buffers(run);
   char* path = pdu_path_join(run->tmp, "summary.json");
   FILE* out = ok ? fopen(path, "w") : NULL;
   free(path);
@@ -769,6 +849,7 @@ void pd_run_abort(pdRunWriter* run) {
   writer_stop(run, true);
   if (run->trajectory) fclose(run->trajectory);
   if (run->contacts) fclose(run->contacts);
+  free_stream_buffers(run);
   pdu_remove_tree(run->tmp);
   free(run->dir);
   free(run->tmp);

@@ -128,7 +128,11 @@ static double stack_mass(const pdModel* model, pdContactSet* set, const pdPose* 
                          double own) {
   const pdContactParams* p = &set->items[first].params;
   double omega;
-  if (!p->modalN || !pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omega)) return 0.0;
+  if (!p->modalN) return 0.0;
+  // ~85 kB zeroed: a list that never needs it (a dense output's view, an island of one falling body) makes none; made
+  // at the first contacts a list has, as its GSL workspaces are (stack_modes.c)
+  if (!set->stackScratch) set->stackScratch = pd_stack_scratch_create();
+  if (!pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omega)) return 0.0;
   double mass = pd_series(p->k1n, p->k2n) / (omega * omega);
   double weight = log(mass / own / PD_STACK_SLOW_FROM) / log(PD_STACK_SLOW_FULL / PD_STACK_SLOW_FROM);
   return weight > 0.0 ? fmin(1.0, weight) * mass : 0.0;
