@@ -65,9 +65,9 @@ void pd_help_wake_all(pdHelpDesk* desk) {
   pthread_mutex_unlock(&desk->lock);
 }
 
-void pd_help_for(pdHelpDesk* desk, int n, int minSplit, pdRangeFcn* f, void* ctx) {
-  PD_ASSERT(n >= 0 && f != NULL);
-  if (!desk || n < minSplit || n < 2 || atomic_load_explicit(&desk->servers, memory_order_relaxed) == 0) {
+void pd_help_for_split(pdHelpDesk* desk, int n, int minSplit, pdRangeFcn* f, void* ctx) {
+  PD_ASSERT(desk != NULL && n >= minSplit && n >= 2 && f != NULL);
+  if (atomic_load_explicit(&desk->servers, memory_order_relaxed) == 0) {
     f(ctx, 0, 0, n);
     return;
   }

@@ -14,6 +14,8 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 
+#include "polydyn/error.h"
+
 // f(ctx, part, begin, end) runs the indices [begin, end) of a loop: part 0 the first half (or the whole loop),
 // part 1 the second half. A loop that collects outputs of varying size keeps them per part.
 typedef void pdRangeFcn(void* ctx, int part, int begin, int end);
@@ -41,10 +43,21 @@ void pd_help_wake_all(pdHelpDesk* desk);
 // evaluation: ~50 ns per body against a handover of about a microsecond).
 #define PD_HELP_MIN_BODIES 128
 
+// pd_help_for's loop that may be split: a desk, at least minSplit and 2 indices.
+void pd_help_for_split(pdHelpDesk* desk, int n, int minSplit, pdRangeFcn* f, void* ctx);
+
 // Runs f over [0, n): f(ctx, 0, 0, n), or f(ctx, 0, 0, n/2) and f(ctx, 1, n/2, n). With a desk, at least minSplit
 // indices and a server waiting, the second half is posted and the first run here; the second half is taken back and run
-// here too when no server took it by then.
-void pd_help_for(pdHelpDesk* desk, int n, int minSplit, pdRangeFcn* f, void* ctx);
+// here too when no server took it by then. Inline: a loop too short to split (every loop of a small island, several
+// per derivative evaluation) is a direct call of f at the loop's site.
+static inline void pd_help_for(pdHelpDesk* desk, int n, int minSplit, pdRangeFcn* f, void* ctx) {
+  PD_ASSERT(n >= 0 && f != NULL);
+  if (!desk || n < minSplit || n < 2) {
+    f(ctx, 0, 0, n);
+    return;
+  }
+  pd_help_for_split(desk, n, minSplit, f, ctx);
+}
 
 // Serves the desk (runs what is posted) while *pending is nonzero. Spins: a server has nothing else to do.
 void pd_help_serve(pdHelpDesk* desk, const atomic_int* pending);

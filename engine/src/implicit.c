@@ -109,6 +109,8 @@ void pd_implicit_reserve(pdImplicit* im, int movingCount, int contacts) {
 }
 
 // Inverts the 8 × 8 matrix a (destroyed) into inv by Gauss–Jordan with partial pivoting; false when singular.
+// Once column col is eliminated, a's columns up to col are never read again (the pivots and factors come from
+// the columns after it, the answer is inv): only the columns after col are updated, the same inv for half the work.
 static bool invert_springs(double a[SPRINGS][SPRINGS], double inv[SPRINGS][SPRINGS]) {
   for (int i = 0; i < SPRINGS; ++i)
     for (int j = 0; j < SPRINGS; ++j) inv[i][j] = i == j ? 1.0 : 0.0;
@@ -117,19 +119,24 @@ static bool invert_springs(double a[SPRINGS][SPRINGS], double inv[SPRINGS][SPRIN
     for (int i = col + 1; i < SPRINGS; ++i)
       if (fabs(a[i][col]) > fabs(a[pivot][col])) pivot = i;
     if (!(fabs(a[pivot][col]) > 0.0) || !isfinite(a[pivot][col])) return false;
-    if (pivot != col)
-      for (int j = 0; j < SPRINGS; ++j) {
+    if (pivot != col) {
+      for (int j = col; j < SPRINGS; ++j) {
         double t = a[col][j];
         a[col][j] = a[pivot][j], a[pivot][j] = t;
-        t = inv[col][j];
+      }
+      for (int j = 0; j < SPRINGS; ++j) {
+        double t = inv[col][j];
         inv[col][j] = inv[pivot][j], inv[pivot][j] = t;
       }
+    }
     double d = 1.0 / a[col][col];
-    for (int j = 0; j < SPRINGS; ++j) a[col][j] *= d, inv[col][j] *= d;
+    for (int j = col + 1; j < SPRINGS; ++j) a[col][j] *= d;
+    for (int j = 0; j < SPRINGS; ++j) inv[col][j] *= d;
     for (int i = 0; i < SPRINGS; ++i) {
       if (i == col || a[i][col] == 0.0) continue;
       double f = a[i][col];
-      for (int j = 0; j < SPRINGS; ++j) a[i][j] -= f * a[col][j], inv[i][j] -= f * inv[col][j];
+      for (int j = col + 1; j < SPRINGS; ++j) a[i][j] -= f * a[col][j];
+      for (int j = 0; j < SPRINGS; ++j) inv[i][j] -= f * inv[col][j];
     }
   }
   return true;
