@@ -518,7 +518,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
 
   // 3. onsets: the earliest new contact that began inside the step and went deeper than its tolerance (a
   // pair onset close enough to the step's end joins there instead)
-  double earliest = pd_onsets_earliest(model, set, h, pd_onsets_effective(s->onsets, model->movingCount), y1);
+  double earliest = pd_onsets_earliest(model, set, h, pd_onsets_effective(s->onsets, model->movingCount), y1, s->t + h);
   pdEventVerdict verdict = pd_eventAccept;
   if (earliest <= 1.0 && pd_onsets_may_retry(set)) {
     double hOnset = earliest * h;

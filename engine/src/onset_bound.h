@@ -18,7 +18,12 @@
 //             impulse making slip). The force law is Lipschitz in the slip (c_t, k_t on its integral, 1 for the cone's
 //             projection), so the tangential impulse is off by at most c_t ∫D + k_t ∫∫D (at most 2 μ J_n), plus μ times
 //             the normal impulse's own error, times how far a tangential impulse moves the point and turns the bodies;
-//   spring:   the tangential springs' stretch is off by at most ∫D, over δ_max (their weight in the error norm);
+//   applied:  in the friction term's drifts: the elements start from the approach and slip at the step's end, which
+//             the applied loads (gravity, a scene's force and torque) changed over τ by at most a (τ − t) since the
+//             onset's time t (a their largest relative acceleration at the point), normal to the approach's drift and
+//             tangential to the slip's, with or without friction (onsets.c, correction_bound);
+//   spring:   the tangential springs' stretch is off by at most ∫D and the normal ones' deflection by ∫D_n, over δ_max
+//             (their weight in the error norm);
 //   turning:  added to the velocity term: PD_ONSET_TURNING_C Ω² r τ ωτ (onsets.c, correction_bound),
 // with ω = √(k_s / m_min) the pair's fastest undamped frequency. An onset is corrected only where the largest of the
 // three is at most PD_ONSET_TOL_SHARE × tol, and ωτ and d stay within the ranges the correction holds in (contact_set.c,

@@ -151,6 +151,7 @@ static pdVec3 point_response(const pdModel* model, const pdPose* poses, const pd
                              pdVec3 impulse);
 static void slip_element(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point, pdVec3 normal,
                          pdVec3 du, onsetElement* e, pdVec3* along);
+static pdMat3 inverse_inertia_at(const pdBody* body, const pdPose* pose);
 
 // What the error bound (onset_bound.h) of joining new contact g (found at y1, poses in set->poses1) as a corrected
 // onset is formed from, apart from its age and depth.
@@ -159,18 +160,54 @@ typedef struct onsetTerms {
   double approach;      // m/s: its approach speed now
   double size;          // m: the smaller moving body's
   double deltaMax;      // m: the pair's δ_max, the error norm's weight of a contact spring
+  pdVec3 normal;        // the contact's
   onsetElement element; // the correction's element at the point's effective mass (its friction: the model's dampers,
                         // which the modal ones never exceed)
   double lever;         // 1/kg: how far a tangential impulse there may move the state, per kg·m/s
   double turning;       // m/s²: Ω² r, the bodies' turning's acceleration of the point (Ω their relative rate)
+  pdVec3 applied;       // m/s²: the applied loads' relative acceleration of the point at the step's end (applied_at)
+  pdVec3 appliedRate;   // m/s³: its rate (a ramped force)
 } onsetTerms;
 
-static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, const double* y1, const pdContactGeom* g) {
+// The relative acceleration at `point` that the applied loads give the pair's bodies at time t (gravity, the scene's
+// force and its torque: dynamics.c's, without the contact forces and the bodies' turning), and its rate, at the
+// poses `poses`. A fixed body has none; gravity alone cancels between two moving bodies.
+static void applied_at(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point, double t,
+                       pdVec3* acceleration, pdVec3* rate) {
+  *acceleration = *rate = (pdVec3){0.0, 0.0, 0.0};
+  for (int side = 0; side < 2; ++side) {
+    int b = side == 0 ? id->body1 : id->body2;
+    const pdBody* body = &model->bodies[b];
+    if (body->fixed) continue;
+    pdVec3 a = model->settings.gravity, aRate = {0.0, 0.0, 0.0};
+    if (body->planar) a.y = 0.0;  // the plane's reaction, as in the derivative
+    if (body->hasForce) {
+      pdVec3 force = pd_body_applied_force(body, t);
+      pdMat3 invInertia = inverse_inertia_at(body, &poses[b]);
+      pdVec3 alpha = pd_mat3_mulv(&invInertia, pd_body_applied_torque(body, &poses[b].R, force));
+      pdVec3 alphaRate = pd_mat3_mulv(&invInertia, pd_body_applied_torque(body, &poses[b].R, body->forceRate));
+      pdVec3 linear = pd_v3_scale(force, body->invMass);
+      aRate = pd_v3_scale(body->forceRate, body->invMass);
+      if (body->planar) {
+        linear.y = aRate.y = 0.0;
+        alpha.x = alpha.z = alphaRate.x = alphaRate.z = 0.0;
+      }
+      pdVec3 r = pd_v3_sub(point, poses[b].x);
+      a = pd_v3_add(a, pd_v3_add(linear, pd_v3_cross(alpha, r)));
+      aRate = pd_v3_add(aRate, pd_v3_cross(alphaRate, r));
+    }
+    *acceleration = side == 0 ? pd_v3_add(*acceleration, a) : pd_v3_sub(*acceleration, a);
+    *rate = side == 0 ? pd_v3_add(*rate, aRate) : pd_v3_sub(*rate, aRate);
+  }
+}
+
+static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, const double* y1, double t1,
+                              const pdContactGeom* g) {
   int a = g->id.body1, b = g->id.body2;
   pdContactParams p = pd_model_contact_params(model, a, b);
   pdVec3 du = relative_velocity(model, y1, set->poses1, &g->id, g->point);
   onsetTerms t = {.omega = sqrt(pd_series(p.k1n, p.k2n) / p.massMin), .approach = -pd_v3_dot(du, g->normal),
-                  .size = INFINITY, .deltaMax = pd_model_pair_delta_max(model, a, b)};
+                  .size = INFINITY, .deltaMax = pd_model_pair_delta_max(model, a, b), .normal = g->normal};
   onsetElement* e = &t.element;
   double inverseMass = pd_v3_dot(g->normal, point_response(model, set->poses1, &g->id, g->point, g->normal));
   e->mass = inverseMass > 0.0 ? 1.0 / inverseMass : INFINITY;
@@ -200,30 +237,58 @@ static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, con
     t.lever += fmax(3.0 * body->invMass + r * r * trInv, r * trInv * body->size);
   }
   t.turning = pd_v3_dot(spin, spin) * reach;
+  applied_at(model, set->poses1, &g->id, g->point, t1, &t.applied, &t.appliedRate);
   return t;
+}
+
+// The largest normal and tangential parts of the applied loads' relative acceleration at the point over the `age`
+// before the step's end (linear in time at the step's end's poses: the larger of its two ends), m/s².
+static void applied_over(const onsetTerms* t, double age, double* alongNormal, double* tangential) {
+  pdVec3 start = pd_v3_sub(t->applied, pd_v3_scale(t->appliedRate, age));
+  double n1 = pd_v3_dot(t->applied, t->normal), n0 = pd_v3_dot(start, t->normal);
+  *alongNormal = fmax(fabs(n1), fabs(n0));
+  *tangential = fmax(pd_v3_norm(pd_v3_sub(t->applied, pd_v3_scale(t->normal, n1))),
+                     pd_v3_norm(pd_v3_sub(start, pd_v3_scale(t->normal, n0))));
 }
 
 // The bound of joining the contact `age` seconds after its onset at `depth` (onset_bound.h). Its friction terms: the
 // correction follows the slip along ŝ under its own friction and the normal element under its own force
 // (onset_motion); what it leaves out are the slip's change off that element, D(t) <= driftPerJt J_t(t) +
 // driftPerJn J_n(t) (the tangential impulse turning the slip, the normal impulse making slip), and the approach's,
-// D_n(t) <= approachPerJt J_t(t) (the tangential impulse pressing or lifting the point). Each force law is Lipschitz in
-// its velocity (the damper by c, the spring by k on its integral, the cone's projection by 1, the clamp of F_n by 1),
-// so the tangential impulse is off by at most c_t ∫D + k_t ∫∫D (never more than both cones' impulses, 2 μ J_n), the
-// normal impulse by c_n ∫D_n + k_n ∫∫D_n, and the cone's radius, μ F_n, by μ times the normal impulse's error: that
-// and the velocity term's (PD_ONSET_BOUND_C). Those impulses move the state by at most `lever` each; the tangential
-// springs' stretch is off by at most ∫D. Its turning term: the correction starts the element at the approach speed
-// found at the step's end, which the bodies' turning changed over the age by up to Ω² r τ without the contact; the
-// element's response to that is at most ωτ of it (PD_ONSET_TURNING_C).
+// D_n(t) <= approachPerJt J_t(t) (the tangential impulse pressing or lifting the point). Its applied term: the elements
+// start from the approach and the slip found at the step's end, which the applied loads (gravity, a scene's force and
+// its torque) changed over the age τ without the contact; followed from the onset, the point's relative velocity
+// differs from the elements' at time t since it by what those loads added over [t, τ], at most a (τ − t) with a their
+// largest relative acceleration there (applied_over), normal to D_n and tangential to D: their integrals are a τ²/2 and
+// a τ³/3. Each force law is Lipschitz in its velocity (the damper by c, the spring by k on its integral, the cone's
+// projection by 1, the clamp of F_n by 1), so the tangential impulse is off by at most c_t ∫D + k_t ∫∫D (never more than
+// both cones' impulses, 2 μ J_n), the normal impulse by c_n ∫D_n + k_n ∫∫D_n, and the cone's radius, μ F_n, by μ times
+// the normal impulse's error: that and the velocity term's (PD_ONSET_BOUND_C). Those impulses move the state by at most
+// `lever` each; the tangential springs' stretch is off by at most ∫D and the normal ones' deflection by ∫D_n. Its
+// turning term: the correction starts the element at the approach speed found at the step's end, which the bodies'
+// turning changed over the age by up to Ω² r τ without the contact; the element's response to that is at most ωτ of it
+// (PD_ONSET_TURNING_C).
 static double correction_bound(const pdModel* model, const onsetTerms* t, double age, double depth) {
   double wt = t->omega * age, velocity = PD_ONSET_TURNING_C * t->turning * age * wt, spring = 0.0;
   const onsetElement* e = &t->element;
-  if (e->mu > 0.0 && isfinite(e->mass) && t->approach > 0.0) {
-    onsetMotion m = onset_motion(e, t->approach, age);
-    double normal = e->mass * (e->omega2 * m.approach2 + e->damping * m.approach1);  // N·s
-    double tangential = fmin(e->ct * m.drift1 + e->kt * m.drift2, 2.0 * e->mu * m.jn);
-    velocity += t->lever * (tangential + (1.0 + e->mu) * normal) + e->mu * PD_ONSET_BOUND_C * wt * wt * wt * t->approach;
-    spring = m.drift1 / t->deltaMax;
+  if (isfinite(e->mass) && t->approach > 0.0) {
+    double an, at;
+    applied_over(t, age, &an, &at);
+    double age2 = 0.5 * age * age, age3 = age * age * age / 3.0;
+    double approach1 = an * age2, approach2 = an * age3;  // m, m·s: ∫D_n and ∫∫D_n, the applied loads' part
+    double drift1 = at * age2, drift2 = at * age3;        // ∫D and ∫∫D, theirs
+    double tangential = 0.0;
+    if (e->mu > 0.0) {
+      onsetMotion m = onset_motion(e, t->approach, age);
+      approach1 += m.approach1, approach2 += m.approach2;
+      drift1 += m.drift1, drift2 += m.drift2;
+      tangential = fmin(e->ct * drift1 + e->kt * drift2, 2.0 * e->mu * m.jn);
+      velocity += e->mu * PD_ONSET_BOUND_C * wt * wt * wt * t->approach;
+      spring = drift1 / t->deltaMax;
+    }
+    double normal = e->mass * (e->omega2 * approach2 + e->damping * approach1);  // N·s
+    velocity += t->lever * (tangential + (1.0 + e->mu) * normal);
+    spring = fmax(spring, approach1 / t->deltaMax);
   }
   return pd_onset_error_bound(t->omega, age, depth, t->approach, model->settings.vmax, t->size, velocity, spring);
 }
@@ -238,10 +303,10 @@ static double correction_bound(const pdModel* model, const onsetTerms* t, double
 // retry whose onset estimate comes early (a vertex swinging down on a rolling body) ends before the contact, and the
 // next full step finds it again a little later: a rimless wheel took thousands of such steps, each closer to the same
 // onset.
-static double retry_target(const pdModel* model, const pdContactSet* set, const double* y1, const candidate* c,
-                           double h, pdOnsets onsets) {
+static double retry_target(const pdModel* model, const pdContactSet* set, const double* y1, double t1,
+                           const candidate* c, double h, pdOnsets onsets) {
   if (onsets != pd_onsetsBounded) return c->onset;
-  onsetTerms t = onset_terms(model, set, y1, &c->geom);
+  onsetTerms t = onset_terms(model, set, y1, t1, &c->geom);
   if (!(t.approach > 0.0) || !(t.omega > 0.0)) return c->onset;
   double deltaMax = pd_model_pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
   double spend = PD_ONSET_AIM_SHARE * PD_ONSET_TOL_SHARE * model->settings.tol;
@@ -261,14 +326,15 @@ static double retry_target(const pdModel* model, const pdContactSet* set, const 
   return target < 1.0 ? target : c->onset;
 }
 
-double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdOnsets onsets, const double* y1) {
+double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdOnsets onsets, const double* y1,
+                          double t1) {
   double earliest = 2.0;
   for (int k = 0; k < set->candidateCount; ++k) {
     candidate* c = &set->candidates[k];
     if (!c->approaching || c->inherit >= 0 || c->released) continue;
     double age = (1.0 - c->onset) * h;
     if (onsets != pd_onsetsExact && joins_as_pair(model, &c->geom, age)) {
-      onsetTerms t = onset_terms(model, set, y1, &c->geom);
+      onsetTerms t = onset_terms(model, set, y1, t1, &c->geom);
       c->onsetBound = correction_bound(model, &t, age, c->geom.depth);
       if (onsets == pd_onsetsPair || pd_onset_bound_allows(c->onsetBound, model->settings.tol)) {
         c->onsetAge = age;
@@ -276,7 +342,7 @@ double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdO
       }
     }
     double tol = PD_ONSET_DEPTH_TOL_REL * pd_model_pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
-    if (c->geom.depth > tol) earliest = fmin(earliest, retry_target(model, set, y1, c, h, onsets));
+    if (c->geom.depth > tol) earliest = fmin(earliest, retry_target(model, set, y1, t1, c, h, onsets));
   }
   return earliest;
 }

@@ -17,8 +17,10 @@ double pd_contact_onset(const pdModel* model, const pdContactId* id, const pdPos
 
 // The earliest onset fraction δ among the candidates of the last contact search (contact_list.h) that
 // approach, carry no springs over and went deeper than their onset tolerance; 2 when there is none. With pairOnsets a
-// candidate close enough to the step's end (of size h) to join there as a pair onset gets its onset age instead.
-double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdOnsets onsets, const double* y1);
+// candidate close enough to the step's end (of size h, at time t1) to join there as a pair onset gets its onset age
+// instead.
+double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdOnsets onsets, const double* y1,
+                          double t1);
 // Whether the step under way may still be retried for an onset (the retries per step are bounded).
 bool pd_onsets_may_retry(const pdContactSet* set);
 // Pair onsets of a list just installed at state y (poses those of y; world inverse inertias and modal dampers set):

@@ -192,7 +192,13 @@ static void test_resting_boxes_stick_in_a_fraction_of_the_steps(void** state) {
 // 9 786) and takes 336 steps, 23 of its trials rejected (26 of 595 before). The rejected trials a switch adds are those
 // beyond step doubling's own: with a corrected onset's friction following the slip (docs/events.md) the stirred stack
 // sets down on another path, on which step doubling itself has 279 of 1 204 trials rejected and the default stepper
-// never switches (287 rejected, the same evaluations to 0.2 %).
+// never switches (287 rejected, the same evaluations to 0.2 %): a torsional ring of its boxes holds step doubling to
+// its error control, not its bound. So the probation is tested on the same stack at tol 1e-7
+// (stirred_stack_tight.scene), where the bound holds step doubling after the landing and the switch happens, its
+// probation passed (implicit steps taken): measured, 9 083 evaluations and 15 rejected trials against step doubling's
+// 14 685 and 0 of 1 335 accepted steps, 31 implicit steps. (With probation trials passing at tol itself it costs 6 657
+// evaluations and 25 rejected trials: this stack does not tell the probation's error share from tol's, only that a
+// switch happens and costs no more than step doubling.)
 #define NOT_PAYING_EVALUATIONS_RATIO_MAX 1.05
 #define NOT_PAYING_REJECTED_SHARE_MAX 0.05  // of step doubling's accepted steps
 
@@ -209,13 +215,15 @@ static void run_both(const pdModel* m, pdCounters counts[2]) {
   }
 }
 
-static void a_switch_that_does_not_pay_costs_nothing(const char* path) {
+// Returns the implicit stepper's accepted implicit steps.
+static long a_switch_that_does_not_pay_costs_nothing(const char* path) {
   pdModel* m = compile_file(path);
   pdCounters c[2];
   run_both(m, c);
   assert_true((double)(c[1].rejected - c[0].rejected) <= NOT_PAYING_REJECTED_SHARE_MAX * (double)c[0].accepted);
   assert_true((double)c[1].derivatives <= NOT_PAYING_EVALUATIONS_RATIO_MAX * (double)c[0].derivatives);
   pd_model_free(m);
+  return c[1].implicitSteps;
 }
 
 static void test_a_switch_that_does_not_pay_is_given_up(void** state) {
@@ -225,7 +233,9 @@ static void test_a_switch_that_does_not_pay_is_given_up(void** state) {
 
 static void test_a_probation_step_must_leave_room_to_grow(void** state) {
   (void)state;
-  a_switch_that_does_not_pay_costs_nothing(PD_SOURCE_DIR "/tests/engine/scenes/stirred_stack.scene");
+  // a switch that passed its probation took implicit steps
+  assert_true(a_switch_that_does_not_pay_costs_nothing(PD_SOURCE_DIR "/tests/engine/scenes/stirred_stack_tight.scene") >
+              0);
 }
 
 // Islands of up to PD_IMPLICIT_BODIES_MAX (32) moving bodies step implicitly: the stack of 20 boxes of the scale
