@@ -24,7 +24,7 @@ pdSleepSet* pd_sleep_create(const pdModel* model) {
   set->quietSince = pd_grow(NULL, (size_t)m, sizeof *set->quietSince);
   set->asleep = pd_grow(NULL, (size_t)m, sizeof *set->asleep);
   set->asleepSince = pd_grow(NULL, (size_t)m, sizeof *set->asleepSince);
-  set->settle = pd_grow(NULL, (size_t)m, sizeof *set->settle);
+  set->horizon = pd_grow(NULL, (size_t)m, sizeof *set->horizon);
   set->inContact = pd_grow(NULL, (size_t)m, sizeof *set->inContact);
   for (int k = 0; k < model->movingCount; ++k) {
     set->speedPeak[k] = 0.0;
@@ -42,7 +42,7 @@ void pd_sleep_free(pdSleepSet* set) {
   free(set->quietSince);
   free(set->asleep);
   free(set->asleepSince);
-  free(set->settle);
+  free(set->horizon);
   free(set->inContact);
   free(set);
 }
@@ -90,7 +90,7 @@ bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb
 void pd_sleep_fall_asleep(pdSleepSet* set, int k, double t, double horizon) {
   set->asleep[k] = true;
   set->asleepSince[k] = t;
-  set->settle[k] = horizon;
+  set->horizon[k] = horizon;
 }
 
 bool pd_sleep_force_changed(const pdSleepSet* set, const pdBody* body, int k, double t) {
@@ -98,5 +98,5 @@ bool pd_sleep_force_changed(const pdSleepSet* set, const pdBody* body, int k, do
   double change = pd_v3_norm(body->forceRate) * fabs(t - set->asleepSince[k]);
   double surface = change * body->invMass;
   if (body->principal[0] > 0.0) surface += change * pd_v3_norm(body->forcePoint) * body->radius / body->principal[0];
-  return surface * set->settle[k] >= set->speedMax;
+  return surface * set->horizon[k] >= set->speedMax;
 }

@@ -39,7 +39,7 @@ typedef struct pdSleepSet {
   double* quietSince;   // (movingCount) s: start of the quiet intervals leading here (NAN: the last was not quiet)
   bool* asleep;         // (movingCount)
   double* asleepSince;  // (movingCount) s: when it fell asleep
-  double* settle;       // (movingCount) s: the horizon of its acceleration threshold when it fell asleep
+  double* horizon;      // (movingCount) s: the horizon of its acceleration threshold when it fell asleep
   bool* inContact;      // (movingCount) scratch: the body has a contact
   long sleeps, wakes;   // islands that fell asleep, islands woken
   double bodySeconds;   // body-seconds spent asleep
