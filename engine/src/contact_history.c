@@ -2,6 +2,7 @@
 #include "contact_history.h"
 
 #include <float.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,6 +27,7 @@ typedef struct traceList {
 
 struct pdContactHistory {
   trace* items;  // [0, sortedCount) sorted by id (pd_contact_id_compare); then those left since the last age
+  trace* scratch;  // as many as items: the merge of those left into the sorted run (pd_history_age)
   int count, capacity, sortedCount;
   traceList handovers;  // contacts broken geometrically with no successor yet (pd_history_leave_handover)
 };
@@ -39,6 +41,7 @@ pdContactHistory* pd_history_create(void) {
 void pd_history_free(pdContactHistory* h) {
   if (!h) return;
   free(h->items);
+  free(h->scratch);
   free(h->handovers.items);
   free(h);
 }
@@ -52,6 +55,7 @@ void pd_history_leave(pdContactHistory* h, const pdContactId* id, const pdSpring
   if (h->count == h->capacity) {
     h->capacity = h->capacity ? 2 * h->capacity : 16;
     h->items = pd_grow(h->items, (size_t)h->capacity, sizeof *h->items);
+    h->scratch = pd_grow(h->scratch, (size_t)h->capacity, sizeof *h->scratch);
   }
   h->items[h->count++] = (trace){*id, *springs, normal, deltaMax, false, 0.0, 0};
 }
@@ -110,12 +114,36 @@ double pd_history_spring_energy(const pdModel* model, const pdContactHistory* h)
   return e;
 }
 
-static int compare_traces(const void* a, const void* b) {
-  return pd_contact_id_compare(&((const trace*)a)->id, &((const trace*)b)->id);
+static int compare_traces(const trace* a, const trace* b) { return pd_contact_id_compare(&a->id, &b->id); }
+
+// Merges the sorted runs a[0, na) and b[0, nb) into out[0, na + nb). out may end where b is (b = out + na): each
+// element is written at or before where b's next one is read.
+static void merge_traces(const trace* a, int na, const trace* b, int nb, trace* out) {
+  int i = 0, j = 0, k = 0;
+  while (i < na && j < nb) out[k++] = compare_traces(&b[j], &a[i]) < 0 ? b[j++] : a[i++];
+  while (i < na) out[k++] = a[i++];
+  while (j < nb) out[k++] = b[j++];
+}
+
+// Sorts t[0, n) by id through scratch[0, n): a bottom-up merge sort, which allocates nothing (qsort may) and, the ids
+// being unique among traces, gives the one order there is.
+static void sort_traces(trace* t, int n, trace* scratch) {
+  trace *from = t, *to = scratch;
+  for (int width = 1; width < n; width *= 2) {
+    for (int lo = 0; lo < n; lo += 2 * width) {
+      int mid = lo + width < n ? lo + width : n, hi = lo + 2 * width < n ? lo + 2 * width : n;
+      merge_traces(from + lo, mid - lo, from + mid, hi - mid, to + lo);
+    }
+    trace* swap = from;
+    from = to;
+    to = swap;
+  }
+  if (from != t) memcpy(t, from, (size_t)n * sizeof *t);
 }
 
 void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* poses) {
-  int kept = 0;
+  // the kept traces keep their order: those of the sorted run first (still sorted), then those left since
+  int kept = 0, keptSorted = 0;
   for (int i = 0; i < h->count; ++i) {
     trace* t = &h->items[i];
     if (t->taken) continue;
@@ -123,6 +151,7 @@ void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* pos
     if (!pd_contact_track(model, &t->id, &poses[t->id.body1], &poses[t->id.body2], &g)) continue;
     if (-g.depth > PD_HISTORY_GAP_REL * t->deltaMax) continue;
     h->items[kept++] = *t;
+    if (i < h->sortedCount) keptSorted = kept;
   }
   // hand-over traces wait a few commits for their successor (it is often found a step or two after its predecessor
   // broke), then go
@@ -133,18 +162,42 @@ void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* pos
     h->handovers.items[waiting++] = *t;
   }
   h->handovers.count = waiting;
-  // ids are unique among traces: a contact breaks only while listed, and a listed contact has no trace left
-  if (kept > 1 && kept > h->sortedCount) qsort(h->items, (size_t)kept, sizeof *h->items, compare_traces);
+  // the new ones sorted, then merged into the sorted run (ids are unique among traces: a contact breaks only while
+  // listed, and a listed contact has no trace left), whatever their number: pd_history_take's binary search and
+  // pd_history_vertex_trace's read the whole run
+  int added = kept - keptSorted;
+  if (added > 0) {
+    trace* run = h->items + keptSorted;
+    sort_traces(run, added, h->scratch);
+    if (keptSorted > 0 && compare_traces(&h->items[keptSorted - 1], &run[0]) > 0) {
+      memcpy(h->scratch, h->items, (size_t)keptSorted * sizeof *h->items);
+      merge_traces(h->scratch, keptSorted, run, added, h->items);  // writes behind what it reads of `run`
+    }
+  }
   h->count = h->sortedCount = kept;
+}
+
+// The first trace of the sorted run whose id is not before *id (sortedCount when none).
+static int lower_bound(const pdContactHistory* h, const pdContactId* id) {
+  int lo = 0, hi = h->sortedCount;
+  while (lo < hi) {
+    int mid = lo + (hi - lo) / 2;
+    if (pd_contact_id_compare(&h->items[mid].id, id) < 0)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
 }
 
 bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, const pdContactParams* params,
                      pdSprings* springs) {
   // a trace left since the last age broke from a contact of this very list, which a new contact is not
   if (h->sortedCount == 0) return false;
-  trace key = {.id = *id};
-  trace* t = bsearch(&key, h->items, (size_t)h->sortedCount, sizeof *h->items, compare_traces);
-  if (!t || t->taken) return false;
+  int i = lower_bound(h, id);
+  if (i == h->sortedCount || pd_contact_id_compare(&h->items[i].id, id) != 0) return false;
+  trace* t = &h->items[i];
+  if (t->taken) return false;
   pdSprings s = t->springs;
   s.s1n = s.s2n = 0.0;  // the normal springs start where the contact does
   // turned to the new normal (and rebalanced where the sides are proportional), not clipped to a cone: the contact
@@ -158,11 +211,14 @@ bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, 
 
 bool pd_history_vertex_trace(const pdContactHistory* h, int vertexBody, int vertex, int faceBody, int face,
                              pdContactId* id) {
-  for (int i = 0; i < h->sortedCount; ++i) {
+  // the traces of this vertex on faceBody's faces follow one another in the sorted run, by face
+  // (pd_contact_id_compare orders by body pair, kind, body1, feat1, then feat2)
+  pdContactId first = {vertexBody, faceBody, pd_contactVF, vertex, INT_MIN};
+  for (int i = lower_bound(h, &first); i < h->sortedCount; ++i) {
     const trace* t = &h->items[i];
-    if (t->taken || t->id.kind != pd_contactVF || t->id.body1 != vertexBody || t->id.feat1 != vertex ||
-        t->id.body2 != faceBody || t->id.feat2 == face)
-      continue;
+    if (t->id.kind != pd_contactVF || t->id.body1 != vertexBody || t->id.body2 != faceBody || t->id.feat1 != vertex)
+      break;
+    if (t->taken || t->id.feat2 == face) continue;
     *id = t->id;
     return true;
   }

@@ -3,6 +3,9 @@
 //   PD_HISTORY_GAP_REL δ_max and back on the same features, a new contact takes them (unchanged: the normal did not
 //   turn) with its normal springs at 0; lifted beyond the gap, or off its face, they are forgotten; a contact on other
 //   features never takes them;
+// - the traces of twelve corners of three boxes resting on a floor, left, taken and aged in a fixed pseudo-random order
+//   (some of those kept from earlier commits taken, so forgotten, as others are left): at every commit each kept trace
+//   is found again, by pd_history_take and by pd_history_vertex_trace, and none that is not kept;
 // - a column of three boxes dropped with 2 mm gaps onto a 20° incline (μ 0.5 sticks: tan 20° = 0.36) chatters while it
 //   lands, keeps the history of some contacts (counted), and then does not creep: the top box moves along the box
 //   below by less than CREEP_DISTANCE from 0.5 s to 2 s;
@@ -95,6 +98,78 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
   pd_model_free(m);
 }
 
+// A fixed pseudo-random sequence (a linear congruential generator): the same draws on every machine.
+static unsigned next_draw(unsigned* seed) {
+  *seed = *seed * 1664525u + 1013904223u;
+  return *seed >> 16;
+}
+
+static void test_every_kept_trace_is_found_as_others_come_and_go(void** state) {
+  (void)state;
+  pdModel* m = compile_apart("cube floor grey 4 4 0.1\nfixed\ncube a red 0.1 0.1 0.1\ncube b red 0.1 0.1 0.1\n"
+                             "cube c red 0.1 0.1 0.1\n");
+  int floor = body_index(m, "floor"), boxes[3] = {body_index(m, "a"), body_index(m, "b"), body_index(m, "c")};
+  pdPose poses[4];
+  poses[floor] = at_height(m, floor, -0.05);  // top face at z = 0
+  enum { CORNERS = 12 };
+  pdContactGeom c[CORNERS];
+  int n = 0;
+  for (int k = 0; k < 3; ++k) {
+    poses[boxes[k]] = at_height(m, boxes[k], 0.05 - DEPTH);
+    poses[boxes[k]].x.x = k - 1.0;
+    int found = pd_contacts_find(m, boxes[k], &poses[boxes[k]], floor, &poses[floor], NULL, NULL, NULL, 0, c + n,
+                                 CORNERS - n);
+    assert_int_equal(found, 4);
+    n += found;
+  }
+  pdContactParams params = pd_model_contact_params(m, boxes[0], floor);
+  pdSprings left = {0.0, 0.0, {1e-6, 0.0, 0.0}, {-1e-6 * params.k1t / params.k2t, 0.0, 0.0}};
+  pdContactHistory* h = pd_history_create();
+  bool kept[CORNERS] = {false};  // kept from an earlier commit: what pd_history_take may find
+  unsigned seed = 42;
+  long takes = 0, lookups = 0;
+  for (int commit = 0; commit < 400; ++commit) {
+    // as a commit goes (contact_set.c): contacts that break leave their traces, new contacts take older ones, then
+    // the history ages
+    bool leaves[CORNERS] = {false}, takes_now[CORNERS] = {false};
+    for (int i = 0; i < n; ++i)
+      if (!kept[i] && next_draw(&seed) % 3 == 0) {
+        pd_history_leave(h, &c[i].id, &left, c[i].normal, pd_model_pair_delta_max(m, c[i].id.body1, c[i].id.body2));
+        leaves[i] = true;
+      }
+    for (int i = 0; i < n; ++i) {
+      pdContactId other;
+      int face = c[i].id.feat2, otherFace = (face + 1) % 6;
+      bool byVertex = pd_history_vertex_trace(h, c[i].id.body1, c[i].id.feat1, c[i].id.body2, otherFace, &other);
+      assert_int_equal(byVertex, kept[i]);
+      if (byVertex) assert_int_equal(pd_contact_id_compare(&other, &c[i].id), 0);
+      assert_false(pd_history_vertex_trace(h, c[i].id.body1, c[i].id.feat1, c[i].id.body2, face, &other));
+      ++lookups;
+    }
+    for (int i = 0; i < n; ++i) {
+      if (kept[i] && next_draw(&seed) % 2 != 0) continue;
+      pdSprings got = {0};
+      bool found = pd_history_take(h, &c[i].id, c[i].normal, &params, &got);
+      if (found != kept[i])
+        print_message("commit %d, corner %d: trace %s but %s\n", commit, i, kept[i] ? "kept" : "not kept",
+                      found ? "found" : "not found");
+      assert_int_equal(found, kept[i]);
+      takes_now[i] = found;
+      takes += found;
+    }
+    pd_history_age(m, h, poses);
+    int count = 0;
+    for (int i = 0; i < n; ++i) {
+      kept[i] = (kept[i] && !takes_now[i]) || leaves[i];
+      count += kept[i];
+    }
+    assert_int_equal(pd_history_count(h), count);
+  }
+  print_message("12 corners over 400 commits: %ld traces taken, %ld vertex lookups, each as kept\n", takes, lookups);
+  pd_history_free(h);
+  pd_model_free(m);
+}
+
 // The column on the incline: three boxes with 2 mm gaps, the top one `lift` higher still and sliding down the slope at
 // `slide` (m/s); into *r and *s by polydyn run's default events, islands as given. Returns the top box's move along the
 // box below, and *slab the lowest box's along the slab, between samples `from` and the last.
@@ -164,6 +239,7 @@ static void test_a_box_landing_sliding_on_the_column_does_not_creep(void** state
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_springs),
+      cmocka_unit_test(test_every_kept_trace_is_found_as_others_come_and_go),
       cmocka_unit_test(test_a_chattering_column_on_an_incline_does_not_creep),
       cmocka_unit_test(test_a_box_landing_sliding_on_the_column_does_not_creep),
   };
