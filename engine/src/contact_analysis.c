@@ -850,6 +850,29 @@ void pd_contact_geometry_framed(const pdModel* model, const pdContactId* id, con
   }
 }
 
+// A vertex pressed through a thin body. A VF contact's element on face F is compressed by the vertex's depth below F;
+// a vertex driven deeper than the body is thick (a heavy corner pressing a thin plate onto a third body: the plate's
+// springs are sized for the plate's own mass, eq. (11), not for the load the third body puts through it) comes out
+// through the far side. It then lies outside the body only across faces turned away from F (outward normals more than
+// 90° apart), over F's polygon and below F: the element is still compressed by that depth, and a contact tracked
+// there (it came in through F: face continuity, §4.4.3) goes on with the paper's geometry and force law while its
+// vertex is its body's support point along −n_F, as beyond an acute edge. Breaking it released the compressed element
+// at once and left the two bodies overlapping by more than the plate's width with no contact: a 100:1 blade between a
+// prism's corner and a third body went 25 δ_max deep, a 38:1 sliver between a plate's corner and the floor 30 δ_max
+// (docs/contact-model.md, "A vertex pressed through a thin body"). Tracking only: a vertex found outside a body is no
+// new contact by this rule, since a vertex resting against the far face from outside lies there too.
+static bool through_far_side(const pdPolyhedron* s, int f, pdVec3 q, double tol, double depth) {
+  if (!(depth > 0.0)) return false;
+  pdVec3 nf = s->faces[f].normal;
+  bool out = false;
+  for (int g = 0; g < s->faceCount; ++g) {
+    if (!(face_depth(s, g, q) < -tol)) continue;
+    if (!(pd_v3_dot(s->faces[g].normal, nf) < 0.0)) return false;
+    out = true;
+  }
+  return out;
+}
+
 bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                       pdContactGeom* out) {
   return pd_contact_track_framed(model, id, p1, p2, NULL, out);
@@ -872,8 +895,11 @@ bool pd_contact_track_framed(const pdModel* model, const pdContactId* id, const 
     if (inside_body(s2, q, outside)) return true;
     // a vertex beyond an acute edge (find_vf) stays on its face while it presses on it as there: outside the body by
     // at most its depth and δ_max, its body's support point along −n_F
+    // or, pressed through a thin body, outside it across faces turned away from its own (through_far_side)
     double beyond = outside_by(s2, q);
-    if (!(beyond <= fmin(out->depth, pd_model_pair_delta_max(model, id->body1, id->body2)))) return false;
+    if (!(beyond <= fmin(out->depth, pd_model_pair_delta_max(model, id->body1, id->body2))) &&
+        !through_far_side(s2, id->feat2, q, outside, out->depth))
+      return false;
     pdMat3 rel;
     pdVec3 off;
     pose_in_frame_of(p2, p1, &rel, &off);

@@ -478,6 +478,41 @@ static void test_edge_along_a_rim_face_gives_both_crossings(void** state) {
   pd_model_free(m);
 }
 
+// A corner pressed through a thin plate (docs/contact-model.md, "A vertex pressed through a thin body"): a
+// tetrahedron's apex in contact on the plate's top face keeps that contact when it has come out through the bottom
+// face (outside only across a face turned away from its own, over the top face, its body's lowest point), and breaks
+// once it is also outside a side face. The search makes no new contact of a vertex there.
+static void test_a_vertex_pressed_through_a_thin_plate_keeps_its_face(void** state) {
+  (void)state;
+  const double half = 0.002;  // the plate's half-thickness, m
+  pdModel* m = compile("cube plate grey 0.4 0.4 0.004\nhull tip red 0 0 0 0.05 0 0.05 -0.05 0.05 0.05 -0.05 -0.05 0.05\n");
+  const pdPolyhedron* tip = &m->bodies[1].shape;
+  int apex = 0;
+  for (int v = 1; v < tip->vertexCount; ++v)
+    if (tip->vertices[v].z < tip->vertices[apex].z) apex = v;
+  double apexZ = tip->vertices[apex].z;  // below the hull's centre of mass, its frame's origin
+  pdPose plate = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  pdPose in = pose(0.05, 0, half - DEPTH - apexZ, 0, pd_v3(0, 0, 1));
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &plate, 1, &in, NULL, NULL, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 1);
+  assert_int_equal(c[0].id.kind, pd_contactVF);
+  assert_int_equal(c[0].id.feat1, apex);
+  pdContactId id = c[0].id;
+  expect_near(c[0].normal.z, 1.0, GEOM_TOL, "the top face's normal");
+  // through the plate and 1 mm beyond its bottom face (the pair's delta_max is a quarter of its 4 mm width)
+  pdPose through = pose(0.05, 0, -half - 1e-3 - apexZ, 0, pd_v3(0, 0, 1));
+  pdContactGeom g;
+  assert_true(pd_contact_track(m, &id, &through, &plate, &g));
+  expect_near(g.depth, 2.0 * half + 1e-3, GEOM_TOL, "depth below the top face");
+  expect_near(g.normal.z, 1.0, GEOM_TOL, "the normal stays the top face's");
+  assert_int_equal(pd_contacts_find(m, 0, &plate, 1, &through, NULL, NULL, NULL, 0, c, CAPACITY), 0);
+  // beyond the plate's side as well (x = 0.2 is its edge): over the top face no more, broken
+  pdPose off = pose(0.2 + 1e-3, 0, -half - 1e-3 - apexZ, 0, pd_v3(0, 0, 1));
+  assert_false(pd_contact_track(m, &id, &off, &plate, &g));
+  pd_model_free(m);
+}
+
 static void test_small_capacity_reports_the_needed_count(void** state) {
   (void)state;
   pdModel* m = compile(cubeOnFloor);
@@ -506,6 +541,7 @@ int main(void) {
       cmocka_unit_test(test_sharp_edge_pair_is_not_pruned_before_the_inside_test),
       cmocka_unit_test(test_a_deep_edge_pair_the_search_finds_is_tracked),
       cmocka_unit_test(test_edge_along_a_rim_face_gives_both_crossings),
+      cmocka_unit_test(test_a_vertex_pressed_through_a_thin_plate_keeps_its_face),
       cmocka_unit_test(test_small_capacity_reports_the_needed_count),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
