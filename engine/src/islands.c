@@ -33,6 +33,11 @@
 //   over the sample interval standing for it in every sync partition. When another body's box over a sync
 //   interval reaches that box, the free body is brought to that sync time alone and joins the others from
 //   there; a free body found outside its box (never expected) is counted (islandStrays), not recovered.
+// - A lone moving body is one island over any interval: its sample interval is not cut, and find_free's partition
+//   (the same one island, the same box: a free body's box over a sync interval is its box over the sample
+//   interval) stands for the interval's. The one island of every moving body (a lone body, a stack joined by its
+//   contacts) is written out, not sorted. So a body alone costs per sample a start (box, bound), one partition,
+//   the gather and the sleep test, which sleeping needs.
 // - Persistence: an island whose bodies are the same as the last interval's keeps its state (its contact
 //   list, caches, step size) and simply goes on; a new island is set up from the scene's state at T (its
 //   bodies' numbers and contacts copied, the contacts' springs, forces and modal dampers as they were:
