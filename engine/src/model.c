@@ -309,6 +309,8 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
       .deflection = s->deflection,
       .sleep = s->sleep,
   };
+  // a scene without `dtmax` gets the cap of its tolerance, which the scene's last `tol` decides
+  if (!(s->setMask & PD_SET_DTMAX)) m->settings.dtmax = pd_default_dtmax(s->tol);
   if (s->setMask & PD_SET_VMAX) {
     m->settings.vmax = s->vmax;
   } else {

@@ -922,6 +922,13 @@ pdScene* pd_scene_parse_buffer(const char* name, const char* text, size_t length
   return parse(name ? name : "<buffer>", NULL, bytes, length, err);
 }
 
+double pd_default_dtmax(double tol) {
+  PD_ASSERT(tol > 0.0);
+  if (tol <= PD_DEFAULT_TOL) return PD_DEFAULT_DTMAX;
+  // RK4's local error grows as h⁵: the step whose error is tol where PD_DEFAULT_DTMAX's is PD_DEFAULT_TOL
+  return fmin(PD_DTMAX_DERIVED_CEILING, PD_DEFAULT_DTMAX * pow(tol / PD_DEFAULT_TOL, 0.2));
+}
+
 void pd_scene_free(pdScene* scene) {
   if (!scene) return;
   for (int i = 0; i < scene->objectCount; ++i) {

@@ -10,12 +10,15 @@
 // - sliding so on the fixed floor itself: the floor's top face is its only way in, and once the two touch the guard
 //   bounds only the move into it (contact_search.c, entry_holds), which sliding does not make: the guard sets none
 //   of its steps but the first.
+// And the largest step of a scene that sets no dtmax follows its tolerance (pd_default_dtmax): the same free fall at
+// tol 1e-2 takes the longer cap, lands where the parabola does, and a scene's own dtmax is kept.
 #include <setjmp.h>
 #include <stdbool.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <math.h>
 #include <stdlib.h>
 
 #include <cmocka.h>
@@ -24,15 +27,18 @@
 #include "polydyn/state.h"
 #include "scene_run.h"
 
-static pdModel* cube_on_floor(const char* placement) {
+// `settings`: extra setting lines ("" for none)
+static pdModel* cube_on_floor_with(const char* settings, const char* placement) {
   char text[512];
   snprintf(text, sizeof text,
-           "tend 0.3\nsample 100\n"
+           "tend 0.3\nsample 100\n%s"
            "cube floor grey 4 1 0.2\nfixed\nloc 1.5 0 -0.1\nmu 0.01\n"
            "cube block red 0.1 0.1 0.1\n%s\nmu 0.01\n",
-           placement);
+           settings, placement);
   return compile_text(text);
 }
+
+static pdModel* cube_on_floor(const char* placement) { return cube_on_floor_with("", placement); }
 
 // The same cube on a free 2 cm slab (3 m by 1 m, of the same material) that lies on the fixed floor.
 static pdModel* cube_on_slab(const char* placement) {
@@ -80,6 +86,40 @@ static void test_a_free_fall_is_held_by_the_largest_step(void** state) {
   pd_model_free(m);
 }
 
+static void test_the_largest_step_follows_a_loose_tolerance(void** state) {
+  (void)state;
+  // the cap itself: the fixed default at the default tolerance and tighter, h ∝ tol^(1/5) looser, with a ceiling
+  assert_true(pd_default_dtmax(PD_DEFAULT_TOL) == PD_DEFAULT_DTMAX);
+  assert_true(pd_default_dtmax(1e-9) == PD_DEFAULT_DTMAX);
+  assert_float_equal(pd_default_dtmax(1e-1), PD_DTMAX_DERIVED_CEILING, 1e-15);
+  assert_true(pd_default_dtmax(10.0) == PD_DTMAX_DERIVED_CEILING);
+  double loose = PD_DEFAULT_DTMAX * pow(1e4, 0.2);  // tol 1e-2: 0.063 s
+  assert_float_equal(pd_default_dtmax(1e-2), loose, 1e-15);
+
+  pdModel* tight = cube_on_floor("loc 0 0 2");
+  pdModel* m = cube_on_floor_with("tol 1e-2\n", "loc 0 0 2");
+  pdModel* own = cube_on_floor_with("tol 1e-2\ndtmax 0.01\n", "loc 0 0 2");
+  assert_true(tight->settings.dtmax == PD_DEFAULT_DTMAX);
+  assert_float_equal(m->settings.dtmax, loose, 1e-15);
+  assert_true(own->settings.dtmax == 0.01);
+  pdState* sTight = held_by(tight, false, pd_limitLargest);
+  pdState* s = held_by(m, false, pd_limitLargest);
+  // 0.3 s at 0.063 s a step after the first steps grow from dt (1e-3, at most 5× a step): 8 steps, against 32
+  print_message("accepted: %ld at tol 1e-2, %ld at tol 1e-6\n", s->count.accepted, sTight->count.accepted);
+  assert_true(s->count.accepted <= 10);
+  assert_true(sTight->count.accepted >= 30);
+  // a free fall has no error for the estimate to see: the long steps land where the parabola does (to rounding)
+  pdBodyState block = pd_state_body(m, s, 1);
+  double fall = 0.5 * 9.81 * 0.3 * 0.3;
+  assert_float_equal(block.x.z, 2.0 - fall, 1e-12);
+  assert_float_equal(block.v.z, -9.81 * 0.3, 1e-12);
+  pd_state_free(sTight);
+  pd_state_free(s);
+  pd_model_free(tight);
+  pd_model_free(m);
+  pd_model_free(own);
+}
+
 static void test_a_resting_cube_is_held_by_the_stability_bound(void** state) {
   (void)state;
   pdModel* m = cube_on_floor("loc 0 0 0.05");
@@ -110,6 +150,7 @@ static void test_a_cube_sliding_fast_on_the_fixed_floor_is_not_held_by_the_tunne
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_free_fall_is_held_by_the_largest_step),
+      cmocka_unit_test(test_the_largest_step_follows_a_loose_tolerance),
       cmocka_unit_test(test_a_resting_cube_is_held_by_the_stability_bound),
       cmocka_unit_test(test_a_cube_sliding_fast_on_a_free_slab_is_held_by_the_tunnelling_guard),
       cmocka_unit_test(test_a_cube_sliding_fast_on_the_fixed_floor_is_not_held_by_the_tunnelling_guard),

@@ -103,7 +103,9 @@ typedef struct pdSceneObject {
 #define PD_DEFAULT_TOL 1e-6           // weighted max-norm of the local error estimate, dimensionless
 #define PD_DEFAULT_DT 1e-3            // s, first step proposed
 #define PD_DEFAULT_DTMIN 1e-9         // s
-#define PD_DEFAULT_DTMAX 1e-2         // s
+#define PD_DEFAULT_DTMAX 1e-2         // s, at tol PD_DEFAULT_TOL and tighter; looser: pd_default_dtmax
+// the longest derived dtmax, s: the longest cap measured on the Gedanken work-precision ladder (tol 1e-1)
+#define PD_DTMAX_DERIVED_CEILING 0.1
 #define PD_DEFAULT_SAMPLE 100.0       // output samples per second
 #define PD_DEFAULT_DEFLECTION 0.01    // δ_max as a fraction of a body's average dimension
 #define PD_DEFAULT_SLEEP true         // islands at rest stop being integrated (docs/sleeping.md)
@@ -145,5 +147,12 @@ PD_API pdScene* pd_scene_parse_buffer(const char* name, const char* text, size_t
 
 // Frees the scene and everything it holds; NULL is allowed.
 PD_API void pd_scene_free(pdScene* scene);
+
+// The largest step of a scene that sets no `dtmax`, s, for its tolerance `tol` (> 0): PD_DEFAULT_DTMAX at
+// PD_DEFAULT_TOL and tighter; looser, PD_DEFAULT_DTMAX (tol / PD_DEFAULT_TOL)^(1/5), the step at which a local
+// error of the steppers' order (step doubling's h⁵) that reaches PD_DEFAULT_TOL at PD_DEFAULT_DTMAX reaches tol,
+// at most PD_DTMAX_DERIVED_CEILING. The cap follows the tolerance as the error control's steps do (docs/events.md,
+// "The largest step"); pd_model_compile applies it.
+PD_API double pd_default_dtmax(double tol);
 
 PD_EXTERN_C_END
