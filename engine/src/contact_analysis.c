@@ -150,6 +150,21 @@ static double penetration_depth(const pdPolyhedron* sa, const pdPose* pa, const 
   return r.depth > 0.0 ? r.depth : 0.0;
 }
 
+// Edge pruning before the Gauss-map test: an edge whose two ends lie outside one face plane of the other
+// body, by more than the pair's δ_max plus PRUNE_OUTSIDE_TOLS boundary tolerances, lies wholly outside that
+// body by more than find_ee's inside test allows (one tolerance, or for a sharp edge's pair up to the depth,
+// at most δ_max): its pairs are skipped unseen. The margin of one more tolerance (1e-12 × size) covers the
+// rounding of the closest points (~1e-16 × size), so pruning never changes a result. (A margin of tolerances
+// alone, from before the sharp-edge rule, pruned such pairs: seed 3, scene 1779 of the soak, two compact
+// bodies met edge on edge 0.05 of an edge from a corner and sank 15 δ_max with no contact.) Masks hold the
+// first 64 faces (a bit per face); vertices beyond PRUNE_VERTICES_MAX are not pruned (correct, only slower).
+// find_vf forms the masks: it places each vertex of one body in the other's frame and measures it against the other's
+// face planes anyway (its placement through the world rounds otherwise than one through the relative pose, by
+// ~1e-16 × size: within the margin's tolerance too).
+#define PRUNE_OUTSIDE_TOLS 2.0
+#define PRUNE_VERTICES_MAX 512
+typedef unsigned long long faceMask;
+
 // ---------------------------------------------------------------- a vertex beyond an acute edge
 //
 // Design note. The paper's VF contact is a vertex inside the other body. At an acute edge of the other body (faces
@@ -251,20 +266,23 @@ __attribute__((noinline)) static int vf_beyond_acute_edge(const pdModel* m, int 
   return n + 1;
 }
 
-// VF contacts of the vertices of body iv inside body jf.
+// VF contacts of the vertices of body iv inside body jf, and, with mask, each vertex's faces of jf (of the first 64)
+// whose plane it lies outside of by more than the pruning margin (find_ee's edge pruning).
 // (Formed twice, for a face body with an acute edge and for one without (find_vf): without, the loop is the paper's
 // alone, as fast as it was before vertices beyond acute edges were looked at.)
 __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m, int iv, const pdPose* pv,
                                                                 const pdPose* pv0, int jf, const pdPose* pf,
                                                                 const pdPose* pf0, const pdContactId* previous,
                                                                 int previousCount, pdContactGeom* out, int capacity,
-                                                                int n, const bool acute) {
+                                                                int n, faceMask* mask, const bool acute) {
   const pdPolyhedron* sv = &m->bodies[iv].shape;
   const pdPolyhedron* sf = &m->bodies[jf].shape;
   double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
   double deltaMax = pd_model_pair_delta_max(m, iv, jf);
   double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
   beyondAcute beyond = {acute, NAN};
+  int maskFaces = mask ? (sf->faceCount < 64 ? sf->faceCount : 64) : 0;
+  double maskMargin = deltaMax + PRUNE_OUTSIDE_TOLS * tol;
   pdMat3 rel;  // the vertex body in the face body's frame
   pdVec3 off;
   pose_in_frame_of(pf, pv, &rel, &off);
@@ -282,12 +300,20 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
     // rounding (1e-11 rad moves it 1e-12 m on a 0.1 m box), must stay a VF contact; lost at the boundary
     // tolerance it left its corner to an edge-edge pair that came and went with the rounding's sign.
     double outsideBy = 0.0;  // m: how far outside the face plane that showed it outside (acute only)
-    for (int f = 0; f < sf->faceCount && !outside; ++f) {
+    faceMask outsideFaces = 0;
+    int f = 0;
+    for (; f < sf->faceCount && !outside; ++f) {
       double d = face_depth(sf, f, q);
+      if (f < maskFaces && d < -maskMargin) outsideFaces |= 1ull << f;
       if (d <= flushTol && d >= -flushTol && !crosses_face_plane(sv, &rel, off, sf, f, flushTol)) continue;
       outside = d < -tol;
       if (acute) outsideBy = -d;
       if (d < penetration) penetration = d;  // fmin but inline (only compared with tol below)
+    }
+    if (mask) {  // the faces past the one that showed the vertex outside
+      for (; f < maskFaces; ++f)
+        if (face_depth(sf, f, q) < -maskMargin) outsideFaces |= 1ull << f;
+      mask[i] = outsideFaces;
     }
     if (outside) {
       // a vertex beyond an acute edge, still pressed into a face (design note above): the vertices outside a body with
@@ -334,10 +360,10 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
 
 static int find_vf(const pdModel* m, int iv, const pdPose* pv, const pdPose* pv0, int jf, const pdPose* pf,
                    const pdPose* pf0, const pdContactId* previous, int previousCount, pdContactGeom* out, int capacity,
-                   int n) {
+                   int n, faceMask* mask) {
   if (pd_polyhedron_has_acute_edge(&m->bodies[jf].shape))
-    return find_vf_formed(m, iv, pv, pv0, jf, pf, pf0, previous, previousCount, out, capacity, n, true);
-  return find_vf_formed(m, iv, pv, pv0, jf, pf, pf0, previous, previousCount, out, capacity, n, false);
+    return find_vf_formed(m, iv, pv, pv0, jf, pf, pf0, previous, previousCount, out, capacity, n, mask, true);
+  return find_vf_formed(m, iv, pv, pv0, jf, pf, pf0, previous, previousCount, out, capacity, n, mask, false);
 }
 
 // Closest points of the lines P + s u and Q + t v; false when (nearly) parallel.
@@ -453,32 +479,6 @@ static bool edge_pair_geometry(const pdPolyhedron* sa, int ea, pdVec3 b0, pdVec3
   return true;
 }
 
-// Edge pruning before the Gauss-map test: an edge whose two ends lie outside one face plane of the other
-// body, by more than the pair's δ_max plus PRUNE_OUTSIDE_TOLS boundary tolerances, lies wholly outside that
-// body by more than find_ee's inside test allows (one tolerance, or for a sharp edge's pair up to the depth,
-// at most δ_max): its pairs are skipped unseen. The margin of one more tolerance (1e-12 × size) covers the
-// rounding of the closest points (~1e-16 × size), so pruning never changes a result. (A margin of tolerances
-// alone, from before the sharp-edge rule, pruned such pairs: seed 3, scene 1779 of the soak, two compact
-// bodies met edge on edge 0.05 of an edge from a corner and sank 15 δ_max with no contact.) Masks hold the
-// first 64 faces (a bit per face); vertices beyond PRUNE_VERTICES_MAX are not pruned (correct, only slower).
-#define PRUNE_OUTSIDE_TOLS 2.0
-#define PRUNE_VERTICES_MAX 512
-typedef unsigned long long faceMask;
-
-// mask[i]: the faces (of the first 64) of `faces` whose plane vertex i (given in that body's frame by
-// rel·v + off) lies outside of by more than `margin`.
-static void outside_masks(const pdPolyhedron* vertices, const pdMat3* rel, pdVec3 off, const pdPolyhedron* faces,
-                          double margin, faceMask* mask) {
-  int faceCount = faces->faceCount < 64 ? faces->faceCount : 64;
-  for (int i = 0; i < vertices->vertexCount; ++i) {
-    pdVec3 q = pd_v3_add(off, pd_mat3_mulv(rel, vertices->vertices[i]));
-    faceMask m = 0;
-    for (int f = 0; f < faceCount; ++f)
-      if (face_depth(faces, f, q) < -margin) m |= 1ull << f;
-    mask[i] = m;
-  }
-}
-
 // Does B's edge b0–b1 (A's frame) lie in the plane of a face of A around A's edge ea, a plane that B does
 // not cross (B's rotation rel and offset off in A's frame): a plane both bodies share (FLUSH_TOL_DEFLECTIONS)?
 static bool in_shared_plane(const pdPolyhedron* sa, const pdEdge* ea, pdVec3 b0, pdVec3 b1, const pdPolyhedron* sb,
@@ -548,8 +548,10 @@ static double least_face_overlap(const pdPolyhedron* sa, const pdPolyhedron* sb,
   return least;
 }
 
-static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, pdContactGeom* out,
-                   int capacity, int n) {
+// Edge-edge contacts of A and B; maskA, maskB (find_vf's, both or neither): A's vertices outside B's face planes and B's
+// outside A's, by more than the pruning margin.
+static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const pdPose* pb, const faceMask* maskA,
+                   const faceMask* maskB, pdContactGeom* out, int capacity, int n) {
   const pdPolyhedron* sa = &model->bodies[ia].shape;
   const pdPolyhedron* sb = &model->bodies[ib].shape;
   pdMat3 rel;  // B in A's frame
@@ -560,15 +562,7 @@ static int find_ee(const pdModel* model, int ia, const pdPose* pa, int ib, const
   double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
   double vertexReach = EE_AT_VF_VERTEX_DEFLECTIONS * deltaMax;
   int vfCount = n < capacity ? n : capacity;                      // this pair's VF contacts, found before its EE ones
-  faceMask maskA[PRUNE_VERTICES_MAX], maskB[PRUNE_VERTICES_MAX];  // A's vertices against B's faces, and B's against A's
-  bool prune = sa->vertexCount <= PRUNE_VERTICES_MAX && sb->vertexCount <= PRUNE_VERTICES_MAX;
-  if (prune) {
-    // A in B's frame: rotation relᵀ, translation −relᵀ off
-    pdMat3 relT = pd_mat3_transpose(&rel);
-    outside_masks(sa, &relT, pd_v3_scale(pd_mat3_mulv(&relT, off), -1.0), sb, deltaMax + PRUNE_OUTSIDE_TOLS * tolB,
-                  maskA);
-    outside_masks(sb, &rel, off, sa, deltaMax + PRUNE_OUTSIDE_TOLS * tolA, maskB);
-  }
+  bool prune = maskA != NULL;
   // A's arcs (its edges' face normals, fixed in A's frame), each formed once for all of B's edges when first
   // needed (most pairs are pruned), and the overlap along a face normal by face (A's, then B's reversed): touching
   // arcs (a 45° stack's flush faces) test the same four faces for most of their edge pairs. A bit per entry says
@@ -733,10 +727,14 @@ int pd_contacts_find(const pdModel* model, int ia, const pdPose* pa, int ib, con
     int ti = ia;
     ia = ib, ib = ti;
   }
+  // A's vertices against B's faces, and B's against A's (find_ee's pruning)
+  faceMask maskA[PRUNE_VERTICES_MAX], maskB[PRUNE_VERTICES_MAX];
+  bool prune = model->bodies[ia].shape.vertexCount <= PRUNE_VERTICES_MAX &&
+               model->bodies[ib].shape.vertexCount <= PRUNE_VERTICES_MAX;
   int n = 0;
-  n = find_vf(model, ia, pa, pa0, ib, pb, pb0, previous, previousCount, out, capacity, n);
-  n = find_vf(model, ib, pb, pb0, ia, pa, pa0, previous, previousCount, out, capacity, n);
-  n = find_ee(model, ia, pa, ib, pb, out, capacity, n);
+  n = find_vf(model, ia, pa, pa0, ib, pb, pb0, previous, previousCount, out, capacity, n, prune ? maskA : NULL);
+  n = find_vf(model, ib, pb, pb0, ia, pa, pa0, previous, previousCount, out, capacity, n, prune ? maskB : NULL);
+  n = find_ee(model, ia, pa, ib, pb, prune ? maskA : NULL, prune ? maskB : NULL, out, capacity, n);
   if (n > capacity) return n;
   n = drop_coincident(out, n, ia);
   // the contact state is kept sorted by id (§4.4): sort this pair's contacts (few: insertion sort)

@@ -116,8 +116,7 @@ double pd_history_spring_energy(const pdModel* model, const pdContactHistory* h)
 
 static int compare_traces(const trace* a, const trace* b) { return pd_contact_id_compare(&a->id, &b->id); }
 
-// Merges the sorted runs a[0, na) and b[0, nb) into out[0, na + nb). out may end where b is (b = out + na): each
-// element is written at or before where b's next one is read.
+// Merges the sorted runs a[0, na) and b[0, nb) into out[0, na + nb) (out overlaps neither).
 static void merge_traces(const trace* a, int na, const trace* b, int nb, trace* out) {
   int i = 0, j = 0, k = 0;
   while (i < na && j < nb) out[k++] = compare_traces(&b[j], &a[i]) < 0 ? b[j++] : a[i++];
@@ -170,8 +169,11 @@ void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* pos
     trace* run = h->items + keptSorted;
     sort_traces(run, added, h->scratch);
     if (keptSorted > 0 && compare_traces(&h->items[keptSorted - 1], &run[0]) > 0) {
-      memcpy(h->scratch, h->items, (size_t)keptSorted * sizeof *h->items);
-      merge_traces(h->scratch, keptSorted, run, added, h->items);  // writes behind what it reads of `run`
+      // from the back, the new ones (few) set aside: each write lands past the sorted run's unread part
+      memcpy(h->scratch, run, (size_t)added * sizeof *run);
+      int i = keptSorted - 1, j = added - 1, k = kept - 1;
+      while (j >= 0)
+        h->items[k--] = i >= 0 && compare_traces(&h->items[i], &h->scratch[j]) > 0 ? h->items[i--] : h->scratch[j--];
     }
   }
   h->count = h->sortedCount = kept;

@@ -318,7 +318,7 @@ void pd_contact_search_free(pdContactSet* set);
 int pd_contact_search_broad_phase(const pdModel* model, pdContactSet* set, const double* y0, const double* y1,
                                   double h, const pdPose* poses0, const pdPose* poses1);
 // Tunnelling guard over the step of h just analysed: whether a listed pair moved too far relative to each other, and
-// then the shorter step to retry (*hRetry).
+// then the shorter step to retry (*hRetry). The bodies' travel is the broad phase's, called just before on that step.
 bool pd_contact_search_travel_retry(const pdModel* model, pdContactSet* set, int pairCount, double h,
                                     double* hRetry);
 // The contact search at y1 over the pairs of the broad phase: the candidates (contacts of C1 not in C0), each with

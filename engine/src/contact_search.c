@@ -116,21 +116,31 @@ static double turn_angle(const pdPose* p0, const pdPose* p1) {
 // than half a turn a step shows a smaller one. The end poses alone miss it: a 0.4 m bar turning 0.5 rad in a step swings
 // its end 6 mm beyond both. The velocities' change is left out, as in the guard's move bound: gravity bends a path by
 // g h²/8, 0.12 mm over the longest default step, and contact forces act on pairs that are listed already.
-static double sway(const double* yb0, const double* yb1, double h, double r, const pdPose* p0, const pdPose* p1) {
-  double turn = fmax(h * fmax(pd_v3_norm(pd_layout_w(yb0)), pd_v3_norm(pd_layout_w(yb1))), turn_angle(p0, p1));
+// turned: turn_angle(p0, p1).
+static double sway(const double* yb0, const double* yb1, double h, double r, double turned) {
+  double turn = fmax(h * fmax(pd_v3_norm(pd_layout_w(yb0)), pd_v3_norm(pd_layout_w(yb1))), turned);
   return r * fmin(0.25 * turn * turn, 2.0);
+}
+
+// How far body i's points move at most between two poses, m: the centre's displacement plus the largest
+// vertex radius times the rotation angle (turned: turn_angle(p0, p1)).
+static double travel(const pdBody* b, const pdPose* p0, const pdPose* p1, double turned) {
+  return pd_v3_norm(pd_v3_sub(p1->x, p0->x)) + b->radius * turned;
 }
 
 // Broad phase over the step: each moving body's box covers its boxes at both ends of the step and how far its points
 // may stray from their chords in between (sway), so a pair that met and parted (or tunnelled) inside the step is
 // listed too, and the tunnelling guard sees it: a spinning body whose corner swings through the floor between two
-// steps' ends. Returns the number of pairs.
+// steps' ends. Returns the number of pairs. Measures each moving body's travel over the step too (travel(), for the
+// tunnelling guard), from the same turn angle.
 int pd_contact_search_broad_phase(const pdModel* model, pdContactSet* set, const double* y0, const double* y1,
                                   double h, const pdPose* poses0, const pdPose* poses1) {
   for (int k = 0; k < model->movingCount; ++k) {
     int i = model->movingBodies[k];
     const double *yb0 = y0 + PD_BODY_STATE_SIZE * k, *yb1 = y1 + PD_BODY_STATE_SIZE * k;
-    double margin = sway(yb0, yb1, h, model->bodies[i].radius, &poses0[i], &poses1[i]);
+    double turned = turn_angle(&poses0[i], &poses1[i]);
+    set->travel[i] = travel(&model->bodies[i], &poses0[i], &poses1[i], turned);
+    double margin = sway(yb0, yb1, h, model->bodies[i].radius, turned);
     pdAabb a = pd_aabb_of(&model->bodies[i].shape, poses0[i].x, &poses0[i].R);
     pdAabb b = pd_aabb_of(&model->bodies[i].shape, poses1[i].x, &poses1[i].R);
     for (int d = 0; d < 3; ++d) a.lo[d] = fmin(a.lo[d], b.lo[d]) - margin, a.hi[d] = fmax(a.hi[d], b.hi[d]) + margin;
@@ -146,12 +156,6 @@ int pd_contact_search_broad_phase(const pdModel* model, pdContactSet* set, const
     grow_pair_lists(set);
   }
   return pairCount;
-}
-
-// How far body i's points move at most between two poses, m: the centre's displacement plus the largest
-// vertex radius times the rotation angle.
-static double travel(const pdBody* b, const pdPose* p0, const pdPose* p1) {
-  return pd_v3_norm(pd_v3_sub(p1->x, p0->x)) + b->radius * turn_angle(p0, p1);
 }
 
 // The planes that bound where a point may end inside body i at the step's end (4 numbers a plane: normal, offset;
@@ -416,12 +420,8 @@ static double reaching_fraction(const pdModel* model, pdContactSet* set, int a, 
 // The longest step (as a fraction of the step just taken, at most PD_TRAVEL_ROOM_MAX) that keeps every listed pair's
 // relative travel within PD_TRAVEL_WIDTH_FRACTION of the thinner body's width and PD_TRAVEL_DEFLECTIONS of its
 // δ_max. A pair whose bodies' whole travel (travel()) exceeds it is measured again over the points that may reach the
-// other body (reaching_fraction).
+// other body (reaching_fraction). The bodies' travel is the broad phase's, over the same step.
 static double travel_room(const pdModel* model, pdContactSet* set, int pairCount) {
-  for (int k = 0; k < model->movingCount; ++k) {
-    int i = model->movingBodies[k];
-    set->travel[i] = travel(&model->bodies[i], &set->poses0[i], &set->poses1[i]);
-  }
   double room = PD_TRAVEL_ROOM_MAX;
   int listed = 0;  // the contact list's cursor: it is sorted by the unordered body pair, as the pairs are
   for (int p = 0; p < pairCount; ++p) {

@@ -46,6 +46,15 @@ bool pd_scene_object_shape(const pdSceneObject* o, pdPolyhedron* shape, pdError*
   return false;
 }
 
+// Do two objects give the same body shape and density, number for number: the same polyhedron (qhull is
+// deterministic) and the same mass properties? A pile of equal boxes builds its hull once.
+static bool same_shape_definition(const pdSceneObject* a, const pdSceneObject* b) {
+  return a->kind == b->kind && a->n == b->n && memcmp(a->scale, b->scale, sizeof a->scale) == 0 &&
+         memcmp(&a->taper, &b->taper, sizeof a->taper) == 0 && memcmp(&a->spgrav, &b->spgrav, sizeof a->spgrav) == 0 &&
+         a->pointCount == b->pointCount &&
+         (a->pointCount == 0 || memcmp(a->points, b->points, 3 * (size_t)a->pointCount * sizeof *a->points) == 0);
+}
+
 static pdMat3 inverse_spd(const pdMat3* a) {
   // inverse by cofactors; a is symmetric positive definite (checked by the mass properties)
   const double(*m)[3] = a->m;
@@ -236,6 +245,10 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
   m->bodyCount = scene->objectCount;
   m->bodies = pd_zeroed((size_t)m->bodyCount, sizeof *m->bodies);
   m->movingBodies = pd_zeroed((size_t)m->bodyCount, sizeof *m->movingBodies);
+  // the objects whose shapes were built (not copied), latest last, and every body's mass properties
+  int* built = pd_zeroed((size_t)m->bodyCount, sizeof *built);
+  int builtCount = 0;
+  pdMassProperties* massProperties = pd_zeroed((size_t)m->bodyCount, sizeof *massProperties);
 
   for (int i = 0; i < scene->objectCount; ++i) {
     const pdSceneObject* o = &scene->objects[i];
@@ -247,21 +260,31 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
     b->where = o->where;
     b->density = 1000.0 * o->spgrav;
 
-    pdError why = {0};
-    pdMassProperties mp;
-    if (!pd_scene_object_shape(o, &b->shape, &why) || !pd_mass_properties(&b->shape, b->density, &mp, &why)) {
-      pd_error_set(err, scene->path, o->where.line, o->where.col, "object '%s': %s", o->name, why.message);
-      pd_model_free(m);
-      return NULL;
+    int same = builtCount - 1;
+    while (same >= 0 && !same_shape_definition(&scene->objects[built[same]], o)) --same;
+    pdMassProperties* mp = &massProperties[i];
+    if (same >= 0) {
+      pd_polyhedron_copy(&b->shape, &m->bodies[built[same]].shape);
+      *mp = massProperties[built[same]];
+    } else {
+      pdError why = {0};
+      if (!pd_scene_object_shape(o, &b->shape, &why) || !pd_mass_properties(&b->shape, b->density, mp, &why)) {
+        pd_error_set(err, scene->path, o->where.line, o->where.col, "object '%s': %s", o->name, why.message);
+        free(built);
+        free(massProperties);
+        pd_model_free(m);
+        return NULL;
+      }
+      // body frame: origin at the centre of mass, axes of the object's own frame
+      pd_polyhedron_translate(&b->shape, pd_v3_scale(mp->centroid, -1.0));
+      built[builtCount++] = i;
     }
-    // body frame: origin at the centre of mass, axes of the object's own frame
-    pd_polyhedron_translate(&b->shape, pd_v3_scale(mp.centroid, -1.0));
-    b->geometricCentre = pd_v3_scale(mp.centroid, -1.0);
-    b->volume = mp.volume;
-    b->mass = mp.mass;
-    b->inertia = mp.inertia;
-    memcpy(b->principal, mp.principal, sizeof b->principal);
-    b->principalAxes = mp.principalAxes;
+    b->geometricCentre = pd_v3_scale(mp->centroid, -1.0);
+    b->volume = mp->volume;
+    b->mass = mp->mass;
+    b->inertia = mp->inertia;
+    memcpy(b->principal, mp->principal, sizeof b->principal);
+    b->principalAxes = mp->principalAxes;
     if (b->fixed) {
       b->stateIndex = -1;
     } else {
@@ -282,6 +305,8 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
       b->w0 = o->spin != 0.0 ? pd_quat_rotate(b->q0, pd_v3_scale(spinAxis, o->spin)) : (pdVec3){0, 0, 0};
     }
     if ((o->setMask & PD_SET_PLANAR) && !make_planar(b, o, scene->path, err)) {
+      free(built);
+      free(massProperties);
       pd_model_free(m);
       return NULL;
     }
@@ -296,6 +321,9 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
       b->forcePoint = (pdVec3){o->forcePoint[0], o->forcePoint[1], o->forcePoint[2]};
     }
   }
+
+  free(built);
+  free(massProperties);
 
   const pdSceneSettings* s = &scene->settings;
   m->settings = (pdSettings){

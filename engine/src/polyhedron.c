@@ -528,6 +528,23 @@ void pd_polyhedron_translate(pdPolyhedron* p, pdVec3 shift) {
   }
 }
 
+void pd_polyhedron_copy(pdPolyhedron* out, const pdPolyhedron* p) {
+  int sides = 0;
+  for (int f = 0; f < p->faceCount; ++f) sides += p->faces[f].count;
+  *out = *p;
+  out->vertices = pd_zeroed((size_t)p->vertexCount, sizeof *out->vertices);
+  out->edges = pd_zeroed((size_t)p->edgeCount, sizeof *out->edges);
+  out->faces = pd_zeroed((size_t)p->faceCount, sizeof *out->faces);
+  out->faceVertices = pd_zeroed((size_t)sides, sizeof *out->faceVertices);
+  memcpy(out->vertices, p->vertices, (size_t)p->vertexCount * sizeof *out->vertices);
+  memcpy(out->edges, p->edges, (size_t)p->edgeCount * sizeof *out->edges);
+  memcpy(out->faces, p->faces, (size_t)p->faceCount * sizeof *out->faces);
+  memcpy(out->faceVertices, p->faceVertices, (size_t)sides * sizeof *out->faceVertices);
+  // the index is formed from the positions alone, so formed again it is the same
+  out->satIndex = NULL;
+  if (p->satIndex) pd_sat_index_build(out);
+}
+
 void pd_polyhedron_free(pdPolyhedron* p) {
   pd_sat_index_free(p->satIndex);
   free(p->vertices);

@@ -3,7 +3,8 @@
 // floor's size does not matter; δ_max at most a quarter of the thinner body's width), the default restitution
 // and modal dampers, explicit constants winning, pair constants (symmetry, μ = √(μ₁μ₂), e = √(e₁e₂), tabulated
 // or computed on the fly), the §3.3.1 and §3.3.2 adjustments as listed data, material classes, the shortest
-// contact period, and the refusals of compile: an unreachable restitution and bodies interpenetrating at t = 0.
+// contact period, and the refusals of compile: an unreachable restitution and bodies interpenetrating at t = 0. Bodies
+// whose objects define the same shape and density are built once: the numbers of each as if built alone.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -383,6 +384,71 @@ static void test_identical_bodies_share_one_material_class(void** state) {
   pd_model_free(m);
 }
 
+// Body i of a and body j of b: the same polyhedron, mass properties, extents and minimum effective mass, bit for bit.
+static void expect_same_body(const pdModel* a, int i, const pdModel* b, int j) {
+  const pdBody *x = &a->bodies[i], *y = &b->bodies[j];
+  const pdPolyhedron *p = &x->shape, *q = &y->shape;
+  assert_int_equal(p->vertexCount, q->vertexCount);
+  assert_int_equal(p->edgeCount, q->edgeCount);
+  assert_int_equal(p->faceCount, q->faceCount);
+  assert_memory_equal(p->vertices, q->vertices, (size_t)p->vertexCount * sizeof *p->vertices);
+  assert_memory_equal(p->edges, q->edges, (size_t)p->edgeCount * sizeof *p->edges);
+  assert_memory_equal(p->faces, q->faces, (size_t)p->faceCount * sizeof *p->faces);
+  int sides = 0;
+  for (int f = 0; f < p->faceCount; ++f) sides += p->faces[f].count;
+  assert_memory_equal(p->faceVertices, q->faceVertices, (size_t)sides * sizeof *p->faceVertices);
+  const double numbers[][2] = {{x->mass, y->mass}, {x->volume, y->volume}, {x->size, y->size}, {x->width, y->width},
+                               {x->radius, y->radius}, {x->principal[0], y->principal[0]},
+                               {x->principal[2], y->principal[2]},
+                               {pd_model_body_contact_info(a, i).mMin, pd_model_body_contact_info(b, j).mMin}};
+  for (size_t k = 0; k < sizeof numbers / sizeof numbers[0]; ++k)
+    if (memcmp(&numbers[k][0], &numbers[k][1], sizeof(double)) != 0)
+      fail_msg("number %zu: %.17g against %.17g built alone", k, numbers[k][0], numbers[k][1]);
+  assert_memory_equal(&x->inertia, &y->inertia, sizeof x->inertia);
+  assert_memory_equal(&x->principalAxes, &y->principalAxes, sizeof x->principalAxes);
+  assert_memory_equal(&x->geometricCentre, &y->geometricCentre, sizeof x->geometricCentre);
+}
+
+static void test_equal_shapes_are_built_once_as_each_alone(void** state) {
+  (void)state;
+  // a and b are equal (turned apart); c is denser; d is 1e-16 m taller (a different double); e is a hull of a's
+  // corners (another kind: built on its own)
+  const char* box = "cube %s tan 0.2 0.15 %s\n";
+  const char* lines[][3] = {{"a", "0.1", ""}, {"b", "0.1", ""}, {"c", "0.1", "spgrav 2\n"},
+                            {"d", "0.1000000000000001", ""}};
+  char text[2048] = "cube floor grey 3 3 0.1\nfixed\nloc 0 0 -0.05\n";
+  for (int k = 0; k < 4; ++k) {
+    size_t at = strlen(text);
+    snprintf(text + at, sizeof text - at, box, lines[k][0], lines[k][1]);
+    at = strlen(text);
+    snprintf(text + at, sizeof text - at, "loc %g 0 0.2  %d 1 2 3\n%s", -0.9 + 0.4 * k, 40 * k, lines[k][2]);
+  }
+  strcat(text, "hull e tan -0.1 -0.075 -0.05 0.1 -0.075 -0.05 -0.1 0.075 -0.05 0.1 0.075 -0.05 "
+               "-0.1 -0.075 0.05 0.1 -0.075 0.05 -0.1 0.075 0.05 0.1 0.075 0.05\nloc 0.9 0 0.2\n");
+  pdModel* pile = compile(text);
+  assert_int_equal(pile->bodyCount, 6);
+  for (int k = 0; k < 5; ++k) {
+    char alone[512];
+    if (k < 4) {
+      snprintf(alone, sizeof alone, box, lines[k][0], lines[k][1]);
+      strcat(alone, lines[k][2]);
+    } else {
+      snprintf(alone, sizeof alone, "hull e tan -0.1 -0.075 -0.05 0.1 -0.075 -0.05 -0.1 0.075 -0.05 0.1 0.075 -0.05 "
+                                    "-0.1 -0.075 0.05 0.1 -0.075 0.05 -0.1 0.075 0.05 0.1 0.075 0.05\n");
+    }
+    pdModel* m = compile(alone);
+    expect_same_body(pile, 1 + k, m, 0);
+    pd_model_free(m);
+  }
+  // copies, not one array twice (each body's shape is its own to free)
+  assert_ptr_not_equal(pile->bodies[1].shape.vertices, pile->bodies[2].shape.vertices);
+  // what differs is seen: twice the density, a taller box
+  assert_true(pile->bodies[3].mass > 1.9 * pile->bodies[1].mass);
+  assert_true(memcmp(pile->bodies[4].shape.vertices, pile->bodies[1].shape.vertices,
+                     8 * sizeof *pile->bodies[1].shape.vertices) != 0);
+  pd_model_free(pile);
+}
+
 static void test_shortest_contact_period_matches_the_pairs(void** state) {
   (void)state;
   pdModel* m = compile("vmax 3\ncube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\n"
@@ -464,6 +530,7 @@ int main(void) {
       cmocka_unit_test(test_dtmin_above_a_contact_time_constant_adjusts_the_pair),
       cmocka_unit_test(test_every_pair_adjustment_is_listed_or_counted),
       cmocka_unit_test(test_identical_bodies_share_one_material_class),
+      cmocka_unit_test(test_equal_shapes_are_built_once_as_each_alone),
       cmocka_unit_test(test_shortest_contact_period_matches_the_pairs),
       cmocka_unit_test(test_unreachable_restitution_is_refused_at_the_object),
       cmocka_unit_test(test_interpenetrating_cubes_are_refused_at_the_later_body),

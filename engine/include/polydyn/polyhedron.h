@@ -82,6 +82,10 @@ PD_API bool pd_polyhedron_validate(const pdPolyhedron* p, pdError* err);
 // Moves every vertex and plane by `shift` (x → x + shift).
 PD_API void pd_polyhedron_translate(pdPolyhedron* p, pdVec3 shift);
 
+// A copy of p into *out, arrays and all (the same numbers, bit for bit), that the caller frees with
+// pd_polyhedron_free.
+PD_API void pd_polyhedron_copy(pdPolyhedron* out, const pdPolyhedron* p);
+
 // Frees the arrays of *p (not p itself) and zeroes it.
 PD_API void pd_polyhedron_free(pdPolyhedron* p);
 
