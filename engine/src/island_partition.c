@@ -44,15 +44,14 @@ static bool boxes_overlap(const pdAabb* a, const pdAabb* b) {
 }
 
 double pd_island_travel_bound(const pdModel* model, const struct pdIslandSet* set, int k, const double* yb,
-                              const pdAabb* box, bool* touchingOut, double t, double dt) {
+                              const pdMat3* r, const pdAabb* box, bool* touchingOut, double t, double dt) {
   const pdBody* b = &model->bodies[model->movingBodies[k]];
   bool touching = *touchingOut;
   double accel = 0.0;
   if (b->hasForce) accel = (pd_v3_norm(b->force0) + pd_v3_norm(b->forceRate) * (fabs(t) + dt)) * b->invMass;
   double slack = (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
   // the spin a torque-free body can reach keeps its rotational energy: |ω| <= √(2 E_rot / I_min)
-  pdMat3 r = pd_quat_to_mat3(pd_quat_normalize(pd_layout_q(yb)));
-  pdVec3 wb = pd_mat3_tmulv(&r, pd_layout_w(yb));
+  pdVec3 wb = pd_mat3_tmulv(r, pd_layout_w(yb));
   double twiceEnergy = pd_v3_dot(wb, pd_mat3_mulv(&b->inertia, wb));
   double spinMax = b->principal[0] > 0.0 ? sqrt(fmax(0.0, twiceEnergy) / b->principal[0]) : 0.0;
   double spin = fmax(pd_v3_norm(pd_layout_w(yb)), spinMax) * b->radius * dt;
@@ -183,6 +182,20 @@ int pd_island_partition(const pdModel* model, const pdState* s, struct pdIslandS
   set->satNext = t;
   set->satCount = tested;
   if (activations > 0) return activations;
+  if (contacts > set->contactCapacity) {
+    set->contactCapacity = 2 * contacts;
+    set->contactOf = pd_grow(set->contactOf, (size_t)set->contactCapacity, sizeof *set->contactOf);
+    set->contacts = pd_grow(set->contacts, (size_t)set->contactCapacity, sizeof *set->contacts);
+  }
+  if (joined && m > 0) {
+    // one island of every moving body (a lone body, a stack): what the counting sorts below would give, written out
+    set->partCount = 1;
+    for (int k = 0; k < m; ++k) set->islandOf[k] = 0, set->members[k] = k;
+    set->first[0] = 0, set->first[1] = m;
+    for (int c = 0; c < contacts; ++c) set->contactOf[c] = 0, set->contacts[c] = c;
+    set->contactFirst[0] = 0, set->contactFirst[1] = contacts;
+    return 0;
+  }
   // islands named by their lowest body, in that order; members grouped by a counting sort
   set->partCount = 0;
   for (int k = 0; k < m; ++k) {
@@ -190,11 +203,6 @@ int pd_island_partition(const pdModel* model, const pdState* s, struct pdIslandS
     set->islandOf[k] = r == k ? set->partCount++ : set->islandOf[r];
   }
   group_by(set->islandOf, m, set->partCount, set->first, set->members);
-  if (contacts > set->contactCapacity) {
-    set->contactCapacity = 2 * contacts;
-    set->contactOf = pd_grow(set->contactOf, (size_t)set->contactCapacity, sizeof *set->contactOf);
-    set->contacts = pd_grow(set->contacts, (size_t)set->contactCapacity, sizeof *set->contacts);
-  }
   for (int c = 0; c < contacts; ++c) {
     int b1, b2;
     pd_contact_set_bodies(s->contacts, c, &b1, &b2);

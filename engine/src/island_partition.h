@@ -21,7 +21,7 @@ int pd_island_partition(const pdModel* model, const pdState* s, struct pdIslandS
 // gravity, which every body shares) takes them, m (design note): an applied force's share, its spin's
 // (r |ω| Δ), and the slack; a body touching anything at T, or whose box may reach a fixed body's, may also
 // reverse its velocity and be held against gravity (2 |v| Δ + |g| Δ²).
-// yb: its 13 numbers at T; box: its box at T; touchingOut: in (touching at T) and out (or its box may reach a fixed
+// yb: its 13 numbers at T; r: its rotation matrix at T (of its normalised orientation); box: its box at T; touchingOut: in (touching at T) and out (or its box may reach a fixed
 // body's). t: T, s; dt: the interval, s.
 double pd_island_travel_bound(const pdModel* model, const struct pdIslandSet* set, int k, const double* yb,
-                              const pdAabb* box, bool* touchingOut, double t, double dt);
+                              const pdMat3* r, const pdAabb* box, bool* touchingOut, double t, double dt);

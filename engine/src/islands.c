@@ -33,6 +33,11 @@
 //   over the sample interval standing for it in every sync partition. When another body's box over a sync
 //   interval reaches that box, the free body is brought to that sync time alone and joins the others from
 //   there; a free body found outside its box (never expected) is counted (islandStrays), not recovered.
+// - A lone moving body is one island over any interval: its sample interval is not cut, and find_free's partition
+//   (the same one island, the same box: a free body's box over a sync interval is its box over the sample
+//   interval) stands for the interval's. The one island of every moving body (a lone body, a stack joined by its
+//   contacts) is written out, not sorted. So a body alone costs per sample a start (box, bound), one partition,
+//   the gather and the sleep test, which sleeping needs.
 // - Persistence: an island whose bodies are the same as the last interval's keeps its state (its contact
 //   list, caches, step size) and simply goes on; a new island is set up from the scene's state at T (its
 //   bodies' numbers and contacts copied, the contacts' springs, forces and modal dampers as they were:
@@ -267,6 +272,7 @@ static void add_job(struct pdIslandSet* set, island* is, bool coarse) {
 // then a wait for the rest. False if an island failed; every job runs either way, so the islands' states do
 // not depend on the thread count.
 static bool run_batch(struct pdIslandSet* set, double tNext, bool land) {
+  if (set->jobCount == 0) return true;  // (the free bodies' batch of an interval with none)
   set->jobTime = tNext;
   set->jobLand = land;
   for (int i = 0; i < set->jobCount; ++i) {
@@ -526,7 +532,8 @@ static void set_start(const pdModel* model, const pdState* s, struct pdIslandSet
     set->bound[k] = 0.0;
     return;
   }
-  set->bound[k] = pd_island_travel_bound(model, set, k, yb, &set->box0[k], &set->touching[k], s->t, dt);
+  set->bound[k] =
+      pd_island_travel_bound(model, set, k, yb, &set->r0[k], &set->box0[k], &set->touching[k], s->t, dt);
 }
 
 // Marks in set->touching the moving bodies of the scene's contacts.
@@ -675,18 +682,24 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
   double dt = tNext - s->t;
   set->t0 = s->t;
   // a sample interval gone through in one (a stack, a pile at rest) has its starts from find_free: the same numbers
-  if (!(set->startsFormed && set->startsT == s->t && set->startsDt == dt)) {
+  bool startsKept = set->startsFormed && set->startsT == s->t && set->startsDt == dt;
+  if (!startsKept) {
     mark_touching(model, s, set);
     for (int k = 0; k < set->movingCount; ++k)
       if (!set->free[k]) set_start(model, s, set, k, dt);
   }
   set->startsFormed = false;  // the rounds below grow bounds and start activated bodies
   for (int j = 0; j < set->islandCount; ++j) set->islands[j]->advanced = false;
+  long wakes = set->sleep ? set->sleep->wakes : 0;
   if (set->sleep) wake_pushed(model, s, set, dt);
+  // A lone moving body whose starts are find_free's, none woken since: the partition find_free formed over this
+  // interval is the one below would form (one island, its box the same: a free body's fine box is its coarse one).
+  bool partitionKept = startsKept && set->movingCount == 1 && (!set->sleep || set->sleep->wakes == wakes);
   for (int round = 0;; ++round) {
     // a free body another body may reach joins the others from here: it is brought to T first; a sleeping island
     // another body may reach wakes here, and the partition is formed again with its bodies moving
     do {
+      if (round == 0 && partitionKept) break;
       for (int activations; (activations = pd_island_partition(model, s, set, dt, true)) > 0;)
         for (int i = 0; i < activations; ++i) {
           int k = set->activate[i];
@@ -827,7 +840,8 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
     int parts = sync_parts(model, set, target - t0);
     if (set->movingCount > 0) {
       find_free(model, s, set, target - t0);
-      if (parts > 1 && !cuts_split_islands(model, s, set, (target - t0) / parts)) parts = 1;
+      // a lone moving body is one island over any part of the interval: nothing to split
+      if (parts > 1 && (set->movingCount == 1 || !cuts_split_islands(model, s, set, (target - t0) / parts))) parts = 1;
     }
     for (int j = 1; j <= parts; ++j) {
       double tSync = j == parts ? target : t0 + (target - t0) * ((double)j / parts);
