@@ -65,6 +65,15 @@ static void print_settings(const pdModel* m, const pdSceneSettings* s) {
     print_origin(s, PD_SET_VMAX);
   printf("  %-11s %s", "sleep", set->sleep ? "on" : "off");
   print_origin(s, PD_SET_SLEEP);
+  // dt is the fixed stepper's step, which nothing holds within the stability bound (docs/integration.md)
+  double bound = pd_model_fixed_step_max(m);
+  if (isnan(bound))
+    printf("  fixed step  bound not computed (too many material classes)\n");
+  else if (isinf(bound))
+    printf("  fixed step  no bound (no contact can form)\n");
+  else
+    printf("  fixed step  at most %.6g s (RK4 stable at the stiffest contact: omega h <= 2.5); dt %s\n", bound,
+           set->dt > bound ? "exceeds it" : "is within it");
 }
 
 // Material as the scene asked for it: only what the file set (mu always has a value).

@@ -546,7 +546,11 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
         pdVec3 du = relative_velocity(model, s->y, set->poses0, id, g0.point);
         if (pd_v3_dot(du, g0.normal) > 0.0) continue;  // separating: with springs at 0 it would pull
         if (count == set->capacity) pd_contact_set_reserve_list(set, count + 1);
-        set->next[count++] = new_slot(model, &g0);
+        contactSlot* k = &set->next[count++];
+        *k = new_slot(model, &g0);
+        // a contact back on the same features after a micro-separation keeps its tangential springs here too
+        if (set->history && pd_history_take(set->history, id, g0.normal, &k->params, &k->springs))
+          ++s->count.historyKept;
         ++added;
       }
       if (added > 0) {

@@ -5,7 +5,8 @@
 // the pair's contacts change and held until they change again. The stability bound: a Gershgorin bound on the
 // contacts' fastest undamped mode ω_max, in two parts — a cheap one formed for every new list, a tight one only when
 // the step the stepper wants exceeds the cheap one's (pd_contact_set_limit_step) — and the step (h/2) ω_max ≤
-// PD_STABLE_STEP_OMEGA that follows from it.
+// PD_STABLE_STEP_OMEGA that follows from it; and the fixed stepper's bound for one contact of the stiffest pair
+// (pd_model_fixed_step_max), which nothing enforces: polydyn run warns of it.
 #ifdef PD_SELF_CHECKS
 #include <gsl/gsl_eigen.h>
 #endif
@@ -15,6 +16,7 @@
 
 #include "contact_list.h"
 #include "material.h"
+#include "model_contact.h"
 #include "stack_modes.h"
 
 // Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can
@@ -460,4 +462,11 @@ double pd_contact_set_dopri_fraction(const pdContactSet* set) {
   int count = (int)(sizeof PD_DOPRI_STABLE_RADIUS / sizeof PD_DOPRI_STABLE_RADIUS[0]), entry = 0;
   while (entry + 1 < count && PD_DOPRI_STABLE_RADIUS[entry + 1][0] <= set->dampingMin) ++entry;
   return PD_DOPRI_STABLE_MARGIN * PD_DOPRI_STABLE_RADIUS[entry][1] / (2.0 * PD_STABLE_STEP_OMEGA);
+}
+
+// ---------------------------------------------------------------- the fixed stepper's bound
+
+double pd_model_fixed_step_max(const pdModel* model) {
+  const double twoPi = 6.28318530717958647692;
+  return PD_STABLE_STEP_OMEGA * pd_model_contact_period_min(model) / twoPi;
 }

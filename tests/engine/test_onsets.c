@@ -29,6 +29,7 @@
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
+#include "polydyn/vecmath.h"
 #include "scene_run.h"
 
 #define RESTITUTION_TOL 0.01       // absolute, on e: a hundredth of the range of e
@@ -36,6 +37,15 @@
 #define REST_EXACT_TOL_DELTA 0.01  // of δ_max: several landings, each located to the onset tolerance 1e-3 δ_max
 #define ENERGY_GAIN_TOL 1e-9       // relative to |E(0)|: integration error only, no energy from the onsets
 #define DROPS 24
+
+// bounce_at's cube, m: distances are measured in its size.
+#define BOUNCE_SIZE 0.2
+// How much closer to the converged run each factor 100 of tol must bring the bounce: RK4's local error falls with
+// tol, so its distance should too; measured 17–37, 5 leaves room for rounding near the reference's own error.
+#define BOUNCE_CONVERGENCE_FACTOR 5.0
+// Body sizes the bounce at tol 1e-12 must come within of the run at tol 1e-13: measured 1.4e-9; a fixed onset depth
+// threshold of 1e-3 δ_max left 1.5e-5.
+#define BOUNCE_CONVERGED 1e-7
 
 static const pdOnsets MODES[] = {pd_onsetsPair, pd_onsetsExact};
 
@@ -230,12 +240,58 @@ static void test_auto_onsets_are_exact_in_small_systems_and_pairs_in_crowds(void
   }
 }
 
+// The sweep's bounce (cases/sweep/bounce.scene: a 0.2 m cube dropped flat from 0.5 m, e 0.5) run adaptively at tol:
+// its trajectory, for converged_bounce.
+static record* bounce_at(double tol) {
+  char text[512];
+  snprintf(text, sizeof text,
+           "tend 1.5\nsample 100\ntol %.17g\n"
+           "cube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nrestitution 0.5\n"
+           "cube box red 0.2 0.2 0.2\nloc 0 0 0.6\nrestitution 0.5\n",
+           tol);
+  pdModel* m = compile_text(text);
+  record* r = run_with(m, pd_stepperRK4Adaptive, NULL);
+  pd_model_free(m);
+  return r;
+}
+
+// The largest distance between two runs' cube positions over their common samples, over the cube's 0.2 m size.
+static double bounce_distance(const record* a, const record* b) {
+  assert_int_equal(a->count, b->count);
+  double worst = 0.0;
+  for (int i = 0; i < a->count; ++i) {
+    pdVec3 d = pd_v3_sub(a->body[0][i].x, b->body[0][i].x);
+    worst = fmax(worst, sqrt(pd_v3_dot(d, d)) / BOUNCE_SIZE);
+  }
+  return worst;
+}
+
+// A tighter tolerance must bring the run closer to the converged one: every onset, however shallow it is found,
+// follows the tolerance (docs/events.md, "Shallow onsets"). Against a run at tol 1e-13, the distance at tol 1e-8,
+// 1e-10 and 1e-12 must fall by at least BOUNCE_CONVERGENCE_FACTOR per factor 100 of tol, and end below
+// BOUNCE_CONVERGED; an onset depth threshold fixed at 1e-3 δ_max left it at ~1e-5 body sizes at every tol.
+static void test_a_bounce_converges_as_the_tolerance_tightens(void** state) {
+  (void)state;
+  record* ref = bounce_at(1e-13);
+  double tols[] = {1e-8, 1e-10, 1e-12}, err[3];
+  for (int i = 0; i < 3; ++i) {
+    record* r = bounce_at(tols[i]);
+    err[i] = bounce_distance(r, ref);
+    printf("tol %g: distance %.3g body sizes\n", tols[i], err[i]);
+    free(r);
+  }
+  free(ref);
+  for (int i = 1; i < 3; ++i) assert_true(err[i] <= err[i - 1] / BOUNCE_CONVERGENCE_FACTOR || err[i] <= BOUNCE_CONVERGED);
+  assert_true(err[2] <= BOUNCE_CONVERGED);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_landings_bounce_with_the_requested_e_in_both_modes),
       cmocka_unit_test(test_a_dropped_cube_rests_at_its_static_deflection),
       cmocka_unit_test(test_a_falling_column_gains_no_energy_and_retries_less),
       cmocka_unit_test(test_auto_onsets_are_exact_in_small_systems_and_pairs_in_crowds),
+      cmocka_unit_test(test_a_bounce_converges_as_the_tolerance_tightens),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -146,6 +146,13 @@ PD_API int pd_model_material_class_count(const pdModel* model);
 // writes up to `capacity` into bodyA[], bodyB[] and returns how many there are.
 PD_API int pd_model_contact_class_pairs(const pdModel* model, int* bodyA, int* bodyB, int capacity);
 
+// The longest step of the fixed RK4 stepper (pd_stepperRK4Fixed) within the stability bound of the scene's stiffest
+// contact (docs/integration.md, "the stability bound"): ω h ≤ 2.5, the bound the adaptive steppers keep, with
+// ω = 2π / the shortest contact period over the pairs of material classes that can touch (one contact, undamped;
+// summary.json's contact_period_min), s. Several contacts acting together can need a shorter step. INFINITY when
+// nothing can touch, NAN when the period is not computed (too many material classes).
+PD_API double pd_model_fixed_step_max(const pdModel* model);
+
 // The time-constant adjustments of §3.3.1 and §3.3.2 made at compile time, per pair of material classes
 // (naming the first body of each class). Adjustments past the list's capacity are not listed but counted
 // (pd_model_adjustments_dropped).

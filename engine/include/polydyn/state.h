@@ -63,7 +63,8 @@ PD_API extern const char* const pdWarningNames[pd_warnCount];
 // ROS34PW2 where the contacts' stability bound holds it) is the default; the fixed one is for sweeps.
 typedef enum pdStepper {
   pd_stepperRK4Adaptive,   // classic RK4 with step doubling: error = |two half steps − one full step|/15
-  pd_stepperRK4Fixed,      // classic RK4 with the step fixed at settings.dt (no error control)
+  pd_stepperRK4Fixed,      // classic RK4 with the step fixed at settings.dt (no error control; stable only within
+                           // pd_model_fixed_step_max)
   pd_stepperRK43Embedded,  // classic RK4 with its embedded third-order partner: error = h |k4 − f(t+h, y1)|/6
   pd_stepperImplicit,      // step doubling, switching system by system to ROS34PW2 (a linearly implicit method of
                            // order 3 with an order-2 estimate and no stability bound) where the contacts' stability
