@@ -98,6 +98,7 @@ static bool batch_progress(int task, int done, int total, void* user) {
 
 // Every word of `list` is one of `allowed` (NULL-terminated); false names the first stranger in *bad.
 static bool list_valid(const char* list, const char* const* allowed, char* bad, size_t badSize) {
+  bad[0] = '\0';  // an empty list is refused with an empty name: the message must not read an unset buffer
   for (const char* p = list; p && *p;) {
     const char* comma = strchr(p, ',');
     size_t len = comma ? (size_t)(comma - p) : strlen(p);

@@ -36,6 +36,9 @@ SC
 check "no --out: says so" 'grep -q -- "--out" "$SCRATCH/err"'
 "$PD" compare "$SCENE" --out "$SCRATCH/x" --engines soft,havok >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "unknown engine: exit 2" '[ $rc -eq 2 ] && grep -q havok "$SCRATCH/err" && [ ! -e "$SCRATCH/x" ]'
+# an empty list names no engine: refused with a whole message (the refusal once printed an unset buffer)
+"$PD" compare "$SCENE" --out "$SCRATCH/x" --engines '' >/dev/null 2>"$SCRATCH/err"; rc=$?
+check "empty engine list: exit 2" '[ $rc -eq 2 ] && grep -q "^polydyn compare: --engines: unknown engine '"''"'" "$SCRATCH/err" && [ ! -e "$SCRATCH/x" ]'
 mkdir "$SCRATCH/precious"
 "$PD" compare "$SCENE" --out "$SCRATCH/precious" --engines soft >/dev/null 2>"$SCRATCH/err"; rc=$?
 check "a directory that is not a compare directory is not replaced" '[ $rc -eq 2 ] && [ -d "$SCRATCH/precious" ] && [ ! -e "$SCRATCH/precious/metrics.csv" ]'
