@@ -65,9 +65,9 @@ static double final_x(bool pushed, double v0, pdOnsets onsets, double tol, pdCou
   return x;
 }
 
-// `refined`: the run must have refined a change (a fast one), else left its changes inside their steps (changes at
-// nearly no slip, whose bound anywhere in the step allows them).
-static void check(const char* what, bool pushed, double v0, double expected, bool refined) {
+// `refined`: the run must have refined a change (a fast one); `left`: it must have left changes inside their steps
+// (changes at nearly no slip, whose bound anywhere in the step allows them).
+static void check(const char* what, bool pushed, double v0, double expected, bool refined, bool left) {
   pdCounters c;
   double x = final_x(pushed, v0, pd_onsetsBounded, 1e-6, &c);
   double exact = final_x(pushed, v0, pd_onsetsExact, REFERENCE_TOL, NULL);
@@ -78,14 +78,14 @@ static void check(const char* what, bool pushed, double v0, double expected, boo
   assert_true(fabs(x - expected) <= SLIDE_REL_TOL * expected);
   assert_true(fabs(x - exact) <= AGREE_TOL * expected);
   assert_true(c.transitionBoundMax <= PD_ONSET_TOL_SHARE * 1e-6);
-  assert_true(c.transitionsUnlocated > 0);
+  if (left) assert_true(c.transitionsUnlocated > 0);
   if (refined) assert_true(c.refinements > 0);
 }
 
 static void test_a_pushed_block_starts_to_slide_when_the_cone_is_reached(void** state) {
   (void)state;
   double slide = MU * G * pow(TEND - STICK_UNTIL, 3) / (6.0 * STICK_UNTIL);
-  check("block pushed from rest", true, 0.0, slide, false);
+  check("block pushed from rest", true, 0.0, slide, false, true);
 }
 
 static void test_a_launched_block_stops_where_it_should(void** state) {
@@ -94,7 +94,10 @@ static void test_a_launched_block_stops_where_it_should(void** state) {
   for (size_t k = 0; k < sizeof v0s / sizeof v0s[0]; ++k) {
     char what[64];
     snprintf(what, sizeof what, "block launched at %g m/s", v0s[k]);
-    check(what, false, v0s[k], v0s[k] * v0s[k] / (2.0 * MU * G), v0s[k] >= 1.0);
+    // at 0.3 m/s the stop's change, its landing's four contacts joined as their pair's joint motion (docs/events.md),
+    // is found with a bound of 5.4e-6 (1.3e-7 with them joined one by one) in a step too short to halve, and taken
+    // there: left and refined nowhere, the slide 1.1e-9 of itself from the exact events'
+    check(what, false, v0s[k], v0s[k] * v0s[k] / (2.0 * MU * G), v0s[k] >= 1.0, v0s[k] >= 1.0);
   }
 }
 
