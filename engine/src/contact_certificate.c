@@ -143,6 +143,30 @@ static double over_face_margin(const pdPolyhedron* s, int f, pdVec3 q, double ov
   return least;
 }
 
+// For vertex i of sv (q, sf's frame) at the end of an edge in a listed edge pair, how far it may move before it could
+// press through sf's far side on a face around the pair's edge on sf (find_vf), m (INFINITY: no such pair).
+static double edge_pair_end_margin(const pdPolyhedron* sv, int iv, int i, pdVec3 q, const pdPolyhedron* sf,
+                                   double tolerance, const pdContactId* exempt, int exemptCount) {
+  double least = INFINITY;
+  for (int k = 0; k < exemptCount; ++k) {
+    const pdContactId* c = &exempt[k];
+    if (c->kind != pd_contactEE) continue;
+    int edgeV = c->body1 == iv ? c->feat1 : c->body2 == iv ? c->feat2 : -1;
+    if (edgeV < 0 || (sv->edges[edgeV].v[0] != i && sv->edges[edgeV].v[1] != i)) continue;
+    const pdEdge* e = &sf->edges[c->body1 == iv ? c->feat2 : c->feat1];
+    for (int s = 0; s < 2; ++s) {
+      // it presses on face F only below F and not outside any face turned less than 90° from F (through_far_side):
+      // not while above one of those planes by more than the tolerance
+      pdVec3 nf = sf->faces[e->f[s]].normal;
+      double apart = -INFINITY;
+      for (int g = 0; g < sf->faceCount; ++g)
+        if (pd_v3_dot(sf->faces[g].normal, nf) >= 0.0) apart = fmax(apart, -face_depth(sf, g, q) - tolerance);
+      least = fmin(least, apart);
+    }
+  }
+  return least;
+}
+
 // The least margin of the vertices of sv (given in sf's frame by rel, off) against sf, vertices listed as VF
 // contacts of body iv in `exempt` left out; stops at `bound` (no lower margin needed).
 static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf,
@@ -159,6 +183,9 @@ static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel,
     }
     double margin = outside_farthest(sf, q, least + tolerance) - tolerance;
     least = margin < least ? margin : least;
+    // the end of an edge in a listed edge pair may become a contact on a face of the other edge it lies below, through
+    // the body's far side (find_vf): it is not while above both faces' planes by more than the search's tolerance
+    least = fmin(least, edge_pair_end_margin(sv, iv, i, q, sf, tolerance, exempt, exemptCount));
   }
   return least;
 }

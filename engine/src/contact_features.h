@@ -51,6 +51,15 @@ static inline void pose_in_frame_of(const pdPose* a, const pdPose* b, pdMat3* re
 // Depth of point q (body frame) below face f's plane (> 0 inside the half-space).
 static inline double face_depth(const pdPolyhedron* s, int f, pdVec3 q) { return s->faces[f].offset - pd_v3_dot(s->faces[f].normal, q); }
 
+// Do faces f and g of s meet at an edge outward normals more than 90° apart: an acute edge, in whose wedge a vertex
+// near one face may move into the other?
+static inline bool faces_meet_at_acute_edge(const pdPolyhedron* s, int f, int g) {
+  if (!(pd_v3_dot(s->faces[f].normal, s->faces[g].normal) < 0.0)) return false;
+  for (int e = 0; e < s->edgeCount; ++e)
+    if ((s->edges[e].f[0] == f && s->edges[e].f[1] == g) || (s->edges[e].f[0] == g && s->edges[e].f[1] == f)) return true;
+  return false;
+}
+
 // An arc (a, b) of the Gauss map with its great circle's normal b × a and that normal's squared length: the
 // search tests every edge of one body against every edge of the other, so each arc's are formed once.
 typedef struct gaussArc {
