@@ -29,12 +29,6 @@
 // (rounding of an edge lying in the plane, as a box's bottom edges on the face it rests on).
 #define ARC_TOUCH_TOL_VF 1e-9
 
-// A tracked contact keeps its features while its vertex (VF) or each edge's closest point (EE) lies inside the other body, to this
-// fraction of that body's δ_max (deflection × size): a crossing that ends with the springs still loaded
-// (elastic contacts end where they began, up to the onset interpolation's error) stays; an edge pair whose
-// lines pass each other outside the bodies (it slid past a corner) does not press anywhere and breaks.
-#define TRACK_INSIDE_TOL_REL 0.1
-
 static pdVec3 to_world(const pdPose* p, pdVec3 local) { return pd_v3_add(p->x, pd_mat3_mulv(&p->R, local)); }
 static pdVec3 to_local(const pdPose* p, pdVec3 world) { return pd_mat3_tmulv(&p->R, pd_v3_sub(world, p->x)); }
 int pd_contact_id_compare(const pdContactId* a, const pdContactId* b) {
@@ -122,6 +116,18 @@ static double segment_distance(pdVec3 a, pdVec3 b, pdVec3 q) {
   return pd_v3_norm(pd_v3_sub(q, pd_v3_muladd(a, s, u)));
 }
 
+// The edge of faceBody in edge pair c when c is an edge pair of vertexBody and faceBody whose edge on vertexBody (shape
+// sv) ends at `vertex`, else -1.
+static int edge_pair_edge_at_vertex(const pdContactId* c, const pdPolyhedron* sv, int vertexBody, int vertex,
+                                    int faceBody) {
+  if (c->kind != pd_contactEE) return -1;
+  int edgeV, edgeF;
+  if (c->body1 == vertexBody && c->body2 == faceBody) edgeV = c->feat1, edgeF = c->feat2;
+  else if (c->body2 == vertexBody && c->body1 == faceBody) edgeV = c->feat2, edgeF = c->feat1;
+  else return -1;
+  return sv->edges[edgeV].v[0] == vertex || sv->edges[edgeV].v[1] == vertex ? edgeF : -1;
+}
+
 static int face_after_edge_pair(const pdModel* m, const pdContactId* previous, int count, int vertexBody, int vertex,
                                 int faceBody, pdVec3 q, double tol, double over, double reach) {
   const pdPolyhedron* sv = &m->bodies[vertexBody].shape;
@@ -129,13 +135,8 @@ static int face_after_edge_pair(const pdModel* m, const pdContactId* previous, i
   int face = -1;
   double deepest = tol;
   for (int i = 0; i < count; ++i) {
-    const pdContactId* c = &previous[i];
-    if (c->kind != pd_contactEE) continue;
-    int edgeV, edgeF;
-    if (c->body1 == vertexBody && c->body2 == faceBody) edgeV = c->feat1, edgeF = c->feat2;
-    else if (c->body2 == vertexBody && c->body1 == faceBody) edgeV = c->feat2, edgeF = c->feat1;
-    else continue;
-    if (sv->edges[edgeV].v[0] != vertex && sv->edges[edgeV].v[1] != vertex) continue;
+    int edgeF = edge_pair_edge_at_vertex(&previous[i], sv, vertexBody, vertex, faceBody);
+    if (edgeF < 0) continue;
     const pdEdge* e = &sf->edges[edgeF];
     if (segment_distance(sf->vertices[e->v[0]], sf->vertices[e->v[1]], q) > reach) continue;
     for (int k = 0; k < 2; ++k) {
@@ -334,13 +335,8 @@ __attribute__((noinline)) static int vf_through_after_edge_pair(const pdModel* m
   int face = -1;
   double deepest = tol;
   for (int k = 0; k < previousCount; ++k) {
-    const pdContactId* c = &previous[k];
-    if (c->kind != pd_contactEE) continue;
-    int edgeV, edgeF;
-    if (c->body1 == iv && c->body2 == jf) edgeV = c->feat1, edgeF = c->feat2;
-    else if (c->body2 == iv && c->body1 == jf) edgeV = c->feat2, edgeF = c->feat1;
-    else continue;
-    if (sv->edges[edgeV].v[0] != i && sv->edges[edgeV].v[1] != i) continue;
+    int edgeF = edge_pair_edge_at_vertex(&previous[k], sv, iv, i, jf);
+    if (edgeF < 0) continue;
     for (int s = 0; s < 2; ++s) {
       int f = sf->edges[edgeF].f[s];
       double d = face_depth(sf, f, q);

@@ -41,6 +41,12 @@
 // Absolute rounding margin of a triple product of unit vectors: ~100 ulps of 1.
 #define ARC_TRIPLE_ROUNDING 1e-14
 
+// A tracked contact keeps its features while its vertex (VF) or each edge's closest point (EE) lies inside the other body, to this
+// fraction of that body's δ_max (deflection × size): a crossing that ends with the springs still loaded
+// (elastic contacts end where they began, up to the onset interpolation's error) stays; an edge pair whose
+// lines pass each other outside the bodies (it slid past a corner) does not press anywhere and breaks.
+#define TRACK_INSIDE_TOL_REL 0.1
+
 // Body b's pose in body a's frame: rotation R_aᵀ R_b, offset R_aᵀ (x_b − x_a).
 static inline void pose_in_frame_of(const pdPose* a, const pdPose* b, pdMat3* rel, pdVec3* off) {
   pdMat3 RaT = pd_mat3_transpose(&a->R);
