@@ -20,7 +20,7 @@
 //             dampers' and springs' response to that drift, times how far an impulse moves the state (onsets.c,
 //             correction_bound), and the springs by a τ²/2 over δ_max (the spring term);
 //   turning:  added to the velocity term: PD_ONSET_TURNING_C Ω² r τ ωτ, and the onset time App. C's chord misplaces on
-//             a turning body, (ω² τ + c/m) Ω² r τ (h − τ) (onsets.c, correction_bound),
+//             a turning body, (ω² τ + c/m) Ω² r τ (h − τ)/2 (onsets.c, correction_bound),
 // with ω = √(k_s / m_min) the pair's fastest undamped frequency. An onset is corrected only where the largest of the
 // three is at most PD_ONSET_TOL_SHARE × tol, and ωτ and d stay within the ranges the correction holds in (contact_set.c,
 // PD_ONSET_PAIR_OMEGA_TAU, PD_ONSET_PAIR_DEPTH_REL); others are located, as the paper does with every one.

@@ -251,10 +251,10 @@ static void applied_over(const onsetTerms* t, double age, double* alongNormal, d
 // The onset time: App. C's interpolation moves the point along the chord of its step,
 // which a turn's arc strays from by λ(1 − λ) Ω² r h²/2 at the fraction λ of the step (sway in contact_search.c), at the
 // onset (λ = 1 − τ/h) by Ω² r τ (h − τ)/2, so the age is off by that over v_n, and the element, whose force per unit mass
-// is at most (ω² τ + c/m) v_n, ends off by (ω² τ + c/m) Ω² r τ (h − τ)/2 in the velocity, taken twice as the sway is.
+// is at most (ω² τ + c/m) v_n, ends off by (ω² τ + c/m) Ω² r τ (h − τ)/2 in the velocity.
 static double correction_bound(const pdModel* model, const onsetTerms* t, double age, double depth, double step) {
   double wt = t->omega * age, velocity = PD_ONSET_TURNING_C * t->turning * age * wt;
-  velocity += (t->omega * t->omega * age + t->dampingRate) * t->turning * age * fmax(step - age, 0.0);
+  velocity += 0.5 * (t->omega * t->omega * age + t->dampingRate) * t->turning * age * fmax(step - age, 0.0);
   if (t->mu > 0.0 && t->approach > 0.0) velocity += t->mu * PD_ONSET_BOUND_C * wt * wt * wt * t->approach;
   double spring = 0.0;
   if (isfinite(t->pointMass) && t->approach > 0.0) {
