@@ -979,6 +979,22 @@ static bool lone_runs(const pdState* s, const struct pdIslandSet* set) {
                                 PD_ISLAND_HELP_WEIGHT;
 }
 
+// A scene of one moving body asleep, its applied force unchanged: the interval loop would keep the island as it is
+// and gather the same frozen numbers again; over the interval to target only the time asleep grows, as fall_asleep
+// counts it. (A force that changed wakes it there: the interval loop. A step observer keeps the interval loop, as
+// for a lone body awake: lone_runs.)
+static bool lone_sleep_on(const pdModel* model, pdState* s, struct pdIslandSet* set, double target) {
+  if (set->movingCount != 1 || set->islandCount != 1 || !set->islands[0]->asleep || s->stepObserver ||
+      pd_sleep_force_changed(set->sleep, &model->bodies[model->movingBodies[0]], 0, s->t))
+    return false;
+  set->t0 = s->t;
+  set->startsFormed = false;
+  set->sleep->bodySeconds += target - set->t0;
+  compose_counters(set, s);
+  s->t = target;
+  return true;
+}
+
 // The lone body's island from the scene's time to tEnd (or to the sample where it falls asleep or the caller
 // stops). False if it failed (the scene keeps its state at the last sample).
 static bool lone_run(const pdModel* model, pdState* s, struct pdIslandSet* set, double tEnd, pdObserverFcn* observer,
@@ -1018,6 +1034,10 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
     }
     double tSample = pd_sample_time(model, s->nextSample);
     double target = fmin(tEnd, tSample);
+    if (lone_sleep_on(model, s, set, target)) {
+      if (s->t == tSample) observe(model, s, set, observer, user);
+      continue;
+    }
     // the sync times: the interval to the sample cut into equal parts short enough for the fastest body
     double t0 = s->t;
     int parts = sync_parts(model, set, target - t0);

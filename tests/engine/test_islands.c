@@ -542,8 +542,8 @@ static void test_a_free_body_reached_in_the_first_interval(void** state) {
 // ---------------------------------------------------------------- a lone body across samples
 
 // A scene of one moving body goes, awake, through one run of its island's steps with the interval loop's work done
-// at each sample (islands.c, "a lone body across samples"); a step observer sends it through the interval loop itself
-// (its stretches start at every sample). Both must give the same samples and counters bit for bit: in one call, in
+// at each sample, and asleep from sample to sample counting its time asleep (islands.c, "a lone body across
+// samples"); a step observer sends it through the interval loop itself (its stretches start at every sample). Both must give the same samples and counters bit for bit: in one call, in
 // slices that end between samples, stopped by the observer and resumed, and on two threads.
 #define LONE_SLICE_S 0.0137  // s: a call's length that ends between samples (5 ms and 1 ms apart)
 
