@@ -337,6 +337,8 @@ static void retire(struct pdIslandSet* set, island* is) {
 
 // The scene state's counters, warnings and stage seconds: the freed islands' plus the live ones', in island
 // order (integers: the order does not matter; seconds are not reproducible anyway).
+static void compose_set_counters(const struct pdIslandSet* set, pdState* s);
+
 static void compose_counters(struct pdIslandSet* set, pdState* s) {
   long samples = s->count.samples;
   s->count = set->retired;
@@ -350,6 +352,12 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
   }
   s->stageSeconds[pd_stageObserve] += set->observeSeconds;
   s->count.samples = samples;
+  compose_set_counters(set, s);
+}
+
+// The scene state's counters of the set's own (islands formed, intervals, sleeping ...): all that changes in the
+// scene's counters while no island steps.
+static void compose_set_counters(const struct pdIslandSet* set, pdState* s) {
   s->count.islandsFormed = set->formed;
   s->count.islandsLargest = set->largest;
   s->count.islandIntervals = set->intervals;
@@ -869,6 +877,7 @@ typedef struct loneRun {
   double pendingT;
   double pendingY[PD_BODY_STATE_SIZE];
   double observeSeconds;  // the island's own observe stage before the run (the caller's observer is counted in the set)
+  long derivatives;       // the island's derivative evaluations when the scene's counters were last composed
 } loneRun;
 
 // The lone body's numbers y at time t inside the interval. A body with no contact at the interval's start has its
@@ -933,7 +942,14 @@ static void lone_interval_end(loneRun* run, double tNext) {
     if (set->free[0] && set->ctravel[0] > set->cbound[0]) ++set->strays;
   }
   gather(model, s, set, tNext, true);
-  compose_counters(set, s);
+  // every counter of the island's but the samples (the scene's own) changes with a step tried, which evaluates the
+  // derivative: without one, only the set's change (the stage timers wait for the run's end)
+  if (run->is->state->count.derivatives != run->derivatives) {
+    compose_counters(set, s);
+    run->derivatives = run->is->state->count.derivatives;
+  } else {
+    compose_set_counters(set, s);
+  }
   s->t = tNext;
   run->open = false;
 }
@@ -1002,16 +1018,14 @@ static bool lone_run(const pdModel* model, pdState* s, struct pdIslandSet* set, 
   island* is = set->islands[0];
   PD_ASSERT(is->bodyCount == 1 && is->state->t == s->t);
   loneRun run = {.model = model, .s = s, .set = set, .is = is, .observer = observer, .user = user, .tEnd = tEnd,
-                 .observeSeconds = is->state->stageSeconds[pd_stageObserve]};
+                 .observeSeconds = is->state->stageSeconds[pd_stageObserve],
+                 .derivatives = is->state->count.derivatives};
   lone_interval_start(&run);
   bool ok = pd_step_until(&is->model, is->state, tEnd, false, lone_sample, &run, lone_step_end, &run);
   is->state->stageSeconds[pd_stageObserve] = run.observeSeconds;
-  if (!ok) {
-    compose_counters(set, s);
-    return !is->state->failed;
-  }
-  if (run.open) lone_interval_end(&run, tEnd);  // a call ending between samples: the scene gathered there
-  return true;
+  if (ok && run.open) lone_interval_end(&run, tEnd);  // a call ending between samples: the scene gathered there
+  compose_counters(set, s);
+  return ok || !is->state->failed;
 }
 
 bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
