@@ -39,7 +39,8 @@
 //   contacts) is written out, not sorted. A scene of one moving body, awake, goes further: its island's steps run
 //   across the samples in one pd_step_until, each sample presented from its dense output as with islands off, and
 //   at each sample the interval loop's work for it is done there, bit for bit (lone_run, below): per sample the
-//   gather, the sleep test, the counters and, for a body touching nothing, its travel from its path.
+//   gather, the sleep test, the counters and, for a body touching nothing, its travel from its path. Asleep, it
+//   goes from sample to sample counting its time asleep until its force changes (lone_sleep_on).
 // - Persistence: an island whose bodies are the same as the last interval's keeps its state (its contact
 //   list, caches, step size) and simply goes on; a new island is set up from the scene's state at T (its
 //   bodies' numbers and contacts copied, the contacts' springs, forces and modal dampers as they were:
