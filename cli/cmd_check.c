@@ -17,7 +17,8 @@ static const char* const help =
     "minimum effective mass and the time constants; then the number of material classes and every\n"
     "time-constant adjustment made to fit dtmin (or \"adjustments: none\"); then the stacks (moving\n"
     "bodies joined by contacts after 0.1 s of the run, or at tend if sooner; scenes of at most 64\n"
-    "moving bodies) with the frequency and damping ratio of each of their contact modes.\n"
+    "moving bodies) with the pairs whose springs are raised for the load pressing them and the\n"
+    "frequency and damping ratio of each of their contact modes.\n"
     "Refuses (exit 2) what `polydyn run` refuses, including a restitution below 0.01 and bodies that\n"
     "overlap at t = 0. Exit status: 0 ok, 2 bad input.\n";
 
