@@ -253,12 +253,15 @@ static void test_a_corner_pressed_through_a_blade_keeps_its_contact(void** state
 // (docs/contact-model.md, "Springs sized by the load"), passes the soak's checks at every step, islands on and off:
 // a 1.05 kg plate's corner through a 0.28 g sliver lying on the floor (25 delta_max with the springs of the sliver's own
 // mass), a 4.3 kg prism squeezed between two bodies of 1.3-1.4 t (3.52), a 14 mg plate under a landing 190 g cube on
-// the floor (4.23).
+// the floor (4.23), a 25:1 plate settling across a sliver's rim on the floor (8.54), a 0.37 g plate struck by a cube's
+// edge on a 3.67 kg cube (5.58).
 static void test_a_light_body_under_a_heavy_one_has_springs_for_its_load(void** state) {
   (void)state;
   assert_passes_at_every_step("cases/hard/plate_corner_through_sliver_on_floor.scene", pd_soakDrop, 3);
   assert_passes_at_every_step("cases/hard/prism_squeezed_between_heavy_bodies.scene", pd_soakFree, 3);
   assert_passes_at_every_step("cases/hard/plate_pinned_under_landing_cube.scene", pd_soakDrop, 3);
+  assert_passes_at_every_step("cases/hard/plate_edge_through_sliver_rim.scene", pd_soakDrop, 3);
+  assert_passes_at_every_step("cases/hard/plate_struck_by_cube_edge_on_cube.scene", pd_soakFree, 3);
 }
 
 // Scene 371 of campaign 3 of the first generator is the file committed with the campaign 3 rerun (after its two
