@@ -216,7 +216,8 @@ static double load_scale(const pdModel* model, const pdContactSet* set, int firs
   n = pd_v3_scale(n, 1.0 / nn);
   double m1 = mass_behind(model, set, c0->id.body1, c0->id.body2, n);
   double m2 = mass_behind(model, set, c0->id.body2, c0->id.body1, pd_v3_scale(n, -1.0));
-  // both sides backed by fixed bodies: the heaviest moving body pressing is what must be stopped
+  // a side backed by a fixed body moves nothing with it: the other side's load is the pair's; both backed (a body
+  // wedged between two fixed ones) bring no moving mass beyond the pair's own
   double load = isinf(m1) ? m2 : isinf(m2) ? m1 : m1 * m2 / (m1 + m2);
   if (isinf(load)) return 1.0;
   double f = load / p->massPair;
