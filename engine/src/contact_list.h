@@ -35,6 +35,7 @@ typedef struct contactSlot {
   int modalCount;       // contacts its pair had when pd_modal_dampers last set its dampers (0: not yet)
   int modalBodyContacts[2];  // contacts of body1, body2 (moving) then: a neighbour's change re-sizes its dampers
   double stackScale[2];      // ζ of its modal dampers at the pair's own mass over the requested (n, P_t; >= 1)
+  double loadScale;          // its springs over eq. (11)'s for the pair alone (>= 1; pd_modal_dampers, "load")
   // its modes at the step's start (record()), held over the step when the set holds modes (pd_contact_force_held)
   bool heldPush, heldSlip;
 } contactSlot;
@@ -304,9 +305,10 @@ void pd_contact_set_reserve_list(pdContactSet* set, int capacity);
 // bodyList, read by the force sums and the tight stability bound.
 void pd_contact_set_list_bodies(const pdModel* model, pdContactSet* set);
 
-// stability_bound.c: the modal dampers of every pair whose contacts changed (poses: the list's, world inverse
-// inertias set), and the stability bound's terms and cheap bound for a new list.
-void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses);
+// stability_bound.c: the springs sized by the load and the modal dampers of every pair whose contacts changed (poses:
+// the list's, world inverse inertias set; y: the state whose springs are re-scaled with their stiffness), and the
+// stability bound's terms and cheap bound for a new list.
+void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses, double* y);
 void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses);
 
 // contact_search.c: the contact search's arrays (broad phase, pairs, caches, certificates, candidates) of a set

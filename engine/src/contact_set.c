@@ -223,6 +223,7 @@ static contactSlot new_slot(const pdModel* model, const pdContactGeom* g) {
   memset(&c, 0, sizeof c);
   c.id = g->id;
   c.params = pd_model_contact_params(model, g->id.body1, g->id.body2);
+  c.loadScale = 1.0;
   c.deltaMax = pd_model_pair_delta_max(model, g->id.body1, g->id.body2);
   c.normal = g->normal;
   c.point = g->point;
@@ -300,7 +301,7 @@ static void world_inverse_inertias(const pdModel* model, pdContactSet* set, cons
 // number of pair onsets started.
 static int prepare_list(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
   world_inverse_inertias(model, set, poses);
-  pd_modal_dampers(model, set, poses);
+  pd_modal_dampers(model, set, poses, y);
   int started = pd_onsets_start_late(model, set, y, poses);
   record(model, set, y, poses);
   pd_stability_prepare(model, set, poses);
@@ -666,7 +667,10 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       *k = new_slot(model, &cand->geom);
       // the successor of a hand-over takes its predecessor's springs: the normal ones as they are, the tangential
       // ones turned into its tangent plane and held within the friction cone of the predecessor's normal force,
-      // so the force goes on where it was (and a spring the cone would not carry does not load it with slip)
+      // so the force goes on where it was (and a spring the cone would not carry does not load it with slip); with
+      // the stiffness they had (a pair of the same two bodies: the same constants but the load's factor)
+      k->params = old->params;
+      k->loadScale = old->loadScale;
       double fn = set->eval[cand->inherit].force.fn;
       k->springs = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * cand->inherit);
       pd_springs_realign(&k->springs, old->normal, cand->geom.normal, k->params.mu, &k->params, fn);
