@@ -72,7 +72,7 @@ static void print_settings(const pdModel* m, const pdSceneSettings* s) {
   else if (isinf(bound))
     printf("  fixed step  no bound (no contact can form)\n");
   else
-    printf("  fixed step  at most %.6g s (RK4 stable at the stiffest contact: omega h <= 2.5); dt %s\n", bound,
+    printf("  fixed step  at most %.6g s (RK4 stable at the stiffest contact: omega h <= " PD_STABLE_STEP_OMEGA_TEXT "); dt %s\n", bound,
            set->dt > bound ? "exceeds it" : "is within it");
 }
 

@@ -37,7 +37,7 @@ static const char helpHead[] =
     "                   adaptive: RK4 with step-doubling error control alone (the paper's);\n"
     "                   fixed: RK4 with the scene's dt (or --step), no error control; warns on\n"
     "                   stderr when the step exceeds RK4's stability bound for the scene's stiffest\n"
-    "                   contact, omega h <= 2.5 (docs/integration.md), and runs anyway;\n"
+    "                   contact, omega h <= " PD_STABLE_STEP_OMEGA_TEXT " (docs/integration.md), and runs anyway;\n"
     "                   embedded: RK4 with its embedded third-order error estimate; dopri: DOPRI5(4);\n"
     "                   implicit-dopri: implicit with DOPRI5(4) for step doubling\n"
     ;
@@ -133,7 +133,7 @@ static void warn_fixed_step(const pdModel* model) {
   if (!(model->settings.dt > bound)) return;  // within the bound, nothing can touch, or the bound is unknown (NAN)
   fprintf(stderr,
           "polydyn run: warning: the fixed step %.6g s exceeds RK4's stability bound %.6g s for the scene's stiffest "
-          "contact (omega h <= 2.5); the run may stop with non-finite steps: use --step H with H <= %.6g s "
+          "contact (omega h <= " PD_STABLE_STEP_OMEGA_TEXT "); the run may stop with non-finite steps: use --step H with H <= %.6g s "
           "(docs/integration.md)\n",
           model->settings.dt, bound, bound);
 }

@@ -263,6 +263,7 @@ pdModel* pd_model_compile(const pdScene* scene, pdError* err) {
     int same = builtCount - 1;
     while (same >= 0 && !same_shape_definition(&scene->objects[built[same]], o)) --same;
     pdMassProperties* mp = &massProperties[i];
+    b->shapeTwin = same >= 0 ? built[same] : -1;
     if (same >= 0) {
       pd_polyhedron_copy(&b->shape, &m->bodies[built[same]].shape);
       *mp = massProperties[built[same]];

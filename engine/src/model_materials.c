@@ -192,31 +192,22 @@ static bool check_restitutions(const pdScene* scene, pdError* err) {
   return true;
 }
 
-// Have two bodies the same mass, inertia and vertices, number for number (the same minimum effective mass: a pile of
-// equal boxes, one after the other in the file, forms it once)?
-static bool same_mass_and_vertices(const pdBody* a, const pdBody* b) {
-  return memcmp(&a->mass, &b->mass, sizeof a->mass) == 0 && memcmp(&a->inertia, &b->inertia, sizeof a->inertia) == 0 &&
-         a->shape.vertexCount == b->shape.vertexCount &&
-         memcmp(a->shape.vertices, b->shape.vertices, (size_t)a->shape.vertexCount * sizeof *a->shape.vertices) == 0;
-}
-
 bool pd_model_build_materials(pdModel* m, const pdScene* scene, pdError* err) {
   PD_ASSERT(m->materials == NULL && scene->objectCount == m->bodyCount);
   if (!check_restitutions(scene, err)) return false;
   const int n = m->bodyCount;
   pdMaterialSide* sides = pd_zeroed((size_t)n, sizeof *sides);
   const unsigned requestBits = PD_SET_KN | PD_SET_KT | PD_SET_CN | PD_SET_CT | PD_SET_RESTITUTION;
-  int previous = -1;  // the last moving body, whose mMin is `previousMMin`
-  double previousMMin = 0.0;
   for (int i = 0; i < n; ++i) {
     const pdBody* b = &m->bodies[i];
     const pdSceneObject* o = &scene->objects[i];
     double mMin = 0.0;
     if (!b->fixed) {
-      mMin = previous >= 0 && same_mass_and_vertices(&m->bodies[previous], b)
-                 ? previousMMin
+      // a pile of equal boxes forms its minimum effective mass once: a shape twin has the same mass and vertices
+      const int twin = b->shapeTwin;
+      mMin = twin >= 0 && !m->bodies[twin].fixed
+                 ? sides[twin].mMin
                  : pd_min_effective_mass(b->mass, &b->inertia, b->shape.vertices, b->shape.vertexCount);
-      previous = i, previousMMin = mMin;
     }
     pdMaterialBody body = {
         .index = i,

@@ -20,12 +20,11 @@
 #include "stack_modes.h"
 
 // Stability bound of the adaptive step (paper §3.3: the contact's time constants set the step it can
-// take): (h/2) ω_max ≤ this, ω_max a Gershgorin bound on the contacts' fastest mode (pd_stability_prepare). Classic
-// RK4 is stable to |hλ| ≈ 2.8 along both the negative real and the imaginary axis; 2.5 leaves a margin
-// for what the bound does not see (contacts coupled through a fixed body's neighbours count none). Without
-// the bound the error control walks the step up to the stability edge, where round-off grows until a
-// step is rejected: a block at rest then jitters at the tolerance (µm/s) instead of round-off.
-#define PD_STABLE_STEP_OMEGA 2.5
+// take): (h/2) ω_max ≤ PD_STABLE_STEP_OMEGA (polydyn/model.h), ω_max a Gershgorin bound on the contacts' fastest
+// mode (pd_stability_prepare). The margin below RK4's |hλ| ≈ 2.8 covers what the bound does not see (contacts coupled
+// through a fixed body's neighbours count none). Without the bound the error control walks the step up to the
+// stability edge, where round-off grows until a step is rejected: a block at rest then jitters at the tolerance
+// (µm/s) instead of round-off.
 // Stability bound of a Dormand–Prince 5(4) step (pd_contact_set_dopri_fraction). Its kept fifth-order result has the
 // stability function R(z) = Σ_{k≤5} z^k/k! + z⁶/600 (the seventh stage has weight 0). A contact mode of frequency ω
 // and damping ratio ζ ≤ 1 has λ = ω(−ζ ± i√(1 − ζ²)), so the step is stable for hω ≤ r(ζ), the distance from 0 to

@@ -17,7 +17,7 @@ import tempfile
 
 PD, SRC = sys.argv[1], sys.argv[2]
 SCENE = os.path.join(SRC, "cases", "examples", "demo.scene")
-STABLE_OMEGA_STEP = 2.5  # ω h of the engine's RK4 stability bound (engine/src/stability_bound.c)
+STABLE_OMEGA_STEP = 2.5  # ω h of the engine's RK4 stability bound (PD_STABLE_STEP_OMEGA, engine/include/polydyn/model.h)
 # The warning prints the bound with 6 significant digits.
 PRINTED_REL = 1e-5
 # Within the bound by a margin: the bound counts one contact, and the demo's bodies land on several at once.

@@ -109,11 +109,18 @@ static void test_the_tight_bound_of_a_cube_resting_on_a_face_is_its_rocking_mode
   pd_model_free(m);
 }
 
+// The messages quote the bound as text; it must be the number the engine applies.
+static void test_the_bound_quoted_in_messages_is_the_one_applied(void** state) {
+  (void)state;
+  assert_true(strtod(PD_STABLE_STEP_OMEGA_TEXT, NULL) == PD_STABLE_STEP_OMEGA);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_resting_cube_needs_the_tight_bound_on_most_steps),
       cmocka_unit_test(test_a_bouncing_cube_needs_it_on_few_steps),
       cmocka_unit_test(test_the_tight_bound_of_a_cube_resting_on_a_face_is_its_rocking_mode),
+      cmocka_unit_test(test_the_bound_quoted_in_messages_is_the_one_applied),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -42,6 +42,8 @@ typedef struct pdBody {
   bool fixed;             // immovable: carries no state
   int stateIndex;         // index among moving bodies (-1 for fixed bodies)
   pdPolyhedron shape;     // body frame (origin at the centre of mass, object axes)
+  int shapeTwin;          // an earlier body of the same shape definition and density (the same polyhedron and
+                          // mass properties, number for number, built once), or -1
   pdVec3 geometricCentre; // the primitive's own origin, in the body frame, m
   double density;         // kg/m³
   double volume;          // m³
@@ -146,8 +148,14 @@ PD_API int pd_model_material_class_count(const pdModel* model);
 // writes up to `capacity` into bodyA[], bodyB[] and returns how many there are.
 PD_API int pd_model_contact_class_pairs(const pdModel* model, int* bodyA, int* bodyB, int capacity);
 
+// RK4's stable step at one undamped contact mode of frequency ω: ω h ≤ PD_STABLE_STEP_OMEGA. Classic RK4 is stable
+// to |hλ| ≈ 2.8 along both the negative real and the imaginary axis; 2.5 leaves a margin for what the bound does not
+// see. PD_STABLE_STEP_OMEGA_TEXT is the same number as text, for messages.
+#define PD_STABLE_STEP_OMEGA 2.5
+#define PD_STABLE_STEP_OMEGA_TEXT "2.5"
+
 // The longest step of the fixed RK4 stepper (pd_stepperRK4Fixed) within the stability bound of the scene's stiffest
-// contact (docs/integration.md, "the stability bound"): ω h ≤ 2.5, the bound the adaptive steppers keep, with
+// contact (docs/integration.md, "the stability bound"): ω h ≤ PD_STABLE_STEP_OMEGA, the bound the adaptive steppers keep, with
 // ω = 2π / the shortest contact period over the pairs of material classes that can touch (one contact, undamped;
 // summary.json's contact_period_min), s. Several contacts acting together can need a shorter step. INFINITY when
 // nothing can touch, NAN when the period is not computed (too many material classes).
