@@ -409,9 +409,17 @@ static void transition_kink(const pdModel* model, pdContactSet* set, int i, cons
     e->kink[side] = 0.0;
     if (body->fixed) continue;
     pdVec3 arm = pd_v3_sub(e->geom.point, set->poses1[bodies[side]].x);
-    double turning = pd_v3_norm(pd_mat3_mulv(&set->invInertiaWorld[bodies[side]], pd_v3_cross(arm, along)));
-    double reach = ftNorm > 0.0 ? turning * body->size : INFINITY;  // no direction: the bound refines
-    e->kink[side] = rate * fmax(body->invMass, reach) / model->settings.vmax;
+    const pdMat3* w = &set->invInertiaWorld[bodies[side]];
+    double turning;
+    if (ftNorm > 0.0) {
+      turning = pd_v3_norm(pd_mat3_mulv(w, pd_v3_cross(arm, along)));
+    } else {  // no direction to follow: |W (r × t̂)| ≤ ‖W‖_F |r| for every t̂
+      double frobenius = 0.0;
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) frobenius += w->m[r][k] * w->m[r][k];
+      turning = sqrt(frobenius) * pd_v3_norm(arm);
+    }
+    e->kink[side] = rate * fmax(body->invMass, turning * body->size) / model->settings.vmax;
   }
   double damper = pd_series(p->c1t, p->c2t);
   e->kink[2] = damper > 0.0 ? rate / (damper * c->deltaMax) : 0.0;
