@@ -313,7 +313,6 @@ static int prepare_list(const pdModel* model, pdContactSet* set, double* y, cons
 // error control (refining them cost pile_10 a third of its derivative evaluations).
 static bool changes_mode(const contactSlot* c, const pdContactForce* f) { return c->force.slip != f->slip; }
 
-
 // Contacts [begin, end) of C0 tracked to y1 and their forces there (set->eval).
 static void tracking_range(void* ctx, int part, int begin, int end) {
   (void)part;
