@@ -116,6 +116,18 @@ static double segment_distance(pdVec3 a, pdVec3 b, pdVec3 q) {
   return pd_v3_norm(pd_v3_sub(q, pd_v3_muladd(a, s, u)));
 }
 
+// The edge of faceBody in edge pair c when c is an edge pair of vertexBody and faceBody whose edge on vertexBody (shape
+// sv) ends at `vertex`, else -1.
+static int edge_pair_edge_at_vertex(const pdContactId* c, const pdPolyhedron* sv, int vertexBody, int vertex,
+                                    int faceBody) {
+  if (c->kind != pd_contactEE) return -1;
+  int edgeV, edgeF;
+  if (c->body1 == vertexBody && c->body2 == faceBody) edgeV = c->feat1, edgeF = c->feat2;
+  else if (c->body2 == vertexBody && c->body1 == faceBody) edgeV = c->feat2, edgeF = c->feat1;
+  else return -1;
+  return sv->edges[edgeV].v[0] == vertex || sv->edges[edgeV].v[1] == vertex ? edgeF : -1;
+}
+
 static int face_after_edge_pair(const pdModel* m, const pdContactId* previous, int count, int vertexBody, int vertex,
                                 int faceBody, pdVec3 q, double tol, double over, double reach) {
   const pdPolyhedron* sv = &m->bodies[vertexBody].shape;
@@ -123,13 +135,8 @@ static int face_after_edge_pair(const pdModel* m, const pdContactId* previous, i
   int face = -1;
   double deepest = tol;
   for (int i = 0; i < count; ++i) {
-    const pdContactId* c = &previous[i];
-    if (c->kind != pd_contactEE) continue;
-    int edgeV, edgeF;
-    if (c->body1 == vertexBody && c->body2 == faceBody) edgeV = c->feat1, edgeF = c->feat2;
-    else if (c->body2 == vertexBody && c->body1 == faceBody) edgeV = c->feat2, edgeF = c->feat1;
-    else continue;
-    if (sv->edges[edgeV].v[0] != vertex && sv->edges[edgeV].v[1] != vertex) continue;
+    int edgeF = edge_pair_edge_at_vertex(&previous[i], sv, vertexBody, vertex, faceBody);
+    if (edgeF < 0) continue;
     const pdEdge* e = &sf->edges[edgeF];
     if (segment_distance(sf->vertices[e->v[0]], sf->vertices[e->v[1]], q) > reach) continue;
     for (int k = 0; k < 2; ++k) {
@@ -203,6 +210,30 @@ static double outside_by(const pdPolyhedron* s, pdVec3 q) {
   return most;
 }
 
+// A vertex pressed through a thin body. A VF contact's element on face F is compressed by the vertex's depth below F;
+// a vertex driven deeper than the body is thick (a heavy corner pressing a thin plate onto a third body: the plate's
+// springs are sized for the plate's own mass, eq. (11), not for the load the third body puts through it) comes out
+// through the far side. It then lies outside the body only across faces turned away from F (outward normals more than
+// 90° apart), over F's polygon and below F: the element is still compressed by that depth, and a contact tracked
+// there (it came in through F: face continuity, §4.4.3) goes on with the paper's geometry and force law while its
+// vertex is its body's support point along −n_F, as beyond an acute edge. Breaking it released the compressed element
+// at once and left the two bodies overlapping by more than the plate's width with no contact: a 100:1 blade between a
+// prism's corner and a third body went 25 δ_max deep, a 38:1 sliver between a plate's corner and the floor 30 δ_max
+// (docs/contact-model.md, "A vertex pressed through a thin body"). A vertex found outside a body is no new contact by
+// this rule alone, since a vertex resting against the far face from outside lies there too; the search makes one only
+// at the end of an edge already in an edge pair with the body (design note below).
+static bool through_far_side(const pdPolyhedron* s, int f, pdVec3 q, double tol, double depth) {
+  if (!(depth > 0.0)) return false;
+  pdVec3 nf = s->faces[f].normal;
+  bool out = false;
+  for (int g = 0; g < s->faceCount; ++g) {
+    if (!(face_depth(s, g, q) < -tol)) continue;
+    if (!(pd_v3_dot(s->faces[g].normal, nf) < 0.0)) return false;
+    out = true;
+  }
+  return out;
+}
+
 // The face a vertex of sv outside sf (q in sf's frame) presses on beyond an acute edge (design note above), or -1:
 // the previous contact's face (while the vertex is below it and over it), else the shallowest that qualifies. *penetration: the bodies'
 // penetration depth, formed here when first needed (NAN until then).
@@ -266,6 +297,64 @@ __attribute__((noinline)) static int vf_beyond_acute_edge(const pdModel* m, int 
   return n + 1;
 }
 
+// ---------------------------------------------------------------- an edge pair's vertex through the far side
+//
+// Design note. An edge of one body pressed across a thin body's rim (a plate's edge lying along a lens-shaped sliver's
+// face, through the sliver where it is under 2 δ_max thick) is held by its edge pairs with the rim's edges, and its end
+// vertex, once that is its body's lowest point along a face F at the other edge, by a VF contact on F. Tracked, that
+// contact goes on through the far side (through_far_side); but when the edge rocks, the support point passes between
+// the edge's two ends and the contact breaks, and a vertex outside the body is no new contact: with both ends outside
+// and the edge pair parting (its Gauss arcs apart), nothing held the two while their overlap grew from 2.4 to 8.5 δ_max
+// (soak campaign 63, scene 4858). So the search makes the vertex at the end of an edge in one of the pair's edge pairs a
+// VF contact on a face F of the other edge when tracking would keep it there: below F and over its polygon, outside
+// the body only across faces turned away from F, its body's support point along −n_F, and no deeper than a new edge
+// pair may be (3 δ_max beyond the bodies' penetration). Its geometry and force law are any VF contact's (point the
+// vertex, eq. (18a); normal n_F, eq. (18b); depth below F's plane): the overlap along n_F is that depth, as the
+// separating-axis test reads it, and it continues the edge pair's normal where the pair's arcs part at n_F. A vertex
+// resting against the far face from outside is not its body's lowest point along −n_F, and its edge is in no edge pair
+// with F's edges pressed into the body.
+
+// The VF contact of vertex i of body iv (at p, world; q in jf's frame) outside body jf at the end of an edge in one of
+// the pair's edge pairs (design note above), appended to out, or nothing: n or n + 1. Out of find_vf's loop over the
+// vertices, which calls it only for a pair that held an edge pair.
+__attribute__((noinline)) static int vf_through_after_edge_pair(const pdModel* m, int iv, const pdPose* pv, int jf,
+                                                                const pdPose* pf, int i, pdVec3 p, pdVec3 q,
+                                                                const pdContactId* previous, int previousCount,
+                                                                double* penetration, pdContactGeom* out, int capacity,
+                                                                int n) {
+  const pdPolyhedron* sv = &m->bodies[iv].shape;
+  const pdPolyhedron* sf = &m->bodies[jf].shape;
+  double tol = BOUNDARY_TOL_REL * m->bodies[jf].size;
+  double deltaMax = pd_model_pair_delta_max(m, iv, jf);
+  double over = fmax(tol, FLUSH_TOL_DEFLECTIONS * deltaMax);
+  // as tracking measures a vertex outside the body (pd_contact_track_framed), so that what is found here is kept there
+  double trackOutside = TRACK_INSIDE_TOL_REL * m->settings.deflection * m->bodies[jf].size;
+  pdMat3 rel;
+  pdVec3 off;
+  pose_in_frame_of(pf, pv, &rel, &off);
+  int face = -1;
+  double deepest = tol;
+  for (int k = 0; k < previousCount; ++k) {
+    int edgeF = edge_pair_edge_at_vertex(&previous[k], sv, iv, i, jf);
+    if (edgeF < 0) continue;
+    for (int s = 0; s < 2; ++s) {
+      int f = sf->edges[edgeF].f[s];
+      double d = face_depth(sf, f, q);
+      if (!(d > deepest) || !projects_inside(sf, f, q, over) || !through_far_side(sf, f, q, trackOutside, d)) continue;
+      if (!support_along(sv, i, &rel, q, sf->faces[f].normal)) continue;
+      if (d > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax) {
+        if (isnan(*penetration)) *penetration = penetration_depth(sv, pv, sf, pf);
+        if (d > EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax + *penetration) continue;
+      }
+      deepest = d, face = f;
+    }
+  }
+  if (face < 0) return n;
+  if (n < capacity)
+    out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, face}, p, pd_mat3_mulv(&pf->R, sf->faces[face].normal), deepest};
+  return n + 1;
+}
+
 // VF contacts of the vertices of body iv inside body jf, and, with mask, each vertex's faces of jf (of the first 64)
 // whose plane it lies outside of by more than the pruning margin (find_ee's edge pruning).
 // (Formed twice, for a face body with an acute edge and for one without (find_vf): without, the loop is the paper's
@@ -281,6 +370,8 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
   double deltaMax = pd_model_pair_delta_max(m, iv, jf);
   double flushTol = FLUSH_TOL_DEFLECTIONS * deltaMax;
   beyondAcute beyond = {acute, NAN};
+  bool edgePairs = false;  // did the pair hold an edge pair
+  for (int k = 0; k < previousCount && !edgePairs; ++k) edgePairs = previous[k].kind == pd_contactEE;
   int maskFaces = mask ? (sf->faceCount < 64 ? sf->faceCount : 64) : 0;
   double maskMargin = deltaMax + PRUNE_OUTSIDE_TOLS * tol;
   pdMat3 rel;  // the vertex body in the face body's frame
@@ -316,6 +407,15 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
       mask[i] = outsideFaces;
     }
     if (outside) {
+      // the end of an edge in an edge pair, through a thin body's far side (design note above)
+      if (edgePairs) {
+        int found = vf_through_after_edge_pair(m, iv, pv, jf, pf, i, p, q, previous, previousCount, &beyond.penetration,
+                                               out, capacity, n);
+        if (found > n) {
+          n = found;
+          continue;
+        }
+      }
       // a vertex beyond an acute edge, still pressed into a face (design note above): the vertices outside a body with
       // such an edge by at most δ_max are looked at again
       if (acute && outsideBy <= deltaMax)
@@ -784,11 +884,6 @@ static bool edge_contact(const pdModel* model, const pdContactId* id, const pdPo
   return true;
 }
 
-// A tracked contact keeps its features while its vertex (VF) or each edge's closest point (EE) lies inside the other body, to this
-// fraction of that body's δ_max (deflection × size): a crossing that ends with the springs still loaded
-// (elastic contacts end where they began, up to the onset interpolation's error) stays; an edge pair whose
-// lines pass each other outside the bodies (it slid past a corner) does not press anywhere and breaks.
-#define TRACK_INSIDE_TOL_REL 0.1
 static bool edge_points_inside(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,
                                const pdContactGeom* g) {
   pdVec3 on1 = pd_v3_muladd(g->point, -0.5 * g->depth, g->normal);  // on body 1's edge
@@ -848,29 +943,6 @@ void pd_contact_geometry_framed(const pdModel* model, const pdContactId* id, con
     out->normal = (pdVec3){0, 0, 0};
     out->depth = 0.0;
   }
-}
-
-// A vertex pressed through a thin body. A VF contact's element on face F is compressed by the vertex's depth below F;
-// a vertex driven deeper than the body is thick (a heavy corner pressing a thin plate onto a third body: the plate's
-// springs are sized for the plate's own mass, eq. (11), not for the load the third body puts through it) comes out
-// through the far side. It then lies outside the body only across faces turned away from F (outward normals more than
-// 90° apart), over F's polygon and below F: the element is still compressed by that depth, and a contact tracked
-// there (it came in through F: face continuity, §4.4.3) goes on with the paper's geometry and force law while its
-// vertex is its body's support point along −n_F, as beyond an acute edge. Breaking it released the compressed element
-// at once and left the two bodies overlapping by more than the plate's width with no contact: a 100:1 blade between a
-// prism's corner and a third body went 25 δ_max deep, a 38:1 sliver between a plate's corner and the floor 30 δ_max
-// (docs/contact-model.md, "A vertex pressed through a thin body"). Tracking only: a vertex found outside a body is no
-// new contact by this rule, since a vertex resting against the far face from outside lies there too.
-static bool through_far_side(const pdPolyhedron* s, int f, pdVec3 q, double tol, double depth) {
-  if (!(depth > 0.0)) return false;
-  pdVec3 nf = s->faces[f].normal;
-  bool out = false;
-  for (int g = 0; g < s->faceCount; ++g) {
-    if (!(face_depth(s, g, q) < -tol)) continue;
-    if (!(pd_v3_dot(s->faces[g].normal, nf) < 0.0)) return false;
-    out = true;
-  }
-  return out;
 }
 
 bool pd_contact_track(const pdModel* model, const pdContactId* id, const pdPose* p1, const pdPose* p2,

@@ -143,10 +143,41 @@ static double over_face_margin(const pdPolyhedron* s, int f, pdVec3 q, double ov
   return least;
 }
 
+// For vertex i of sv (q, sf's frame) at the end of an edge in a listed edge pair, how far it may move before it could
+// press through sf's far side on a face F around the pair's edge on sf (find_vf, vf_through_after_edge_pair), m
+// (INFINITY: no such pair). That needs it below F, outside no face turned less than 90° from F by more than tracking's
+// tolerance `outside`, and outside one turned away from F by more than it: not while any of these is further away than
+// the margin. `tolerance` covers the search's tolerance and the rounding.
+static double edge_pair_end_margin(const pdPolyhedron* sv, int iv, int i, pdVec3 q, const pdPolyhedron* sf,
+                                   double tolerance, double outside, const pdContactId* exempt, int exemptCount) {
+  double least = INFINITY;
+  for (int k = 0; k < exemptCount; ++k) {
+    const pdContactId* c = &exempt[k];
+    if (c->kind != pd_contactEE) continue;
+    int edgeV = c->body1 == iv ? c->feat1 : c->body2 == iv ? c->feat2 : -1;
+    if (edgeV < 0 || (sv->edges[edgeV].v[0] != i && sv->edges[edgeV].v[1] != i)) continue;
+    const pdEdge* e = &sf->edges[c->body1 == iv ? c->feat2 : c->feat1];
+    for (int s = 0; s < 2; ++s) {
+      int f = e->f[s];
+      pdVec3 nf = sf->faces[f].normal;
+      double above = -face_depth(sf, f, q) - tolerance;  // above F's plane
+      double inside = INFINITY;                           // from leaving a face turned away from F
+      for (int g = 0; g < sf->faceCount; ++g) {
+        double d = face_depth(sf, g, q);
+        if (pd_v3_dot(sf->faces[g].normal, nf) < 0.0) inside = fmin(inside, d - tolerance);
+        else if (g != f) above = fmax(above, -d - outside - tolerance);
+      }
+      least = fmin(least, fmax(above, inside));
+    }
+  }
+  return least;
+}
+
 // The least margin of the vertices of sv (given in sf's frame by rel, off) against sf, vertices listed as VF
 // contacts of body iv in `exempt` left out; stops at `bound` (no lower margin needed).
 static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf,
-                              double tolerance, double over, const pdContactId* exempt, int exemptCount, double bound) {
+                              double tolerance, double over, double outside, const pdContactId* exempt, int exemptCount,
+                              double bound) {
   double least = bound;
   for (int i = 0; i < sv->vertexCount && least > 0.0; ++i) {
     pdVec3 q = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[i]));
@@ -159,6 +190,9 @@ static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel,
     }
     double margin = outside_farthest(sf, q, least + tolerance) - tolerance;
     least = margin < least ? margin : least;
+    // the end of an edge in a listed edge pair may become a contact on a face of the other edge it lies below, through
+    // the body's far side (find_vf): it is not while above both faces' planes by more than the search's tolerance
+    least = fmin(least, edge_pair_end_margin(sv, iv, i, q, sf, tolerance, outside, exempt, exemptCount));
   }
   return least;
 }
@@ -185,8 +219,12 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   double onA = pd_polyhedron_has_acute_edge(sa) ? fmax(deltaMax, tolA) : fmax(tolA, flushTol);
   double onB = pd_polyhedron_has_acute_edge(sb) ? fmax(deltaMax, tolB) : fmax(tolB, flushTol);
   double overA = fmax(tolA, flushTol) - guard, overB = fmax(tolB, flushTol) - guard;  // find_vf's "over its face"
-  double least = vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, exempt, exemptCount, INFINITY);
-  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, exempt, exemptCount, least);
+  // tracking's tolerance for a vertex outside a body (find_vf's vertex through the far side at an edge pair's end)
+  double outsideA = TRACK_INSIDE_TOL_REL * model->settings.deflection * sizeA;
+  double outsideB = TRACK_INSIDE_TOL_REL * model->settings.deflection * sizeB;
+  double least =
+      vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, outsideA, exempt, exemptCount, INFINITY);
+  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, outsideB, exempt, exemptCount, least);
   if (!(least > 0.0)) return cert;
   // EE: per edge, how far it lies beyond one face plane of the other body (then any pair with it is certified)
   enum { EDGES_MAX = 64 };

@@ -41,6 +41,12 @@
 // Absolute rounding margin of a triple product of unit vectors: ~100 ulps of 1.
 #define ARC_TRIPLE_ROUNDING 1e-14
 
+// A tracked contact keeps its features while its vertex (VF) or each edge's closest point (EE) lies inside the other body, to this
+// fraction of that body's δ_max (deflection × size): a crossing that ends with the springs still loaded
+// (elastic contacts end where they began, up to the onset interpolation's error) stays; an edge pair whose
+// lines pass each other outside the bodies (it slid past a corner) does not press anywhere and breaks.
+#define TRACK_INSIDE_TOL_REL 0.1
+
 // Body b's pose in body a's frame: rotation R_aᵀ R_b, offset R_aᵀ (x_b − x_a).
 static inline void pose_in_frame_of(const pdPose* a, const pdPose* b, pdMat3* rel, pdVec3* off) {
   pdMat3 RaT = pd_mat3_transpose(&a->R);
@@ -50,6 +56,15 @@ static inline void pose_in_frame_of(const pdPose* a, const pdPose* b, pdMat3* re
 
 // Depth of point q (body frame) below face f's plane (> 0 inside the half-space).
 static inline double face_depth(const pdPolyhedron* s, int f, pdVec3 q) { return s->faces[f].offset - pd_v3_dot(s->faces[f].normal, q); }
+
+// Do faces f and g of s meet at an edge outward normals more than 90° apart: an acute edge, in whose wedge a vertex
+// near one face may move into the other?
+static inline bool faces_meet_at_acute_edge(const pdPolyhedron* s, int f, int g) {
+  if (!(pd_v3_dot(s->faces[f].normal, s->faces[g].normal) < 0.0)) return false;
+  for (int e = 0; e < s->edgeCount; ++e)
+    if ((s->edges[e].f[0] == f && s->edges[e].f[1] == g) || (s->edges[e].f[0] == g && s->edges[e].f[1] == f)) return true;
+  return false;
+}
 
 // An arc (a, b) of the Gauss map with its great circle's normal b × a and that normal's squared length: the
 // search tests every edge of one body against every edge of the other, so each arc's are formed once.

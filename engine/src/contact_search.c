@@ -14,6 +14,7 @@
 #include "model_contact.h"
 #include "onsets.h"
 #include "state_layout.h"
+#include "contact_features.h"
 
 // Tunnelling guard: over one step, two bodies whose swept boxes overlap may move relative to each other by
 // at most this fraction of the thinner one's width. A quarter keeps a vertex that crossed a face within
@@ -579,6 +580,11 @@ static void find_range(void* ctx, int part, int begin, int end) {
   }
 }
 
+// A vertex leaving a body through face F recedes from F as fast as it sinks into a face f opposite F (the far side of
+// a plate: the two rates are equal for parallel faces, within the lateral motion's share for a lens whose faces meet at
+// a few degrees); one sinking into f more than this many times as fast as it recedes from F is not leaving through F.
+#define SINKING_NOT_LEAVING 2.0
+
 // Face continuity (§4.4.3) through a release by force: a vertex whose contact on face F was released by its dampers
 // while still inside the other body, and that the search finds again on another face of that body, keeps F while the
 // history keeps its trace (its features still tracked, within the history's gap: contact_history.h). The search takes
@@ -604,7 +610,15 @@ static bool keep_released_face(const pdModel* model, const pdContactSet* set, co
   pdVec3 du = relative_velocity(model, y1, poses1, &released, kept.point);
   // receding from F it is no contact on a face turned away from F (the far side of a plate, which it approaches only
   // by leaving through F); on a face beside F it may have slid in, and is that face's as found
-  if (!(pd_v3_dot(du, kept.normal) < 0.0)) return !(pd_v3_dot(kept.normal, c->geom.normal) < 0.0);
+  if (!(pd_v3_dot(du, kept.normal) < 0.0)) {
+    if (!(pd_v3_dot(kept.normal, c->geom.normal) < 0.0)) return true;
+    // in the wedge of an acute edge of F and f, a vertex sinking into f much faster than it recedes from F moves
+    // along F into the body through f (a corner entered at a thin plate's rim edge rising through its bottom face),
+    // not out through F: it is f's contact as found
+    double sinking = -pd_v3_dot(du, c->geom.normal), receding = pd_v3_dot(du, kept.normal);
+    return sinking > SINKING_NOT_LEAVING * receding &&
+           faces_meet_at_acute_edge(&model->bodies[released.body2].shape, released.feat2, c->geom.id.feat2);
+  }
   c->geom = kept;
   c->approaching = true;
   c->released = true;

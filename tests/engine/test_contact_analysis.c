@@ -513,6 +513,57 @@ static void test_a_vertex_pressed_through_a_thin_plate_keeps_its_face(void** sta
   pd_model_free(m);
 }
 
+// An edge pressed through a thin plate's rim (docs/contact-model.md, "An edge pair's vertex through the far side"): a
+// tetrahedron in an edge pair with the plate's top edge, its apex through the plate 1 mm beyond the bottom face, below
+// the top face and over it, its body's lowest point. The apex presses on the top face as a vertex tracked there would
+// (through_far_side): the search finds it there, its normal and depth the top face's; with no edge pair at the apex it
+// finds no contact of that vertex, as above.
+static void test_an_edge_pairs_end_through_a_thin_plate_is_found_on_the_face(void** state) {
+  (void)state;
+  const double half = 0.002;  // the plate's half-thickness, m
+  pdModel* m = compile("cube plate grey 0.4 0.4 0.004\nhull tip red 0 0 0 0.05 0 0.05 -0.05 0.05 0.05 -0.05 -0.05 0.05\n");
+  const pdPolyhedron* plateShape = &m->bodies[0].shape;
+  const pdPolyhedron* tip = &m->bodies[1].shape;
+  int apex = 0;
+  for (int v = 1; v < tip->vertexCount; ++v)
+    if (tip->vertices[v].z < tip->vertices[apex].z) apex = v;
+  int top = -1, rim = -1, tipEdge = -1;
+  for (int f = 0; f < plateShape->faceCount; ++f)
+    if (plateShape->faces[f].normal.z > 0.5) top = f;
+  for (int e = 0; e < plateShape->edgeCount && rim < 0; ++e) {  // the top face's edge along x = 0.2
+    pdVec3 a = plateShape->vertices[plateShape->edges[e].v[0]], b = plateShape->vertices[plateShape->edges[e].v[1]];
+    if (a.x > 0.19 && b.x > 0.19 && a.z > 0.0 && b.z > 0.0) rim = e;
+  }
+  for (int e = 0; e < tip->edgeCount && tipEdge < 0; ++e)
+    if (tip->edges[e].v[0] == apex || tip->edges[e].v[1] == apex) tipEdge = e;
+  assert_true(top >= 0 && rim >= 0 && tipEdge >= 0);
+  double apexZ = tip->vertices[apex].z;
+  pdPose plate = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
+  // 1 cm in from the rim's side face (the tetrahedron's edges pass over the rim), through the plate and 1 mm beyond its
+  // bottom face
+  pdVec3 apexAt = tip->vertices[apex];  // in the hull's frame, about its centre of mass
+  pdPose through = pose(0.2 - 1e-2 - apexAt.x, -apexAt.y, -half - 1e-3 - apexZ, 0, pd_v3(0, 0, 1));
+  pdContactId edgePair = {0, 1, pd_contactEE, rim, tipEdge};
+  pdContactGeom c[CAPACITY];
+  int n = pd_contacts_find(m, 0, &plate, 1, &through, NULL, NULL, &edgePair, 1, c, CAPACITY);
+  assert_true(n <= CAPACITY);
+  int found = -1;
+  for (int k = 0; k < n; ++k)
+    if (c[k].id.kind == pd_contactVF && c[k].id.body1 == 1 && c[k].id.feat1 == apex) found = k;
+  assert_true(found >= 0);
+  assert_int_equal(c[found].id.feat2, top);
+  expect_near(c[found].depth, 2.0 * half + 1e-3, GEOM_TOL, "depth below the top face");
+  expect_near(c[found].normal.z, 1.0, GEOM_TOL, "the top face's normal");
+  // tracked there as a vertex pressed through the plate
+  pdContactGeom g;
+  assert_true(pd_contact_track(m, &c[found].id, &through, &plate, &g));
+  // no edge pair at the apex: no contact of it
+  n = pd_contacts_find(m, 0, &plate, 1, &through, NULL, NULL, NULL, 0, c, CAPACITY);
+  for (int k = 0; k < n && k < CAPACITY; ++k)
+    assert_false(c[k].id.kind == pd_contactVF && c[k].id.body1 == 1 && c[k].id.feat1 == apex);
+  pd_model_free(m);
+}
+
 static void test_small_capacity_reports_the_needed_count(void** state) {
   (void)state;
   pdModel* m = compile(cubeOnFloor);
@@ -542,6 +593,7 @@ int main(void) {
       cmocka_unit_test(test_a_deep_edge_pair_the_search_finds_is_tracked),
       cmocka_unit_test(test_edge_along_a_rim_face_gives_both_crossings),
       cmocka_unit_test(test_a_vertex_pressed_through_a_thin_plate_keeps_its_face),
+      cmocka_unit_test(test_an_edge_pairs_end_through_a_thin_plate_is_found_on_the_face),
       cmocka_unit_test(test_small_capacity_reports_the_needed_count),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
