@@ -66,6 +66,8 @@ typedef struct contactEval {
   pdContactForce force;
   pdVec3 du;         // relative velocity at the contact point, m/s
   double modeBound;  // a stick–slip change left inside the step: its error bound (onset_bound.h), else 0
+  bool slipChanged;  // stick ↔ slip inside the step, under bounded events (kink then holds its slopes)
+  double kink[3];    // a stick–slip change inside the step: its kink's slopes (onset_bound.h) on body1, body2, springs
   // a held mode that the force law left inside the step (holdModes), corrected at the commit: the impulse on body 1
   // (N·s) and the change of its springs (m) that take out what the held law applied since the change
   bool modeCorrected;
