@@ -17,7 +17,8 @@ static const char* const help =
     "minimum effective mass and the time constants; then the number of material classes and every\n"
     "time-constant adjustment made to fit dtmin (or \"adjustments: none\"); then the stacks (moving\n"
     "bodies joined by contacts after 0.1 s of the run, or at tend if sooner; scenes of at most 64\n"
-    "moving bodies) with the frequency and damping ratio of each of their contact modes.\n"
+    "moving bodies) with the pairs whose springs are raised for the load pressing them and the\n"
+    "frequency and damping ratio of each of their contact modes.\n"
     "Refuses (exit 2) what `polydyn run` refuses, including a restitution below 0.01 and bodies that\n"
     "overlap at t = 0. Exit status: 0 ok, 2 bad input.\n";
 
@@ -168,6 +169,26 @@ static void print_adjustments(const pdModel* m) {
 // At most this many roots are printed per stack (the slowest; 12 per body in all).
 #define PD_CHECK_STACK_ROOTS_MAX 12
 
+// The stack's pairs whose springs are raised for the load they carry (docs/contact-model.md, "Springs sized by the
+// load"), one line each: the factor over eq. (11)'s and the stiffness per contact it gives. Contacts are listed by
+// pair, so a pair's contacts are adjacent.
+static void print_load_springs(const pdModel* m, const pdState* s, const int* stackOf, int stack) {
+  int n = pd_state_contact_count(s);
+  for (int i = 0; i < n; ++i) {
+    pdContactReport c = pd_state_contact(s, i);
+    if (stackOf[c.bodyA] != stack && stackOf[c.bodyB] != stack) continue;
+    if (i > 0) {
+      pdContactReport p = pd_state_contact(s, i - 1);
+      if ((p.bodyA == c.bodyA && p.bodyB == c.bodyB) || (p.bodyA == c.bodyB && p.bodyB == c.bodyA)) continue;
+    }
+    if (!(c.springScale > 1.0)) continue;
+    pdPairContact pair = pd_model_pair_contact(m, c.bodyA, c.bodyB);
+    printf("    springs       %s / %s: %.4g times eq. (11)'s for the load pressing them (kn %g N/m per contact, "
+           "m_pair %g kg)\n",
+           m->bodies[c.bodyA].name, m->bodies[c.bodyB].name, c.springScale, c.springScale * pair.kn, pair.massPair);
+  }
+}
+
 static void print_stack(const pdModel* m, const pdState* s, const int* stackOf, int stack) {
   int bodies = 0, contacts = 0;
   double lightest = INFINITY, heaviest = 0.0;
@@ -184,6 +205,7 @@ static void print_stack(const pdModel* m, const pdState* s, const int* stackOf, 
     contacts += stackOf[c.bodyA] == stack || stackOf[c.bodyB] == stack;
   }
   printf(" (%d bodies, %d contacts, masses %.6g to %.6g kg)\n", bodies, contacts, lightest, heaviest);
+  print_load_springs(m, s, stackOf, stack);
   pdStackMode modes[12 * PD_STACK_MODES_BODIES_MAX];
   int count = pd_state_stack_modes(m, s, stackOf, stack, modes, 12 * PD_STACK_MODES_BODIES_MAX);
   if (count < 0) {

@@ -36,6 +36,7 @@ typedef struct pdContactParams {
   double mu;                  // pair friction coefficient √(μ₁μ₂), >= 0
   bool proportionalN, proportionalT;  // c1/k1 = c2/k2 along n, in P_t (set where that holds by construction)
   bool modalN, modalT;        // the dampers are set per contact from the pair's modal mass (material.h)
+  bool loadSized;             // all four springs from eq. (11): raised for the load the pair carries (material.h)
   double zetaN, zetaT;        // damping ratios the modal dampers reach
   double massPair;            // kg: the pair's reduced mass (a fixed body counts as infinite)
   double massMin;             // kg: the pair's minimum effective mass (both bodies' m_min in series)

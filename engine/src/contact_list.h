@@ -35,6 +35,7 @@ typedef struct contactSlot {
   int modalCount;       // contacts its pair had when pd_modal_dampers last set its dampers (0: not yet)
   int modalBodyContacts[2];  // contacts of body1, body2 (moving) then: a neighbour's change re-sizes its dampers
   double stackScale[2];      // ζ of its modal dampers at the pair's own mass over the requested (n, P_t; >= 1)
+  double loadScale;          // its springs over eq. (11)'s for the pair alone (>= 1; pd_modal_dampers, "load")
   // its modes at the step's start (record()), held over the step when the set holds modes (pd_contact_force_held)
   bool heldPush, heldSlip;
 } contactSlot;
@@ -65,6 +66,8 @@ typedef struct contactEval {
   pdContactForce force;
   pdVec3 du;         // relative velocity at the contact point, m/s
   double modeBound;  // a stick–slip change left inside the step: its error bound (onset_bound.h), else 0
+  bool slipChanged;  // stick ↔ slip inside the step, under bounded events (kink then holds its slopes)
+  double kink[3];    // a stick–slip change inside the step: its kink's slopes (onset_bound.h) on body1, body2, springs
   // a held mode that the force law left inside the step (holdModes), corrected at the commit: the impulse on body 1
   // (N·s) and the change of its springs (m) that take out what the held law applied since the change
   bool modeCorrected;
@@ -304,9 +307,10 @@ void pd_contact_set_reserve_list(pdContactSet* set, int capacity);
 // bodyList, read by the force sums and the tight stability bound.
 void pd_contact_set_list_bodies(const pdModel* model, pdContactSet* set);
 
-// stability_bound.c: the modal dampers of every pair whose contacts changed (poses: the list's, world inverse
-// inertias set), and the stability bound's terms and cheap bound for a new list.
-void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses);
+// stability_bound.c: the springs sized by the load and the modal dampers of every pair whose contacts changed (poses:
+// the list's, world inverse inertias set; y: the state whose springs are re-scaled with their stiffness), and the
+// stability bound's terms and cheap bound for a new list.
+void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses, double* y);
 void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses);
 
 // contact_search.c: the contact search's arrays (broad phase, pairs, caches, certificates, candidates) of a set

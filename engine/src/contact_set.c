@@ -223,6 +223,7 @@ static contactSlot new_slot(const pdModel* model, const pdContactGeom* g) {
   memset(&c, 0, sizeof c);
   c.id = g->id;
   c.params = pd_model_contact_params(model, g->id.body1, g->id.body2);
+  c.loadScale = 1.0;
   c.deltaMax = pd_model_pair_delta_max(model, g->id.body1, g->id.body2);
   c.normal = g->normal;
   c.point = g->point;
@@ -300,7 +301,7 @@ static void world_inverse_inertias(const pdModel* model, pdContactSet* set, cons
 // number of pair onsets started.
 static int prepare_list(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
   world_inverse_inertias(model, set, poses);
-  pd_modal_dampers(model, set, poses);
+  pd_modal_dampers(model, set, poses, y);
   int started = pd_onsets_start_late(model, set, y, poses);
   record(model, set, y, poses);
   pd_stability_prepare(model, set, poses);
@@ -312,16 +313,6 @@ static int prepare_list(const pdModel* model, pdContactSet* set, double* y, cons
 // of Δu_t within one mode are smooth in this model (linear springs and dampers) and are left to the
 // error control (refining them cost pile_10 a third of its derivative evaluations).
 static bool changes_mode(const contactSlot* c, const pdContactForce* f) { return c->force.slip != f->slip; }
-
-// The error bound (onset_bound.h) of leaving contact c's stick–slip change (evaluated at the step's end in e) inside
-// a step of h.
-static double transition_bound(const pdModel* model, const contactSlot* c, const contactEval* e, double h) {
-  const pdContactParams* p = &c->params;
-  double approach = pd_v3_dot(e->du, e->geom.normal);
-  double slide = pd_v3_norm(pd_v3_sub(e->du, pd_v3_scale(e->geom.normal, approach)));
-  return pd_transition_error_bound(pd_series(p->k1t, p->k2t) / p->massMin, pd_series(p->k1n, p->k2n) / p->massMin,
-                                   p->mu, slide, fabs(approach), h, model->settings.vmax);
-}
 
 // Contacts [begin, end) of C0 tracked to y1 and their forces there (set->eval).
 static void tracking_range(void* ctx, int part, int begin, int end) {
@@ -337,6 +328,7 @@ static void tracking_range(void* ctx, int part, int begin, int end) {
     e->transferred = false;
     e->modeBound = 0.0;
     e->modeCorrected = false;
+    e->slipChanged = false;
   }
 }
 
@@ -386,6 +378,68 @@ static void switching_at(const pdModel* model, pdContactSet* set, int i, const d
   pd_contact_force(&c->params, &sp, g.normal, du, &f);
   *fn = f.fn;
   *margin = f.coneMargin;
+}
+
+// The slopes of the kink that contact i's stick–slip change inside a step of h leaves (onset_bound.h), in the error
+// norm's units, into e->kink: on body1, body2 (0 for a fixed body) and the contact's springs. The rate jump ġ is the
+// cone's margin's, from its values at the step's start, the first half step's end and the end (the larger of the half
+// steps' chords and the parabola's slope at its crossing); without the middle, or off the damper-determined branch
+// (no finite margin), the rate the springs and the cone can reach, k_t |Δu_t| + μ k_n |Δu_n|.
+static void transition_kink(const pdModel* model, pdContactSet* set, int i, const double* yMid, double h) {
+  const contactSlot* c = &set->items[i];
+  contactEval* e = &set->eval[i];
+  const pdContactParams* p = &c->params;
+  double g0 = c->force.coneMargin, g1 = e->force.coneMargin, gm = NAN, fnMid;
+  if (yMid && isfinite(g0) && isfinite(g1)) switching_at(model, set, i, yMid, &fnMid, &gm);
+  double rate;
+  if (isfinite(gm)) {
+    double theta = 1.0 - crossing_age_mid(g0, gm, g1, h) / h;
+    double a = 2.0 * (g1 - 2.0 * gm + g0), b = g1 - g0 - a;
+    rate = fmax(fmax(fabs(gm - g0), fabs(g1 - gm)) / (0.5 * h), fabs(b + 2.0 * a * theta) / h);
+  } else {
+    double approach = pd_v3_dot(e->du, e->geom.normal);
+    double slide = pd_v3_norm(pd_v3_sub(e->du, pd_v3_scale(e->geom.normal, approach)));
+    rate = pd_series(p->k1t, p->k2t) * slide + p->mu * pd_series(p->k1n, p->k2n) * fabs(approach);
+  }
+  double ftNorm = pd_v3_norm(e->force.ft);
+  pdVec3 along = ftNorm > 0.0 ? pd_v3_scale(e->force.ft, 1.0 / ftNorm) : (pdVec3){0.0, 0.0, 0.0};
+  int bodies[2] = {c->id.body1, c->id.body2};
+  for (int side = 0; side < 2; ++side) {
+    const pdBody* body = &model->bodies[bodies[side]];
+    e->kink[side] = 0.0;
+    if (body->fixed) continue;
+    pdVec3 arm = pd_v3_sub(e->geom.point, set->poses1[bodies[side]].x);
+    const pdMat3* w = &set->invInertiaWorld[bodies[side]];
+    double turning;
+    if (ftNorm > 0.0) {
+      turning = pd_v3_norm(pd_mat3_mulv(w, pd_v3_cross(arm, along)));
+    } else {  // no direction to follow: |W (r × t̂)| ≤ ‖W‖_F |r| for every t̂
+      double frobenius = 0.0;
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) frobenius += w->m[r][k] * w->m[r][k];
+      turning = sqrt(frobenius) * pd_v3_norm(arm);
+    }
+    e->kink[side] = rate * fmax(body->invMass, turning * body->size) / model->settings.vmax;
+  }
+  double damper = pd_series(p->c1t, p->c2t);
+  e->kink[2] = damper > 0.0 ? rate / (damper * c->deltaMax) : 0.0;
+}
+
+// The error bound of contact i's change inside a step of h: its kink's slopes summed with those of the step's other
+// changes (slipChanged) on the same bodies, the largest.
+static double transition_bound(const pdModel* model, const pdContactSet* set, int i, double h) {
+  const contactSlot* c = &set->items[i];
+  double sum[2] = {0.0, 0.0};
+  for (int j = 0; j < set->count; ++j) {
+    if (!set->eval[j].slipChanged) continue;
+    const contactSlot* o = &set->items[j];
+    const double* kink = set->eval[j].kink;
+    int theirs[2] = {o->id.body1, o->id.body2}, ours[2] = {c->id.body1, c->id.body2};
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b)
+        if (ours[a] == theirs[b] && !model->bodies[ours[a]].fixed) sum[a] += kink[b];
+  }
+  return pd_transition_error_bound(fmax(fmax(sum[0], sum[1]), set->eval[i].kink[2]), h);
 }
 
 // Whether the force law at the step's end left a mode contact c held over the step (holdModes): the normal force's
@@ -469,6 +523,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   double locate = h;        // the step that ends just past the earliest held mode's change to locate (h: none)
   pdOnsets mode = pd_onsets_effective(s->onsets, model->movingCount);
   bool bounded = mode == pd_onsetsBounded || mode == pd_onsetsHeld;
+  int slipChanges = 0;
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     contactEval* e = &set->eval[i];
@@ -489,15 +544,23 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     }
     if (set->holdModes && pd_contact_slip_held(&c->params)) continue;  // held: a change is the branch above
     if (!changes_mode(c, &e->force)) continue;
-    // bounded events leave a change inside the step where its bound allows (onset_bound.h); others refine it
+    // bounded events leave a change inside the step where its bound allows (onset_bound.h; below, once every
+    // change's kink is known); others refine it
     if (bounded) {
-      double bound = transition_bound(model, c, e, h);
-      if (pd_onset_bound_allows(bound, model->settings.tol)) {
-        e->modeBound = bound;
-        continue;
-      }
+      transition_kink(model, set, i, yMid, h);
+      e->slipChanged = true;
+      ++slipChanges;
+      continue;
     }
     refineStep = fmax(refineStep, refine_step(model, &c->params));
+  }
+  for (int i = 0; slipChanges > 0 && i < set->count; ++i) {
+    contactEval* e = &set->eval[i];
+    if (!e->slipChanged) continue;
+    if (pd_onset_bound_allows(transition_bound(model, set, i, h), model->settings.tol))
+      e->modeBound = pd_transition_error_bound(fmax(fmax(e->kink[0], e->kink[1]), e->kink[2]), h);  // its own share
+    else
+      refineStep = fmax(refineStep, refine_step(model, &set->items[i].params));
   }
   pd_stopwatch_lap(watch, analysisSeconds);
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
@@ -666,7 +729,10 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       *k = new_slot(model, &cand->geom);
       // the successor of a hand-over takes its predecessor's springs: the normal ones as they are, the tangential
       // ones turned into its tangent plane and held within the friction cone of the predecessor's normal force,
-      // so the force goes on where it was (and a spring the cone would not carry does not load it with slip)
+      // so the force goes on where it was (and a spring the cone would not carry does not load it with slip); with
+      // the stiffness they had (a pair of the same two bodies: the same constants but the load's factor)
+      k->params = old->params;
+      k->loadScale = old->loadScale;
       double fn = set->eval[cand->inherit].force.fn;
       k->springs = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * cand->inherit);
       pd_springs_realign(&k->springs, old->normal, cand->geom.normal, k->params.mu, &k->params, fn);

@@ -405,6 +405,7 @@ void pd_contact_params_pair(const pdMaterialSide* s1, const pdMaterialSide* s2, 
   out->k2n = s2->kn > 0.0 ? s2->kn : kSide;
   out->k1t = s1->kt > 0.0 ? s1->kt : out->k1n;
   out->k2t = s2->kt > 0.0 ? s2->kt : out->k2n;
+  out->loadSized = !(s1->kn > 0.0 || s2->kn > 0.0 || s1->kt > 0.0 || s2->kt > 0.0);
   check_pair_stiffness(&out->k1n, &out->k2n, massMin, pd_paramKn, body1, body2, set->dtmin, adj);
   check_pair_stiffness(&out->k1t, &out->k2t, massMin, pd_paramKt, body1, body2, set->dtmin, adj);
   dampers(s1->cn, s2->cn, out->k1n, out->k2n, out->zetaN, massPair, &out->c1n, &out->c2n, &out->modalN,

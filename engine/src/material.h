@@ -10,7 +10,9 @@
 //   Stiffness (eq. (11) for the pair): the relative kinetic energy ½ m_pair v_max² is stored at
 //   δ_max = deflection × the SMALLER body's size, m_pair = m₁m₂/(m₁+m₂) (a fixed body: infinite mass), so
 //   the series stiffness is k_s = m_pair v_max²/δ_max², and each side without an explicit kn gets 2 k_s
-//   (equal sides: the surface elements sit in the middle). kt = kn of the same side unless set.
+//   (equal sides: the surface elements sit in the middle). kt = kn of the same side unless set. Where all four are
+//   derived (loadSized), a pair pressed by a heavier body towards a third has them raised for that load while the
+//   simulation runs (stability_bound.c, load_scale).
 //   Damping: when neither side gives cn (ct), the pair's dampers are "modal": each contact gets
 //   c_s = 2ζ√(k_s m_c), with m_c the mass per contact of the pair's joint motion along the normals (in the
 //   tangent plane), set from the pair's active contacts whenever they change (stability_bound.c) — so the

@@ -11,9 +11,5 @@ double pd_onset_error_bound(double omega, double tau, double depth, double appro
   return fmax(fmax(velocity, position), spring);
 }
 
-double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, double slide, double approach, double h,
-                                 double vmax) {
-  double kinkSlope = omegaT2 * fabs(slide) + mu * omegaN2 * fabs(approach);  // m/s³
-  return kinkSlope * h * h / (48.0 * vmax);
-}
+double pd_transition_error_bound(double kink, double h) { return kink * h * h / 96.0; }
 

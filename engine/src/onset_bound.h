@@ -59,13 +59,17 @@ static inline bool pd_onset_bound_allows(double bound, double tol) { return boun
 // contact found at the retried step's end, its onset a little off the estimate, is still corrected.
 #define PD_ONSET_AIM_SHARE 0.5
 
-// A stick–slip change left inside a step (docs/events.md). The contact force is continuous there but its rate jumps,
-// by at most [Ḟ] = k_t |Δu_t| + μ k_n |Δu_n| (the spring rates of stick against those of the cone; series constants),
-// so the acceleration has a kink of slope [a'] <= [Ḟ] / m_min. RK4 integrates the velocity across it like Simpson's
-// rule across a kinked integrand, whose error is at most [a'] h²/24 (the kink at the middle); with step doubling the
-// kink lies in one half step, h/2. Twice that, for the spring rates the bodies' turning adds:
-//   bound = 2 [a'] (h/2)² / 24 / vmax = (ω_t² |Δu_t| + μ ω_n² |Δu_n|) h² / (48 vmax),  ω² = k / m_min,
-// in the error norm's units; the change is left inside the step where the bound is within PD_ONSET_TOL_SHARE × tol,
-// else the step is halved towards it as the paper does (contact_set.c, refine_step).
-double pd_transition_error_bound(double omegaT2, double omegaN2, double mu, double slide, double approach, double h,
-                                 double vmax);
+// A stick–slip change left inside a step (docs/events.md, "Stick–slip changes"). The contact force is continuous there
+// but its rate jumps by exactly ġ along the tangential force, g = F⁺ − |b_t| the cone's margin (stick F_t = −b_t and
+// slip F_t = −F⁺ b̂_t have the same rate across b̂_t where |b_t| = F⁺). So each moving body B of the contact has a kink
+// in its accelerations of slope ġ/m_B (linear) and |ġ W_B (r × t̂)| (angular, W_B = R I⁻¹ Rᵀ, r from B's centre of mass
+// to the contact point), and the contact's springs one of slope ġ/c* (their slip rate Δw_t, c* the tangential
+// dampers in series). RK4 integrates across a kink of slope s like Simpson's rule across a kinked integrand: at most
+// s H²/24 in the half step H = h/2 that holds it (the kink at its middle). In the error norm's units (velocities over
+// vmax, angular velocities over vmax / L_B, springs over δ_max) and summed over the changes that share a body in the
+// step:
+//   bound = kink h²/96,  kink = Σ ġ max(1/m_B, L_B |W_B (r × t̂)|) / vmax  (or ġ / (c* δ_max) for the springs),
+// which is what pd_transition_error_bound returns for kink (1/s², summed by the caller). The change is left inside
+// the step where the bound is within PD_ONSET_TOL_SHARE × tol, else the step is halved towards it as the paper does
+// (contact_set.c, refine_step).
+double pd_transition_error_bound(double kink, double h);

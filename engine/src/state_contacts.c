@@ -28,5 +28,6 @@ pdContactReport pd_state_contact(const pdState* s, int i) {
   r.fn = pulls ? 0.0 : c->force.fn;
   r.ft = pulls ? (pdVec3){0, 0, 0} : c->force.ft;
   r.slip = c->force.slip;
+  r.springScale = c->loadScale;
   return r;
 }

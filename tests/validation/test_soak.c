@@ -97,12 +97,22 @@ static void test_energy_gained_between_samples_is_caught_at_the_steps(void** sta
 
 static void test_a_light_body_under_a_heavy_one_is_judged_by_the_load(void** state) {
   (void)state;
-  pdSoakScene scene = scene_file("cases/hard/heavy_block_on_chip.scene", pd_soakDrop, 3);
+  // the chip's springs as eq. (11) gives them for the chip alone (explicit kn): beyond the plain limit (measured 3.7
+  // δ_max), below the closed form without dampers (4.9, tests/engine/test_hard_cases.c); the pair's limit is the
+  // chain's, 3 √(20 kg / 16 g) = 106
+  pdSoakScene scene = scene_file("tests/validation/soak/heavy_block_on_chip_own_springs.scene", pd_soakDrop, 3);
   for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e) {
     pdSoakResult r = run_told(&scene, softEngines[e], true);
-    // beyond the plain limit (measured 3.7 δ_max), below the closed form without dampers (4.9,
-    // tests/engine/test_hard_cases.c); the pair's limit is the chain's, 3 √(20 kg / 16 g) = 106
     assert_true(r.penetration > PD_SOAK_PENETRATION_LIMIT && r.penetration < 4.9);
+    assert_int_equal(r.status, pd_soakOk);
+  }
+  pd_soak_scene_free(&scene);
+  // with its springs sized by the load (100 times eq. (11)'s: the block is 1 250 times the chip) the chip stays
+  // within one δ_max of the floor and the block (measured 0.1 δ_max)
+  scene = scene_file("cases/hard/heavy_block_on_chip.scene", pd_soakDrop, 3);
+  for (size_t e = 0; e < sizeof softEngines / sizeof softEngines[0]; ++e) {
+    pdSoakResult r = run_told(&scene, softEngines[e], true);
+    assert_true(r.penetration < 1.0);
     assert_int_equal(r.status, pd_soakOk);
   }
   pd_soak_scene_free(&scene);
@@ -249,6 +259,21 @@ static void test_a_corner_rising_through_a_plate_beside_its_rim_keeps_a_contact(
   assert_passes_at_every_step("reports/reliability/campaign63/failures/002576-soft.scene", pd_soakFree, 5);
 }
 
+// A light body pressed between a heavy one and a third body, its springs sized by the load it carries
+// (docs/contact-model.md, "Springs sized by the load"), passes the soak's checks at every step, islands on and off:
+// a 1.05 kg plate's corner through a 0.28 g sliver lying on the floor (25 delta_max with the springs of the sliver's own
+// mass), a 4.3 kg prism squeezed between two bodies of 1.3-1.4 t (3.52), a 14 mg plate under a landing 190 g cube on
+// the floor (4.23), a 25:1 plate settling across a sliver's rim on the floor (8.54), a 0.37 g plate struck by a cube's
+// edge on a 3.67 kg cube (5.58).
+static void test_a_light_body_under_a_heavy_one_has_springs_for_its_load(void** state) {
+  (void)state;
+  assert_passes_at_every_step("cases/hard/plate_corner_through_sliver_on_floor.scene", pd_soakDrop, 3);
+  assert_passes_at_every_step("cases/hard/prism_squeezed_between_heavy_bodies.scene", pd_soakFree, 3);
+  assert_passes_at_every_step("cases/hard/plate_pinned_under_landing_cube.scene", pd_soakDrop, 3);
+  assert_passes_at_every_step("cases/hard/plate_edge_through_sliver_rim.scene", pd_soakDrop, 3);
+  assert_passes_at_every_step("cases/hard/plate_struck_by_cube_edge_on_cube.scene", pd_soakFree, 3);
+}
+
 // Scene 371 of campaign 3 of the first generator is the file committed with the campaign 3 rerun (after its two
 // header lines: what happened and how to replay it).
 static void test_the_first_generator_replays_committed_campaigns(void** state) {
@@ -330,6 +355,7 @@ int main(void) {
       cmocka_unit_test(test_a_prism_corner_on_a_cube_after_a_release_stays_within_the_limit),
       cmocka_unit_test(test_a_corner_pressed_through_a_blade_keeps_its_contact),
       cmocka_unit_test(test_a_corner_rising_through_a_plate_beside_its_rim_keeps_a_contact),
+      cmocka_unit_test(test_a_light_body_under_a_heavy_one_has_springs_for_its_load),
       cmocka_unit_test(test_the_first_generator_replays_committed_campaigns),
       cmocka_unit_test(test_the_second_generator_draws_plates),
   };

@@ -311,6 +311,8 @@ typedef struct pdContactReport {
   double fn;            // N, normal force on A (>= 0)
   pdVec3 ft;            // N, friction force on A
   bool slip;            // the friction limit is active
+  double springScale;   // its springs over eq. (11)'s for the pair alone, >= 1: raised for the load the pair carries
+                        // (docs/contact-model.md, "Springs sized by the load")
 } pdContactReport;
 
 // The active contacts at the state's time t (in an observer, or after pd_advance returned): their number,
