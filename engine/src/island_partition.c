@@ -43,13 +43,17 @@ static bool boxes_overlap(const pdAabb* a, const pdAabb* b) {
   return true;
 }
 
+double pd_island_slack(const pdModel* model, const pdBody* b) {
+  return (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
+}
+
 double pd_island_travel_bound(const pdModel* model, const struct pdIslandSet* set, int k, const double* yb,
                               const pdMat3* r, const pdAabb* box, bool* touchingOut, double t, double dt) {
   const pdBody* b = &model->bodies[model->movingBodies[k]];
   bool touching = *touchingOut;
   double accel = 0.0;
   if (b->hasForce) accel = (pd_v3_norm(b->force0) + pd_v3_norm(b->forceRate) * (fabs(t) + dt)) * b->invMass;
-  double slack = (PD_ISLAND_SLACK_DEFLECTIONS * model->settings.deflection + PD_ISLAND_SLACK_SIZE) * b->size;
+  double slack = pd_island_slack(model, b);
   // the spin a torque-free body can reach keeps its rotational energy: |ω| <= √(2 E_rot / I_min)
   pdVec3 wb = pd_mat3_tmulv(r, pd_layout_w(yb));
   double twiceEnergy = pd_v3_dot(wb, pd_mat3_mulv(&b->inertia, wb));

@@ -25,3 +25,6 @@ int pd_island_partition(const pdModel* model, const pdState* s, struct pdIslandS
 // body's). t: T, s; dt: the interval, s.
 double pd_island_travel_bound(const pdModel* model, const struct pdIslandSet* set, int k, const double* yb,
                               const pdMat3* r, const pdAabb* box, bool* touchingOut, double t, double dt);
+
+// The slack of body b's bound, m: pd_island_travel_bound never returns less (its other terms are not negative).
+double pd_island_slack(const pdModel* model, const pdBody* b);

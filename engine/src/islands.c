@@ -36,8 +36,11 @@
 // - A lone moving body is one island over any interval: its sample interval is not cut, and find_free's partition
 //   (the same one island, the same box: a free body's box over a sync interval is its box over the sample
 //   interval) stands for the interval's. The one island of every moving body (a lone body, a stack joined by its
-//   contacts) is written out, not sorted. So a body alone costs per sample a start (box, bound), one partition,
-//   the gather and the sleep test, which sleeping needs.
+//   contacts) is written out, not sorted. A scene of one moving body, awake, goes further: its island's steps run
+//   across the samples in one pd_step_until, each sample presented from its dense output as with islands off, and
+//   at each sample the interval loop's work for it is done there, bit for bit (lone_run, below): per sample the
+//   gather, the sleep test, the counters and, for a body touching nothing, its travel from its path. Asleep, it
+//   goes from sample to sample counting its time asleep until its force changes (lone_sleep_on).
 // - Persistence: an island whose bodies are the same as the last interval's keeps its state (its contact
 //   list, caches, step size) and simply goes on; a new island is set up from the scene's state at T (its
 //   bodies' numbers and contacts copied, the contacts' springs, forces and modal dampers as they were:
@@ -216,29 +219,32 @@ typedef struct travelProbe {
   pdSleepSet* sleep;      // nullable: the bodies' speed peaks (sleep.h)
 } travelProbe;
 
-static void measure_travel(const pdModel* sub, const pdState* state, void* user) {
-  const travelProbe* probe = user;
-  double tau = state->t - probe->t0;
-  for (int j = 0; j < probe->is->bodyCount; ++j) {
-    int k = probe->is->bodies[j];
-    const double* y = state->y + PD_BODY_STATE_SIZE * j;
-    pdQuat q = pd_layout_q(y), q0 = probe->q0[k];
-    double dot = fabs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z);
-    double norms =
-        sqrt((q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z));
-    double angle = 2.0 * acos(fmin(1.0, dot / norms));
-    const pdBody* b = &sub->bodies[sub->movingBodies[j]];
-    pdVec3 ballistic = pd_v3_add(
-        probe->x0[k], pd_v3_add(pd_v3_scale(probe->v0[k], tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
-    double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
-    probe->travel[k] = fmax(probe->travel[k], moved);
-    if (probe->sleep) pd_sleep_step_end(probe->sleep, b, k, y);
-  }
+// Island body j's numbers y at time t: its travel from the path and its speed peak.
+static void measure_body(const pdModel* sub, const travelProbe* probe, int j, double t, const double* y) {
+  double tau = t - probe->t0;
+  int k = probe->is->bodies[j];
+  pdQuat q = pd_layout_q(y), q0 = probe->q0[k];
+  double dot = fabs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z);
+  double norms =
+      sqrt((q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z));
+  double angle = 2.0 * acos(fmin(1.0, dot / norms));
+  const pdBody* b = &sub->bodies[sub->movingBodies[j]];
+  pdVec3 ballistic = pd_v3_add(
+      probe->x0[k], pd_v3_add(pd_v3_scale(probe->v0[k], tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
+  double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
+  probe->travel[k] = fmax(probe->travel[k], moved);
+  if (probe->sleep) pd_sleep_step_end(probe->sleep, b, k, y);
 }
 
-// Advances island `is` to tNext; false if it failed. A free body's island (coarse) measures against its path
-// over the whole sample interval, and keeps what it measured since T0.
-static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool land, bool coarse) {
+static void measure_travel(const pdModel* sub, const pdState* state, void* user) {
+  const travelProbe* probe = user;
+  for (int j = 0; j < probe->is->bodyCount; ++j)
+    measure_body(sub, probe, j, state->t, state->y + PD_BODY_STATE_SIZE * j);
+}
+
+// Island `is` starts an interval: its bodies' travel and speed peaks restart (a free body's island, coarse, keeps
+// what it measured since T0). Returns the probe its step ends are measured with.
+static travelProbe start_probe(struct pdIslandSet* set, island* is, bool coarse) {
   if (!coarse)
     for (int j = 0; j < is->bodyCount; ++j) {
       set->travel[is->bodies[j]] = 0.0;
@@ -246,9 +252,15 @@ static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bo
         pd_sleep_interval_start(set->sleep, &is->model.bodies[is->model.movingBodies[j]], is->bodies[j],
                                 is->state->y + PD_BODY_STATE_SIZE * j);
     }
-  travelProbe probe = coarse ? (travelProbe){is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel, NULL}
-                             : (travelProbe){is, set->t0, set->x0, set->v0, set->q0, set->travel, set->sleep};
   is->advanced = true;
+  return coarse ? (travelProbe){is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel, NULL}
+                : (travelProbe){is, set->t0, set->x0, set->v0, set->q0, set->travel, set->sleep};
+}
+
+// Advances island `is` to tNext; false if it failed. A free body's island (coarse) measures against its path
+// over the whole sample interval, and keeps what it measured since T0.
+static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool land, bool coarse) {
+  travelProbe probe = start_probe(set, is, coarse);
   return pd_step_until(&is->model, is->state, tNext, land, NULL, NULL, measure_travel, &probe);
 }
 
@@ -326,6 +338,8 @@ static void retire(struct pdIslandSet* set, island* is) {
 
 // The scene state's counters, warnings and stage seconds: the freed islands' plus the live ones', in island
 // order (integers: the order does not matter; seconds are not reproducible anyway).
+static void compose_set_counters(const struct pdIslandSet* set, pdState* s);
+
 static void compose_counters(struct pdIslandSet* set, pdState* s) {
   long samples = s->count.samples;
   s->count = set->retired;
@@ -339,6 +353,12 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
   }
   s->stageSeconds[pd_stageObserve] += set->observeSeconds;
   s->count.samples = samples;
+  compose_set_counters(set, s);
+}
+
+// The scene state's counters of the set's own (islands formed, intervals, sleeping ...): all that changes in the
+// scene's counters while no island steps.
+static void compose_set_counters(const struct pdIslandSet* set, pdState* s) {
   s->count.islandsFormed = set->formed;
   s->count.islandsLargest = set->largest;
   s->count.islandIntervals = set->intervals;
@@ -661,6 +681,28 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
   }
 }
 
+// The islands at tNext gathered into the scene's state: bodies, then contacts (sorted by id), and each body's next
+// step; then the islands quiet long enough fall asleep. Free bodies' numbers only at the sample (`last`).
+static void gather(const pdModel* model, pdState* s, struct pdIslandSet* set, double tNext, bool last) {
+  for (int j = 0; j < set->islandCount; ++j) {
+    const island* is = set->islands[j];
+    if (set->free[is->bodies[0]] && !last) continue;  // still at T0: the scene keeps its numbers from there
+    for (int m = 0; m < is->bodyCount; ++m) {
+      int k = is->bodies[m];
+      memcpy(s->y + PD_BODY_STATE_SIZE * k, is->state->y + PD_BODY_STATE_SIZE * m, PD_BODY_STATE_SIZE * sizeof *s->y);
+      set->h[k] = is->state->h;
+    }
+  }
+  for (int j = 0; j < set->islandCount; ++j) {
+    const island* is = set->islands[j];
+    set->subModels[j] = &is->model;
+    set->subStates[j] = is->state;
+    set->subMaps[j] = is->toScene;
+  }
+  pd_contact_set_gather(model, s, set->islandCount, set->subModels, set->subStates, set->subMaps);
+  if (set->sleep) fall_asleep(model, s, set, tNext);
+}
+
 // A free body's island goes on to tNext alone (coarse: against its path over the sample interval); its
 // numbers go to the scene's state. False if it failed.
 static bool free_advance(pdState* s, struct pdIslandSet* set, int k, double tNext, bool land) {
@@ -743,24 +785,7 @@ static bool advance_interval(const pdModel* model, pdState* s, struct pdIslandSe
     for (int k = 0; k < set->movingCount; ++k)
       if (set->free[k] && !free_advance(s, set, k, tNext, false)) return false;
   }
-  // gather: bodies, then contacts (sorted by id), and each body's next step
-  for (int j = 0; j < set->islandCount; ++j) {
-    const island* is = set->islands[j];
-    if (set->free[is->bodies[0]] && !last) continue;  // still at T0: the scene keeps its numbers from there
-    for (int m = 0; m < is->bodyCount; ++m) {
-      int k = is->bodies[m];
-      memcpy(s->y + PD_BODY_STATE_SIZE * k, is->state->y + PD_BODY_STATE_SIZE * m, PD_BODY_STATE_SIZE * sizeof *s->y);
-      set->h[k] = is->state->h;
-    }
-  }
-  for (int j = 0; j < set->islandCount; ++j) {
-    const island* is = set->islands[j];
-    set->subModels[j] = &is->model;
-    set->subStates[j] = is->state;
-    set->subMaps[j] = is->toScene;
-  }
-  pd_contact_set_gather(model, s, set->islandCount, set->subModels, set->subStates, set->subMaps);
-  if (set->sleep) fall_asleep(model, s, set, tNext);
+  gather(model, s, set, tNext, last);
   return true;
 }
 
@@ -822,6 +847,188 @@ static void observe(const pdModel* model, pdState* s, struct pdIslandSet* set, p
   set->observeSeconds += pd_observe(model, s, observer, user);
 }
 
+// ---------------------------------------------------------------- a lone body across samples
+
+// A scene of one moving body, awake, is one island at every sync time, and its sample intervals are never cut
+// (sync_parts' cut splits no island). Its island's steps then run to the call's end in one pd_step_until, as with
+// islands off: each sample is presented from the step that passed it (dense output), and there, through the
+// island's sample observer (lone_sample), the scene gets exactly what the interval loop would have given it at that
+// sample: the travel and speed peaks measured on the same states (the step ends in the interval and the state
+// presented at its end), the free-body test (find_free's, where its outcome can tell: lone_interval_end), the gather,
+// the sleep test and the counters. The island falling asleep or the caller's observer stopping ends the run at that
+// sample, with the island presented there as the interval loop leaves it; the interval loop takes over from there.
+// The island's own steps, contact search and events are pd_step_until's, as in the interval loop: only the calls
+// between samples go (per sample about 2 500 instructions of partition, rebuild, batch and re-entry, against the
+// ~1 000 of a sample's presentation and observation that islands off spends too).
+typedef struct loneRun {
+  const pdModel* model;
+  pdState* s;  // the scene's state
+  struct pdIslandSet* set;
+  island* is;
+  pdObserverFcn* observer;  // the caller's, and its user pointer
+  void* user;
+  double tEnd;       // s: the call's end
+  double tInterval;  // s: the end of the sample interval under way (the next sample, or tEnd)
+  bool open;         // an interval under way (none once the one ending at tEnd is closed)
+  bool untouched;    // the body had no contact at the interval's start (lone_interval_start)
+  travelProbe probe;  // the interval's
+  // A step end past tInterval, shown to the hook before the samples it passed are presented: it belongs to the
+  // interval it ends in, and is measured when that interval starts.
+  bool pending;
+  double pendingT;
+  double pendingY[PD_BODY_STATE_SIZE];
+  double observeSeconds;  // the island's own observe stage before the run (the caller's observer is counted in the set)
+  long derivatives;       // the island's derivative evaluations when the scene's counters were last composed
+} loneRun;
+
+// The lone body's numbers y at time t inside the interval. A body with no contact at the interval's start has its
+// travel from its path measured (its stray counted: lone_interval_end) and its speed peak; one in contact only its
+// speed peak (the sleep test): its box, bound and travel serve the partition and the redo, which with one moving
+// body form the same one island every time.
+static void lone_measure(loneRun* run, double t, const double* y) {
+  const pdModel* sub = &run->is->model;
+  if (run->untouched)
+    measure_body(sub, &run->probe, 0, t, y);
+  else if (run->set->sleep)
+    pd_sleep_step_end(run->set->sleep, &sub->bodies[sub->movingBodies[0]], 0, y);
+}
+
+// The sample interval from the scene's time to the next sample (or tEnd) starts, as advance_interval starts it for
+// the one island. find_free's test is put off to the interval's end (lone_interval_end): the partition of one moving
+// body is that body alone, so it is free when it touches nothing at the start and its box reaches no fixed body.
+// A body in contact is not free; a body without is measured as a free one is, against its path from here.
+static void lone_interval_start(loneRun* run) {
+  pdState* s = run->s;
+  struct pdIslandSet* set = run->set;
+  double target = fmin(run->tEnd, pd_sample_time(run->model, s->nextSample));
+  set->t0 = set->ct0 = s->t;
+  set->startsFormed = false;
+  set->free[0] = false;
+  ++set->intervals;
+  run->untouched = pd_state_contact_count(s) == 0;
+  set->touching[0] = !run->untouched;
+  run->probe = start_probe(set, run->is, false);
+  if (run->untouched) {
+    const double* y = s->y;
+    set->cx0[0] = pd_layout_x(y);
+    set->cv0[0] = pd_layout_v(y);
+    set->cq0[0] = pd_layout_q(y);
+    set->ctravel[0] = 0.0;
+    run->probe = (travelProbe){run->is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel, set->sleep};
+  }
+  run->tInterval = target;
+  run->open = true;
+  if (run->pending && run->pendingT <= target) {
+    lone_measure(run, run->pendingT, run->pendingY);
+    run->pending = false;
+  }
+}
+
+// The interval ends at tNext with the island's state there; the scene's state s is still at its start T0. Whether
+// the body was free decides two things only: a stray (its travel beyond its bound) is counted, and the sleep test
+// is skipped. So find_free's test runs, from s at T0 as find_free would have run it, only where either can tell:
+// a travel beyond the slack (the bound is never below it) or a contact at tNext (a free body has none: it would
+// be skipped, not tested). Otherwise the body is taken as not free: its test finds no contact, so it leaves the
+// quiet time as a free body's skipped test does (unset since the body's last contact). Then the gather (and the
+// sleep test) and the counters; the scene's time is tNext.
+static void lone_interval_end(loneRun* run, double tNext) {
+  const pdModel* model = run->model;
+  pdState* s = run->s;
+  struct pdIslandSet* set = run->set;
+  if (run->untouched && (set->ctravel[0] > pd_island_slack(model, &model->bodies[model->movingBodies[0]]) ||
+                         pd_state_contact_count(run->is->state) > 0)) {
+    set_start(model, s, set, 0, tNext - s->t);
+    set->cbound[0] = set->bound[0];
+    set->free[0] = !set->touching[0];
+    if (set->free[0] && set->ctravel[0] > set->cbound[0]) ++set->strays;
+  }
+  gather(model, s, set, tNext, true);
+  // every counter of the island's but the samples (the scene's own) changes with a step tried, which evaluates the
+  // derivative: without one, only the set's change (the stage timers wait for the run's end)
+  if (run->is->state->count.derivatives != run->derivatives) {
+    compose_counters(set, s);
+    run->derivatives = run->is->state->count.derivatives;
+  } else {
+    compose_set_counters(set, s);
+  }
+  s->t = tNext;
+  run->open = false;
+}
+
+// The island's step hook: a step end inside the interval is measured; one past it waits for its interval.
+static void lone_step_end(const pdModel* sub, const pdState* state, void* user) {
+  (void)sub;  // the island's: run->is->model
+  loneRun* run = user;
+  if (!run->open) return;  // the presented end of a call whose last sample closed the interval, measured there
+  if (state->t <= run->tInterval) {
+    lone_measure(run, state->t, state->y);
+    return;
+  }
+  run->pending = true;
+  run->pendingT = state->t;
+  memcpy(run->pendingY, state->y, sizeof run->pendingY);
+}
+
+// The island's sample observer (pdObserverFcn): the interval ends at the sample, the scene is observed, the next
+// interval starts. False (the island stops, presented at the sample) when the island fell asleep or the caller's
+// observer stopped.
+static bool lone_sample(const pdModel* sub, const pdState* state, void* user) {
+  (void)sub;  // the island's: run->is->model
+  loneRun* run = user;
+  PD_ASSERT(run->open && state->t == run->tInterval);
+  run->is->state->stageSeconds[pd_stageObserve] = run->observeSeconds;
+  lone_measure(run, state->t, state->y);
+  lone_interval_end(run, state->t);
+  observe(run->model, run->s, run->set, run->observer, run->user);
+  if (run->s->stopped || run->is->asleep) return false;
+  if (run->s->t < run->tEnd) lone_interval_start(run);
+  return true;
+}
+
+// Whether the scene's next sample intervals can go as one run of its lone body's island (above): one moving body,
+// awake, no step observer (whose stretches start at every sync time: state.h), and on one thread unless the island is
+// too light to be helped (PD_ISLAND_HELP_WEIGHT: a run through the pool could call the caller's observer from a
+// worker thread).
+static bool lone_runs(const pdState* s, const struct pdIslandSet* set) {
+  if (set->movingCount != 1 || set->islandCount != 1 || set->islands[0]->asleep || s->stepObserver) return false;
+  const island* is = set->islands[0];
+  return s->threads == 1 || is->bodyCount + PD_ISLAND_CONTACT_WEIGHT * (long)pd_state_contact_count(is->state) <
+                                PD_ISLAND_HELP_WEIGHT;
+}
+
+// A scene of one moving body asleep, its applied force unchanged: the interval loop would keep the island as it is
+// and gather the same frozen numbers again; over the interval to target only the time asleep grows, as fall_asleep
+// counts it. (A force that changed wakes it there: the interval loop. A step observer keeps the interval loop, as
+// for a lone body awake: lone_runs.)
+static bool lone_sleep_on(const pdModel* model, pdState* s, struct pdIslandSet* set, double target) {
+  if (set->movingCount != 1 || set->islandCount != 1 || !set->islands[0]->asleep || s->stepObserver ||
+      pd_sleep_force_changed(set->sleep, &model->bodies[model->movingBodies[0]], 0, s->t))
+    return false;
+  set->t0 = s->t;
+  set->startsFormed = false;
+  set->sleep->bodySeconds += target - set->t0;
+  compose_counters(set, s);
+  s->t = target;
+  return true;
+}
+
+// The lone body's island from the scene's time to tEnd (or to the sample where it falls asleep or the caller
+// stops). False if it failed (the scene keeps its state at the last sample).
+static bool lone_run(const pdModel* model, pdState* s, struct pdIslandSet* set, double tEnd, pdObserverFcn* observer,
+                     void* user) {
+  island* is = set->islands[0];
+  PD_ASSERT(is->bodyCount == 1 && is->state->t == s->t);
+  loneRun run = {.model = model, .s = s, .set = set, .is = is, .observer = observer, .user = user, .tEnd = tEnd,
+                 .observeSeconds = is->state->stageSeconds[pd_stageObserve],
+                 .derivatives = is->state->count.derivatives};
+  lone_interval_start(&run);
+  bool ok = pd_step_until(&is->model, is->state, tEnd, false, lone_sample, &run, lone_step_end, &run);
+  is->state->stageSeconds[pd_stageObserve] = run.observeSeconds;
+  if (ok && run.open) lone_interval_end(&run, tEnd);  // a call ending between samples: the scene gathered there
+  compose_counters(set, s);
+  return ok || !is->state->failed;
+}
+
 bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
   if (s->failed) return false;
@@ -833,8 +1040,19 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
   while (pd_sample_time(model, s->nextSample) < s->t) ++s->nextSample;
   if (pd_sample_time(model, s->nextSample) == s->t) observe(model, s, set, observer, user);
   while (s->t < tEnd && !s->stopped) {
+    if (lone_runs(s, set)) {
+      if (!lone_run(model, s, set, tEnd, observer, user)) {
+        s->failed = true;
+        return false;
+      }
+      continue;
+    }
     double tSample = pd_sample_time(model, s->nextSample);
     double target = fmin(tEnd, tSample);
+    if (lone_sleep_on(model, s, set, target)) {
+      if (s->t == tSample) observe(model, s, set, observer, user);
+      continue;
+    }
     // the sync times: the interval to the sample cut into equal parts short enough for the fastest body
     double t0 = s->t;
     int parts = sync_parts(model, set, target - t0);

@@ -31,6 +31,10 @@
 //   inside a sample interval, and that the partition then left alone, once kept that time's numbers to the next);
 // - a free body reached in the first sample interval, before any island exists (two blocks thrown at a wall,
 //   cases/hard/thrown_at_wall.scene): it joins, and the run agrees with islands off until the first wall impact;
+// - a lone body: a scene of one moving body, run across samples in one run of its island's steps, gives every sample
+//   and counter bit for bit as the interval loop (which a step observer forces): a cube thrown, bouncing and falling
+//   asleep, and a cube at rest under a growing force, asleep and woken again and again; in one call, in slices that
+//   end between samples, stopped by the observer and resumed, and on two threads;
 // - stage timers (pdState.stageSeconds): on one thread, the stages timed whole (broad phase, interference,
 //   contact analysis, observe; laps of one stopwatch or intervals of their own, never overlapping) each ran and
 //   add up to no more than the time spent in pd_advance.
@@ -535,6 +539,120 @@ static void test_a_free_body_reached_in_the_first_interval(void** state) {
 
 // The stages timed whole are disjoint parts of pd_advance's interval: on one thread their sum cannot exceed it
 // (forces, derivative and integrate are left out: they are scaled-up samples and the remainders of them).
+// ---------------------------------------------------------------- a lone body across samples
+
+// A scene of one moving body goes, awake, through one run of its island's steps with the interval loop's work done
+// at each sample, and asleep from sample to sample counting its time asleep (islands.c, "a lone body across
+// samples"); a step observer sends it through the interval loop itself (its stretches start at every sample). Both must give the same samples and counters bit for bit: in one call, in
+// slices that end between samples, stopped by the observer and resumed, and on two threads.
+#define LONE_SLICE_S 0.0137  // s: a call's length that ends between samples (5 ms and 1 ms apart)
+
+static void count_step(const pdModel* model, const pdState* s, bool start, void* user) {
+  (void)model, (void)s, (void)start;
+  ++*(long*)user;
+}
+
+typedef struct stopAt {
+  trace* r;
+  int at;  // the observer stops after this many samples (then never again)
+} stopAt;
+
+static bool record_and_stop(const pdModel* model, const pdState* s, void* user) {
+  stopAt* stop = user;
+  bool go = record_trace(model, s, stop->r);
+  if (stop->r->count != stop->at) return go;
+  stop->at = -1;
+  return false;
+}
+
+typedef enum loneWay { loneOneCall, loneSlices, loneStopped, loneTwoThreads } loneWay;
+
+static trace* run_lone(const pdModel* m, loneWay way, bool loop, pdCounters* count) {
+  trace* r = calloc(1, sizeof *r);
+  assert_non_null(r);
+  r->finite = true;
+  long steps = 0;
+  pdStateOptions options = pd_state_options_default();
+  if (loop) options.stepObserver = count_step, options.stepUser = &steps;
+  if (way == loneTwoThreads) options.threads = 2;
+  pdState* s = pd_state_create(m, &options);
+  double tend = m->settings.tend;
+  if (way == loneSlices) {
+    for (double t = LONE_SLICE_S; s->t < tend; t += LONE_SLICE_S)
+      assert_true(pd_advance(m, s, fmin(t, tend), record_trace, r));
+  } else if (way == loneStopped) {
+    stopAt stop = {r, 37};
+    int calls = 0;
+    while (!pd_advance(m, s, tend, record_and_stop, &stop)) {
+      assert_false(s->failed);
+      ++calls;
+    }
+    assert_int_equal(calls, 1);
+  } else {
+    assert_true(pd_advance(m, s, tend, record_trace, r));
+  }
+  if (loop) assert_true(steps > 0);
+  assert_false(s->failed);
+  *count = s->count;
+  pd_state_free(s);
+  return r;
+}
+
+static void expect_same_lone(const trace* a, const pdCounters* ca, const trace* b, const pdCounters* cb,
+                             const char* what) {
+  assert_int_equal(a->count, b->count);
+  for (int k = 0; k < a->count; ++k) {
+    if (a->t[k] != b->t[k] || !same_body(&a->body[k][0], &b->body[k][0]) || a->contacts[k] != b->contacts[k])
+      fail_msg("%s: sample %d (t = %g s) differs", what, k, a->t[k]);
+  }
+  assert_int_equal(ca->accepted, cb->accepted);
+  assert_int_equal(ca->rejected, cb->rejected);
+  assert_int_equal(ca->derivatives, cb->derivatives);
+  assert_int_equal(ca->samples, cb->samples);
+  assert_int_equal(ca->contactsMade, cb->contactsMade);
+  assert_int_equal(ca->islandsFormed, cb->islandsFormed);
+  assert_int_equal(ca->islandIntervals, cb->islandIntervals);
+  assert_int_equal(ca->islandStrays, cb->islandStrays);
+  assert_int_equal(ca->islandsSlept, cb->islandsSlept);
+  assert_int_equal(ca->islandsWoken, cb->islandsWoken);
+  assert_true(ca->bodySecondsAsleep == cb->bodySecondsAsleep);
+}
+
+static void expect_lone_as_loop(const char* text, const char* what, long slept, long woken) {
+  pdModel* m = compile_text(text);
+  assert_int_equal(m->movingCount, 1);
+  const loneWay ways[] = {loneOneCall, loneSlices, loneStopped, loneTwoThreads};
+  const char* names[] = {"one call", "slices", "stopped and resumed", "two threads"};
+  for (int w = 0; w < 4; ++w) {
+    pdCounters loopCount, count;
+    trace* loop = run_lone(m, ways[w], true, &loopCount);
+    trace* r = run_lone(m, ways[w], false, &count);
+    assert_true(loop->finite);
+    assert_true(loopCount.islandsSlept >= slept && loopCount.islandsWoken >= woken);
+    char label[160];
+    snprintf(label, sizeof label, "%s, %s", what, names[w]);
+    expect_same_lone(r, &count, loop, &loopCount, label);
+    print_message("%s: %d samples, %ld intervals, %ld slept, %ld woken: bit for bit as the interval loop\n", label,
+                  loop->count, loopCount.islandIntervals, loopCount.islandsSlept, loopCount.islandsWoken);
+    free(r), free(loop);
+  }
+  pd_model_free(m);
+}
+
+static void test_a_lone_body_runs_across_samples_as_the_interval_loop(void** state) {
+  (void)state;
+  // thrown spinning from 0.3 m: free flight (its box out of the floor's reach), bounces, rest, asleep
+  expect_lone_as_loop("tend 1.2\nsample 200\ntol 1e-6\nvmax 3\n" FLOOR
+                      "cube box red 0.1 0.1 0.1\nloc 0 0 0.3 10 1 1 0\nvel 0.3 0 1 200 0 2 5\n"
+                      "mu 0.5\nrestitution 0.5\n",
+                      "thrown cube", 1, 0);
+  // a cube at rest under a force growing from 0 (b3_ramp_onset's): asleep, woken by the force, asleep again ...
+  expect_lone_as_loop("tend 0.6\nsample 1000\ntol 1e-3\nvmax 1\n"
+                      "cube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nmu 0.4\nrestitution 0.5\nkn 1e6\nkt 1e6\n"
+                      "cube box red 0.1 0.1 0.1\nloc 0 0 0.05\nmu 0.4\nrestitution 0.5\nforce 0 0 0 ramp 4 0 0\n",
+                      "pushed cube", 1, 1);
+}
+
 // ---------------------------------------------------------------- a free body reached late
 
 // A box falling from rest without spin is integrated to rounding (RK4 and dense output are exact on a parabola); one
@@ -614,6 +732,7 @@ int main(void) {
       cmocka_unit_test(test_a_free_body_reached_late_keeps_falling),
       cmocka_unit_test(test_a_free_body_reached_in_the_first_interval),
       cmocka_unit_test(test_whole_stages_add_up_to_at_most_the_run),
+      cmocka_unit_test(test_a_lone_body_runs_across_samples_as_the_interval_loop),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
