@@ -662,7 +662,7 @@ void pd_contact_search(const pdModel* model, pdState* s, const double* y1, int p
       const pdContactGeom* g = &found[f];
       while (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) < 0) ++j;
       if (j < first + previousCount && pd_contact_id_compare(&set->items[j].id, &g->id) == 0) continue;
-      candidate c = {*g, 1.0, false, 0.0, -1, 0.0, false};
+      candidate c = {.geom = *g, .onset = 1.0, .approaching = false, .onsetAge = 0.0, .inherit = -1, .onsetBound = 0.0};
       int b1 = g->id.body1, b2 = g->id.body2;
       if (!keep_released_face(model, set, y1, poses1, &c)) continue;
       if (c.released) {  // continues a contact released by force: no onset of its own, its springs from the trace

@@ -1,30 +1,26 @@
 // polydyn (internal) — the error a corrected onset may add, and whether the step may spend it (docs/events.md).
 //
 // Design note. A contact that began τ seconds before a step's end, found there at depth d approaching at v_n, can
-// join at the step's end as its pair alone would be after τ (onsets.c, pd_onsets_start_late: springs at the
-// deflection x of a Kelvin–Voigt element at the pair's modal mass, the bodies given the impulse that element took).
-// Along the normal of one point mass that is the exact motion; what it misses is the rest of the system over τ: the
-// bodies' turning under the impulse (a modal mass, not the motion of every contact of the pair), the other contacts,
-// and the interpolated onset time. These terms bound it, all in the units of the stepper's error norm (state.c's
-// weights), so they compare with tol:
+// join at the step's end as its pair would be after τ (onsets.c, pd_onsets_start_late: the contacts of the pair that
+// began in the step followed together from their onsets under the two bodies' masses and inertias at the step end's
+// poses, each contact's springs at the deflection and stretch reached, the bodies given the impulses taken). That
+// follows the normal impulse's slip at an off-centre point, the tangential impulse's push along the normal and the
+// pair's joint motion; what it misses is the rest of the system over τ: the bodies' turning under the impulse (their
+// arms and inertias held at the step end's), the other forces on the bodies (applied loads, other contacts), and the
+// interpolated onset time. These terms bound it, all in the units of the stepper's error norm (state.c's weights), so
+// they compare with tol:
 //   velocity: |δe| v_n / vmax, with |δe| <= PD_ONSET_BOUND_C (ωτ)³, the restitution error of a corrected onset
-//             (C measured: tests/engine/test_events.c, the drops whose onsets are forced to be corrected);
+//             (C measured: tests/engine/test_events.c, the drops whose onsets are forced to be corrected), and μ times
+//             it for the cone's radius;
 //   position: (d − x) / L <= d (ωτ)² / (6 L), how much deeper the contact's rest point sits than a located onset's,
 //             L the smaller moving body's size;
-//   friction: added to the velocity term where the pair has friction: the correction follows the slip along its
-//             direction ŝ under its own friction, within the cone (onsets.c, onset_motion); what it leaves out is the
-//             slip's change off that element, D(t) <= |P K ŝ| J_t(t) + |P_t K n| J_n(t) (K the point's inverse mass
-//             matrix, P the projection off n and ŝ, P_t off n: the tangential impulse turning the slip, the normal
-//             impulse making slip). The force law is Lipschitz in the slip (c_t, k_t on its integral, 1 for the cone's
-//             projection), so the tangential impulse is off by at most c_t ∫D + k_t ∫∫D (at most 2 μ J_n), plus μ times
-//             the normal impulse's own error, times how far a tangential impulse moves the point and turns the bodies;
-//   applied:  in the friction term's drifts: the elements start from the approach and slip at the step's end, which
-//             the applied loads (gravity, a scene's force and torque) changed over τ by at most a (τ − t) since the
-//             onset's time t (a their largest relative acceleration at the point), normal to the approach's drift and
-//             tangential to the slip's, with or without friction (onsets.c, correction_bound);
-//   spring:   the tangential springs' stretch is off by at most ∫D and the normal ones' deflection by ∫D_n, over δ_max
-//             (their weight in the error norm);
-//   turning:  added to the velocity term: PD_ONSET_TURNING_C Ω² r τ ωτ (onsets.c, correction_bound),
+//   applied:  added to the velocity term: the motion starts from the velocities found at the step's end, which the
+//             applied loads changed over τ by at most a (τ − t) since the onset's time t (a their largest relative
+//             acceleration at the point); the force laws are Lipschitz, so the impulses are off by at most the
+//             dampers' and springs' response to that drift, times how far an impulse moves the state (onsets.c,
+//             correction_bound), and the springs by a τ²/2 over δ_max (the spring term);
+//   turning:  added to the velocity term: PD_ONSET_TURNING_C Ω² r τ ωτ, and the onset time App. C's chord misplaces on
+//             a turning body, (ω² τ + c/m) Ω² r τ (h − τ)/2 (onsets.c, correction_bound),
 // with ω = √(k_s / m_min) the pair's fastest undamped frequency. An onset is corrected only where the largest of the
 // three is at most PD_ONSET_TOL_SHARE × tol, and ωτ and d stay within the ranges the correction holds in (contact_set.c,
 // PD_ONSET_PAIR_OMEGA_TAU, PD_ONSET_PAIR_DEPTH_REL); others are located, as the paper does with every one.

@@ -13,9 +13,10 @@
 // tolerance's share, in a system of any size; the others are located (docs/events.md).
 // Contacts start at zero spring deflection where they are added, so a late start shifts a contact's rest point by the
 // depth it was found at but injects no energy; the onset tolerance bounds that shift. A pair onset instead starts
-// where its pair alone would be after the τ since the onset: springs at that deflection x and the two bodies given
-// the impulse of those τ seconds (normal, and the friction cone's when they slide), so its energy and phase are its
-// own and its rest point sits d − x ≈ d (ωτ)²/6 deeper (d the depth reached without it).
+// where its pair would be after the τ since the onset: the pair's contacts that began in the step followed together from
+// their onsets under the two bodies' masses and inertias (onset_group_motion), each contact's springs at the deflection
+// and stretch reached and the bodies given the impulses they took, so its energy and phase are its own and its rest
+// point sits d − x ≈ d (ωτ)²/6 deeper (d the depth reached without it).
 // A slip at the rounding of Δu (PD_ONSET_PAIR_SLIP_REL) counts as none: its direction is noise, and friction along
 // it broke a flush stack's bitwise symmetry (docs/contact-model.md).
 #include "onsets.h"
@@ -46,7 +47,7 @@ static double onset_depth_tol(const pdModel* model, const pdContactId* id) {
 #define PD_ONSET_RETRIES_MAX 4
 // A pair onset (pd_onsetsPair) is applied to the pair alone when it lies at most this many radians of the
 // contact's fastest undamped oscillation (ω = √(k_s/m_min)) before the step's end: its motion since the
-// onset is integrated alone (onset_motion), and the rest point it leaves sits ≈ d (ωτ)²/6 deeper. Measured on
+// onset is followed with its pair's (onset_group_motion), and the rest point it leaves sits ≈ d (ωτ)²/6 deeper. Measured on
 // cases/bench/pile_10.scene (0.5 s): 0.5 left 435 onset retries and 16 % more derivative evaluations than
 // 1.0 (279), 2.0 took 1 % fewer (122 retries) at 4× the rest-point shift.
 #define PD_ONSET_PAIR_OMEGA_TAU 1.0
@@ -130,55 +131,30 @@ static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double a
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
 
-// The pair's motion over the τ since an onset, alone (onset_motion): a Kelvin–Voigt element along the normal and one
-// along the slip, coupled by the cone.
-typedef struct onsetElement {
-  double omega2;        // 1/s²: k_n / m, the normal element's (m its mass along the normal)
-  double damping;       // 1/s: c_n / m
-  double mass;          // kg: m
-  double mu;
-  double kt, ct;        // N/m, N·s/m: the tangential spring and damper (series)
-  double slipInvMass;   // 1/kg: ŝᵀKŝ, the slip's change per unit tangential impulse along it (K the point's)
-  double slip;          // m/s: the slip speed at the onset (0: none)
-  double driftPerJt;    // 1/kg: |(I − n nᵀ − ŝ ŝᵀ) K ŝ|, the slip's turn off ŝ per unit tangential impulse
-  double driftPerJn;    // 1/kg: |(I − n nᵀ) K n|, the slip the normal impulse makes, per unit of it
-  double approachPerJt; // 1/kg: |nᵀ K ŝ|, the approach the tangential impulse changes, per unit of it
-} onsetElement;
-
-typedef struct onsetMotion {
-  double x, u;          // m, m/s: the normal deflection and approach speed at τ
-  double jn, jt;        // N·s: the normal and tangential impulses over τ (jt against the slip)
-  double spring;        // m: the tangential spring's stretch since the onset (∫ slip in stick)
-  double cone;          // N: μ F_n at τ
-  double drift1;        // m: ∫₀^τ D(t) dt, D the slip's change that the element leaves out (onset_bound.h)
-  double drift2;        // m·s: ∫₀^τ ∫₀^t D
-  double approach1;     // m: ∫₀^τ D_n(t) dt, D_n the approach's change that the element leaves out
-  double approach2;     // m·s: ∫₀^τ ∫₀^t D_n
-} onsetMotion;
-
-static onsetMotion onset_motion(const onsetElement* e, double v0, double tau);
-static pdVec3 point_response(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point,
-                             pdVec3 impulse);
-static void slip_element(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point, pdVec3 normal,
-                         pdVec3 du, onsetElement* e, pdVec3* along);
-static pdMat3 inverse_inertia_at(const pdBody* body, const pdPose* pose);
-
 // What the error bound (onset_bound.h) of joining new contact g (found at y1, poses in set->poses1) as a corrected
 // onset is formed from, apart from its age and depth.
 typedef struct onsetTerms {
   double omega;         // 1/s: the pair's fastest undamped frequency, √(k_s / m_min)
   double approach;      // m/s: its approach speed now
   double size;          // m: the smaller moving body's
+  double mu;
+  double dampingRate;   // 1/s: c_n / m_min, the normal damper's (series) over the pair's smaller mass
+  double kn, cn, kt, ct;  // N/m, N·s/m: the model's series springs and dampers (the modal dampers never exceed them)
+  pdVec3 normal;
   double deltaMax;      // m: the pair's δ_max, the error norm's weight of a contact spring
-  pdVec3 normal;        // the contact's
-  onsetElement element; // the correction's element at the point's effective mass (its friction: the model's dampers,
-                        // which the modal ones never exceed)
-  double lever;         // 1/kg: how far a tangential impulse there may move the state, per kg·m/s
+  double pointMass;     // kg: the point's effective mass along the normal (INFINITY: neither body moves)
+  double lever;         // 1/kg: how far an impulse there may move the state, per kg·m/s
   double turning;       // m/s²: Ω² r, the bodies' turning's acceleration of the point (Ω their relative rate)
   pdVec3 applied;       // m/s²: the applied loads' relative acceleration of the point at the step's end (applied_at)
   pdVec3 appliedRate;   // m/s³: its rate (a ramped force)
 } onsetTerms;
 
+// A body's inverse inertia in the world frame at `pose`, R I⁻¹ Rᵀ: computed here, since the set's copy is the last
+// installed list's (a step's start, and zero before the first), and an onset's bound is formed at the step's end.
+static pdMat3 inverse_inertia_at(const pdBody* body, const pdPose* pose) {
+  pdMat3 rt = pd_mat3_transpose(&pose->R), tmp = pd_mat3_mul(&body->invInertia, &rt);
+  return pd_mat3_mul(&pose->R, &tmp);
+}
 // The relative acceleration at `point` that the applied loads give the pair's bodies at time t (gravity, the scene's
 // force and its torque: dynamics.c's, without the contact forces and the bodies' turning), and its rate, at the
 // poses `poses`. A fixed body has none; gravity alone cancels between two moving bodies.
@@ -217,36 +193,30 @@ static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, con
   pdContactParams p = pd_model_contact_params(model, a, b);
   pdVec3 du = relative_velocity(model, y1, set->poses1, &g->id, g->point);
   onsetTerms t = {.omega = sqrt(pd_series(p.k1n, p.k2n) / p.massMin), .approach = -pd_v3_dot(du, g->normal),
-                  .size = INFINITY, .deltaMax = pd_model_pair_delta_max(model, a, b), .normal = g->normal};
-  onsetElement* e = &t.element;
-  double inverseMass = pd_v3_dot(g->normal, point_response(model, set->poses1, &g->id, g->point, g->normal));
-  e->mass = inverseMass > 0.0 ? 1.0 / inverseMass : INFINITY;
-  e->mu = p.mu;
-  if (isfinite(e->mass)) {
-    e->omega2 = pd_series(p.k1n, p.k2n) / e->mass;
-    e->damping = pd_series(p.c1n, p.c2n) / e->mass;
-    e->kt = pd_series(p.k1t, p.k2t);
-    e->ct = pd_series(p.c1t, p.c2t);
-    pdVec3 along;
-    slip_element(model, set->poses1, &g->id, g->point, g->normal, du, e, &along);
-  }
+                  .size = INFINITY, .mu = p.mu, .dampingRate = pd_series(p.c1n, p.c2n) / p.massMin,
+                  .normal = g->normal, .deltaMax = pd_model_pair_delta_max(model, a, b), .kn = pd_series(p.k1n, p.k2n),
+                  .cn = pd_series(p.c1n, p.c2n), .kt = pd_series(p.k1t, p.k2t), .ct = pd_series(p.c1t, p.c2t)};
   pdVec3 spin = {0.0, 0.0, 0.0};
-  double reach = 0.0;
+  double reach = 0.0, inverseMass = 0.0;
   for (int side = 0; side < 2; ++side) {
     const pdBody* body = &model->bodies[side == 0 ? a : b];
     if (body->fixed) continue;
     t.size = fmin(t.size, body->size);
     pdVec3 w = pd_layout_w(y1 + PD_BODY_STATE_SIZE * body->stateIndex);
     spin = side == 0 ? pd_v3_add(spin, w) : pd_v3_sub(spin, w);
-    reach = fmax(reach, pd_v3_norm(pd_v3_sub(g->point, set->poses1[side == 0 ? a : b].x)));
-    // a tangential impulse J at the point moves it by at most |J| λ_max(K) <= |J| tr K (K its inverse mass matrix
-    // there, 1/m + [r]ᵀ I⁻¹ [r], tr <= 3/m + |r|² tr I⁻¹) and turns the body by at most |J| |r| tr I⁻¹, which the
-    // error norm weighs by size / vmax
-    double r = pd_v3_norm(pd_v3_sub(g->point, set->poses1[side == 0 ? a : b].x));
-    double trInv = body->invInertia.m[0][0] + body->invInertia.m[1][1] + body->invInertia.m[2][2];
+    pdVec3 arm = pd_v3_sub(g->point, set->poses1[side == 0 ? a : b].x);
+    reach = fmax(reach, pd_v3_norm(arm));
+    // the point's inverse mass along the normal, and `lever`: a tangential impulse J at the point moves it by at most
+    // |J| λ_max(K) <= |J| tr K (K its inverse mass matrix there, 1/m + [r]ᵀ I⁻¹ [r], tr <= 3/m + |r|² tr I⁻¹) and turns
+    // the body by at most |J| |r| tr I⁻¹, which the error norm weighs by size / vmax
+    pdVec3 rn = pd_v3_cross(arm, g->normal);
+    pdMat3 invInertia = inverse_inertia_at(body, &set->poses1[side == 0 ? a : b]);
+    inverseMass += body->invMass + pd_v3_dot(rn, pd_mat3_mulv(&invInertia, rn));
+    double r = pd_v3_norm(arm), trInv = body->invInertia.m[0][0] + body->invInertia.m[1][1] + body->invInertia.m[2][2];
     t.lever += fmax(3.0 * body->invMass + r * r * trInv, r * trInv * body->size);
   }
   t.turning = pd_v3_dot(spin, spin) * reach;
+  t.pointMass = inverseMass > 0.0 ? 1.0 / inverseMass : INFINITY;
   applied_at(model, set->poses1, &g->id, g->point, t1, &t.applied, &t.appliedRate);
   return t;
 }
@@ -261,44 +231,40 @@ static void applied_over(const onsetTerms* t, double age, double* alongNormal, d
                      pd_v3_norm(pd_v3_sub(start, pd_v3_scale(t->normal, n0))));
 }
 
-// The bound of joining the contact `age` seconds after its onset at `depth` (onset_bound.h). Its friction terms: the
-// correction follows the slip along ŝ under its own friction and the normal element under its own force
-// (onset_motion); what it leaves out are the slip's change off that element, D(t) <= driftPerJt J_t(t) +
-// driftPerJn J_n(t) (the tangential impulse turning the slip, the normal impulse making slip), and the approach's,
-// D_n(t) <= approachPerJt J_t(t) (the tangential impulse pressing or lifting the point). Its applied term: the elements
-// start from the approach and the slip found at the step's end, which the applied loads (gravity, a scene's force and
-// its torque) changed over the age τ without the contact; followed from the onset, the point's relative velocity
-// differs from the elements' at time t since it by what those loads added over [t, τ], at most a (τ − t) with a their
-// largest relative acceleration there (applied_over), normal to D_n and tangential to D: their integrals are a τ²/2 and
-// a τ³/3. Each force law is Lipschitz in its velocity (the damper by c, the spring by k on its integral, the cone's
-// projection by 1, the clamp of F_n by 1), so the tangential impulse is off by at most c_t ∫D + k_t ∫∫D (never more than
-// both cones' impulses, 2 μ J_n), the normal impulse by c_n ∫D_n + k_n ∫∫D_n, and the cone's radius, μ F_n, by μ times
-// the normal impulse's error: that and the velocity term's (PD_ONSET_BOUND_C). Those impulses move the state by at most
-// `lever` each; the tangential springs' stretch is off by at most ∫D and the normal ones' deflection by ∫D_n. Its
-// turning term: the correction starts the element at the approach speed found at the step's end, which the bodies'
-// turning changed over the age by up to Ω² r τ without the contact; the element's response to that is at most ωτ of it
-// (PD_ONSET_TURNING_C).
-static double correction_bound(const pdModel* model, const onsetTerms* t, double age, double depth) {
-  double wt = t->omega * age, velocity = PD_ONSET_TURNING_C * t->turning * age * wt, spring = 0.0;
-  const onsetElement* e = &t->element;
-  if (isfinite(e->mass) && t->approach > 0.0) {
-    double an, at;
+// The bound of joining the contact `age` seconds after its onset at `depth`, its onset interpolated over a step of
+// `step` seconds (onset_bound.h). The correction follows the pair's bodies under every contact of the pair that began in
+// the step, at the step end's poses (onset_group_motion), so the slip a normal impulse makes, the push a tangential
+// impulse gives along the normal and the pair's joint motion are its own. What it leaves: the bodies' masses and arms
+// turning under the impulse (the velocity term, PD_ONSET_BOUND_C (ωτ)³, and μ times it for the cone's radius, μ F_n,
+// which the normal impulse's error moves; the turning term, PD_ONSET_TURNING_C Ω² r τ ωτ), the rest point the normal
+// deflection leaves (the position term), what the other forces on the bodies changed over the age (the applied term),
+// and the onset time.
+// The applied term: the motion starts from the relative velocity found at the step's end, which the applied loads
+// (gravity, a scene's force and its torque) changed over the age without the contact; followed from the onset, the
+// point's relative velocity differs from the motion's at time t since it by at most a (τ − t), a the loads' largest
+// relative acceleration there (applied_over): ∫ a (τ − t) dt = a τ²/2 and ∫∫ = a τ³/3. Each force law is Lipschitz in its
+// velocity (the damper by c, the spring by k on its integral, the cone's projection and the clamp by 1), so the normal
+// impulse is off by at most c_n a_n τ²/2 + k_n a_n τ³/3, the tangential one by c_t a_t τ²/2 + k_t a_t τ³/3 (at most both
+// cones' impulses, 2 μ J_n, J_n <= k_n v_n τ²/2 + c_n v_n τ) and by μ times the normal one's error; those impulses move
+// the state by at most `lever` each; the springs are off by at most a τ²/2, over δ_max. The loads are followed by
+// none of it: a body resting on others has them balanced by contacts the motion does not see.
+// The onset time: App. C's interpolation moves the point along the chord of its step,
+// which a turn's arc strays from by λ(1 − λ) Ω² r h²/2 at the fraction λ of the step (sway in contact_search.c), at the
+// onset (λ = 1 − τ/h) by Ω² r τ (h − τ)/2, so the age is off by that over v_n, and the element, whose force per unit mass
+// is at most (ω² τ + c/m) v_n, ends off by (ω² τ + c/m) Ω² r τ (h − τ)/2 in the velocity.
+static double correction_bound(const pdModel* model, const onsetTerms* t, double age, double depth, double step) {
+  double wt = t->omega * age, velocity = PD_ONSET_TURNING_C * t->turning * age * wt;
+  velocity += 0.5 * (t->omega * t->omega * age + t->dampingRate) * t->turning * age * fmax(step - age, 0.0);
+  if (t->mu > 0.0 && t->approach > 0.0) velocity += t->mu * PD_ONSET_BOUND_C * wt * wt * wt * t->approach;
+  double spring = 0.0;
+  if (isfinite(t->pointMass) && t->approach > 0.0) {
+    double an, at, age2 = 0.5 * age * age, age3 = age * age * age / 3.0;
     applied_over(t, age, &an, &at);
-    double age2 = 0.5 * age * age, age3 = age * age * age / 3.0;
-    double approach1 = an * age2, approach2 = an * age3;  // m, m·s: ∫D_n and ∫∫D_n, the applied loads' part
-    double drift1 = at * age2, drift2 = at * age3;        // ∫D and ∫∫D, theirs
-    double tangential = 0.0;
-    if (e->mu > 0.0) {
-      onsetMotion m = onset_motion(e, t->approach, age);
-      approach1 += m.approach1, approach2 += m.approach2;
-      drift1 += m.drift1, drift2 += m.drift2;
-      tangential = fmin(e->ct * drift1 + e->kt * drift2, 2.0 * e->mu * m.jn);
-      velocity += e->mu * PD_ONSET_BOUND_C * wt * wt * wt * t->approach;
-      spring = drift1 / t->deltaMax;
-    }
-    double normal = e->mass * (e->omega2 * approach2 + e->damping * approach1);  // N·s
-    velocity += t->lever * (tangential + (1.0 + e->mu) * normal);
-    spring = fmax(spring, approach1 / t->deltaMax);
+    double normal = t->cn * an * age2 + t->kn * an * age3;  // N·s
+    double cones = 2.0 * t->mu * (t->kn * t->approach * age2 + t->cn * t->approach * age);
+    double tangential = t->mu > 0.0 ? fmin(t->ct * at * age2 + t->kt * at * age3, cones) : 0.0;
+    velocity += t->lever * (tangential + (1.0 + t->mu) * normal);
+    spring = fmax(an, t->mu > 0.0 ? at : 0.0) * age2 / t->deltaMax;
   }
   return pd_onset_error_bound(t->omega, age, depth, t->approach, model->settings.vmax, t->size, velocity, spring);
 }
@@ -321,12 +287,13 @@ static double retry_target(const pdModel* model, const pdContactSet* set, const 
   double deltaMax = pd_model_pair_delta_max(model, c->geom.id.body1, c->geom.id.body2);
   double spend = PD_ONSET_AIM_SHARE * PD_ONSET_TOL_SHARE * model->settings.tol;
   double lo = 0.0, hi = fmin(PD_ONSET_PAIR_OMEGA_TAU / t.omega, PD_ONSET_PAIR_DEPTH_REL * deltaMax / t.approach);
-  if (correction_bound(model, &t, hi, t.approach * hi) <= spend) {
+  // the retried step ends `age` past the onset, at c->onset h + age
+  if (correction_bound(model, &t, hi, t.approach * hi, c->onset * h + hi) <= spend) {
     lo = hi;
   } else {
     for (int k = 0; k < PD_ONSET_AIM_BISECTIONS; ++k) {
       double age = 0.5 * (lo + hi);
-      if (correction_bound(model, &t, age, t.approach * age) <= spend)
+      if (correction_bound(model, &t, age, t.approach * age, c->onset * h + age) <= spend)
         lo = age;
       else
         hi = age;
@@ -345,7 +312,7 @@ double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdO
     double age = (1.0 - c->onset) * h;
     if (onsets != pd_onsetsExact && joins_as_pair(model, &c->geom, age)) {
       onsetTerms t = onset_terms(model, set, y1, t1, &c->geom);
-      c->onsetBound = correction_bound(model, &t, age, c->geom.depth);
+      c->onsetBound = correction_bound(model, &t, age, c->geom.depth, h);
       if (onsets == pd_onsetsPair || pd_onset_bound_allows(c->onsetBound, model->settings.tol)) {
         c->onsetAge = age;
         continue;
@@ -360,169 +327,216 @@ bool pd_onsets_may_retry(const pdContactSet* set) { return set->onsetRetries < P
 
 // ---------------------------------------------------------------- pair onsets at commit
 
-// The motion of one contact over the τ since its onset, alone (onsetElement): along the normal a Kelvin–Voigt element at
-// mass m that never pulls, from deflection 0 at approach speed v0; along the slip ŝ a Kelvin–Voigt element (k_t, c_t)
-// from stretch 0 at the slip speed, within the cone μ F_n, that slows the slip at ŝᵀKŝ per unit impulse. Linear and
-// short (ω τ <= PD_ONSET_PAIR_OMEGA_TAU): a few classic RK4 substeps are exact to ~(ωτ/8)⁵ away from the cone's and
-// the clamp's kinks. With the slip's own slowing, the tangential impulse is second order in τ where the slip is slow
-// (the springs take a while to reach the cone, which the normal damper makes large at once) and the slip stopping
-// within τ is followed, not capped afterwards. Also the integrals of D = driftPerJt J_t + driftPerJn J_n, what the
-// element leaves out of the slip (correction_bound).
+// The contacts of one pair whose onsets are followed together (onset_group_motion): a face on a face has its corners
+// and edge crossings, 8 between two boxes; a pair with more is followed in groups of this many.
+#define PD_ONSET_GROUP_MAX 16
+// Substeps of classic RK4 between two onsets of a group: the motion is linear and short (ω τ <= PD_ONSET_PAIR_OMEGA_TAU),
+// so they are exact to ~(ωτ/8)⁵ away from the cone's and the clamp's kinks; every onset falls on a substep's start, so
+// that no substep straddles the jump of a damper's force.
 #define PD_ONSET_PAIR_SUBSTEPS 8
-enum { M_X, M_U, M_VT, M_Q, M_JN, M_JT, M_I1, M_I2, M_N1, M_N2, M_STATE };
-static void motion_rate(const onsetElement* e, const double s[M_STATE], double r[M_STATE]) {
-  double fn = e->mass * fmax(0.0, e->omega2 * s[M_X] + e->damping * s[M_U]);  // N
-  // the tangential law (contact_force.h): the spring and damper in stick, on the cone in slip with the spring's stretch
-  // relaxing towards it through the damper, k_t q + c_t q̇ = ±μ F_n
-  double cone = e->mu * fn, trial = e->kt * s[M_Q] + e->ct * s[M_VT], ft = fmin(cone, fmax(-cone, trial));
-  r[M_X] = s[M_U];
-  r[M_U] = -fn / e->mass;
-  r[M_VT] = -e->slipInvMass * ft;
-  r[M_Q] = ft == trial || !(e->ct > 0.0) ? s[M_VT] : (ft - e->kt * s[M_Q]) / e->ct;
-  r[M_JN] = fn;
-  r[M_JT] = ft;
-  r[M_I1] = e->driftPerJt * fabs(s[M_JT]) + e->driftPerJn * s[M_JN];
-  r[M_I2] = s[M_I1];
-  r[M_N1] = e->approachPerJt * fabs(s[M_JT]);
-  r[M_N2] = s[M_N1];
+
+typedef struct onsetPoint {
+  int side;                   // +1: the contact's body 1 is the group's body A; −1: its body 2 is
+  pdVec3 normal, arm[2];      // the contact's normal; its point less the centre of body A and of body B
+  double kn, cn, kt, ct, mu;  // series constants (the modal dampers the contact has)
+  double start;               // s: its onset, after the group's earliest
+  pdVec3 free;                // m/s: Δu at the step's end (body 1's less body 2's), without the group's impulses
+} onsetPoint;
+
+typedef struct onsetGroup {
+  int count;
+  double tau;                 // s: the earliest onset's age
+  double invMass[2];          // 1/kg: body A's, body B's (0: fixed)
+  pdMat3 invInertia[2];       // world frame (zero: fixed)
+  bool planar[2];
+  onsetPoint points[PD_ONSET_GROUP_MAX];
+} onsetGroup;
+
+// State: body A's and body B's velocity changes (Δv, Δω each), then per contact its normal deflection, tangential
+// stretch and impulse on its body 1.
+enum { G_BODIES = 12, G_X = 0, G_Q = 1, G_J = 4, G_POINT = 7, G_STATE = G_BODIES + G_POINT * PD_ONSET_GROUP_MAX };
+static pdVec3 group_vec(const double* s) { return (pdVec3){s[0], s[1], s[2]}; }
+static void group_store(double* s, pdVec3 v) { s[0] = v.x, s[1] = v.y, s[2] = v.z; }
+
+// Δu of contact p at time `time` since the group's earliest onset, state s.
+static pdVec3 group_du(const onsetPoint* p, const double* s) {
+  pdVec3 a = pd_v3_add(group_vec(s), pd_v3_cross(group_vec(s + 3), p->arm[0]));
+  pdVec3 b = pd_v3_add(group_vec(s + 6), pd_v3_cross(group_vec(s + 9), p->arm[1]));
+  return pd_v3_add(p->free, pd_v3_scale(pd_v3_sub(a, b), p->side));
 }
 
-static onsetMotion onset_motion(const onsetElement* e, double v0, double tau) {
-  double s[M_STATE] = {0.0}, k[4][M_STATE], tmp[M_STATE], dt = tau / PD_ONSET_PAIR_SUBSTEPS;
-  s[M_U] = v0;
-  s[M_VT] = e->slip;
-  for (int i = 0; i < PD_ONSET_PAIR_SUBSTEPS; ++i) {
-    motion_rate(e, s, k[0]);
-    for (int j = 0; j < M_STATE; ++j) tmp[j] = s[j] + 0.5 * dt * k[0][j];
-    motion_rate(e, tmp, k[1]);
-    for (int j = 0; j < M_STATE; ++j) tmp[j] = s[j] + 0.5 * dt * k[1][j];
-    motion_rate(e, tmp, k[2]);
-    for (int j = 0; j < M_STATE; ++j) tmp[j] = s[j] + dt * k[2][j];
-    motion_rate(e, tmp, k[3]);
-    for (int j = 0; j < M_STATE; ++j) s[j] += dt / 6.0 * (k[0][j] + 2.0 * k[1][j] + 2.0 * k[2][j] + k[3][j]);
+// Contact p's force on its body 1 at deflection x, stretch q and relative velocity du, by the contact law: along the
+// normal a Kelvin–Voigt element that never pulls; across it the spring and damper in stick, on the cone μ F_n in slip
+// with the stretch relaxing towards it through the damper, k_t q + c_t q̇ = μ F_n along the trial force
+// (contact_force.h). *stretchRate gets q̇, *cone μ F_n.
+static pdVec3 group_force(const onsetPoint* p, double x, pdVec3 q, pdVec3 du, pdVec3* stretchRate, double* cone) {
+  double fn = fmax(0.0, p->kn * x - p->cn * pd_v3_dot(du, p->normal));  // N
+  pdVec3 slip = pd_v3_sub(du, pd_v3_scale(p->normal, pd_v3_dot(du, p->normal)));
+  pdVec3 trial = pd_v3_add(pd_v3_scale(q, p->kt), pd_v3_scale(slip, p->ct)), ft = trial;
+  double size = pd_v3_norm(trial);
+  *cone = p->mu * fn;
+  *stretchRate = slip;
+  if (size > *cone) {
+    ft = size > 0.0 ? pd_v3_scale(trial, *cone / size) : (pdVec3){0.0, 0.0, 0.0};
+    if (p->ct > 0.0) *stretchRate = pd_v3_scale(pd_v3_sub(ft, pd_v3_scale(q, p->kt)), 1.0 / p->ct);
   }
-  double fn = e->mass * fmax(0.0, e->omega2 * s[M_X] + e->damping * s[M_U]);
-  return (onsetMotion){.x = s[M_X], .u = s[M_U], .jn = s[M_JN], .jt = s[M_JT], .spring = s[M_Q], .cone = e->mu * fn,
-                       .drift1 = s[M_I1], .drift2 = s[M_I2], .approach1 = s[M_N1], .approach2 = s[M_N2]};
+  return pd_v3_sub(pd_v3_scale(p->normal, fn), ft);
 }
 
-// A body's inverse inertia in the world frame at `pose`, R I⁻¹ Rᵀ: computed here, since the set's copy is the last
-// installed list's (a step's start, and zero before the first), and an onset's bound is formed at the step's end.
-static pdMat3 inverse_inertia_at(const pdBody* body, const pdPose* pose) {
-  pdMat3 rt = pd_mat3_transpose(&pose->R), tmp = pd_mat3_mul(&body->invInertia, &rt);
-  return pd_mat3_mul(&pose->R, &tmp);
-}
-
-// K·j at a contact point: how the relative velocity Δu there changes under impulse j on body 1 (−j on body 2), 1/kg
-// times the impulse.
-static pdVec3 point_response(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point,
-                             pdVec3 impulse) {
-  pdVec3 out = {0.0, 0.0, 0.0};
-  for (int side = 0; side < 2; ++side) {
-    int b = side == 0 ? id->body1 : id->body2;
-    const pdBody* body = &model->bodies[b];
-    if (body->fixed) continue;
-    pdVec3 r = pd_v3_sub(point, poses[b].x);
-    pdMat3 invInertia = inverse_inertia_at(body, &poses[b]);
-    pdVec3 turn = pd_mat3_mulv(&invInertia, pd_v3_cross(r, impulse));
-    out = pd_v3_add(out, pd_v3_add(pd_v3_scale(impulse, body->invMass), pd_v3_cross(turn, r)));
-  }
-  return out;
-}
-
-// The tangential part of a correction's element at a contact point whose relative velocity is du: the slip, its
-// direction *along (any tangent where there is none), and how the impulses change it (K the point's inverse mass).
-static void slip_element(const pdModel* model, const pdPose* poses, const pdContactId* id, pdVec3 point, pdVec3 normal,
-                         pdVec3 du, onsetElement* e, pdVec3* along) {
-  pdVec3 slip = pd_v3_sub(du, pd_v3_scale(normal, pd_v3_dot(du, normal)));
-  double speed = pd_v3_norm(slip);
-  if (!(e->mu > 0.0) || speed <= PD_ONSET_PAIR_SLIP_REL * pd_v3_norm(du)) speed = 0.0;  // rounding, not slip
-  e->slip = speed;
-  if (speed > 0.0) {
-    *along = pd_v3_scale(slip, 1.0 / speed);
-  } else {  // a tangent: the axis least along the normal, crossed with it
-    pdVec3 axis = fabs(normal.x) <= fabs(normal.y) && fabs(normal.x) <= fabs(normal.z) ? pd_v3(1, 0, 0)
-                  : fabs(normal.y) <= fabs(normal.z)                                    ? pd_v3(0, 1, 0)
-                                                                                        : pd_v3(0, 0, 1);
-    *along = pd_v3_normalize(pd_v3_cross(normal, axis));
-  }
-  pdVec3 ks = point_response(model, poses, id, point, *along);
-  pdVec3 kn = point_response(model, poses, id, point, normal);
-  e->slipInvMass = pd_v3_dot(*along, ks);
-  pdVec3 off = pd_v3_sub(ks, pd_v3_add(pd_v3_scale(*along, e->slipInvMass), pd_v3_scale(normal, pd_v3_dot(normal, ks))));
-  e->driftPerJt = pd_v3_norm(off);
-  e->approachPerJt = fabs(pd_v3_dot(normal, ks));
-  e->driftPerJn = pd_v3_norm(pd_v3_sub(kn, pd_v3_scale(normal, pd_v3_dot(normal, kn))));
-}
-
-// The effective mass of the bodies of contact `id` along `normal` at `point`, kg (INFINITY if neither moves).
-static double point_mass_at(const pdModel* model, const pdContactSet* set, const pdPose* poses, const pdContactId* id,
-                            pdVec3 point, pdVec3 normal) {
-  double invMass = 0.0;
-  for (int side = 0; side < 2; ++side) {
-    int b = side == 0 ? id->body1 : id->body2;
-    const pdBody* body = &model->bodies[b];
-    if (body->fixed) continue;
-    pdVec3 rn = pd_v3_cross(pd_v3_sub(point, poses[b].x), normal);
-    invMass += body->invMass + pd_v3_dot(rn, pd_mat3_mulv(&set->invInertiaWorld[b], rn));
-  }
-  return invMass > 0.0 ? 1.0 / invMass : INFINITY;
-}
-
-// The effective mass of contact c's two bodies along its normal at its point, kg (INFINITY if neither moves).
-static double point_mass(const pdModel* model, const pdContactSet* set, const pdPose* poses, const contactSlot* c) {
-  return point_mass_at(model, set, poses, &c->id, c->point, c->normal);
-}
-
-// Pair onsets of a list just installed at state y (poses those of y; world inverse inertias and modal dampers
-// set): each contact with an onset age τ > 0 is put where it would be after τ on its own (onset_motion, m the
-// modal mass per contact or the point's effective mass, from its approach speed now): its normal springs at
-// that deflection x, split as series springs share a static load (k1 s1 + k2 s2 = 0), and its two bodies
-// given the normal impulse that slows their approach to that speed u. Its energy and phase are then the
-// contact's own; its rest point sits deeper by the depth d reached without it, less x (≈ d (ωτ)²/6).
-// All impulses are formed before any is applied, so the list's order does not matter. Returns the number
-// of such contacts.
-int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
-  int base = spring_base(model), started = 0;
-  for (int i = 0; i < set->count; ++i) {
-    contactSlot* c = &set->items[i];
-    if (c->onsetAge <= 0.0) continue;
-    const pdContactParams* p = &c->params;
-    double k = pd_series(p->k1n, p->k2n), damper = pd_series(p->c1n, p->c2n);
-    // the approach speed and the slip at the contact point
-    pdVec3 n = c->normal;
-    pdVec3 du = relative_velocity(model, y, poses, &c->id, c->point);
-    double approach = -pd_v3_dot(du, n);
-    c->onsetImpulse = (pdVec3){0, 0, 0};
-    double mass = c->modalMass > 0.0 && isfinite(c->modalMass) ? c->modalMass : point_mass(model, set, poses, c);
-    if (isfinite(mass) && approach > 0.0 && k > 0.0) {
-      onsetElement e = {.omega2 = k / mass, .damping = damper / mass, .mass = mass, .mu = p->mu,
-                        .kt = pd_series(p->k1t, p->k2t), .ct = pd_series(p->c1t, p->c2t)};
-      pdVec3 along;
-      slip_element(model, poses, &c->id, c->point, n, du, &e, &along);
-      // the pair's contacts that join together slow the slip together, as they do the approach (the modal mass): each
-      // contact's element slows it by the ratio of its normal's modal to point inverse mass more, so that several
-      // contacts, each stopping the slip alone, do not reverse it
-      double pointMass = point_mass(model, set, poses, c);
-      if (isfinite(pointMass) && mass < pointMass) e.slipInvMass *= pointMass / mass;
-      onsetMotion m = onset_motion(&e, approach, c->onsetAge);
-      double x = fmin(fmax(m.x, 0.0), fmax(c->depth, 0.0));
-      pdSprings sp = springs_load(y + base + PD_CONTACT_STATE_SIZE * i);
-      sp.s1n = -k * x / p->k1n;
-      sp.s2n = k * x / p->k2n;
-      double normalImpulse = mass * fmax(0.0, approach - fmax(m.u, 0.0));  // the pair's contacts together slow it so
-      c->onsetImpulse = pd_v3_scale(n, normalImpulse);
-      // friction over τ: sliding, the element's impulse against the slip (within the cone, the slip slowing under it),
-      // and the tangential springs loaded by the slip since the onset, capped by the cone
-      if (p->mu > 0.0 && e.kt > 0.0 && e.slip > 0.0) {
-        c->onsetImpulse = pd_v3_sub(c->onsetImpulse, pd_v3_scale(along, fmax(m.jt, 0.0)));
-        double ft = fmin(m.cone, e.kt * fmax(m.spring, 0.0));  // the spring's |F_t| on body 1, against the slip
-        sp.s1t = pd_v3_scale(along, ft / p->k1t);                     // F_t = −k1t s1t = k2t s2t = −ft · along
-        sp.s2t = pd_v3_scale(along, -ft / p->k2t);
-      }
-      springs_store(y + base + PD_CONTACT_STATE_SIZE * i, &sp);
+// The rate of state s, the contacts [0, active) begun (they are sorted by their onsets): the system is autonomous.
+static void group_rate(const onsetGroup* g, int active, const double* s, double* r) {
+  for (int j = 0; j < G_STATE; ++j) r[j] = 0.0;
+  for (int i = 0; i < active; ++i) {
+    const onsetPoint* p = &g->points[i];
+    const double* sp = s + G_BODIES + G_POINT * i;
+    double* rp = r + G_BODIES + G_POINT * i;
+    pdVec3 du = group_du(p, s), stretchRate;
+    double cone;
+    pdVec3 force = group_force(p, sp[G_X], group_vec(sp + G_Q), du, &stretchRate, &cone);
+    rp[G_X] = -pd_v3_dot(du, p->normal);
+    group_store(rp + G_Q, stretchRate);
+    group_store(rp + G_J, force);
+    pdVec3 onA = pd_v3_scale(force, p->side);  // on body A; body B takes its opposite
+    for (int b = 0; b < 2; ++b) {
+      pdVec3 f = b == 0 ? onA : pd_v3_scale(onA, -1.0);
+      pdVec3 dv = pd_v3_scale(f, g->invMass[b]), dw = pd_mat3_mulv(&g->invInertia[b], pd_v3_cross(p->arm[b], f));
+      if (g->planar[b]) dv.y = 0.0, dw.x = dw.z = 0.0;  // the plane takes the out-of-plane part (model.h)
+      group_store(r + 6 * b, pd_v3_add(group_vec(r + 6 * b), dv));
+      group_store(r + 6 * b + 3, pd_v3_add(group_vec(r + 6 * b + 3), dw));
     }
-    ++started;
+  }
+}
+
+// The motion of a group of contacts of one pair over the τ since the earliest's onset (points sorted by onset): the
+// changes of the two bodies' velocities from the step's end's, under every begun contact's force through the bodies'
+// masses and inertias at the step end's poses. So the slip a normal impulse makes at an off-centre point, the push a
+// tangential impulse gives along the normal and the pair's contacts beginning together are followed, not bounded
+// (onset_bound.h); the other forces on the bodies over τ are bounded (correction_bound). s holds the state at the
+// earliest onset (the velocity changes and deflections 0, the stretches those the contacts join with) and gets the
+// state at the step's end.
+static void onset_group_motion(const onsetGroup* g, double s[G_STATE]) {
+  double k[4][G_STATE], tmp[G_STATE];
+  double time = 0.0;
+  for (int active = 1; active <= g->count; ++active) {
+    double end = active < g->count ? g->points[active].start : g->tau;
+    if (!(end > time)) continue;  // onsets together: begun at once
+    double dt = (end - time) / PD_ONSET_PAIR_SUBSTEPS;
+    for (int i = 0; i < PD_ONSET_PAIR_SUBSTEPS; ++i) {
+      group_rate(g, active, s, k[0]);
+      for (int j = 0; j < G_STATE; ++j) tmp[j] = s[j] + 0.5 * dt * k[0][j];
+      group_rate(g, active, tmp, k[1]);
+      for (int j = 0; j < G_STATE; ++j) tmp[j] = s[j] + 0.5 * dt * k[1][j];
+      group_rate(g, active, tmp, k[2]);
+      for (int j = 0; j < G_STATE; ++j) tmp[j] = s[j] + dt * k[2][j];
+      group_rate(g, active, tmp, k[3]);
+      for (int j = 0; j < G_STATE; ++j) s[j] += dt / 6.0 * (k[0][j] + 2.0 * k[1][j] + 2.0 * k[2][j] + k[3][j]);
+    }
+    time = end;
+  }
+}
+
+// Whether contacts a and b are between the same two bodies.
+static bool same_pair(const pdContactId* a, const pdContactId* b) {
+  return (a->body1 == b->body1 && a->body2 == b->body2) || (a->body1 == b->body2 && a->body2 == b->body1);
+}
+
+// Follows the pair onsets members[0 .. count) of set (all of one pair, at most PD_ONSET_GROUP_MAX) at state y from their
+// onsets to the step's end together (onset_group_motion), and puts each where it gets to: its normal springs at the
+// deflection reached (at most its depth), split as series springs share a static load (k1 s1 + k2 s2 = 0), its
+// tangential ones at the stretch reached, held within the cone, and its onsetImpulse the impulse it gave.
+static void start_group(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses, const int* members,
+                        int count) {
+  int base = spring_base(model);
+  onsetGroup g = {.count = count};
+  const pdContactId* first = &set->items[members[0]].id;
+  int bodies[2] = {first->body1, first->body2};
+  for (int b = 0; b < 2; ++b) {
+    const pdBody* body = &model->bodies[bodies[b]];
+    g.invMass[b] = body->fixed ? 0.0 : body->invMass;
+    g.invInertia[b] = body->fixed ? pd_mat3_zero() : set->invInertiaWorld[bodies[b]];
+    g.planar[b] = body->planar;
+  }
+  // by onset, the earliest first (insertion: a group is small); the order of equal onsets is the list's
+  int order[PD_ONSET_GROUP_MAX] = {0};
+  for (int i = 0; i < count; ++i) {
+    int j = i;
+    while (j > 0 && set->items[members[order[j - 1]]].onsetAge < set->items[members[i]].onsetAge) {
+      order[j] = order[j - 1];
+      --j;
+    }
+    order[j] = i;
+  }
+  g.tau = set->items[members[order[0]]].onsetAge;
+  double s[G_STATE] = {0.0};
+  for (int i = 0; i < count; ++i) {
+    const contactSlot* c = &set->items[members[order[i]]];
+    const pdContactParams* p = &c->params;
+    onsetPoint* q = &g.points[i];
+    q->side = c->id.body1 == bodies[0] ? 1 : -1;
+    q->normal = c->normal;
+    for (int b = 0; b < 2; ++b) q->arm[b] = pd_v3_sub(c->point, poses[bodies[b]].x);
+    q->kn = pd_series(p->k1n, p->k2n), q->cn = pd_series(p->c1n, p->c2n);
+    q->kt = pd_series(p->k1t, p->k2t), q->ct = pd_series(p->c1t, p->c2t), q->mu = p->mu;
+    if (!(q->mu > 0.0) || !(q->kt > 0.0)) q->kt = q->ct = q->mu = 0.0;  // no friction
+    q->start = g.tau - c->onsetAge;
+    q->free = relative_velocity(model, y, poses, &c->id, c->point);
+    // a slip at the rounding of Δu is none: its direction is noise, and friction along it broke a flush stack's symmetry
+    pdVec3 slip = pd_v3_sub(q->free, pd_v3_scale(q->normal, pd_v3_dot(q->free, q->normal)));
+    if (pd_v3_norm(slip) <= PD_ONSET_PAIR_SLIP_REL * pd_v3_norm(q->free)) q->free = pd_v3_sub(q->free, slip);
+    // the tangential springs it joins with (a kept history, else 0) are where its stretch starts: F_t = −k1t s1t
+    pdSprings sp = springs_load(y + base + PD_CONTACT_STATE_SIZE * members[order[i]]);
+    pdVec3 s0 = q->kt > 0.0 ? pd_v3_scale(sp.s1t, p->k1t / q->kt) : (pdVec3){0.0, 0.0, 0.0};
+    group_store(s + G_BODIES + G_POINT * i + G_Q, pd_v3_sub(s0, pd_v3_scale(q->normal, pd_v3_dot(s0, q->normal))));
+  }
+  onset_group_motion(&g, s);
+  for (int i = 0; i < count; ++i) {
+    contactSlot* c = &set->items[members[order[i]]];
+    const pdContactParams* p = &c->params;
+    const onsetPoint* q = &g.points[i];
+    const double* sp = s + G_BODIES + G_POINT * i;
+    double* springs = y + base + PD_CONTACT_STATE_SIZE * members[order[i]];
+    pdSprings out = springs_load(springs);
+    double x = fmin(fmax(sp[G_X], 0.0), fmax(c->depth, 0.0));
+    out.s1n = -q->kn * x / p->k1n;
+    out.s2n = q->kn * x / p->k2n;
+    c->onsetImpulse = group_vec(sp + G_J);
+    if (q->kt > 0.0) {  // the spring's force k_t q, held within the cone at the step's end: F_t = −k1t s1t = k2t s2t
+      pdVec3 du = group_du(q, s), stretchRate;
+      double cone;
+      pdVec3 stretch = group_vec(sp + G_Q);
+      stretch = pd_v3_sub(stretch, pd_v3_scale(q->normal, pd_v3_dot(stretch, q->normal)));
+      (void)group_force(q, sp[G_X], stretch, du, &stretchRate, &cone);
+      double force = q->kt * pd_v3_norm(stretch);
+      if (force > cone) stretch = pd_v3_scale(stretch, cone / force);
+      out.s1t = pd_v3_scale(stretch, q->kt / p->k1t);
+      out.s2t = pd_v3_scale(stretch, -q->kt / p->k2t);
+    }
+    springs_store(springs, &out);
+  }
+}
+
+// Pair onsets of a list just installed at state y (poses those of y; world inverse inertias and modal dampers set):
+// the contacts with an onset age τ > 0 are followed from their onsets, each pair's together (start_group), and put
+// where they get to, their bodies given the impulses they gave. Their energy and phase are then their own; a rest point
+// sits deeper by the depth d reached without the contact, less the deflection x (≈ d (ωτ)²/6). All impulses are formed
+// before any is applied, so the list's order does not matter. Returns the number of such contacts.
+int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
+  int started = 0, members[PD_ONSET_GROUP_MAX];
+  for (int i = 0; i < set->count;) {
+    int end = i + 1;  // the pair's contacts: the list holds them together (sorted by the unordered pair first)
+    while (end < set->count && same_pair(&set->items[i].id, &set->items[end].id)) ++end;
+    int count = 0;
+    for (int j = i; j < end; ++j) {
+      if (set->items[j].onsetAge <= 0.0) continue;
+      members[count++] = j;
+      ++started;
+      if (count == PD_ONSET_GROUP_MAX) {
+        start_group(model, set, y, poses, members, count);
+        count = 0;
+      }
+    }
+    if (count > 0) start_group(model, set, y, poses, members, count);
+    i = end;
   }
   for (int i = 0; i < set->count && started > 0; ++i) {
     contactSlot* c = &set->items[i];
@@ -532,7 +546,6 @@ int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, con
   }
   return started;
 }
-
 void pd_contact_impulse(const pdModel* model, const pdContactSet* set, double* y, const pdPose* poses,
                         const pdContactId* id, pdVec3 point, pdVec3 j) {
   for (int side = 0; side < 2; ++side) {

@@ -28,7 +28,7 @@
 #include "polydyn/scene.h"
 #include "polydyn/state.h"
 
-#define EXPECTED_HASH UINT64_C(0xfa18bfa526de3dec)
+#define EXPECTED_HASH UINT64_C(0x2a376fc9461a5ae0)
 #define PILE PD_SOURCE_DIR "/cases/sweep/pile_10.scene"
 #define PILE_TEND 0.5  // s: the boxes land at about 0.2 s
 // Samples per alternating slice. A slice ends on a sample time k / sampleRate computed as pd_advance computes
