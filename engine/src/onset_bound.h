@@ -32,8 +32,10 @@
 // τ; what it leaves out (the bodies turning under that impulse, so the point's effective mass drifting, and the onset
 // time's interpolation) enters the velocity at third order in ωτ. Measured on single bodies (tests/engine/test_events.c:
 // a cube landing on a face, a corner and an edge, e 0.3–0.8, at 0.02–3 m/s, stiff and soft, ωτ up to 0.82, at tol
-// 1e-10): at most 1.1e-4 (ωτ)³, so 0.004 keeps a factor of ~36 for what no test isolates (a crowd's other contacts
-// over τ). The 1-D spring–dashpot figure of the cruder impulse (c v_n + ½ k δ₀) τ is 0.08.
+// 1e-10): at most 1.1e-4 (ωτ)³. 0.004 would keep a factor of ~36 for what no test isolates (a crowd's other contacts
+// over τ), but a turning body's correction errs far beyond the landings' figure (docs/events.md: at 0.004 the
+// eccentric bar's impact stops converging with the tolerance), so C is 0.04. The 1-D spring–dashpot figure of the
+// cruder impulse (c v_n + ½ k δ₀) τ is 0.08.
 #define PD_ONSET_BOUND_C 0.04
 // The turning term's coefficient (onsets.c, correction_bound): a body turning at Ω as it lands changes its point's
 // approach by Ω² r τ over the τ the correction stands in for; calibrated on a bar 0.6 m long landing on its edge while
