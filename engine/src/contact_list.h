@@ -1,8 +1,8 @@
-// polydyn (internal) — the contact list's structures and the helpers the contact files share: contact_set.c (the
-// list, its events and commit), contact_forces.c (forces in the derivative, linearisation), stability_bound.c (modal
-// dampers, the stable step), stack_modes.c (the modes of stacks), onsets.c (late onsets), contact_search.c (broad
-// phase, travel, certificates, search) and state_contacts.c (the state's contact read-out). Nothing outside these
-// files includes it: everyone else sees pdContactSet through contact_set.h alone.
+// polydyn (internal) — the contact list's structures and the helpers the contact files share: contact_set.c (the list,
+// its events and commit), contact_forces.c (forces in the derivative, linearisation), pair_params.c (the springs sized
+// by the load, modal dampers), stability_bound.c (the stable step), stack_modes.c (the modes of stacks), onsets.c (late
+// onsets), contact_search.c (broad phase, travel, certificates, search) and state_contacts.c (the state's contact
+// read-out). Nothing outside these files includes it: everyone else sees pdContactSet through contact_set.h alone.
 #pragma once
 
 #include <stdbool.h>
@@ -307,7 +307,7 @@ void pd_contact_set_reserve_list(pdContactSet* set, int capacity);
 // bodyList, read by the force sums and the tight stability bound.
 void pd_contact_set_list_bodies(const pdModel* model, pdContactSet* set);
 
-// stability_bound.c: the springs sized by the load and the modal dampers of every pair whose contacts changed (poses:
+// pair_params.c: the springs sized by the load and the modal dampers of every pair whose contacts changed (poses:
 // the list's, world inverse inertias set; y: the state whose springs are re-scaled with their stiffness), and the
 // stability bound's terms and cheap bound for a new list.
 void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses, double* y);

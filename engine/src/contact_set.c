@@ -1,7 +1,8 @@
 // polydyn — the contact list of a state: its storage, the contact events between steps and their commit (paper
 // Fig. 8, §3.4, §4.2–§4.4; docs/DESIGN.md §5.3). The work they call on is in files of its own: the forces inside the
-// derivative (contact_forces.c), the modal dampers and the stability bound (stability_bound.c), the onsets (onsets.c)
-// and the contact search (contact_search.c), all over the structures of contact_list.h.
+// derivative (contact_forces.c), the springs sized by the load and the modal dampers (pair_params.c), the stability
+// bound (stability_bound.c), the onsets (onsets.c) and the contact search (contact_search.c), all over the structures
+// of contact_list.h.
 //
 // Design note. The loop of Fig. 8 runs as: the stepper proposes a step from (t0, y0) to y1 with the
 // contact list C0 fixed; the error control accepts it; pd_contact_events then analyses y1:

@@ -12,10 +12,10 @@
 //   the series stiffness is k_s = m_pair v_max²/δ_max², and each side without an explicit kn gets 2 k_s
 //   (equal sides: the surface elements sit in the middle). kt = kn of the same side unless set. Where all four are
 //   derived (loadSized), a pair pressed by a heavier body towards a third has them raised for that load while the
-//   simulation runs (stability_bound.c, load_scale).
+//   simulation runs (pair_params.c, load_scale).
 //   Damping: when neither side gives cn (ct), the pair's dampers are "modal": each contact gets
 //   c_s = 2ζ√(k_s m_c), with m_c the mass per contact of the pair's joint motion along the normals (in the
-//   tangent plane), set from the pair's active contacts whenever they change (stability_bound.c) — so the
+//   tangent plane), set from the pair's active contacts whenever they change (pair_params.c) — so the
 //   requested e holds for one vertex, an edge (2 contacts) or a face (4) alike. Both sides get the same
 //   c/k (c_i = (c_s/k_s) k_i): two Kelvin–Voigt elements with one c/k ARE one Kelvin–Voigt element, which
 //   is what makes eq. (15) exact for any two bodies; the contact force then takes its "proportional"

@@ -2,10 +2,10 @@
 //
 // Design note. A pair's modal dampers are sized for a mode: c = 2ζ√(k_s m_c) gives the requested damping ratio ζ
 // to the mode whose frequency is ω = √(k_s/m_c). For two bodies alone that is their joint motion (m_c from the pair,
-// stability_bound.c). In a stack the slow mode is another one: an 80 kg block on a 0.2 kg pad on a floor bounces on
+// pair_params.c). In a stack the slow mode is another one: an 80 kg block on a 0.2 kg pad on a floor bounces on
 // both interfaces in series at √(k/2/80), while each pair alone would size its dampers for the pad (ζ 0.01 left for
 // the block). Only where the masses differ (PD_STACK_MASS_RATIO) and the slow mode is far slower than the pair's own
-// (stability_bound.c, PD_STACK_SLOW_FROM): among bodies of one mass the pair's own dampers are kept. Dampers proportional to the springs with one c/k = 2ζ/ω along a chain in series are one Kelvin–Voigt
+// (pair_params.c, PD_STACK_SLOW_FROM): among bodies of one mass the pair's own dampers are kept. Dampers proportional to the springs with one c/k = 2ζ/ω along a chain in series are one Kelvin–Voigt
 // element, so the chain's mode at ω gets exactly ζ; hence each pair's dampers are sized for the slowest mode of its
 // local system in which its springs hold a real share of the strain energy (min(1, s/PD_STACK_SHARE) weighs it: a
 // light body resting on a heavy one holds ~(m/M)² of the heavy one's bounce and keeps its own, faster mode). The
@@ -30,7 +30,7 @@
 // evaluations to its 0.3 s, with 1/2 3 530 (2 543 with each pair's own dampers).
 #define PD_STACK_SHARE 0.5
 // A local system whose masses differ by at most this factor is not analysed: among bodies of one mass a pair's own
-// mode and the slow modes around it are within the factor of PD_STACK_SLOW_FROM (stability_bound.c), so the
+// mode and the slow modes around it are within the factor of PD_STACK_SLOW_FROM (pair_params.c), so the
 // analysis would change nothing.
 #define PD_STACK_MASS_RATIO 2.0
 // Modes below this fraction of the largest eigenvalue are the local system's free motions (a body sliding
