@@ -478,6 +478,17 @@ static void test_edge_along_a_rim_face_gives_both_crossings(void** state) {
   pd_model_free(m);
 }
 
+// A 4 mm plate and a tetrahedron above it, its apex down (the two thin-plate cases below).
+#define PLATE_AND_TIP "cube plate grey 0.4 0.4 0.004\nhull tip red 0 0 0 0.05 0 0.05 -0.05 0.05 0.05 -0.05 -0.05 0.05\n"
+
+// The vertex of a shape lowest along its own z.
+static int lowest_vertex(const pdPolyhedron* shape) {
+  int lowest = 0;
+  for (int v = 1; v < shape->vertexCount; ++v)
+    if (shape->vertices[v].z < shape->vertices[lowest].z) lowest = v;
+  return lowest;
+}
+
 // A corner pressed through a thin plate (docs/contact-model.md, "A vertex pressed through a thin body"): a
 // tetrahedron's apex in contact on the plate's top face keeps that contact when it has come out through the bottom
 // face (outside only across a face turned away from its own, over the top face, its body's lowest point), and breaks
@@ -485,11 +496,9 @@ static void test_edge_along_a_rim_face_gives_both_crossings(void** state) {
 static void test_a_vertex_pressed_through_a_thin_plate_keeps_its_face(void** state) {
   (void)state;
   const double half = 0.002;  // the plate's half-thickness, m
-  pdModel* m = compile("cube plate grey 0.4 0.4 0.004\nhull tip red 0 0 0 0.05 0 0.05 -0.05 0.05 0.05 -0.05 -0.05 0.05\n");
+  pdModel* m = compile(PLATE_AND_TIP);
   const pdPolyhedron* tip = &m->bodies[1].shape;
-  int apex = 0;
-  for (int v = 1; v < tip->vertexCount; ++v)
-    if (tip->vertices[v].z < tip->vertices[apex].z) apex = v;
+  int apex = lowest_vertex(tip);
   double apexZ = tip->vertices[apex].z;  // below the hull's centre of mass, its frame's origin
   pdPose plate = pose(0, 0, 0, 0, pd_v3(0, 0, 1));
   pdPose in = pose(0.05, 0, half - DEPTH - apexZ, 0, pd_v3(0, 0, 1));
@@ -521,12 +530,10 @@ static void test_a_vertex_pressed_through_a_thin_plate_keeps_its_face(void** sta
 static void test_an_edge_pairs_end_through_a_thin_plate_is_found_on_the_face(void** state) {
   (void)state;
   const double half = 0.002;  // the plate's half-thickness, m
-  pdModel* m = compile("cube plate grey 0.4 0.4 0.004\nhull tip red 0 0 0 0.05 0 0.05 -0.05 0.05 0.05 -0.05 -0.05 0.05\n");
+  pdModel* m = compile(PLATE_AND_TIP);
   const pdPolyhedron* plateShape = &m->bodies[0].shape;
   const pdPolyhedron* tip = &m->bodies[1].shape;
-  int apex = 0;
-  for (int v = 1; v < tip->vertexCount; ++v)
-    if (tip->vertices[v].z < tip->vertices[apex].z) apex = v;
+  int apex = lowest_vertex(tip);
   int top = -1, rim = -1, tipEdge = -1;
   for (int f = 0; f < plateShape->faceCount; ++f)
     if (plateShape->faces[f].normal.z > 0.5) top = f;
