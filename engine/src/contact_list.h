@@ -175,6 +175,7 @@ struct pdContactSet {
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
+  double* kinkSum;         // (bodyCount) scratch of pd_contact_events: the step's stick–slip kinks' slopes per body
   struct pdStackScratch* stackScratch;  // the modal dampers' local mode analyses (stack_modes.h); NULL until first needed
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation
   // the state record() formed every contact's force at (its slots' force, point and rates), while recordedValid:

@@ -89,6 +89,7 @@ static pdContactSet* create(const pdModel* model, bool search) {
   set->bodyFirst = pd_grow(NULL, n + 1, sizeof *set->bodyFirst);
   set->invInertiaWorld = pd_grow(NULL, n, sizeof *set->invInertiaWorld);
   for (int i = 0; i < n; ++i) set->invInertiaWorld[i] = pd_mat3_zero();
+  set->kinkSum = pd_zeroed((size_t)n, sizeof *set->kinkSum);
   set->stackScratch = NULL;  // made when a pair's modal dampers first need it (stack_mass)
   set->stableStep = set->stableCheap = INFINITY;
   set->dampingMin = 1.0;
@@ -143,6 +144,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->bodyBlocks);
   free(set->bodyRowsRight);
   free(set->invInertiaWorld);
+  free(set->kinkSum);
   pd_stack_scratch_free(set->stackScratch);
   free(set->travel);
   free(set->torque);
@@ -426,21 +428,26 @@ static void transition_kink(const pdModel* model, pdContactSet* set, int i, cons
   e->kink[2] = damper > 0.0 ? rate / (damper * c->deltaMax) : 0.0;
 }
 
-// The error bound of contact i's change inside a step of h: its kink's slopes summed with those of the step's other
-// changes (slipChanged) on the same bodies, the largest.
-static double transition_bound(const pdModel* model, const pdContactSet* set, int i, double h) {
-  const contactSlot* c = &set->items[i];
-  double sum[2] = {0.0, 0.0};
+// The step's stick–slip kinks' slopes summed per moving body into set->kinkSum (in the contacts' order), over the
+// contacts whose change is inside the step (slipChanged): one pass, whatever the number of changes.
+static void sum_kinks(const pdModel* model, pdContactSet* set) {
+  for (int j = 0; j < set->count; ++j)
+    if (set->eval[j].slipChanged) set->kinkSum[set->items[j].id.body1] = set->kinkSum[set->items[j].id.body2] = 0.0;
   for (int j = 0; j < set->count; ++j) {
     if (!set->eval[j].slipChanged) continue;
-    const contactSlot* o = &set->items[j];
-    const double* kink = set->eval[j].kink;
-    int theirs[2] = {o->id.body1, o->id.body2}, ours[2] = {c->id.body1, c->id.body2};
-    for (int a = 0; a < 2; ++a)
-      for (int b = 0; b < 2; ++b)
-        if (ours[a] == theirs[b] && !model->bodies[ours[a]].fixed) sum[a] += kink[b];
+    const pdContactId* id = &set->items[j].id;
+    if (!model->bodies[id->body1].fixed) set->kinkSum[id->body1] += set->eval[j].kink[0];
+    if (!model->bodies[id->body2].fixed) set->kinkSum[id->body2] += set->eval[j].kink[1];
   }
-  return pd_transition_error_bound(fmax(fmax(sum[0], sum[1]), set->eval[i].kink[2]), h);
+}
+
+// The error bound of contact i's change inside a step of h: its kink's slopes summed with those of the step's other
+// changes on the same bodies (sum_kinks), the largest.
+static double transition_bound(const pdModel* model, const pdContactSet* set, int i, double h) {
+  const pdContactId* id = &set->items[i].id;
+  double sum1 = model->bodies[id->body1].fixed ? 0.0 : set->kinkSum[id->body1];
+  double sum2 = model->bodies[id->body2].fixed ? 0.0 : set->kinkSum[id->body2];
+  return pd_transition_error_bound(fmax(fmax(sum1, sum2), set->eval[i].kink[2]), h);
 }
 
 // Whether the force law at the step's end left a mode contact c held over the step (holdModes): the normal force's
@@ -555,6 +562,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     }
     refineStep = fmax(refineStep, refine_step(model, &c->params));
   }
+  if (slipChanges > 0) sum_kinks(model, set);
   for (int i = 0; slipChanges > 0 && i < set->count; ++i) {
     contactEval* e = &set->eval[i];
     if (!e->slipChanged) continue;
