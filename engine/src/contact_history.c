@@ -226,6 +226,12 @@ bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, 
   return true;
 }
 
+double pd_history_load_scale(const pdContactHistory* h, const pdContactId* id) {
+  int i = lower_bound(h, id);
+  if (i == h->sortedCount || pd_contact_id_compare(&h->items[i].id, id) != 0 || h->items[i].taken) return 1.0;
+  return h->items[i].loadScale;
+}
+
 bool pd_history_vertex_trace(const pdContactHistory* h, int vertexBody, int vertex, int faceBody, int face,
                              pdContactId* id) {
   // the traces of this vertex on faceBody's faces follow one another in the sorted run, by face

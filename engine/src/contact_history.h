@@ -57,6 +57,9 @@ double pd_history_spring_energy(const pdModel* model, const pdContactHistory* h)
 // After a commit, at the bodies' new poses (indexed by model body): forgets every trace whose features no longer
 // track or are apart by more than the gap tolerance, and every trace left before this call and taken since.
 void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* poses);
+// The factor over eq. (11)'s of the springs a new contact `id` would take back from a trace left by force on the same
+// features (pd_history_take), 1 when none is kept.
+double pd_history_load_scale(const pdContactHistory* h, const pdContactId* id);
 // The id of the trace left by force by vertex `vertex` of body vertexBody on a face of faceBody other than `face`, into
 // *id: true when one is kept (not taken), else false.
 bool pd_history_vertex_trace(const pdContactHistory* h, int vertexBody, int vertex, int faceBody, int face,

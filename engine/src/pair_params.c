@@ -233,6 +233,29 @@ static int pair_end(const pdContactSet* set, int first) {
   return last;
 }
 
+pdContactParams pd_onset_params(const pdModel* model, const pdContactSet* set, const pdContactId* id) {
+  pdContactParams p = pd_model_contact_params(model, id->body1, id->body2);
+  if (!p.loadSized) return p;
+  int a = id->body1 < id->body2 ? id->body1 : id->body2, b = id->body1 < id->body2 ? id->body2 : id->body1;
+  int lo = 0, hi = set->count;  // the pair's first listed contact (the list is sorted by pair)
+  while (lo < hi) {
+    int mid = lo + (hi - lo) / 2;
+    if (compare_to_pair(&set->items[mid].id, a, b) < 0)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  double f = set->history ? pd_history_load_scale(set->history, id) : 1.0;
+  for (int i = lo; i < set->count && compare_to_pair(&set->items[i].id, a, b) == 0; ++i)
+    f = fmax(f, set->items[i].loadScale);
+  if (f == 1.0) return p;
+  p.k1n *= f, p.k2n *= f, p.k1t *= f, p.k2t *= f;
+  double root = sqrt(f);
+  if (p.modalN) p.c1n *= root, p.c2n *= root;
+  if (p.modalT) p.c1t *= root, p.c2t *= root;
+  return p;
+}
+
 void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses, double* y) {
   if (!set->bodyListValid) pd_contact_set_list_bodies(model, set);
   // the springs first, all from eq. (11)'s (the load does not depend on the order of the pairs), then the dampers
