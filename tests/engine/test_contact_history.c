@@ -45,17 +45,24 @@ static pdPose at_height(const pdModel* m, int body, double z) {
   return (pdPose){{0.0, 0.0, z}, pd_quat_to_mat3(pd_quat_identity())};
 }
 
+// A 10 cm cube DEPTH into a 1 m floor's top face (z = 0): the model, the two bodies' poses and its four corner contacts.
+static pdModel* box_on_floor(int* floor, int* box, pdPose poses[2], pdContactGeom c[CAPACITY]) {
+  pdModel* m = compile_apart("cube floor grey 1 1 0.1\nfixed\ncube box red 0.1 0.1 0.1\n");
+  *floor = body_index(m, "floor"), *box = body_index(m, "box");
+  poses[*floor] = at_height(m, *floor, -0.05);  // top face at z = 0
+  poses[*box] = at_height(m, *box, 0.05 - DEPTH);
+  int n = pd_contacts_find(m, *box, &poses[*box], *floor, &poses[*floor], NULL, NULL, NULL, 0, c, CAPACITY);
+  assert_int_equal(n, 4);
+  return m;
+}
+
 static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_springs(void** state) {
   (void)state;
-  pdModel* m = compile_apart("cube floor grey 1 1 0.1\nfixed\ncube box red 0.1 0.1 0.1\n");
-  int floor = body_index(m, "floor"), box = body_index(m, "box");
-  double deltaMax = pd_model_pair_delta_max(m, box, floor);
+  int floor, box;
   pdPose poses[2];
-  poses[floor] = at_height(m, floor, -0.05);  // top face at z = 0
-  poses[box] = at_height(m, box, 0.05 - DEPTH);
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, box, &poses[box], floor, &poses[floor], NULL, NULL, NULL, 0, c, CAPACITY);
-  assert_int_equal(n, 4);
+  pdModel* m = box_on_floor(&floor, &box, poses, c);
+  double deltaMax = pd_model_pair_delta_max(m, box, floor);
   pdContactParams params = pd_model_contact_params(m, c[0].id.body1, c[0].id.body2);
   // springs as a contact leaves them: the two sides balanced (k1t s1t + k2t s2t = 0), in the floor's plane
   pdVec3 s1t = {2e-6, -1e-6, 0.0};
@@ -107,15 +114,11 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
 // the trace counts meanwhile is that of the raised springs, which the contact then holds.
 static void test_a_trace_of_raised_springs_is_taken_back_at_their_stiffness(void** state) {
   (void)state;
-  pdModel* m = compile_apart("cube floor grey 1 1 0.1\nfixed\ncube box red 0.1 0.1 0.1\n");
-  int floor = body_index(m, "floor"), box = body_index(m, "box");
-  double deltaMax = pd_model_pair_delta_max(m, box, floor);
+  int floor, box;
   pdPose poses[2];
-  poses[floor] = at_height(m, floor, -0.05);
-  poses[box] = at_height(m, box, 0.05 - DEPTH);
   pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, box, &poses[box], floor, &poses[floor], NULL, NULL, NULL, 0, c, CAPACITY);
-  assert_int_equal(n, 4);
+  pdModel* m = box_on_floor(&floor, &box, poses, c);
+  double deltaMax = pd_model_pair_delta_max(m, box, floor);
   const double raised = 40.0;  // the contact's factor when it broke
   pdContactParams own = pd_model_contact_params(m, c[0].id.body1, c[0].id.body2);
   pdVec3 s1t = {2e-7, -1e-7, 0.0};

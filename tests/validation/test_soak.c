@@ -278,9 +278,8 @@ static void test_a_light_body_under_a_heavy_one_has_springs_for_its_load(void** 
 // (cases/hard/frustum_pressed_deep_before_its_springs_rise.scene): the frustum's pair with the icosahedron held a
 // vertex-face contact of the frustum's vertex and an edge pair named from the icosahedron, whose normals, added as
 // named (each into its own first body), nearly cancelled, so the cube pressing the frustum along the pair's normal
-// was not seen and
-// the pair went 5.5 delta_max deep on its own springs before another contact's change raised them (islands on); the
-// overlap then outlived every contact (5.63). Each contact's normal taken into one body of the pair, the load is found
+// was not seen and the pair went 5.5 delta_max deep on its own springs before another contact's change raised them
+// (islands on); the overlap then outlived every contact (5.63). Each contact's normal taken into one body of the pair, the load is found
 // when the pair is shallow: the soak's checks pass at every step, islands on and off.
 static void test_a_pair_whose_contacts_name_its_bodies_both_ways_finds_its_load(void** state) {
   (void)state;
