@@ -45,25 +45,32 @@ static pdPose at_height(const pdModel* m, int body, double z) {
   return (pdPose){{0.0, 0.0, z}, pd_quat_to_mat3(pd_quat_identity())};
 }
 
-// A 10 cm cube DEPTH into a 1 m floor's top face (z = 0): the model, the two bodies' poses and its four corner contacts.
-static pdModel* box_on_floor(int* floor, int* box, pdPose poses[2], pdContactGeom c[CAPACITY]) {
-  pdModel* m = compile_apart("cube floor grey 1 1 0.1\nfixed\ncube box red 0.1 0.1 0.1\n");
-  *floor = body_index(m, "floor"), *box = body_index(m, "box");
-  poses[*floor] = at_height(m, *floor, -0.05);  // top face at z = 0
-  poses[*box] = at_height(m, *box, 0.05 - DEPTH);
-  int n = pd_contacts_find(m, *box, &poses[*box], *floor, &poses[*floor], NULL, NULL, NULL, 0, c, CAPACITY);
+// A 10 cm cube DEPTH into a 1 m floor's top face (z = 0): the model, the two bodies' poses, its four corner contacts and
+// the pair's δ_max.
+typedef struct boxOnFloor {
+  pdModel* m;
+  int floor, box;
+  pdPose poses[2];
+  pdContactGeom c[CAPACITY];
+  double deltaMax;
+} boxOnFloor;
+
+static void box_on_floor(boxOnFloor* b) {
+  b->m = compile_apart("cube floor grey 1 1 0.1\nfixed\ncube box red 0.1 0.1 0.1\n");
+  b->floor = body_index(b->m, "floor"), b->box = body_index(b->m, "box");
+  b->poses[b->floor] = at_height(b->m, b->floor, -0.05);  // top face at z = 0
+  b->poses[b->box] = at_height(b->m, b->box, 0.05 - DEPTH);
+  int n = pd_contacts_find(b->m, b->box, &b->poses[b->box], b->floor, &b->poses[b->floor], NULL, NULL, NULL, 0, b->c,
+                           CAPACITY);
   assert_int_equal(n, 4);
-  return m;
+  b->deltaMax = pd_model_pair_delta_max(b->m, b->box, b->floor);
 }
 
 static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_springs(void** state) {
   (void)state;
-  int floor, box;
-  pdPose poses[2];
-  pdContactGeom c[CAPACITY];
-  pdModel* m = box_on_floor(&floor, &box, poses, c);
-  double deltaMax = pd_model_pair_delta_max(m, box, floor);
-  pdContactParams params = pd_model_contact_params(m, c[0].id.body1, c[0].id.body2);
+  boxOnFloor b;
+  box_on_floor(&b);
+  pdContactParams params = pd_model_contact_params(b.m, b.c[0].id.body1, b.c[0].id.body2);
   // springs as a contact leaves them: the two sides balanced (k1t s1t + k2t s2t = 0), in the floor's plane
   pdVec3 s1t = {2e-6, -1e-6, 0.0};
   pdSprings left = {-1e-5, 1e-5, s1t, pd_v3_scale(s1t, -params.k1t / params.k2t)};
@@ -72,12 +79,12 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
   double lifts[] = {0.05, 0.5};  // of δ_max: within the gap, beyond it
   for (int k = 0; k < 2; ++k) {
     pdContactHistory* h = pd_history_create();
-    pd_history_leave(h, &c[0].id, &left, c[0].normal, deltaMax, 1.0);
-    poses[box] = at_height(m, box, 0.05 + lifts[k] * deltaMax);
-    pd_history_age(m, h, poses);
+    pd_history_leave(h, &b.c[0].id, &left, b.c[0].normal, b.deltaMax, 1.0);
+    b.poses[b.box] = at_height(b.m, b.box, 0.05 + lifts[k] * b.deltaMax);
+    pd_history_age(b.m, h, b.poses);
     pdSprings got = {0};
     double scale = 1.0;
-    bool kept = pd_history_take(h, &c[0].id, c[0].normal, &params, &scale, &got);
+    bool kept = pd_history_take(h, &b.c[0].id, b.c[0].normal, &params, &scale, &got);
     print_message("corner lifted %.2f delta_max (gap tolerance %.2f): history %s\n", lifts[k], PD_HISTORY_GAP_REL,
                   kept ? "kept" : "forgotten");
     if (lifts[k] <= PD_HISTORY_GAP_REL) {
@@ -86,7 +93,7 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
       assert_true(pd_v3_norm(pd_v3_sub(got.s1t, left.s1t)) <= SPRING_TOL);
       assert_true(pd_v3_norm(pd_v3_sub(got.s2t, left.s2t)) <= SPRING_TOL);
       pdSprings again = {0};
-      assert_false(pd_history_take(h, &c[0].id, c[0].normal, &params, &scale, &again));  // taken once
+      assert_false(pd_history_take(h, &b.c[0].id, b.c[0].normal, &params, &scale, &again));  // taken once
     } else {
       assert_false(kept);
     }
@@ -95,17 +102,17 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
 
   // another corner (other features) does not take them; nor does the same one after its vertex left the face
   pdContactHistory* h = pd_history_create();
-  pd_history_leave(h, &c[0].id, &left, c[0].normal, deltaMax, 1.0);
-  poses[box] = at_height(m, box, 0.05);
-  pd_history_age(m, h, poses);
+  pd_history_leave(h, &b.c[0].id, &left, b.c[0].normal, b.deltaMax, 1.0);
+  b.poses[b.box] = at_height(b.m, b.box, 0.05);
+  pd_history_age(b.m, h, b.poses);
   pdSprings got = {0};
   double scale = 1.0;
-  assert_false(pd_history_take(h, &c[1].id, c[1].normal, &params, &scale, &got));
-  poses[box].x = (pdVec3){2.0, 0.0, 0.05};  // beside the 1 m floor: the vertex is off its face
-  pd_history_age(m, h, poses);
+  assert_false(pd_history_take(h, &b.c[1].id, b.c[1].normal, &params, &scale, &got));
+  b.poses[b.box].x = (pdVec3){2.0, 0.0, 0.05};  // beside the 1 m floor: the vertex is off its face
+  pd_history_age(b.m, h, b.poses);
   assert_int_equal(pd_history_count(h), 0);
   pd_history_free(h);
-  pd_model_free(m);
+  pd_model_free(b.m);
 }
 
 // A contact whose springs were raised for its pair's load (docs/contact-model.md, "Springs sized by the load") leaves
@@ -114,27 +121,24 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
 // the trace counts meanwhile is that of the raised springs, which the contact then holds.
 static void test_a_trace_of_raised_springs_is_taken_back_at_their_stiffness(void** state) {
   (void)state;
-  int floor, box;
-  pdPose poses[2];
-  pdContactGeom c[CAPACITY];
-  pdModel* m = box_on_floor(&floor, &box, poses, c);
-  double deltaMax = pd_model_pair_delta_max(m, box, floor);
+  boxOnFloor b;
+  box_on_floor(&b);
   const double raised = 40.0;  // the contact's factor when it broke
-  pdContactParams own = pd_model_contact_params(m, c[0].id.body1, c[0].id.body2);
+  pdContactParams own = pd_model_contact_params(b.m, b.c[0].id.body1, b.c[0].id.body2);
   pdVec3 s1t = {2e-7, -1e-7, 0.0};
   pdSprings left = {-1e-6, 1e-6, s1t, pd_v3_scale(s1t, -own.k1t / own.k2t)};
   double energies[2];
   double scales[2] = {1.0, raised};
   for (int k = 0; k < 2; ++k) {
     pdContactHistory* h = pd_history_create();
-    pd_history_leave(h, &c[0].id, &left, c[0].normal, deltaMax, scales[k]);
-    poses[box] = at_height(m, box, 0.05);
-    pd_history_age(m, h, poses);
-    energies[k] = pd_history_spring_energy(m, h);
+    pd_history_leave(h, &b.c[0].id, &left, b.c[0].normal, b.deltaMax, scales[k]);
+    b.poses[b.box] = at_height(b.m, b.box, 0.05);
+    pd_history_age(b.m, h, b.poses);
+    energies[k] = pd_history_spring_energy(b.m, h);
     pdContactParams params = own;
     double scale = 1.0;
     pdSprings got = {0};
-    assert_true(pd_history_take(h, &c[0].id, c[0].normal, &params, &scale, &got));
+    assert_true(pd_history_take(h, &b.c[0].id, b.c[0].normal, &params, &scale, &got));
     assert_true(scale == scales[k]);
     assert_true(params.k1t == scales[k] * own.k1t && params.k2t == scales[k] * own.k2t);
     assert_true(params.k1n == scales[k] * own.k1n && params.k2n == scales[k] * own.k2n);
@@ -145,7 +149,7 @@ static void test_a_trace_of_raised_springs_is_taken_back_at_their_stiffness(void
   print_message("trace energy at factor 1 %.6g J, at factor %.0f %.6g J\n", energies[0], raised, energies[1]);
   assert_true(energies[0] > 0.0);
   assert_true(fabs(energies[1] - raised * energies[0]) <= 1e-12 * energies[1]);
-  pd_model_free(m);
+  pd_model_free(b.m);
 }
 
 // A fixed pseudo-random sequence (a linear congruential generator): the same draws on every machine.
