@@ -797,10 +797,11 @@ void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y)
   int count = view->capturedCount;
   view->count = count;
   view->bodyListValid = false;
+  // the poses and inverse inertias are read for the bodies of the view's contacts only (below, and the implicit
+  // stepper's linearisation): a view without contacts (a body in flight, presented at every sample) needs none
+  if (count == 0) return;
   poses_from(model, y, view->poses1);
-  // read by the implicit stepper's linearisation, for the bodies of its contacts only: a view without contacts (a
-  // body in flight, sampled at every output sample) needs none
-  if (count > 0) world_inverse_inertias(model, view, view->poses1);
+  world_inverse_inertias(model, view, view->poses1);
   int base = spring_base(model);
   // realigned as a commit realigns the contacts it keeps (one that pulls keeps its springs: a commit drops it),
   // then recorded as record() records: the same geometry and relative velocity, the force of the springs as
