@@ -7,8 +7,9 @@
 // a writer thread, started by pd_run_open, takes the filled blocks in order and prints them with the same
 // functions as pd_write_trajectory_rows and pd_write_contact_rows, so the files hold the same bytes, and the
 // simulation goes on meanwhile (on a second core, if there is one). The observer waits only when every block
-// is full. pd_run_drain waits until everything observed is written (`polydyn run` times the run up to there,
-// so its wall_seconds includes the printing not hidden behind the simulation); pd_run_finish drains and joins
+// is full, and wakes the writer only when several blocks wait (PD_OUTPUT_WAKE_BLOCKS). pd_run_drain waits until
+// everything observed is written (`polydyn run` times the run up to there, so its wall_seconds includes the
+// printing not hidden behind the simulation); pd_run_finish drains and joins
 // the thread; pd_run_abort stops it. A write error seen by the writer makes the next pd_run_observe return
 // false. Blocks grow (at the first samples) to hold the largest sample seen; after that nothing is allocated. The
 // writer copies the text of a number it printed recently instead of forming it again (numberCache).
@@ -40,6 +41,11 @@
 #define PD_OUTPUT_RING_BYTES (1024 * 1024)
 #define PD_OUTPUT_BLOCKS_MIN 4
 #define PD_OUTPUT_BLOCKS_MAX 64
+// The writer is woken when this many blocks wait for it (or the ring is full, or the run drains or stops), and then
+// prints every block that waits: it prints faster than the samples come, so woken at every block it slept and woke
+// once per sample, two context switches each (cases/hard/stack_10.scene: 676 for 301 samples, each a kernel's
+// round trip on both threads). Eight blocks are at most eight samples left to print after the last step.
+#define PD_OUTPUT_WAKE_BLOCKS 8
 // The stdio buffer of trajectory.csv and of contacts.csv: glibc ignores setvbuf's size when it is given no buffer and
 // writes in blocks of the file system's (4 KiB: 1 572 write calls for cases/hard/stack_10.scene's 6.4 MB), so the
 // buffers are ours.
@@ -336,14 +342,17 @@ static void* writer_main(void* user) {
   return NULL;
 }
 
-// Hands the block being filled to the writer (if it holds anything).
-static void hand_over(pdRunWriter* run) {
+// Hands the block being filled to the writer (if it holds anything), waking it when PD_OUTPUT_WAKE_BLOCKS wait (at
+// most the whole ring, so that an observer waiting for a free block has woken it) or when `wake`.
+static void hand_over(pdRunWriter* run, bool wake) {
   if (run->ringBlocks == 0) return;  // no sample yet
   outputBlock* b = &run->blocks[run->produced % run->ringBlocks];
-  if (b->used == 0) return;
+  if (b->used == 0 && !wake) return;
   pthread_mutex_lock(&run->lock);
-  ++run->produced;
-  pthread_cond_signal(&run->filled);
+  if (b->used > 0) ++run->produced;
+  long waiting = run->produced - run->consumed;
+  if (wake || waiting >= (run->ringBlocks < PD_OUTPUT_WAKE_BLOCKS ? run->ringBlocks : PD_OUTPUT_WAKE_BLOCKS))
+    pthread_cond_signal(&run->filled);
   pthread_mutex_unlock(&run->lock);
 }
 
@@ -359,7 +368,7 @@ static outputBlock* block_with_room(pdRunWriter* run, size_t bytes) {
   }
   outputBlock* b = &run->blocks[run->produced % run->ringBlocks];
   if (b->used > 0 && b->used + bytes > b->capacity) {
-    hand_over(run);
+    hand_over(run, false);
     pthread_mutex_lock(&run->lock);
     while (run->produced - run->consumed >= run->ringBlocks) pthread_cond_wait(&run->freed, &run->lock);
     pthread_mutex_unlock(&run->lock);
@@ -376,7 +385,7 @@ static outputBlock* block_with_room(pdRunWriter* run, size_t bytes) {
 }
 
 void pd_run_drain(pdRunWriter* run) {
-  hand_over(run);
+  hand_over(run, true);
   pthread_mutex_lock(&run->lock);
   while (run->consumed < run->produced) pthread_cond_wait(&run->freed, &run->lock);
   pthread_mutex_unlock(&run->lock);
@@ -385,7 +394,7 @@ void pd_run_drain(pdRunWriter* run) {
 // Stops the writer thread: after printing what it holds (finish), or at once (abort).
 static void writer_stop(pdRunWriter* run, bool discard) {
   if (!run->threadStarted) return;
-  if (!discard) hand_over(run);
+  if (!discard) hand_over(run, false);
   pthread_mutex_lock(&run->lock);
   run->quit = true;
   run->discard = discard;
