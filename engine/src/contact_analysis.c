@@ -355,6 +355,67 @@ __attribute__((noinline)) static int vf_through_after_edge_pair(const pdModel* m
   return n + 1;
 }
 
+// ---------------------------------------------------------------- a vertex pressed into both faces of a right-angled edge
+//
+// Design note. A vertex v of one body inside the other, in the wedge of an edge e whose faces F and f meet at a right
+// angle (outward normals n_F ⟂ n_f), keeps F by face continuity (§4.4.3) for as long as it is over F's polygon, which
+// inside the body it always is at a right angle; its contact reads only its depth d_F below F. When the other body
+// turns so that f sweeps into v (a spinning plate whose side face holds a corner of a bar while its broad face rolls
+// onto it), the overlap along n_f grows while the contact reads and resists none of it: soak campaign 68, scene 2429,
+// 8.35 δ_max along n_f under a contact 1.0 δ_max deep on F (docs/contact-model.md, "A corner or an edge inside an
+// edge's wedge"). The pair of features that touches there is v and e, whose vertex–edge element has depth |w| along
+// n = w/|w| (w from v to its foot on e's line). At a right angle w = d_F n_F + d_f n_f exactly, so a VF contact on F
+// and one on f, each with the paper's geometry and force law (eqs. (18a), (18b), §3.1), carry elastic forces
+// k d_F n_F + k d_f n_f = k |w| n: the vertex–edge element's. So the vertex held on F becomes a VF contact on f as well
+// once it crosses f's plane (its onset, as any VF contact's by App. C: it starts at depth 0, or at the flush tolerance,
+// 10⁻³ δ_max, beyond which a plane counts as crossed, so the force is continuous to the onsets' own precision),
+// while it is over f's polygon, and keeps it while tracking does. F's contact goes on as it was (its springs kept), so
+// no hand-over is needed at either end of e's Gauss arc: there the element is the one face's contact, the other's
+// depth 0. A vertex not held on F (found now, or handed over from an edge pair: its face carries the pair's force on)
+// gets its face by the rules above alone: made beside such a hand-over, f's contact started at 150 N, 90° from the
+// pair's normal, and a sliver's corner went 3.49 δ_max into a cube (cases/hard/sliver_corner_past_cube_edge.scene;
+// 0.49 without). At obtuse edges (normals less than 90° apart) no rule is needed: a vertex inside with n on e's arc
+// projects inside both faces and its contact reads at least the bodies' overlap; at acute ones two VF contacts do not
+// sum to the element, and which should carry the vertex is open.
+
+// The VF contacts of vertex i of body iv (at p, world; q in jf's frame), inside body jf and held on `face` by face
+// continuity, on the faces across right-angled edges of that face (design note above), appended to out, or nothing:
+// n to n + 2. `over`: find_vf's flush tolerance. Out of find_vf's loop over the vertices, which calls it only for a
+// held vertex.
+__attribute__((noinline)) static int vf_across_right_edge(const pdModel* m, int iv, int jf, const pdPose* pf,
+                                                          const pdPose* pf0, const pdPose* pv0, int i, int face,
+                                                          pdVec3 p, pdVec3 q, const pdContactId* previous,
+                                                          int previousCount, double over, pdContactGeom* out,
+                                                          int capacity, int n) {
+  const pdPolyhedron* sv = &m->bodies[iv].shape;
+  const pdPolyhedron* sf = &m->bodies[jf].shape;
+  bool start = false;  // q0, the vertex at the step's start (jf's frame), formed when first needed
+  pdVec3 q0 = q;
+  for (int e = 0; e < sf->edgeCount; ++e) {
+    int f = face_across_right_edge(sf, e, face);
+    if (f < 0) continue;
+    // beyond the flush tolerance, as find_vf's planes: a corner on a plane both bodies share (a brick flush over the
+    // side of the brick below, rocked by rounding) does not press into it
+    double d = face_depth(sf, f, q);
+    if (!(d > over)) continue;
+    bool held = false;
+    for (int k = 0; k < previousCount && !held; ++k)
+      held = previous[k].kind == pd_contactVF && previous[k].body1 == iv && previous[k].feat1 == i &&
+             previous[k].body2 == jf && previous[k].feat2 == f;
+    // new only where the vertex crossed f's plane in the step (its onset)
+    if (!held) {
+      if (!pv0) continue;
+      if (!start) q0 = to_local(pf0, to_world(pv0, sv->vertices[i])), start = true;
+      if (!(face_depth(sf, f, q0) <= over)) continue;
+    }
+    if (!projects_inside(sf, f, q, over)) continue;
+    if (n < capacity)
+      out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, f}, p, pd_mat3_mulv(&pf->R, sf->faces[f].normal), d};
+    ++n;
+  }
+  return n;
+}
+
 // VF contacts of the vertices of body iv inside body jf, and, with mask, each vertex's faces of jf (of the first 64)
 // whose plane it lies outside of by more than the pruning margin (find_ee's edge pruning).
 // (Formed twice, for a face body with an acute edge and for one without (find_vf): without, the loop is the paper's
@@ -428,6 +489,7 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
     // off it onto the next face is found there now, so that its contact hands over in this commit (a successor found
     // only at the next commit leaves the vertex without a contact for a step)
     if (face >= 0 && !projects_inside(sf, face, q, fmax(tol, flushTol))) face = -1;
+    bool held = face >= 0;
     // the successor of an edge pair whose crossing passed this vertex: the face that carries its normal on
     if (face < 0) face = face_after_edge_pair(m, previous, previousCount, iv, i, jf, q, tol, fmax(tol, flushTol),
                                              EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax);
@@ -454,6 +516,10 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
       out[n] = (pdContactGeom){{iv, jf, pd_contactVF, i, face}, p, pd_mat3_mulv(&pf->R, sf->faces[face].normal),
                                face_depth(sf, face, q)};
     ++n;
+    // held on its face by continuity: pressed into the faces across that face's right-angled edges too
+    if (held)
+      n = vf_across_right_edge(m, iv, jf, pf, pf0, pv0, i, face, p, q, previous, previousCount, fmax(tol, flushTol), out,
+                               capacity, n);
   }
   return n;
 }

@@ -173,11 +173,29 @@ static double edge_pair_end_margin(const pdPolyhedron* sv, int iv, int i, pdVec3
   return least;
 }
 
+// For vertex i of sv (q, sf's frame) listed on face F, how far it may move before it could cross the plane of a face
+// f across a right-angled edge of F that it is not listed on (its depth below f passing `threshold`, find_vf's flush
+// tolerance), where find_vf makes it a contact on f as well (vf_across_right_edge, contact_analysis.c), m (INFINITY:
+// no such face). `guard`: the rounding kept back.
+static double right_edge_face_margin(const pdPolyhedron* sf, int iv, int i, int F, pdVec3 q, double threshold,
+                                     double guard, const pdContactId* exempt, int exemptCount) {
+  double least = INFINITY;
+  for (int e = 0; e < sf->edgeCount; ++e) {
+    int f = face_across_right_edge(sf, e, F);
+    if (f < 0) continue;
+    bool listed = false;
+    for (int k = 0; k < exemptCount && !listed; ++k)
+      listed = exempt[k].kind == pd_contactVF && exempt[k].body1 == iv && exempt[k].feat1 == i && exempt[k].feat2 == f;
+    if (!listed) least = fmin(least, fabs(face_depth(sf, f, q) - threshold) - guard);
+  }
+  return least;
+}
+
 // The least margin of the vertices of sv (given in sf's frame by rel, off) against sf, vertices listed as VF
 // contacts of body iv in `exempt` left out; stops at `bound` (no lower margin needed).
 static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel, pdVec3 off, const pdPolyhedron* sf,
-                              double tolerance, double over, double outside, const pdContactId* exempt, int exemptCount,
-                              double bound) {
+                              double tolerance, double over, double outside, double guard, const pdContactId* exempt,
+                              int exemptCount, double bound) {
   double least = bound;
   for (int i = 0; i < sv->vertexCount && least > 0.0; ++i) {
     pdVec3 q = pd_v3_add(off, pd_mat3_mulv(rel, sv->vertices[i]));
@@ -186,6 +204,8 @@ static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel,
       // a vertex in contact keeps its face while it is over it (find_vf), and takes another once it is not
       double margin = over_face_margin(sf, exempt[listed].feat2, q, over);
       least = margin < least ? margin : least;
+      least = fmin(least, right_edge_face_margin(sf, iv, i, exempt[listed].feat2, q, over + guard, guard, exempt,
+                                                 exemptCount));
       continue;
     }
     double margin = outside_farthest(sf, q, least + tolerance) - tolerance;
@@ -223,8 +243,8 @@ pdSearchCertificate pd_contacts_certify(const pdModel* model, int ia, const pdPo
   double outsideA = TRACK_INSIDE_TOL_REL * model->settings.deflection * sizeA;
   double outsideB = TRACK_INSIDE_TOL_REL * model->settings.deflection * sizeB;
   double least =
-      vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, outsideA, exempt, exemptCount, INFINITY);
-  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, outsideB, exempt, exemptCount, least);
+      vertices_margin(sb, ib, &cert.rel, cert.off, sa, onA + guard, overA, outsideA, guard, exempt, exemptCount, INFINITY);
+  least = vertices_margin(sa, ia, &relT, offA, sb, onB + guard, overB, outsideB, guard, exempt, exemptCount, least);
   if (!(least > 0.0)) return cert;
   // EE: per edge, how far it lies beyond one face plane of the other body (then any pair with it is certified)
   enum { EDGES_MAX = 64 };

@@ -4,6 +4,8 @@
 #ifndef POLYDYN_CONTACT_FEATURES_H
 #define POLYDYN_CONTACT_FEATURES_H
 
+#include <math.h>
+
 #include "polydyn/model.h"
 #include "polydyn/vecmath.h"
 
@@ -64,6 +66,20 @@ static inline bool faces_meet_at_acute_edge(const pdPolyhedron* s, int f, int g)
   for (int e = 0; e < s->edgeCount; ++e)
     if ((s->edges[e].f[0] == f && s->edges[e].f[1] == g) || (s->edges[e].f[0] == g && s->edges[e].f[1] == f)) return true;
   return false;
+}
+
+// Outward normals of two faces whose cosine is within this of 0 meet at a right angle: a vertex pressed into both is
+// held by a VF contact on each, whose elastic forces sum to the vertex–edge element's (contact_analysis.c,
+// vf_across_right_edge). Box and prism normals are built to ~1e-16; this admits hulls given to ~6 digits.
+#define RIGHT_ANGLE_COS_TOL 1e-6
+
+// The face across edge e of s from face F when e borders F and the two meet at a right angle (normals perpendicular
+// within RIGHT_ANGLE_COS_TOL), else -1.
+static inline int face_across_right_edge(const pdPolyhedron* s, int e, int F) {
+  const pdEdge* edge = &s->edges[e];
+  if (edge->f[0] != F && edge->f[1] != F) return -1;
+  int f = edge->f[0] == F ? edge->f[1] : edge->f[0];
+  return fabs(pd_v3_dot(s->faces[F].normal, s->faces[f].normal)) <= RIGHT_ANGLE_COS_TOL ? f : -1;
 }
 
 // An arc (a, b) of the Gauss map with its great circle's normal b × a and that normal's squared length: the

@@ -259,6 +259,18 @@ static void test_a_corner_rising_through_a_plate_beside_its_rim_keeps_a_contact(
   assert_passes_at_every_step("reports/reliability/campaign63/failures/002576-soft.scene", pd_soakFree, 5);
 }
 
+// A 3 g box plate spinning at 140-240 rad/s rolls over a 12 g octagonal bar (soak campaign 68, scene 2429, five bodies
+// in the air; cases/hard/plate_rolling_on_plate_unread_overlap.scene, its two bodies): the bar's corner, handed over by
+// an edge pair to the plate's side face 1 delta_max deep, kept that face while the plate's broad face, at a right
+// angle to it, rolled 8.35 delta_max into the corner with no contact on it. A corner held on a face is pressed into the
+// face across a right-angled edge too once it crosses its plane: the soak's checks pass at every step, islands on and
+// off, both for the cut and the whole scene.
+static void test_a_corner_held_on_a_plates_side_is_pressed_into_its_broad_face_too(void** state) {
+  (void)state;
+  assert_passes_at_every_step("cases/hard/plate_rolling_on_plate_unread_overlap.scene", pd_soakFree, 2);
+  assert_passes_at_every_step("reports/reliability/campaign68/failures/002429-soft.scene", pd_soakFree, 5);
+}
+
 // A light body pressed between a heavy one and a third body, its springs sized by the load it carries
 // (docs/contact-model.md, "Springs sized by the load"), passes the soak's checks at every step, islands on and off:
 // a 1.05 kg plate's corner through a 0.28 g sliver lying on the floor (25 delta_max with the springs of the sliver's own
@@ -355,6 +367,7 @@ int main(void) {
       cmocka_unit_test(test_a_prism_corner_on_a_cube_after_a_release_stays_within_the_limit),
       cmocka_unit_test(test_a_corner_pressed_through_a_blade_keeps_its_contact),
       cmocka_unit_test(test_a_corner_rising_through_a_plate_beside_its_rim_keeps_a_contact),
+      cmocka_unit_test(test_a_corner_held_on_a_plates_side_is_pressed_into_its_broad_face_too),
       cmocka_unit_test(test_a_light_body_under_a_heavy_one_has_springs_for_its_load),
       cmocka_unit_test(test_the_first_generator_replays_committed_campaigns),
       cmocka_unit_test(test_the_second_generator_draws_plates),
