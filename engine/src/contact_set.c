@@ -301,11 +301,11 @@ static void world_inverse_inertias(const pdModel* model, pdContactSet* set, cons
 // After a new list is installed at state y (poses those of y): the bodies' world inverse inertias, the
 // modal dampers, the pair onsets' springs and impulses (pd_onsets_start_late), each contact's geometry and
 // force (record), and the stability bound, in that order (the bound reads which contacts slip). Returns the
-// number of pair onsets started.
-static int prepare_list(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
+// number of pair onsets started; *uncorrected counts those joined uncorrected (pd_onsets_start_late).
+static int prepare_list(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses, long* uncorrected) {
   world_inverse_inertias(model, set, poses);
   pd_modal_dampers(model, set, poses, y);
-  int started = pd_onsets_start_late(model, set, y, poses);
+  int started = pd_onsets_start_late(model, set, y, poses, uncorrected);
   record(model, set, y, poses);
   pd_stability_prepare(model, set, poses);
   return started;
@@ -629,7 +629,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
         s->count.contactsVirtual += added;
         install(model, s, count);
         poses_from(model, s->y, set->poses0);
-        prepare_list(model, set, s->y, set->poses0);
+        prepare_list(model, set, s->y, set->poses0, &s->warnings[pd_warnLateOnset]);
         verdict = pd_eventRestart;
       }
     }
@@ -775,7 +775,8 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
                          set->eval[i].modeImpulse);
   install(model, s, count);
   poses_from(model, s->y, set->poses1);
-  s->count.onsetsInterpolated += prepare_list(model, set, s->y, set->poses1);
+  s->count.onsetsInterpolated +=
+      prepare_list(model, set, s->y, set->poses1, &s->warnings[pd_warnLateOnset]);
   if (set->history) pd_history_age(model, set->history, set->poses1);
   pd_stopwatch_lap(watch, &s->stageSeconds[pd_stageContactAnalysis]);
 }
