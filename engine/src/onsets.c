@@ -123,10 +123,10 @@ pdOnsets pd_onsets_effective(pdOnsets onsets, int movingBodies) {
 }
 
 // Can a new contact that began `age` seconds before the step's end join there (pd_onsetsPair)?
-static bool joins_as_pair(const pdModel* model, const pdContactGeom* g, double age) {
+static bool joins_as_pair(const pdModel* model, const pdContactSet* set, const pdContactGeom* g, double age) {
   int a = g->id.body1, b = g->id.body2;
   if (!(g->depth > 0.0) || g->depth > PD_ONSET_PAIR_DEPTH_REL * pd_model_pair_delta_max(model, a, b)) return false;
-  pdContactParams p = pd_model_contact_params(model, a, b);
+  pdContactParams p = pd_onset_params(model, set, &g->id);
   double k = pd_series(p.k1n, p.k2n);
   return k > 0.0 && age * sqrt(k / p.massMin) <= PD_ONSET_PAIR_OMEGA_TAU;
 }
@@ -190,7 +190,7 @@ static void applied_at(const pdModel* model, const pdPose* poses, const pdContac
 static onsetTerms onset_terms(const pdModel* model, const pdContactSet* set, const double* y1, double t1,
                               const pdContactGeom* g) {
   int a = g->id.body1, b = g->id.body2;
-  pdContactParams p = pd_model_contact_params(model, a, b);
+  pdContactParams p = pd_onset_params(model, set, &g->id);
   pdVec3 du = relative_velocity(model, y1, set->poses1, &g->id, g->point);
   onsetTerms t = {.omega = sqrt(pd_series(p.k1n, p.k2n) / p.massMin), .approach = -pd_v3_dot(du, g->normal),
                   .size = INFINITY, .mu = p.mu, .dampingRate = pd_series(p.c1n, p.c2n) / p.massMin,
@@ -310,7 +310,7 @@ double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdO
     candidate* c = &set->candidates[k];
     if (!c->approaching || c->inherit >= 0 || c->released) continue;
     double age = (1.0 - c->onset) * h;
-    if (onsets != pd_onsetsExact && joins_as_pair(model, &c->geom, age)) {
+    if (onsets != pd_onsetsExact && joins_as_pair(model, set, &c->geom, age)) {
       onsetTerms t = onset_terms(model, set, y1, t1, &c->geom);
       c->onsetBound = correction_bound(model, &t, age, c->geom.depth, h);
       if (onsets == pd_onsetsPair || pd_onset_bound_allows(c->onsetBound, model->settings.tol)) {
@@ -334,26 +334,15 @@ bool pd_onsets_may_retry(const pdContactSet* set) { return set->onsetRetries < P
 // so they are exact to ~(ωτ/8)⁵ away from the cone's and the clamp's kinks; every onset falls on a substep's start, so
 // that no substep straddles the jump of a damper's force.
 #define PD_ONSET_PAIR_SUBSTEPS 8
-// ... and more where the group's own fastest rate (onset_group_motion) would take a substep beyond this many of its
-// time constants: the join's test (joins_as_pair) reads ω from the model's eq. (11) springs, but the group moves under
-// the contacts' own, which the load may have raised (up to 100×) and whose modal dampers a stack sizes for a heavy
-// body's mode: a 1 mg chip's contact with the floor under a 49 g prism had c_n/m 10⁸ 1/s, 26 of them per substep,
-// where RK4 (stable to 2.79 on the real axis) grew the chip's velocity 10²⁵-fold in one onset (soak campaign 62, scene
-// 6037). 2 keeps a substep inside RK4's stability region (2.79 on the real axis, 2.83 on the imaginary) with room, for a
-// rate that is itself an upper bound (a sum over the points of a trace's bound); at 1 a 10-box stack's landing took
-// more substeps than 8 and moved its bytes by rounding, with no error to remove.
-#define PD_ONSET_SUBSTEP_REACH 2.0
-// At most this many substeps per onset interval: bounds a join's cost; a group that would need more is joined with its
-// springs at 0 instead (start_group).
-#define PD_ONSET_SUBSTEPS_MAX 4096
+// More substeps where the group's dampers relax faster (group_damping_rate): at most this rate times a substep, well
+// inside classic RK4's stable 2.8 on the real axis, and as accurate per substep as 8 are for ωτ = 1.
+#define PD_ONSET_SUBSTEP_DAMPING 1.0
 
 typedef struct onsetPoint {
   int side;                   // +1: the contact's body 1 is the group's body A; −1: its body 2 is
   pdVec3 normal, arm[2];      // the contact's normal; its point less the centre of body A and of body B
   double kn, cn, kt, ct, mu;  // series constants (the modal dampers the contact has)
   double start;               // s: its onset, after the group's earliest
-  double mobility;            // 1/kg: Σ over the two bodies of 1/m + |r|² tr I⁻¹, at least its inverse mass matrix's
-                              // largest eigenvalue at the point
   pdVec3 free;                // m/s: Δu at the step's end (body 1's less body 2's), without the group's impulses
 } onsetPoint;
 
@@ -421,30 +410,42 @@ static void group_rate(const onsetGroup* g, int active, const double* s, double*
   }
 }
 
+// A bound on the rate (1/s) at which the group's normal dampers relax its points' approach: Σ c_n w_n over its contacts,
+// w_n the point's inverse mass along its normal (both bodies, turning included). The join test bounds the springs'
+// frequency (ωτ <= PD_ONSET_PAIR_OMEGA_TAU), not the dampers': a light body's pair in a stack has them sized for the
+// stack's slow mode, overdamped by √(M/m) for its own, and a 1.1 mg blade under a 49 g prism had c_n w_n τ = 35 over a
+// pair onset, which classic RK4 in 8 substeps (stable to a real rate of 2.8 per substep) took to 10^23 J (soak campaign
+// 62, scene 6037: the integration failed at its minimum step).
+static double group_damping_rate(const onsetGroup* g) {
+  double rate = 0.0;
+  for (int i = 0; i < g->count; ++i) {
+    const onsetPoint* p = &g->points[i];
+    double w = 0.0;
+    for (int b = 0; b < 2; ++b) {
+      pdVec3 rn = pd_v3_cross(p->arm[b], p->normal);
+      w += g->invMass[b] + pd_v3_dot(rn, pd_mat3_mulv(&g->invInertia[b], rn));
+    }
+    rate += p->cn * w;
+  }
+  return rate;
+}
+
 // The motion of a group of contacts of one pair over the τ since the earliest's onset (points sorted by onset): the
 // changes of the two bodies' velocities from the step's end's, under every begun contact's force through the bodies'
 // masses and inertias at the step end's poses. So the slip a normal impulse makes at an off-centre point, the push a
 // tangential impulse gives along the normal and the pair's contacts beginning together are followed, not bounded
 // (onset_bound.h); the other forces on the bodies over τ are bounded (correction_bound). s holds the state at the
 // earliest onset (the velocity changes and deflections 0, the stretches those the contacts join with) and gets the
-// state at the step's end. Each interval between onsets takes PD_ONSET_PAIR_SUBSTEPS, or as many more as keep a substep
-// within PD_ONSET_SUBSTEP_REACH of the begun contacts' fastest rate: the dampers' Σ (c_n + c_t) w, the springs'
-// √(Σ (k_n + k_t) w), w each point's mobility (the largest eigenvalue of a sum of such terms is at most their sum), and
-// a slipping stretch's relaxation k_t / c_t.
-// Returns false, s unfinished, where an interval would need more than PD_ONSET_SUBSTEPS_MAX.
-static bool onset_group_motion(const onsetGroup* g, double s[G_STATE]) {
+// state at the step's end.
+static void onset_group_motion(const onsetGroup* g, double s[G_STATE]) {
   double k[4][G_STATE], tmp[G_STATE];
-  double time = 0.0, damping = 0.0, stiffness = 0.0, relaxation = 0.0;  // 1/s, 1/s², 1/s
+  double time = 0.0, rate = group_damping_rate(g);
   for (int active = 1; active <= g->count; ++active) {
-    const onsetPoint* begun = &g->points[active - 1];
-    damping += (begun->cn + begun->ct) * begun->mobility;
-    stiffness += (begun->kn + begun->kt) * begun->mobility;
-    if (begun->ct > 0.0) relaxation = fmax(relaxation, begun->kt / begun->ct);
     double end = active < g->count ? g->points[active].start : g->tau;
     if (!(end > time)) continue;  // onsets together: begun at once
-    double reach = (end - time) * (damping + sqrt(stiffness) + relaxation) / PD_ONSET_SUBSTEP_REACH;
-    if (!(reach <= PD_ONSET_SUBSTEPS_MAX)) return false;
-    int substeps = reach > PD_ONSET_PAIR_SUBSTEPS ? (int)ceil(reach) : PD_ONSET_PAIR_SUBSTEPS;
+    int substeps = PD_ONSET_PAIR_SUBSTEPS;
+    if ((end - time) * rate > PD_ONSET_PAIR_SUBSTEPS * PD_ONSET_SUBSTEP_DAMPING)
+      substeps = (int)ceil((end - time) * rate / PD_ONSET_SUBSTEP_DAMPING);
     double dt = (end - time) / substeps;
     for (int i = 0; i < substeps; ++i) {
       group_rate(g, active, s, k[0]);
@@ -458,7 +459,6 @@ static bool onset_group_motion(const onsetGroup* g, double s[G_STATE]) {
     }
     time = end;
   }
-  return true;
 }
 
 // Whether contacts a and b are between the same two bodies.
@@ -469,9 +469,8 @@ static bool same_pair(const pdContactId* a, const pdContactId* b) {
 // Follows the pair onsets members[0 .. count) of set (all of one pair, at most PD_ONSET_GROUP_MAX) at state y from their
 // onsets to the step's end together (onset_group_motion), and puts each where it gets to: its normal springs at the
 // deflection reached (at most its depth), split as series springs share a static load (k1 s1 + k2 s2 = 0), its
-// tangential ones at the stretch reached, held within the cone, and its onsetImpulse the impulse it gave. Returns the
-// number of them joined uncorrected instead (onset_group_motion refused: 0 or count).
-static int start_group(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses, const int* members,
+// tangential ones at the stretch reached, held within the cone, and its onsetImpulse the impulse it gave.
+static void start_group(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses, const int* members,
                         int count) {
   int base = spring_base(model);
   onsetGroup g = {.count = count};
@@ -501,12 +500,7 @@ static int start_group(const pdModel* model, pdContactSet* set, double* y, const
     onsetPoint* q = &g.points[i];
     q->side = c->id.body1 == bodies[0] ? 1 : -1;
     q->normal = c->normal;
-    q->mobility = 0.0;
-    for (int b = 0; b < 2; ++b) {
-      q->arm[b] = pd_v3_sub(c->point, poses[bodies[b]].x);
-      const pdMat3* inv = &g.invInertia[b];
-      q->mobility += g.invMass[b] + pd_v3_dot(q->arm[b], q->arm[b]) * (inv->m[0][0] + inv->m[1][1] + inv->m[2][2]);
-    }
+    for (int b = 0; b < 2; ++b) q->arm[b] = pd_v3_sub(c->point, poses[bodies[b]].x);
     q->kn = pd_series(p->k1n, p->k2n), q->cn = pd_series(p->c1n, p->c2n);
     q->kt = pd_series(p->k1t, p->k2t), q->ct = pd_series(p->c1t, p->c2t), q->mu = p->mu;
     if (!(q->mu > 0.0) || !(q->kt > 0.0)) q->kt = q->ct = q->mu = 0.0;  // no friction
@@ -520,12 +514,7 @@ static int start_group(const pdModel* model, pdContactSet* set, double* y, const
     pdVec3 s0 = q->kt > 0.0 ? pd_v3_scale(sp.s1t, p->k1t / q->kt) : (pdVec3){0.0, 0.0, 0.0};
     group_store(s + G_BODIES + G_POINT * i + G_Q, pd_v3_sub(s0, pd_v3_scale(q->normal, pd_v3_dot(s0, q->normal))));
   }
-  if (!onset_group_motion(&g, s)) {
-    // too stiff to follow at a bounded cost: the contacts join as uncorrected ones do, springs at 0 and no impulse
-    // (no energy injected; the rest point shifted by the depth), each counted
-    for (int i = 0; i < count; ++i) set->items[members[i]].onsetImpulse = (pdVec3){0.0, 0.0, 0.0};
-    return count;
-  }
+  onset_group_motion(&g, s);
   for (int i = 0; i < count; ++i) {
     contactSlot* c = &set->items[members[order[i]]];
     const pdContactParams* p = &c->params;
@@ -550,16 +539,14 @@ static int start_group(const pdModel* model, pdContactSet* set, double* y, const
     }
     springs_store(springs, &out);
   }
-  return 0;
 }
 
 // Pair onsets of a list just installed at state y (poses those of y; world inverse inertias and modal dampers set):
 // the contacts with an onset age τ > 0 are followed from their onsets, each pair's together (start_group), and put
 // where they get to, their bodies given the impulses they gave. Their energy and phase are then their own; a rest point
 // sits deeper by the depth d reached without the contact, less the deflection x (≈ d (ωτ)²/6). All impulses are formed
-// before any is applied, so the list's order does not matter. Returns the number of such contacts; *uncorrected is
-// increased by those joined with their springs at 0 instead (a group too stiff to follow: start_group).
-int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses, long* uncorrected) {
+// before any is applied, so the list's order does not matter. Returns the number of such contacts.
+int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses) {
   int started = 0, members[PD_ONSET_GROUP_MAX];
   for (int i = 0; i < set->count;) {
     int end = i + 1;  // the pair's contacts: the list holds them together (sorted by the unordered pair first)
@@ -570,11 +557,11 @@ int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, con
       members[count++] = j;
       ++started;
       if (count == PD_ONSET_GROUP_MAX) {
-        *uncorrected += start_group(model, set, y, poses, members, count);
+        start_group(model, set, y, poses, members, count);
         count = 0;
       }
     }
-    if (count > 0) *uncorrected += start_group(model, set, y, poses, members, count);
+    if (count > 0) start_group(model, set, y, poses, members, count);
     i = end;
   }
   for (int i = 0; i < set->count && started > 0; ++i) {

@@ -25,6 +25,5 @@ double pd_onsets_earliest(const pdModel* model, pdContactSet* set, double h, pdO
 bool pd_onsets_may_retry(const pdContactSet* set);
 // Pair onsets of a list just installed at state y (poses those of y; world inverse inertias and modal dampers set):
 // each contact with an onset age τ > 0 is put where it would be after τ on its own, its springs and its bodies'
-// velocities changed so. Returns the number of such contacts; *uncorrected is increased by those joined with their
-// springs at 0 and no impulse instead (their motion too stiff to follow at a bounded cost).
-int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses, long* uncorrected);
+// velocities changed so. Returns the number of such contacts.
+int pd_onsets_start_late(const pdModel* model, pdContactSet* set, double* y, const pdPose* poses);

@@ -52,9 +52,8 @@ PD_API extern const char* const pdStageNames[pd_stageCount];
 typedef enum pdWarning {
   pd_warnStepAtMinimum,  // a step at dtmin still exceeded the tolerance and was accepted anyway
   pd_warnNonFinite,      // a trial step produced a non-finite number and was retried smaller
-  pd_warnLateOnset,      // a contact onset could not be located within the retries, or a pair onset's motion since
-                         // it was too stiff to follow at a bounded cost: the contact was added where it was found,
-                         // its springs at 0
+  pd_warnLateOnset,      // a contact onset could not be located within the retries: the contact was
+                         // added deeper than the onset tolerance (its springs start at 0 there)
   pd_warnCount
 } pdWarning;
 // Names of the warnings (e.g. "step_at_minimum"), as summary.json writes them.
