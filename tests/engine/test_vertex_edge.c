@@ -10,7 +10,7 @@
 // - Obtuse edge: a vertex inside an octagonal prism's lateral edge, with w on the edge's Gauss arc, projects inside
 //   both faces and its contact reads w·n_F on the face it takes, at least cos 45° |w|; no second contact.
 // - Acute edge: a corner held on a wedge's top face and moved through the lower face's plane into the wedge stays one
-//   contact, on the top face, its depth continuous and at least the vertex's own overlap (no second face, as the design
+//   contact, on the top face, its depth continuous and at least the vertex's own overlap (no second face: the design
 //   note in engine/src/contact_analysis.c says why).
 // - Search certificates: a corner held on the side face, inside the top face's plane by less than the flush tolerance
 //   (no contact on the top face yet), is certified for no more than its way to that tolerance.
@@ -226,7 +226,7 @@ static void test_a_vertex_in_an_obtuse_edges_sector_is_read_by_one_face(void** s
 // vertex beyond an acute edge, kept on F), then moved through f's plane into the wedge in steps of 0.01 δ_max while it
 // sinks 0.005 δ_max per step: it stays one VF contact, on F (face continuity), its depth F's depth, continuous, and at
 // least the vertex's own penetration, min(d_F, d_f); no contact on f is added as at a right-angled edge, since there
-// d_f's force would push the vertex back along −n_F, through f, by |cos θ| of itself (the vertex–edge element, which
+// f's force k d_f n_f would push the vertex along −n_F with |cos θ| of itself, against F's (the vertex–edge element, which
 // reads |w| ≥ d_F / sin θ inside the wedge, would jump at f's plane). Found anew at the last pose, one face.
 static void test_a_held_corner_at_an_acute_edge_keeps_its_face(void** state) {
   (void)state;
