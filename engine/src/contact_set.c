@@ -797,8 +797,11 @@ void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y)
   int count = view->capturedCount;
   view->count = count;
   view->bodyListValid = false;
+  // the poses and inverse inertias are read for the bodies of the view's contacts only (below, and the implicit
+  // stepper's linearisation): a view without contacts (a body in flight, presented at every sample) needs none
+  if (count == 0) return;
   poses_from(model, y, view->poses1);
-  world_inverse_inertias(model, view, view->poses1);  // read by the implicit stepper's linearisation
+  world_inverse_inertias(model, view, view->poses1);
   int base = spring_base(model);
   // realigned as a commit realigns the contacts it keeps (one that pulls keeps its springs: a commit drops it),
   // then recorded as record() records: the same geometry and relative velocity, the force of the springs as
@@ -882,6 +885,12 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
   if (set->history) pd_history_clear(set->history);
   int total = 0;
   for (int p = 0; p < parts; ++p) total += from[p]->contacts->count;
+  if (total == 0 && set->count == 0) {  // an empty list stays empty (a lone body in flight, gathered every sample)
+    PD_ASSERT(to->n == spring_base(model));
+    set->bodyListValid = false;
+    set->recordedValid = false;  // its bodies were just gathered: what record() kept is of other numbers
+    return;
+  }
   pd_contact_set_reserve_list(set, total);
   int count = 0;
   for (int p = 0; p < parts; ++p)

@@ -23,6 +23,11 @@ struct pdDense {
   double t0, h;
   int n, capacity;
   double* node[NODE_COUNT];  // (capacity) each
+  // The interpolant's terms, up to 4 per number (keep_terms), kept by a step that passes many samples (a body in flight
+  // sampled at 2 kHz, some 40 a step; a slide at 1 kHz, some 25): each sample then costs only the polynomial's
+  // evaluation, the same operations on the same numbers.
+  bool kept;
+  double* terms[4];  // (capacity) each
   // the presentation
   pdContactSet* view;  // the captured contact list, presented (NULL until the first capture)
   double keptEnergy;   // J: the springs the history keeps for broken contacts over the step (the view has none)
@@ -44,6 +49,7 @@ void pd_dense_free(pdDense* d) {
   if (!d) return;
   PD_ASSERT(!d->presenting);
   for (int k = 0; k < NODE_COUNT; ++k) free(d->node[k]);
+  for (int k = 0; k < 4; ++k) free(d->terms[k]);
   free(d->yView);
   pd_contact_set_free(d->view);
   free(d);
@@ -54,6 +60,7 @@ static void reserve(pdDense* d, int n) {
   int c = d->capacity > 0 ? d->capacity : n;
   while (c < n) c *= 2;
   for (int k = 0; k < NODE_COUNT; ++k) d->node[k] = pd_grow(d->node[k], (size_t)c, sizeof(double));
+  for (int k = 0; k < 4; ++k) d->terms[k] = pd_grow(d->terms[k], (size_t)c, sizeof(double));
   d->yView = pd_grow(d->yView, (size_t)c, sizeof(double));
   d->capacity = c;
 }
@@ -85,6 +92,7 @@ static pdDense* capture_ends(const pdModel* model, pdState* s, double h, const d
   d->h = h;
   d->n = n;
   d->captured = true;
+  d->kept = false;
   return d;
 }
 
@@ -112,42 +120,107 @@ void pd_dense_capture_dopri(const pdModel* model, pdState* s, double h, const do
   memcpy(d->node[NODE_YHALF], ext, bytes);
 }
 
+// The quartic's terms for one number: slope h f0 and a, b, c (pd_dense_quartic's p(θ)).
+static void quartic_terms(double h, double y0, double f0, double yHalf, double fHalf, double y1, double terms[4]) {
+  double slope = h * f0;
+  double dHalf = yHalf - y0 - 0.5 * slope, dSlope = h * (fHalf - f0), dEnd = y1 - y0 - slope;
+  terms[0] = slope;
+  terms[1] = dEnd - 4.0 * dSlope + 16.0 * dHalf;
+  terms[2] = -4.0 * dEnd + 12.0 * dSlope - 32.0 * dHalf;
+  terms[3] = 4.0 * dEnd - 8.0 * dSlope + 16.0 * dHalf;
+}
+
+static inline double quartic_at(double y0, double t0, double t1, double t2, double t3, double theta) {
+  return y0 + theta * (t0 + theta * (t1 + theta * (t2 + theta * t3)));
+}
+
 void pd_dense_quartic(int n, double h, double theta, const double* y0, const double* f0, const double* yHalf,
                       const double* fHalf, const double* y1, double* out) {
   // p(θ) = y0 + h f0 θ + a θ² + b θ³ + c θ⁴ through p(½) = y½, p'(½) = h f½, p(1) = y1 (derivation: the three
   // conditions solved for a, b, c with D½ = y½ − y0 − h f0/2, Df = h (f½ − f0), D1 = y1 − y0 − h f0)
   for (int i = 0; i < n; ++i) {
-    double slope = h * f0[i];
-    double dHalf = yHalf[i] - y0[i] - 0.5 * slope, dSlope = h * (fHalf[i] - f0[i]), dEnd = y1[i] - y0[i] - slope;
-    double a = dEnd - 4.0 * dSlope + 16.0 * dHalf;
-    double b = -4.0 * dEnd + 12.0 * dSlope - 32.0 * dHalf;
-    double c = 4.0 * dEnd - 8.0 * dSlope + 16.0 * dHalf;
-    out[i] = y0[i] + theta * (slope + theta * (a + theta * (b + theta * c)));
+    double t[4];
+    quartic_terms(h, y0[i], f0[i], yHalf[i], fHalf[i], y1[i], t);
+    out[i] = quartic_at(y0[i], t[0], t[1], t[2], t[3], theta);
   }
 }
 
-// The interpolant at θ into out (d->n numbers).
-static void interpolate(const pdDense* d, double theta, double* out) {
-  const double *y0 = d->node[NODE_Y0], *f0 = d->node[NODE_F0], *y1 = d->node[NODE_Y1];
+// The cubic Hermite interpolant's terms for one number, h f0, c2 and c3, and its value at θ.
+static inline void cubic_terms(double h, double y0, double f0, double y1, double f1, double t[3]) {
+  double dy = y1 - y0;
+  t[0] = h * f0;
+  t[1] = 3.0 * dy - h * (2.0 * f0 + f1);
+  t[2] = -2.0 * dy + h * (f0 + f1);
+}
+
+static inline double cubic_at(double y0, double t0, double t1, double t2, double theta) {
+  return y0 + theta * (t0 + theta * (t1 + theta * t2));
+}
+
+// Dormand–Prince's continuous extension's terms for one number, Δ, r3 and r4, and its value at θ (ext: its term d).
+static inline void dopri_terms(double h, double y0, double f0, double y1, double f1, double t[3]) {
+  double dy = y1 - y0, r3 = h * f0 - dy;
+  t[0] = dy;
+  t[1] = r3;
+  t[2] = dy - h * f1 - r3;
+}
+
+static inline double dopri_at(double y0, double t0, double t1, double t2, double ext, double theta) {
+  return y0 + theta * (t0 + (1.0 - theta) * (t1 + theta * (t2 + (1.0 - theta) * ext)));
+}
+
+// A step that passes at least this many samples from its first presentation keeps its interpolant's terms: forming
+// and storing them costs more than evaluating the interpolant directly twice (cases/hard/stack_10.scene, whose steps
+// pass one or two samples of 1 000 per second, paid 40 % more for the interpolation when every step kept them).
+#define PD_DENSE_KEEP_SAMPLES 4
+
+// Each number's terms into d->terms[0 .. 3] (the cubics use three).
+static void keep_terms(pdDense* d) {
+  const double *y0 = d->node[NODE_Y0], *f0 = d->node[NODE_F0], *y1 = d->node[NODE_Y1], *f1 = d->node[NODE_F1];
+  const double *yHalf = d->node[NODE_YHALF], *fHalf = d->node[NODE_FHALF];
   double h = d->h;
-  if (d->quartic) {
-    pd_dense_quartic(d->n, h, theta, y0, f0, d->node[NODE_YHALF], d->node[NODE_FHALF], y1, out);
-    return;
-  }
-  const double* f1 = d->node[NODE_F1];
-  if (d->dopri) {
-    const double* ext = d->node[NODE_YHALF];
-    for (int i = 0; i < d->n; ++i) {
-      double dy = y1[i] - y0[i], r3 = h * f0[i] - dy, r4 = dy - h * f1[i] - r3;
-      out[i] = y0[i] + theta * (dy + (1.0 - theta) * (r3 + theta * (r4 + (1.0 - theta) * ext[i])));
-    }
-    return;
-  }
   for (int i = 0; i < d->n; ++i) {
-    double dy = y1[i] - y0[i];
-    double c2 = 3.0 * dy - h * (2.0 * f0[i] + f1[i]);
-    double c3 = -2.0 * dy + h * (f0[i] + f1[i]);
-    out[i] = y0[i] + theta * (h * f0[i] + theta * (c2 + theta * c3));
+    double t[4] = {0.0, 0.0, 0.0, 0.0};
+    if (d->quartic)
+      quartic_terms(h, y0[i], f0[i], yHalf[i], fHalf[i], y1[i], t);
+    else if (d->dopri)
+      dopri_terms(h, y0[i], f0[i], y1[i], f1[i], t);
+    else
+      cubic_terms(h, y0[i], f0[i], y1[i], f1[i], t);
+    for (int k = 0; k < 4; ++k) d->terms[k][i] = t[k];
+  }
+  d->kept = true;
+}
+
+// The interpolant at θ into out (d->n numbers); `many`: the step passes PD_DENSE_KEEP_SAMPLES samples from θ on.
+static void interpolate(pdDense* d, double theta, double* restrict out, bool many) {
+  const double *y0 = d->node[NODE_Y0], *f0 = d->node[NODE_F0], *y1 = d->node[NODE_Y1], *f1 = d->node[NODE_F1];
+  const double *yHalf = d->node[NODE_YHALF], *fHalf = d->node[NODE_FHALF];
+  double h = d->h;
+  if (!d->kept && many) keep_terms(d);
+  // restrict: out (the view's vector) overlaps no term, so these loops may take two numbers at a time
+  const double *restrict t0 = d->terms[0], *restrict t1 = d->terms[1], *restrict t2 = d->terms[2];
+  const double* restrict t3 = d->terms[3];
+  if (d->quartic && d->kept) {
+    for (int i = 0; i < d->n; ++i) out[i] = quartic_at(y0[i], t0[i], t1[i], t2[i], t3[i], theta);
+  } else if (d->quartic) {
+    pd_dense_quartic(d->n, h, theta, y0, f0, yHalf, fHalf, y1, out);
+  } else if (d->dopri && d->kept) {  // the extension's terms d are in NODE_YHALF
+    for (int i = 0; i < d->n; ++i) out[i] = dopri_at(y0[i], t0[i], t1[i], t2[i], yHalf[i], theta);
+  } else if (d->dopri) {
+    for (int i = 0; i < d->n; ++i) {
+      double t[3];
+      dopri_terms(h, y0[i], f0[i], y1[i], f1[i], t);
+      out[i] = dopri_at(y0[i], t[0], t[1], t[2], yHalf[i], theta);
+    }
+  } else if (d->kept) {
+    for (int i = 0; i < d->n; ++i) out[i] = cubic_at(y0[i], t0[i], t1[i], t2[i], theta);
+  } else {
+    for (int i = 0; i < d->n; ++i) {
+      double t[3];
+      cubic_terms(h, y0[i], f0[i], y1[i], f1[i], t);
+      out[i] = cubic_at(y0[i], t[0], t[1], t[2], theta);
+    }
   }
 }
 
@@ -158,7 +231,8 @@ void pd_dense_present(const pdModel* model, pdState* s, double t) {
     if (s->t == t) return;
     pd_dense_resume(s);
   }
-  interpolate(d, (t - d->t0) / d->h, d->yView);
+  interpolate(d, (t - d->t0) / d->h, d->yView,
+              (d->t0 + d->h - t) * model->settings.sampleRate >= PD_DENSE_KEEP_SAMPLES - 1);
   for (int k = 0; k < model->movingCount; ++k) {
     double* q = d->yView + PD_BODY_STATE_SIZE * k + PD_Y_Q;
     double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
