@@ -75,6 +75,18 @@ static pdVec3 apex_depth_sum(const pdContactGeom* found, int n, int* count) {
   return sum;
 }
 
+// The contacts a step carries to the next: those found (n), and `held` if the search left it to tracking. Their number.
+static int carried(const pdContactGeom* found, int n, pdContactId held, pdContactId* previous) {
+  int count = 0;
+  bool heldFound = false;
+  for (int i = 0; i < n; ++i) {
+    previous[count++] = found[i].id;
+    heldFound = heldFound || pd_contact_id_compare(&found[i].id, &held) == 0;
+  }
+  if (!heldFound) previous[count++] = held;
+  return count;
+}
+
 static void test_a_held_corner_at_a_right_edge_reads_the_vertex_edge_depth(void** state) {
   (void)state;
   pdModel* m = compile_apart(BOX_AND_TETRAHEDRON);
@@ -90,7 +102,7 @@ static void test_a_held_corner_at_a_right_edge_reads_the_vertex_edge_depth(void*
   pdContactGeom found[CAPACITY];
   int count = 0;
   // moved in -x through the side plane, then on into the wedge, 0.01 δ_max per step, the previous step's contacts held
-  pdContactId previous[CAPACITY];
+  pdContactId previous[CAPACITY + 1];  // the found ones and the held one
   int previousCount = 1;
   previous[0] = held;
   pdVec3 lastSum = {0, 0, 0};
@@ -124,13 +136,7 @@ static void test_a_held_corner_at_a_right_edge_reads_the_vertex_edge_depth(void*
     lastSum = sum, lastX = p.x;
     // the step's contacts, and the top face's, which tracking keeps while the vertex is outside by less than its
     // tolerance
-    previousCount = 0;
-    bool topFound = false;
-    for (int i = 0; i < n; ++i) {
-      previous[previousCount++] = found[i].id;
-      topFound = topFound || pd_contact_id_compare(&found[i].id, &held) == 0;
-    }
-    if (!topFound) previous[previousCount++] = held;
+    previousCount = carried(found, n, held, previous);
   }
   assert_true(onset);
   assert_true(both > 200);
@@ -249,7 +255,7 @@ static void test_a_held_corner_at_an_acute_edge_keeps_its_face(void** state) {
   start.x = xEdge + (0.05 * deltaMax - (start.z - zTop) * nf.z) / nf.x;
   assert_true(fabs(face_depth(wedge, low, start) + 0.05 * deltaMax) <= tol);
   pdContactGeom found[CAPACITY];
-  pdContactId previous[CAPACITY];
+  pdContactId previous[CAPACITY + 1];  // the found ones and the held one
   int previousCount = 1;
   previous[0] = held;
   pdVec3 last = start;
@@ -280,13 +286,7 @@ static void test_a_held_corner_at_an_acute_edge_keeps_its_face(void** state) {
       assert_true(df <= 0.0);
     }
     last = p;
-    previousCount = 0;
-    bool topFound = false;
-    for (int i = 0; i < n; ++i) {
-      previous[previousCount++] = found[i].id;
-      topFound = topFound || pd_contact_id_compare(&found[i].id, &held) == 0;
-    }
-    if (!topFound) previous[previousCount++] = held;
+    previousCount = carried(found, n, held, previous);
   }
   assert_true(inside > 250);
   pdPose b = apex_at(m, last);
