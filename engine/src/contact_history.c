@@ -17,6 +17,7 @@ typedef struct trace {
   bool taken;
   double fn;  // N: a hand-over trace's normal force when its contact broke
   int age;    // commits a hand-over trace has been kept
+  double loadScale;  // the springs' factor over eq. (11)'s (contactSlot.loadScale)
 } trace;
 
 // A growable list of traces.
@@ -51,31 +52,41 @@ void pd_history_clear(pdContactHistory* h) { h->count = h->sortedCount = h->hand
 int pd_history_count(const pdContactHistory* h) { return h->count; }
 
 void pd_history_leave(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
-                      double deltaMax) {
+                      double deltaMax, double loadScale) {
   if (h->count == h->capacity) {
     h->capacity = h->capacity ? 2 * h->capacity : 16;
     h->items = pd_grow(h->items, (size_t)h->capacity, sizeof *h->items);
     h->scratch = pd_grow(h->scratch, (size_t)h->capacity, sizeof *h->scratch);
   }
-  h->items[h->count++] = (trace){*id, *springs, normal, deltaMax, false, 0.0, 0};
+  h->items[h->count++] = (trace){*id, *springs, normal, deltaMax, false, 0.0, 0, loadScale};
 }
 
 void pd_history_leave_handover(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
-                               double fn) {
+                               double fn, double loadScale) {
   traceList* l = &h->handovers;
   if (l->count == l->capacity) {
     l->capacity = l->capacity ? 2 * l->capacity : 16;
     l->items = pd_grow(l->items, (size_t)l->capacity, sizeof *l->items);
   }
-  l->items[l->count++] = (trace){*id, *springs, normal, 0.0, false, fn, 0};
+  l->items[l->count++] = (trace){*id, *springs, normal, 0.0, false, fn, 0, loadScale};
+}
+
+// The springs of `p` (eq. (11)'s, factor 1) at a trace's factor: its deflections were kept at that stiffness, and at
+// eq. (11)'s they would give back that force divided by it.
+static void at_trace_scale(const trace* t, pdContactParams* p) {
+  double f = t->loadScale;
+  p->k1n *= f, p->k2n *= f, p->k1t *= f, p->k2t *= f;
 }
 
 bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const pdContactId* id, pdVec3 normal,
-                              const pdContactParams* params, pdSprings* springs) {
+                              pdContactParams* params, double* loadScale, pdSprings* springs) {
   traceList* l = &h->handovers;
   for (int i = 0; i < l->count; ++i) {
     trace* t = &l->items[i];
     if (t->taken || !pd_contact_continues(model, &t->id, id)) continue;
+    PD_ASSERT(*loadScale == 1.0);
+    at_trace_scale(t, params);
+    *loadScale = t->loadScale;
     // as a hand-over within one commit (contact_set.c): the springs turned into the new tangent plane and held within
     // the cone of the predecessor's normal force
     *springs = t->springs;
@@ -95,6 +106,7 @@ bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const p
 // at the commit and fell back when the trace expired (soak campaign 48, scene 1728: 5.1e-3 of E(0)).
 static double trace_energy(const pdModel* model, const trace* t, bool normalReturns) {
   pdContactParams p = pd_model_contact_params(model, t->id.body1, t->id.body2);
+  at_trace_scale(t, &p);
   pdSprings s = t->springs;
   if (!normalReturns) {
     s.s1n = s.s2n = 0.0;
@@ -192,14 +204,17 @@ static int lower_bound(const pdContactHistory* h, const pdContactId* id) {
   return lo;
 }
 
-bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, const pdContactParams* params,
-                     pdSprings* springs) {
+bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, pdContactParams* params,
+                     double* loadScale, pdSprings* springs) {
   // a trace left since the last age broke from a contact of this very list, which a new contact is not
   if (h->sortedCount == 0) return false;
   int i = lower_bound(h, id);
   if (i == h->sortedCount || pd_contact_id_compare(&h->items[i].id, id) != 0) return false;
   trace* t = &h->items[i];
   if (t->taken) return false;
+  PD_ASSERT(*loadScale == 1.0);
+  at_trace_scale(t, params);
+  *loadScale = t->loadScale;
   pdSprings s = t->springs;
   s.s1n = s.s2n = 0.0;  // the normal springs start where the contact does
   // turned to the new normal (and rebalanced where the sides are proportional), not clipped to a cone: the contact
@@ -209,6 +224,12 @@ bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, 
   springs->s2t = s.s2t;
   t->taken = true;
   return true;
+}
+
+double pd_history_load_scale(const pdContactHistory* h, const pdContactId* id) {
+  int i = lower_bound(h, id);
+  if (i == h->sortedCount || pd_contact_id_compare(&h->items[i].id, id) != 0 || h->items[i].taken) return 1.0;
+  return h->items[i].loadScale;
 }
 
 bool pd_history_vertex_trace(const pdContactHistory* h, int vertexBody, int vertex, int faceBody, int face,

@@ -35,18 +35,20 @@ void pd_history_free(pdContactHistory* h);
 void pd_history_clear(pdContactHistory* h);
 int pd_history_count(const pdContactHistory* h);
 
-// Contact `id` of the list broke by force with these springs, its normal `normal` and the pair's δ_max deltaMax (m).
+// Contact `id` of the list broke by force with these springs, its normal `normal`, the pair's δ_max deltaMax (m) and
+// its springs' factor over eq. (11)'s loadScale (contactSlot.loadScale: the springs' deflections are at that factor).
 void pd_history_leave(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
-                      double deltaMax);
+                      double deltaMax, double loadScale);
 // Contact `id` of the list broke geometrically (its features parted) with these springs, its normal and normal force fn
-// (N), and no contact took over from it: kept PD_HANDOVER_COMMITS commits for a successor.
+// (N) and springs' factor loadScale, and no contact took over from it: kept PD_HANDOVER_COMMITS commits for a successor.
 void pd_history_leave_handover(pdContactHistory* h, const pdContactId* id, const pdSprings* springs, pdVec3 normal,
-                               double fn);
+                               double fn, double loadScale);
 // A new contact `id` with normal `normal` that continues a hand-over trace (pd_contact_continues): its springs, normal
 // and tangential, turned to `normal` and the tangential ones held within the cone of the trace's normal force, into
-// *springs; the trace is forgotten; true. Else false.
+// *springs, with the stiffness they had: *params' springs and *loadScale (the new contact's, eq. (11)'s and 1) raised
+// to the trace's factor; the trace is forgotten; true. Else false.
 bool pd_history_take_handover(const pdModel* model, pdContactHistory* h, const pdContactId* id, pdVec3 normal,
-                              const pdContactParams* params, pdSprings* springs);
+                              pdContactParams* params, double* loadScale, pdSprings* springs);
 // The energy the kept traces will bring back, J: ½ k s² of the tangential springs of each trace left by force (its
 // normal springs start at zero on return) and of every spring of each hand-over trace. A contact that breaks with
 // springs kept moves their energy here rather than losing it, so a state's energy (pd_state_energy) does not jump up
@@ -55,12 +57,16 @@ double pd_history_spring_energy(const pdModel* model, const pdContactHistory* h)
 // After a commit, at the bodies' new poses (indexed by model body): forgets every trace whose features no longer
 // track or are apart by more than the gap tolerance, and every trace left before this call and taken since.
 void pd_history_age(const pdModel* model, pdContactHistory* h, const pdPose* poses);
+// The factor over eq. (11)'s of the springs a new contact `id` would take back from a trace left by force on the same
+// features (pd_history_take), 1 when none is kept.
+double pd_history_load_scale(const pdContactHistory* h, const pdContactId* id);
 // The id of the trace left by force by vertex `vertex` of body vertexBody on a face of faceBody other than `face`, into
 // *id: true when one is kept (not taken), else false.
 bool pd_history_vertex_trace(const pdContactHistory* h, int vertexBody, int vertex, int faceBody, int face,
                              pdContactId* id);
 // A new contact `id` with normal `normal`: when a trace of the same features is kept, writes its tangential springs,
-// realigned from the trace's normal to `normal` (pd_springs_realign), into *springs, forgets the trace and returns
-// true; else false.
-bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, const pdContactParams* params,
-                     pdSprings* springs);
+// realigned from the trace's normal to `normal` (pd_springs_realign), into *springs, raises *params' springs and
+// *loadScale (the new contact's, eq. (11)'s and 1) to the trace's factor, forgets the trace and returns true; else
+// false.
+bool pd_history_take(pdContactHistory* h, const pdContactId* id, pdVec3 normal, pdContactParams* params,
+                     double* loadScale, pdSprings* springs);

@@ -312,6 +312,11 @@ void pd_contact_set_list_bodies(const pdModel* model, pdContactSet* set);
 // the list's, world inverse inertias set; y: the state whose springs are re-scaled with their stiffness), and the
 // stability bound's terms and cheap bound for a new list.
 void pd_modal_dampers(const pdModel* model, pdContactSet* set, const pdPose* poses, double* y);
+// pair_params.c: the constants a new contact `id` found in a step would have at the step's commit as far as the step
+// knows them: the model's (eq. (11)'s), with the springs at the factor of its pair's listed contacts (which never falls
+// while they last) or of the trace it would take back (pd_history_load_scale), and modal dampers raised with them
+// (√ of it). Read by the onsets' join test and error bound (onsets.c).
+pdContactParams pd_onset_params(const pdModel* model, const pdContactSet* set, const pdContactId* id);
 void pd_stability_prepare(const pdModel* model, pdContactSet* set, const pdPose* poses);
 
 // contact_search.c: the contact search's arrays (broad phase, pairs, caches, certificates, candidates) of a set

@@ -621,7 +621,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
         contactSlot* k = &set->next[count++];
         *k = new_slot(model, &g0);
         // a contact back on the same features after a micro-separation keeps its tangential springs here too
-        if (set->history && pd_history_take(set->history, id, g0.normal, &k->params, &k->springs))
+        if (set->history && pd_history_take(set->history, id, g0.normal, &k->params, &k->loadScale, &k->springs))
           ++s->count.historyKept;
         ++added;
       }
@@ -704,7 +704,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       if (set->history) {
         pdSprings left = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
         if (e->modeCorrected) springs_add(&left, &e->modeSprings);
-        pd_history_leave(set->history, &c->id, &left, e->geom.normal, c->deltaMax);
+        pd_history_leave(set->history, &c->id, &left, e->geom.normal, c->deltaMax, c->loadScale);
       }
       continue;
     }
@@ -728,7 +728,8 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
     const contactEval* e = &set->eval[i];
     if (e->tracked || e->transferred) continue;
     pdSprings left = springs_load(y1 + base + PD_CONTACT_STATE_SIZE * i);
-    pd_history_leave_handover(set->history, &set->items[i].id, &left, e->geom.normal, e->force.fn);
+    pd_history_leave_handover(set->history, &set->items[i].id, &left, e->geom.normal, e->force.fn,
+                              set->items[i].loadScale);
   }
   for (int j = 0; j < set->candidateCount; ++j) {
     const candidate* cand = &set->candidates[j];
@@ -751,10 +752,11 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
       contactSlot* k = &set->next[count++];
       *k = new_slot(model, &cand->geom);
       k->onsetAge = cand->onsetAge;
-      if (set->history && pd_history_take(set->history, &cand->geom.id, cand->geom.normal, &k->params, &k->springs))
+      if (set->history &&
+          pd_history_take(set->history, &cand->geom.id, cand->geom.normal, &k->params, &k->loadScale, &k->springs))
         ++s->count.historyKept;
       else if (set->history && pd_history_take_handover(model, set->history, &cand->geom.id, cand->geom.normal,
-                                                        &k->params, &k->springs))
+                                                        &k->params, &k->loadScale, &k->springs))
         ++s->count.contactsTransferred;
       if (cand->onsetAge > 0.0) {
         s->count.onsetBoundMax = fmax(s->count.onsetBoundMax, cand->onsetBound);

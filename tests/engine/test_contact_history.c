@@ -2,7 +2,8 @@
 // - a corner contact of a cube on a floor that broke by force leaves its tangential springs; lifted by less than
 //   PD_HISTORY_GAP_REL δ_max and back on the same features, a new contact takes them (unchanged: the normal did not
 //   turn) with its normal springs at 0; lifted beyond the gap, or off its face, they are forgotten; a contact on other
-//   features never takes them;
+//   features never takes them; one left by a contact whose springs were raised for its pair's load is taken back at
+//   that stiffness, and counts that stiffness's energy while kept;
 // - the traces of twelve corners of three boxes resting on a floor, left, taken and aged in a fixed pseudo-random order
 //   (some of those kept from earlier commits taken, so forgotten, as others are left): at every commit each kept trace
 //   is found again, by pd_history_take and by pd_history_vertex_trace, and none that is not kept;
@@ -44,18 +45,32 @@ static pdPose at_height(const pdModel* m, int body, double z) {
   return (pdPose){{0.0, 0.0, z}, pd_quat_to_mat3(pd_quat_identity())};
 }
 
+// A 10 cm cube DEPTH into a 1 m floor's top face (z = 0): the model, the two bodies' poses, its four corner contacts and
+// the pair's δ_max.
+typedef struct boxOnFloor {
+  pdModel* m;
+  int floor, box;
+  pdPose poses[2];
+  pdContactGeom c[CAPACITY];
+  double deltaMax;
+} boxOnFloor;
+
+static void box_on_floor(boxOnFloor* b) {
+  b->m = compile_apart("cube floor grey 1 1 0.1\nfixed\ncube box red 0.1 0.1 0.1\n");
+  b->floor = body_index(b->m, "floor"), b->box = body_index(b->m, "box");
+  b->poses[b->floor] = at_height(b->m, b->floor, -0.05);  // top face at z = 0
+  b->poses[b->box] = at_height(b->m, b->box, 0.05 - DEPTH);
+  int n = pd_contacts_find(b->m, b->box, &b->poses[b->box], b->floor, &b->poses[b->floor], NULL, NULL, NULL, 0, b->c,
+                           CAPACITY);
+  assert_int_equal(n, 4);
+  b->deltaMax = pd_model_pair_delta_max(b->m, b->box, b->floor);
+}
+
 static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_springs(void** state) {
   (void)state;
-  pdModel* m = compile_apart("cube floor grey 1 1 0.1\nfixed\ncube box red 0.1 0.1 0.1\n");
-  int floor = body_index(m, "floor"), box = body_index(m, "box");
-  double deltaMax = pd_model_pair_delta_max(m, box, floor);
-  pdPose poses[2];
-  poses[floor] = at_height(m, floor, -0.05);  // top face at z = 0
-  poses[box] = at_height(m, box, 0.05 - DEPTH);
-  pdContactGeom c[CAPACITY];
-  int n = pd_contacts_find(m, box, &poses[box], floor, &poses[floor], NULL, NULL, NULL, 0, c, CAPACITY);
-  assert_int_equal(n, 4);
-  pdContactParams params = pd_model_contact_params(m, c[0].id.body1, c[0].id.body2);
+  boxOnFloor b;
+  box_on_floor(&b);
+  pdContactParams params = pd_model_contact_params(b.m, b.c[0].id.body1, b.c[0].id.body2);
   // springs as a contact leaves them: the two sides balanced (k1t s1t + k2t s2t = 0), in the floor's plane
   pdVec3 s1t = {2e-6, -1e-6, 0.0};
   pdSprings left = {-1e-5, 1e-5, s1t, pd_v3_scale(s1t, -params.k1t / params.k2t)};
@@ -64,11 +79,12 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
   double lifts[] = {0.05, 0.5};  // of δ_max: within the gap, beyond it
   for (int k = 0; k < 2; ++k) {
     pdContactHistory* h = pd_history_create();
-    pd_history_leave(h, &c[0].id, &left, c[0].normal, deltaMax);
-    poses[box] = at_height(m, box, 0.05 + lifts[k] * deltaMax);
-    pd_history_age(m, h, poses);
+    pd_history_leave(h, &b.c[0].id, &left, b.c[0].normal, b.deltaMax, 1.0);
+    b.poses[b.box] = at_height(b.m, b.box, 0.05 + lifts[k] * b.deltaMax);
+    pd_history_age(b.m, h, b.poses);
     pdSprings got = {0};
-    bool kept = pd_history_take(h, &c[0].id, c[0].normal, &params, &got);
+    double scale = 1.0;
+    bool kept = pd_history_take(h, &b.c[0].id, b.c[0].normal, &params, &scale, &got);
     print_message("corner lifted %.2f delta_max (gap tolerance %.2f): history %s\n", lifts[k], PD_HISTORY_GAP_REL,
                   kept ? "kept" : "forgotten");
     if (lifts[k] <= PD_HISTORY_GAP_REL) {
@@ -77,7 +93,7 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
       assert_true(pd_v3_norm(pd_v3_sub(got.s1t, left.s1t)) <= SPRING_TOL);
       assert_true(pd_v3_norm(pd_v3_sub(got.s2t, left.s2t)) <= SPRING_TOL);
       pdSprings again = {0};
-      assert_false(pd_history_take(h, &c[0].id, c[0].normal, &params, &again));  // taken once
+      assert_false(pd_history_take(h, &b.c[0].id, b.c[0].normal, &params, &scale, &again));  // taken once
     } else {
       assert_false(kept);
     }
@@ -86,16 +102,54 @@ static void test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_s
 
   // another corner (other features) does not take them; nor does the same one after its vertex left the face
   pdContactHistory* h = pd_history_create();
-  pd_history_leave(h, &c[0].id, &left, c[0].normal, deltaMax);
-  poses[box] = at_height(m, box, 0.05);
-  pd_history_age(m, h, poses);
+  pd_history_leave(h, &b.c[0].id, &left, b.c[0].normal, b.deltaMax, 1.0);
+  b.poses[b.box] = at_height(b.m, b.box, 0.05);
+  pd_history_age(b.m, h, b.poses);
   pdSprings got = {0};
-  assert_false(pd_history_take(h, &c[1].id, c[1].normal, &params, &got));
-  poses[box].x = (pdVec3){2.0, 0.0, 0.05};  // beside the 1 m floor: the vertex is off its face
-  pd_history_age(m, h, poses);
+  double scale = 1.0;
+  assert_false(pd_history_take(h, &b.c[1].id, b.c[1].normal, &params, &scale, &got));
+  b.poses[b.box].x = (pdVec3){2.0, 0.0, 0.05};  // beside the 1 m floor: the vertex is off its face
+  pd_history_age(b.m, h, b.poses);
   assert_int_equal(pd_history_count(h), 0);
   pd_history_free(h);
-  pd_model_free(m);
+  pd_model_free(b.m);
+}
+
+// A contact whose springs were raised for its pair's load (docs/contact-model.md, "Springs sized by the load") leaves
+// deflections at that stiffness: the contact that takes them back gets the springs they were kept at, so its friction
+// force is the one the contact broke with (at eq. (11)'s springs it was that divided by the factor), and the energy
+// the trace counts meanwhile is that of the raised springs, which the contact then holds.
+static void test_a_trace_of_raised_springs_is_taken_back_at_their_stiffness(void** state) {
+  (void)state;
+  boxOnFloor b;
+  box_on_floor(&b);
+  const double raised = 40.0;  // the contact's factor when it broke
+  pdContactParams own = pd_model_contact_params(b.m, b.c[0].id.body1, b.c[0].id.body2);
+  pdVec3 s1t = {2e-7, -1e-7, 0.0};
+  pdSprings left = {-1e-6, 1e-6, s1t, pd_v3_scale(s1t, -own.k1t / own.k2t)};
+  double energies[2];
+  double scales[2] = {1.0, raised};
+  for (int k = 0; k < 2; ++k) {
+    pdContactHistory* h = pd_history_create();
+    pd_history_leave(h, &b.c[0].id, &left, b.c[0].normal, b.deltaMax, scales[k]);
+    b.poses[b.box] = at_height(b.m, b.box, 0.05);
+    pd_history_age(b.m, h, b.poses);
+    energies[k] = pd_history_spring_energy(b.m, h);
+    pdContactParams params = own;
+    double scale = 1.0;
+    pdSprings got = {0};
+    assert_true(pd_history_take(h, &b.c[0].id, b.c[0].normal, &params, &scale, &got));
+    assert_true(scale == scales[k]);
+    assert_true(params.k1t == scales[k] * own.k1t && params.k2t == scales[k] * own.k2t);
+    assert_true(params.k1n == scales[k] * own.k1n && params.k2n == scales[k] * own.k2n);
+    // the same deflections, so the force they left with: k1t s1t at the stiffness they were kept at
+    assert_true(pd_v3_norm(pd_v3_sub(got.s1t, left.s1t)) <= SPRING_TOL);
+    pd_history_free(h);
+  }
+  print_message("trace energy at factor 1 %.6g J, at factor %.0f %.6g J\n", energies[0], raised, energies[1]);
+  assert_true(energies[0] > 0.0);
+  assert_true(fabs(energies[1] - raised * energies[0]) <= 1e-12 * energies[1]);
+  pd_model_free(b.m);
 }
 
 // A fixed pseudo-random sequence (a linear congruential generator): the same draws on every machine.
@@ -134,7 +188,8 @@ static void test_every_kept_trace_is_found_as_others_come_and_go(void** state) {
     bool leaves[CORNERS] = {false}, takes_now[CORNERS] = {false};
     for (int i = 0; i < n; ++i)
       if (!kept[i] && next_draw(&seed) % 3 == 0) {
-        pd_history_leave(h, &c[i].id, &left, c[i].normal, pd_model_pair_delta_max(m, c[i].id.body1, c[i].id.body2));
+        pd_history_leave(h, &c[i].id, &left, c[i].normal, pd_model_pair_delta_max(m, c[i].id.body1, c[i].id.body2),
+                         1.0);
         leaves[i] = true;
       }
     for (int i = 0; i < n; ++i) {
@@ -149,7 +204,8 @@ static void test_every_kept_trace_is_found_as_others_come_and_go(void** state) {
     for (int i = 0; i < n; ++i) {
       if (kept[i] && next_draw(&seed) % 2 != 0) continue;
       pdSprings got = {0};
-      bool found = pd_history_take(h, &c[i].id, c[i].normal, &params, &got);
+      double scale = 1.0;
+      bool found = pd_history_take(h, &c[i].id, c[i].normal, &params, &scale, &got);
       if (found != kept[i])
         print_message("commit %d, corner %d: trace %s but %s\n", commit, i, kept[i] ? "kept" : "not kept",
                       found ? "found" : "not found");
@@ -239,6 +295,7 @@ static void test_a_box_landing_sliding_on_the_column_does_not_creep(void** state
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_broken_corner_returning_within_the_gap_keeps_its_tangential_springs),
+      cmocka_unit_test(test_a_trace_of_raised_springs_is_taken_back_at_their_stiffness),
       cmocka_unit_test(test_every_kept_trace_is_found_as_others_come_and_go),
       cmocka_unit_test(test_a_chattering_column_on_an_incline_does_not_creep),
       cmocka_unit_test(test_a_box_landing_sliding_on_the_column_does_not_creep),

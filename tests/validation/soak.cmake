@@ -4,3 +4,5 @@
 pd_add_test(test_soak_checks ${CMAKE_CURRENT_LIST_DIR}/test_soak.c)
 target_link_libraries(test_soak_checks PRIVATE polydyn_validation)
 pd_test_labels(physics test_soak_checks)
+# slow: it runs a committed failure of six bodies to its end islands off (about 10^5 accepted steps)
+pd_test_labels(slow test_soak_checks)
