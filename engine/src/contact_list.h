@@ -38,6 +38,9 @@ typedef struct contactSlot {
   double loadScale;          // its springs over eq. (11)'s for the pair alone (>= 1; pd_modal_dampers, "load")
   // its modes at the step's start (record()), held over the step when the set holds modes (pd_contact_force_held)
   bool heldPush, heldSlip;
+  // presented at a sample and not evaluated there yet (pd_contact_set_settle): its springs in y as interpolated, its
+  // normal, point and depth as captured at the step's start, its force and held modes not those of the sample
+  bool unevaluated;
 } contactSlot;
 
 // A pair's search certificate (contact_analysis.h, "search certificates") and when to issue its next, kept beside
@@ -175,6 +178,11 @@ struct pdContactSet {
   pdVec3* bodyRowsK;       // (bodyCount) per row p: Σ_q |(K_j^½)_pq| summed over the contacts j of each body
   pdVec3* bodyRowsRight;   // (bodyCount) the same for W [r_j]ₓ K_j^½ (j's end on that body)
   pdMat3* invInertiaWorld; // (bodyCount) R I⁻¹ Rᵀ at the poses of the list's last preparation (fixed: 0)
+  // slots presented and not evaluated yet (contactSlot.unevaluated), of this model, and the poses their evaluation
+  // forms (bodyCount; fixed bodies' set once)
+  int unevaluated;
+  const pdModel* unevaluatedModel;
+  pdPose* settlePoses;
   double* kinkSum;         // (bodyCount) scratch of pd_contact_events: the step's stick–slip kinks' slopes per body
   struct pdStackScratch* stackScratch;  // the modal dampers' local mode analyses (stack_modes.h); NULL until first needed
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation

@@ -103,12 +103,13 @@ static pdContactSet* create(const pdModel* model, bool search) {
   set->poses = pd_grow(NULL, n, sizeof *set->poses);
   set->poses0 = pd_grow(NULL, n, sizeof *set->poses0);
   set->poses1 = pd_grow(NULL, n, sizeof *set->poses1);
+  set->settlePoses = pd_grow(NULL, n, sizeof *set->settlePoses);
   set->boxes = pd_grow(NULL, n, sizeof *set->boxes);
   bool* fixed = pd_grow(NULL, n, sizeof *fixed);
   for (int i = 0; i < n; ++i) {
     const pdBody* b = &model->bodies[i];
     fixed[i] = b->fixed;
-    set->poses[i] = set->poses0[i] = set->poses1[i] = pose_of(b->x0, b->q0);
+    set->poses[i] = set->poses0[i] = set->poses1[i] = set->settlePoses[i] = pose_of(b->x0, b->q0);
     set->boxes[i] = pd_aabb_of(&b->shape, set->poses[i].x, &set->poses[i].R);
   }
   if (!search) {
@@ -151,6 +152,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->poses);
   free(set->poses0);
   free(set->poses1);
+  free(set->settlePoses);
   free(set->boxes);
   if (set->broad) pd_contact_search_free(set);
   free(set);
@@ -159,6 +161,7 @@ void pd_contact_set_free(pdContactSet* set) {
 void pd_contact_set_clear(pdContactSet* set) {
   if (set->history) pd_history_clear(set->history);
   set->count = 0;
+  set->unevaluated = 0;
   set->bodyListValid = false;
   set->recordedValid = false;
   set->stableStep = set->stableCheap = INFINITY;
@@ -207,6 +210,7 @@ static void install(const pdModel* model, pdState* s, int count) {
   set->items = set->next;
   set->next = old;
   set->count = count;
+  set->unevaluated = 0;  // a gather counts the unevaluated slots it moved (pd_contact_set_gather)
   set->bodyListValid = false;
   set->recordedValid = false;
   s->n = base + PD_CONTACT_STATE_SIZE * count;
@@ -793,34 +797,51 @@ void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
   }
   view->capturedCount = from->count;
   view->count = 0;  // nothing presented yet
+  view->unevaluated = 0;
 }
 
 void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y) {
   int count = view->capturedCount;
   view->count = count;
   view->bodyListValid = false;
-  // the poses and inverse inertias are read for the bodies of the view's contacts only (below, and the implicit
-  // stepper's linearisation): a view without contacts (a body in flight, presented at every sample) needs none
+  view->unevaluated = 0;
+  // the poses and inverse inertias are read for the bodies of the view's contacts only (the implicit stepper's
+  // linearisation): a view without contacts (a body in flight, presented at every sample) needs none
   if (count == 0) return;
   poses_from(model, y, view->poses1);
   world_inverse_inertias(model, view, view->poses1);
+  // each contact as captured (a presentation at another time of the same step evaluated it there), evaluated at
+  // the sample only when read (pd_contact_set_settle): most samples' observers read the bodies alone
+  for (int i = 0; i < count; ++i) {
+    contactSlot* c = &view->items[i];
+    c->normal = view->captured[i].normal;
+    c->point = view->captured[i].point;
+    c->depth = view->captured[i].depth;
+    c->unevaluated = true;
+  }
+  view->unevaluated = count;
+  view->unevaluatedModel = model;
+}
+
+void pd_contact_set_settle(pdContactSet* set, double* y) {
+  if (set->unevaluated == 0) return;
+  const pdModel* model = set->unevaluatedModel;
+  const pdPose* poses = set->settlePoses;
+  poses_from(model, y, set->settlePoses);
   int base = spring_base(model);
   // realigned as a commit realigns the contacts it keeps (one that pulls keeps its springs: a commit drops it),
   // then recorded as record() records: the same geometry and relative velocity, the force of the springs as
   // they are now
   pdPairFrame frame;
   frame.p1 = NULL;  // empty (the rest is formed with it)
-  for (int i = 0; i < count; ++i) {
-    contactSlot* c = &view->items[i];
-    // as captured: a presentation at another time of the same step overwrote them (the rest it does not change)
-    c->normal = view->captured[i].normal;
-    c->point = view->captured[i].point;
-    c->depth = view->captured[i].depth;
+  for (int i = 0; i < set->count; ++i) {
+    contactSlot* c = &set->items[i];
+    if (!c->unevaluated) continue;
     double* yc = y + base + PD_CONTACT_STATE_SIZE * i;
     pdSprings sp = springs_load(yc);
     pdContactGeom g;
     pdVec3 du;
-    contact_motion(model, c, y, view->poses1, &frame, &g, NULL, &du);
+    contact_motion(model, c, y, poses, &frame, &g, NULL, &du);
     // the normal force decides (pd_contact_fn_pulls) whether the springs are realigned before the whole force
     double fn = pd_contact_normal_force(&c->params, &sp, g.normal, du);
     if (!pd_contact_fn_pulls(fn)) {
@@ -830,7 +851,9 @@ void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y)
     pd_contact_force(&c->params, &sp, g.normal, du, &c->force);
     record_geometry(c, &g);
     hold_modes(c);
+    c->unevaluated = false;
   }
+  set->unevaluated = 0;
 }
 
 // ---------------------------------------------------------------- islands (islands.c)
@@ -868,6 +891,7 @@ static void install_moved(const pdModel* model, pdState* to, int count) {
 void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int* contacts, int count,
                             const pdModel* sub, pdState* to, const int* toSub) {
   pdContactSet* set = to->contacts;
+  pd_contact_set_settle(from->contacts, from->y);  // the new island goes on from the springs realigned at T
   if (set->history) pd_history_clear(set->history);  // its traces' ids are another model's
   pd_contact_set_reserve_list(set, count);
   for (int k = 0; k < count; ++k) {
@@ -899,6 +923,10 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
     for (int i = 0; i < from[p]->contacts->count; ++i)
       remap_slot(&set->next[count++], subs[p], from[p], i, toModel[p]);
   install_moved(model, to, count);
+  // an island's contacts presented and not read there come unevaluated, with their springs as interpolated: the
+  // scene's state evaluates them when read, at the same numbers (its bodies' are the islands')
+  for (int i = 0; i < count; ++i) set->unevaluated += set->items[i].unevaluated;
+  set->unevaluatedModel = model;
 }
 
 // The state's vectors grow with its contact list: install, above, calls it between steps (state_layout.h).

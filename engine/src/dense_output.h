@@ -4,7 +4,7 @@
 // passes such a time keeps what it needs to give the state anywhere inside it (captured before its commit, in its
 // contact list's layout), and the state is presented there: the bodies' and springs' numbers interpolated, the
 // step's contact list with each contact's geometry and force at that time, its springs realigned to that normal as
-// a commit would. While a state is presented, state->t, y, n and contacts are the presented ones and the
+// a commit would (when first read: pd_contact_set_settle; an observer reading the bodies alone skips it). While a state is presented, state->t, y, n and contacts are the presented ones and the
 // integration's own state (at the step's end, later than state->t) is put aside; pd_advance puts it back before it
 // steps on, so presenting never changes what the integration computes.
 //

@@ -71,6 +71,7 @@ static void bodies_range(void* ctx, int part, int begin, int end) {
 }
 
 void pd_state_derivative(const pdModel* model, pdState* state, double t, const double* y, double* dydt) {
+  pd_contact_set_settle(state->contacts, state->y);  // a presented state's springs, realigned
   pd_state_derivative_sampled(model, state, t, y, dydt, 1.0);
 }
 

@@ -183,6 +183,7 @@ void pd_implicit_linearise(const pdModel* model, pdState* state, pdImplicit* im,
   // sized between steps (pd_implicit_reserve): a trial step does not allocate
   PD_ASSERT(contacts <= im->contactCapacity && rows <= im->rowCapacity && im->perm && im->perm->size == (size_t)rows);
   im->rows = rows;
+  pd_contact_set_settle(state->contacts, state->y);  // a presented state's modes (the linearisation reads them)
   pd_contact_set_linearise(model, state->contacts, y, im->linear);
 }
 

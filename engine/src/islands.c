@@ -695,6 +695,8 @@ static void gather(const pdModel* model, pdState* s, struct pdIslandSet* set, do
   }
   for (int j = 0; j < set->islandCount; ++j) {
     const island* is = set->islands[j];
+    // a sleeping island's state stays presented as it fell asleep: evaluated once there, not at every gather's read
+    if (is->asleep) pd_contact_set_settle(is->state->contacts, is->state->y);
     set->subModels[j] = &is->model;
     set->subStates[j] = is->state;
     set->subMaps[j] = is->toScene;

@@ -116,6 +116,7 @@ double pd_state_energy(const pdModel* model, const pdState* s) {
     pdBodyState bs = pd_state_body(model, s, i);
     e += pd_body_kinetic_energy(b, bs.v, bs.w, bs.q) - b->mass * pd_v3_dot(model->settings.gravity, bs.x);
   }
+  pd_contact_set_settle(s->contacts, s->y);  // a presented state's springs, realigned
   e += pd_contact_spring_energy(s->contacts, s->y, PD_BODY_STATE_SIZE * model->movingCount);
   // the springs that broken contacts keep for a return (contact_history.h) are energy the state still holds
   // (a presented state's contact list is the dense output's view, without a history: the step's, kept aside)

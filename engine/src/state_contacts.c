@@ -14,6 +14,7 @@ int pd_state_contact_count(const pdState* s) { return s->contacts ? s->contacts-
 
 pdContactReport pd_state_contact(const pdState* s, int i) {
   PD_ASSERT(s->contacts != NULL && i >= 0 && i < s->contacts->count);
+  pd_contact_set_settle(s->contacts, s->y);  // a presented state's contacts are evaluated at their first read
   const contactSlot* c = &s->contacts->items[i];
   pdContactReport r;
   r.bodyA = c->id.body1;

@@ -9,6 +9,10 @@
 // - Stopped between samples and resumed (islands off), a run is the run that did not stop, bit for bit.
 // - A presented state's contacts carry their forces there: a box resting on a floor, sampled at 1 kHz inside the
 //   implicit stepper's 10 ms steps, has its normal forces summing to its weight at every sample.
+// - A presented state's contacts are evaluated when first read (pd_contact_set_settle): a run whose observer reads
+//   every contact and the energy at every sample (as an eager evaluation would form them) and one that reads them at
+//   every 9th sample only give the same contacts, energies and bodies there bit for bit, and the same bodies at every
+//   sample, with sliding, sticking and sleeping contacts, islands off and on.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -207,6 +211,89 @@ static void test_a_run_stopped_between_samples_is_the_run_that_did_not_stop(void
   pd_model_free(m);
 }
 
+enum { READ_BODIES = 3, READ_CONTACTS = 16, READ_SAMPLES = 801 };
+
+// What an observer saw at each sample: every moving body and, at the samples it reads them, the contacts and energy.
+typedef struct readings {
+  int count, every;  // every: the contacts are read at samples k with k % every == 0
+  const pdModel* model;
+  pdBodyState b[READ_SAMPLES][READ_BODIES];
+  int contacts[READ_SAMPLES];
+  pdContactReport c[READ_SAMPLES][READ_CONTACTS];
+  double energy[READ_SAMPLES];
+  int sliding, sticking;  // contacts read slipping and holding
+} readings;
+
+static bool read_sample(const pdModel* model, const pdState* state, void* user) {
+  readings* r = user;
+  if (r->count == READ_SAMPLES) return false;
+  int k = r->count++;
+  for (int j = 0; j < model->movingCount && j < READ_BODIES; ++j)
+    r->b[k][j] = pd_state_body(model, state, model->movingBodies[j]);
+  if (k % r->every != 0) return true;
+  r->contacts[k] = pd_state_contact_count(state);
+  for (int i = 0; i < r->contacts[k] && i < READ_CONTACTS; ++i) {
+    r->c[k][i] = pd_state_contact(state, i);
+    if (r->c[k][i].fn > 0.0) r->c[k][i].slip ? ++r->sliding : ++r->sticking;
+  }
+  r->energy[k] = pd_state_energy(model, state);
+  return true;
+}
+
+static bool same_bits(const void* a, const void* b, size_t n) { return memcmp(a, b, n) == 0; }
+
+// Field by field: the report's padding is not part of it.
+static bool same_report(const pdContactReport* a, const pdContactReport* b) {
+  return a->bodyA == b->bodyA && a->bodyB == b->bodyB && a->edgeEdge == b->edgeEdge && a->featureA == b->featureA &&
+         a->featureB == b->featureB && same_bits(&a->point, &b->point, sizeof a->point) &&
+         same_bits(&a->normal, &b->normal, sizeof a->normal) && same_bits(&a->depth, &b->depth, sizeof a->depth) &&
+         same_bits(&a->fn, &b->fn, sizeof a->fn) && same_bits(&a->ft, &b->ft, sizeof a->ft) && a->slip == b->slip &&
+         same_bits(&a->springScale, &b->springScale, sizeof a->springScale);
+}
+
+static readings* run_read(const char* text, pdIslands islands, int every) {
+  pdModel* m = compile_text(text);
+  pdStateOptions options = pd_state_options_default();
+  options.islands = islands;
+  pdState* s = pd_state_create(m, &options);
+  readings* r = calloc(1, sizeof *r);
+  assert_non_null(r);
+  r->every = every;
+  assert_true(pd_advance(m, s, m->settings.tend, read_sample, r));
+  pd_state_free(s);
+  pd_model_free(m);
+  return r;
+}
+
+static void test_contacts_read_when_needed_are_those_evaluated_at_every_sample(void** state) {
+  (void)state;
+  // a box sliding and tumbling to rest, and one landing flat beside it that sticks and (sleep on) falls asleep
+  static const char SCENE[] =
+      "tend 0.8\nsample 1000\nsleep %s\n"
+      "cube floor grey 3 2 0.2\nfixed\nloc 0 0 -0.1\nmu 0.5\n"
+      "cube box red 0.2 0.15 0.1\nloc 0 0 0.12  30 1 1 0\nvel 0.4 0 0  5 0 1 0\nmu 0.5\nrestitution 0.5\n"
+      "cube rest blue 0.2 0.2 0.2\nloc 0.9 0 0.102\nmu 0.5\n";
+  for (int variant = 0; variant < 3; ++variant) {
+    pdIslands islands = variant == 0 ? pd_islandsOff : pd_islandsOn;
+    char text[1024];
+    snprintf(text, sizeof text, SCENE, variant == 2 ? "on" : "off");
+    readings* every = run_read(text, islands, 1);
+    readings* some = run_read(text, islands, 9);
+    assert_int_equal(every->count, some->count);
+    assert_true(every->sliding > 0 && every->sticking > 0);
+    for (int k = 0; k < every->count; ++k) {
+      assert_true(same_bits(every->b[k], some->b[k], sizeof every->b[k]));
+      if (k % 9 != 0) continue;
+      assert_int_equal(every->contacts[k], some->contacts[k]);
+      assert_true(same_bits(&every->energy[k], &some->energy[k], sizeof every->energy[k]));
+      for (int i = 0; i < every->contacts[k] && i < READ_CONTACTS; ++i)
+        assert_true(same_report(&every->c[k][i], &some->c[k][i]));
+    }
+    free(every);
+    free(some);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_the_samples_do_not_change_the_steps),
@@ -214,6 +301,7 @@ int main(void) {
       cmocka_unit_test(test_dopri_presents_a_spinning_box_between_its_steps_to_the_tolerance),
       cmocka_unit_test(test_a_presented_resting_box_carries_its_weight),
       cmocka_unit_test(test_a_run_stopped_between_samples_is_the_run_that_did_not_stop),
+      cmocka_unit_test(test_contacts_read_when_needed_are_those_evaluated_at_every_sample),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

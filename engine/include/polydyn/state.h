@@ -319,7 +319,9 @@ typedef struct pdContactReport {
 // and contact i (0 <= i < count, in contact-id order; asserts otherwise) as a copy. Its force is the one the
 // springs carry at t; a contact whose normal springs would pull reports no force (it is dropped after the
 // step). The sum over contacts of ±(fn·normal + ft) (+ when the body is A, − when it is B) is the total
-// contact force on a body (examples/embed/main.c).
+// contact force on a body (examples/embed/main.c). In a state presented at a sample (pd_advance), the first call
+// evaluates all its contacts there and keeps them: state is const to the caller, but two threads must not make
+// that first read of one state at once.
 PD_API int pd_state_contact_count(const pdState* state);
 PD_API pdContactReport pd_state_contact(const pdState* state, int i);
 
@@ -355,9 +357,10 @@ typedef bool pdObserverFcn(const pdModel* model, const pdState* state, void* use
 // choice), calling `observer` (nullable) with `user` at every output sample t = k / sampleRate <= tEnd,
 // including t = 0 when the state is there. Neither the samples nor tEnd cut the error-controlled steppers' steps
 // (dense output, docs/integration.md): at a sample inside a step, and at tEnd when the last step passed it, the
-// state is presented there (its bodies and springs interpolated within that step, its contacts' forces evaluated
-// there), and the integration's own state waits at that step's end; writing to state->y between calls does not
-// reach it. The fixed stepper ends its steps on every sample and on tEnd. Call it again with a later tEnd to go
+// state is presented there (its bodies and springs interpolated within that step; its contacts' springs realigned
+// and forces evaluated there when first read, by pd_state_contact, pd_state_energy or the next island set-up, so a
+// sample whose observer reads only the bodies pays for the interpolant alone: the numbers are the same either way),
+// and the integration's own state waits at that step's end; writing to state->y between calls does not reach it. The fixed stepper ends its steps on every sample and on tEnd. Call it again with a later tEnd to go
 // on: the samples continue where they stopped, and a run stopped on a sample time (tEnd = k / sampleRate, that very
 // division) and resumed computes the same numbers as one call (tests/engine/test_determinism.c); so does one
 // stopped at any other tEnd with islands off (with islands on, tEnd ends a sync interval there).
