@@ -375,8 +375,11 @@ __attribute__((noinline)) static int vf_through_after_edge_pair(const pdModel* m
 // gets its face by the rules above alone: made beside such a hand-over, f's contact started at 150 N, 90° from the
 // pair's normal, and a sliver's corner went 3.49 δ_max into a cube (cases/hard/sliver_corner_past_cube_edge.scene;
 // 0.49 without). At obtuse edges (normals less than 90° apart) no rule is needed: a vertex inside with n on e's arc
-// projects inside both faces and its contact reads at least the bodies' overlap; at acute ones two VF contacts do not
-// sum to the element, and which should carry the vertex is open.
+// projects inside both faces and its contact reads at least the bodies' overlap. At acute ones F alone carries it: its
+// depth d_F is at least the vertex's own overlap min(d_F, d_f); the element, |w| ≥ d_F / sin θ there, would jump where
+// the vertex crosses f's plane; and f's contact would push it along −n_F with |cos θ| of its force: at a sliver's rim
+// (cos θ → −1) the two sum to about k (d_F − d_f) n_F, which drives a vertex deeper below f than below F on through the
+// body and out through f (measured: docs/contact-model.md, "Acute edges").
 
 // The VF contacts of vertex i of body iv (at p, world; q in jf's frame), inside body jf and held on `face` by face
 // continuity, on the faces across right-angled edges of that face (design note above), appended to out, or nothing:

@@ -9,6 +9,9 @@
 // - A vertex found anew (not held on the top face) gets one face by the paper's rules only.
 // - Obtuse edge: a vertex inside an octagonal prism's lateral edge, with w on the edge's Gauss arc, projects inside
 //   both faces and its contact reads w·n_F on the face it takes, at least cos 45° |w|; no second contact.
+// - Acute edge: a corner held on a wedge's top face and moved through the lower face's plane into the wedge stays one
+//   contact, on the top face, its depth continuous and at least the vertex's own overlap (no second face: the design
+//   note in engine/src/contact_analysis.c says why).
 // - Search certificates: a corner held on the side face, inside the top face's plane by less than the flush tolerance
 //   (no contact on the top face yet), is certified for no more than its way to that tolerance.
 #include <math.h>
@@ -72,6 +75,18 @@ static pdVec3 apex_depth_sum(const pdContactGeom* found, int n, int* count) {
   return sum;
 }
 
+// The contacts a step carries to the next: those found (n), and `held` if the search left it to tracking. Their number.
+static int carried(const pdContactGeom* found, int n, pdContactId held, pdContactId* previous) {
+  int count = 0;
+  bool heldFound = false;
+  for (int i = 0; i < n; ++i) {
+    previous[count++] = found[i].id;
+    heldFound = heldFound || pd_contact_id_compare(&found[i].id, &held) == 0;
+  }
+  if (!heldFound) previous[count++] = held;
+  return count;
+}
+
 static void test_a_held_corner_at_a_right_edge_reads_the_vertex_edge_depth(void** state) {
   (void)state;
   pdModel* m = compile_apart(BOX_AND_TETRAHEDRON);
@@ -87,7 +102,7 @@ static void test_a_held_corner_at_a_right_edge_reads_the_vertex_edge_depth(void*
   pdContactGeom found[CAPACITY];
   int count = 0;
   // moved in -x through the side plane, then on into the wedge, 0.01 δ_max per step, the previous step's contacts held
-  pdContactId previous[CAPACITY];
+  pdContactId previous[CAPACITY + 1];  // the found ones and the held one
   int previousCount = 1;
   previous[0] = held;
   pdVec3 lastSum = {0, 0, 0};
@@ -121,13 +136,7 @@ static void test_a_held_corner_at_a_right_edge_reads_the_vertex_edge_depth(void*
     lastSum = sum, lastX = p.x;
     // the step's contacts, and the top face's, which tracking keeps while the vertex is outside by less than its
     // tolerance
-    previousCount = 0;
-    bool topFound = false;
-    for (int i = 0; i < n; ++i) {
-      previous[previousCount++] = found[i].id;
-      topFound = topFound || pd_contact_id_compare(&found[i].id, &held) == 0;
-    }
-    if (!topFound) previous[previousCount++] = held;
+    previousCount = carried(found, n, held, previous);
   }
   assert_true(onset);
   assert_true(both > 200);
@@ -218,11 +227,81 @@ static void test_a_vertex_in_an_obtuse_edges_sector_is_read_by_one_face(void** s
   pd_model_free(m);
 }
 
+// A wedge (body 0, a hull: a horizontal top face F and a lower face f that rises to meet it at 45°, their outward
+// normals 135° apart) and the tetrahedron's apex held on F, 1 δ_max below it, first 0.05 δ_max outside f's plane (a
+// vertex beyond an acute edge, kept on F), then moved through f's plane into the wedge in steps of 0.01 δ_max while it
+// sinks 0.005 δ_max per step: it stays one VF contact, on F (face continuity), its depth F's depth, continuous, and at
+// least the vertex's own penetration, min(d_F, d_f); no contact on f is added as at a right-angled edge, since there
+// f's force k d_f n_f would push the vertex along −n_F with |cos θ| of itself, against F's (the vertex–edge element, which
+// reads |w| ≥ d_F / sin θ inside the wedge, would jump at f's plane). Found anew at the last pose, one face.
+static void test_a_held_corner_at_an_acute_edge_keeps_its_face(void** state) {
+  (void)state;
+  pdModel* m = compile_apart("hull a grey 0 -0.05 0  0 0.05 0  -0.1 -0.05 0  -0.1 0.05 0  -0.1 -0.05 -0.1  -0.1 0.05 -0.1\n"
+                             "hull b blue 0 0 0  0.03 0.01 0.02  -0.01 0.03 0.02  -0.015 -0.02 0.02\n");
+  const pdPolyhedron* wedge = &m->bodies[0].shape;
+  int top = face_along(wedge, pd_v3(0, 0, 1)), low = face_along(wedge, pd_v3(1, 0, -1));
+  double cosTheta = pd_v3_dot(wedge->faces[top].normal, wedge->faces[low].normal);
+  assert_true(fabs(cosTheta + sqrt(0.5)) <= 1e-9);
+  double deltaMax = pd_model_pair_delta_max(m, 0, 1), tol = GEOMETRY_TOL_REL * 0.1;
+  pdPose a = {{0, 0, 0}, pd_mat3_identity()};
+  apex = apex_index(m);
+  pdContactId held = {1, 0, pd_contactVF, apex, top};
+  // the acute edge's line in the wedge's frame (y = 0): on F's plane, z = zTop, and on f's, nf·q = f's offset
+  double zTop = wedge->faces[top].offset;
+  pdVec3 nf = wedge->faces[low].normal;
+  double xEdge = (wedge->faces[low].offset - nf.z * zTop) / nf.x;
+  // 1 δ_max below F and outside f's plane by 0.05 δ_max: (x − xEdge) nf.x + (z − zTop) nf.z = 0.05 δ_max
+  pdVec3 start = {0.0, 0.0, zTop - deltaMax};
+  start.x = xEdge + (0.05 * deltaMax - (start.z - zTop) * nf.z) / nf.x;
+  assert_true(fabs(face_depth(wedge, low, start) + 0.05 * deltaMax) <= tol);
+  pdContactGeom found[CAPACITY];
+  pdContactId previous[CAPACITY + 1];  // the found ones and the held one
+  int previousCount = 1;
+  previous[0] = held;
+  pdVec3 last = start;
+  double lastDepth = zTop - start.z;
+  int inside = 0;
+  for (int k = 1; k <= 300; ++k) {
+    pdVec3 p = {start.x - 0.01 * k * deltaMax, 0.0, start.z - 0.005 * k * deltaMax};
+    pdPose b = apex_at(m, p), bPrev = apex_at(m, last);
+    int n = pd_contacts_find(m, 0, &a, 1, &b, &a, &bPrev, previous, previousCount, found, CAPACITY);
+    assert_true(n <= CAPACITY);
+    int count = 0;
+    apex_depth_sum(found, n, &count);
+    double dF = face_depth(wedge, top, p), df = face_depth(wedge, low, p);
+    if (df > 0.0) ++inside;
+    if (count > 0) {
+      assert_int_equal(count, 1);
+      for (int i = 0; i < n; ++i) {
+        if (found[i].id.kind != pd_contactVF || found[i].id.body1 != 1 || found[i].id.feat1 != apex) continue;
+        assert_true(pd_contact_id_compare(&found[i].id, &held) == 0);
+        assert_true(fabs(found[i].depth - dF) <= tol);
+        assert_true(found[i].depth >= fmin(dF, df) - tol);
+        // continuous: it moves no more than the vertex does along n_F
+        assert_true(fabs(found[i].depth - lastDepth) <= 0.005 * deltaMax + tol);
+        lastDepth = found[i].depth;
+      }
+    } else {
+      // outside f's plane the search may leave it to tracking, which keeps F's contact at its depth
+      assert_true(df <= 0.0);
+    }
+    last = p;
+    previousCount = carried(found, n, held, previous);
+  }
+  assert_true(inside > 250);
+  pdPose b = apex_at(m, last);
+  int count = 0, n = pd_contacts_find(m, 0, &a, 1, &b, NULL, NULL, NULL, 0, found, CAPACITY);
+  apex_depth_sum(found, n, &count);
+  assert_int_equal(count, 1);
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_held_corner_at_a_right_edge_reads_the_vertex_edge_depth),
       cmocka_unit_test(test_a_held_corner_by_a_right_edges_face_is_certified_no_farther_than_its_onset),
       cmocka_unit_test(test_a_vertex_in_an_obtuse_edges_sector_is_read_by_one_face),
+      cmocka_unit_test(test_a_held_corner_at_an_acute_edge_keeps_its_face),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
