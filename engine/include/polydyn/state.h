@@ -353,20 +353,20 @@ PD_API int pd_state_stack_modes(const pdModel* model, const pdState* state, cons
 // const) and may do anything else, but must not call pd_advance or pd_state_reset on this state.
 typedef bool pdObserverFcn(const pdModel* model, const pdState* state, void* user);
 
-// Advances the state to tEnd, s (tEnd >= state->t, asserted; clamping to settings.tend is the caller's
-// choice), calling `observer` (nullable) with `user` at every output sample t = k / sampleRate <= tEnd,
-// including t = 0 when the state is there. Neither the samples nor tEnd cut the error-controlled steppers' steps
-// (dense output, docs/integration.md): at a sample inside a step, and at tEnd when the last step passed it, the
-// state is presented there (its bodies and springs interpolated within that step; its contacts' springs realigned
-// and forces evaluated there when first read, by pd_state_contact, pd_state_energy or the next island set-up, so a
-// sample whose observer reads only the bodies pays for the interpolant alone: the numbers are the same either way),
-// and the integration's own state waits at that step's end; writing to state->y between calls does not reach it. The fixed stepper ends its steps on every sample and on tEnd. Call it again with a later tEnd to go
-// on: the samples continue where they stopped, and a run stopped on a sample time (tEnd = k / sampleRate, that very
-// division) and resumed computes the same numbers as one call (tests/engine/test_determinism.c); so does one
-// stopped at any other tEnd with islands off (with islands on, tEnd ends a sync interval there).
-// Returns true when state->t == tEnd; false if the run had to stop (state->failed,
-// with the reason counted in state->warnings; the state stays finite and later calls return false at once)
-// or the observer asked to stop (state->stopped; state->t is then that sample's time).
+// Advances the state to tEnd, s (tEnd >= state->t, asserted; clamping to settings.tend is the caller's choice), calling
+// `observer` (nullable) with `user` at every output sample t = k / sampleRate <= tEnd, including t = 0 when the state
+// is there. Neither the samples nor tEnd cut the error-controlled steppers' steps (dense output, docs/integration.md):
+// at a sample inside a step, and at tEnd when the last step passed it, the state is presented there (its bodies and
+// springs interpolated within that step; its contacts' springs realigned and forces evaluated there when first read, by
+// pd_state_contact, pd_state_energy or the next island set-up, so a sample whose observer reads only the bodies pays
+// for the interpolant alone: the numbers are the same either way), and the integration's own state waits at that step's
+// end; writing to state->y between calls does not reach it. The fixed stepper ends its steps on every sample and on
+// tEnd. Call it again with a later tEnd to go on: the samples continue where they stopped, and a run stopped on a
+// sample time (tEnd = k / sampleRate, that very division) and resumed computes the same numbers as one call
+// (tests/engine/test_determinism.c); so does one stopped at any other tEnd with islands off (with islands on, tEnd ends
+// a sync interval there). Returns true when state->t == tEnd; false if the run had to stop (state->failed, with the
+// reason counted in state->warnings; the state stays finite and later calls return false at once) or the observer asked
+// to stop (state->stopped; state->t is then that sample's time).
 PD_API bool pd_advance(const pdModel* model, pdState* state, double tEnd, pdObserverFcn* observer, void* user);
 
 // The state derivative dy/dt at (t, y), y laid out for the state's current contact list (its length is
