@@ -401,12 +401,8 @@ __attribute__((noinline)) static int vf_across_right_edge(const pdModel* m, int 
     // side of the brick below, rocked by rounding) does not press into it
     double d = face_depth(sf, f, q);
     if (!(d > over)) continue;
-    bool held = false;
-    for (int k = 0; k < previousCount && !held; ++k)
-      held = previous[k].kind == pd_contactVF && previous[k].body1 == iv && previous[k].feat1 == i &&
-             previous[k].body2 == jf && previous[k].feat2 == f;
     // new only where the vertex crossed f's plane in the step (its onset)
-    if (!held) {
+    if (!vf_listed_on(previous, previousCount, iv, i, jf, f)) {
       if (!pv0) continue;
       if (!start) q0 = to_local(pf0, to_world(pv0, sv->vertices[i])), start = true;
       if (!(face_depth(sf, f, q0) <= over)) continue;

@@ -173,20 +173,18 @@ static double edge_pair_end_margin(const pdPolyhedron* sv, int iv, int i, pdVec3
   return least;
 }
 
-// For vertex i of sv (q, sf's frame) listed on face F, how far it may move before it could cross the plane of a face
-// f across a right-angled edge of F that it is not listed on (its depth below f passing `threshold`, find_vf's flush
-// tolerance), where find_vf makes it a contact on f as well (vf_across_right_edge, contact_analysis.c), m (INFINITY:
-// no such face). `guard`: the rounding kept back.
-static double right_edge_face_margin(const pdPolyhedron* sf, int iv, int i, int F, pdVec3 q, double threshold,
+// For vertex i of sv (q, sf's frame) listed on face F of body jf, how far it may move before it could cross the plane
+// of a face f across a right-angled edge of F that it is not listed on (its depth below f passing `threshold`,
+// find_vf's flush tolerance), where find_vf makes it a contact on f as well (vf_across_right_edge,
+// contact_analysis.c), m (INFINITY: no such face). `guard`: the rounding kept back.
+static double right_edge_face_margin(const pdPolyhedron* sf, int iv, int i, int jf, int F, pdVec3 q, double threshold,
                                      double guard, const pdContactId* exempt, int exemptCount) {
   double least = INFINITY;
   for (int e = 0; e < sf->edgeCount; ++e) {
     int f = face_across_right_edge(sf, e, F);
     if (f < 0) continue;
-    bool listed = false;
-    for (int k = 0; k < exemptCount && !listed; ++k)
-      listed = exempt[k].kind == pd_contactVF && exempt[k].body1 == iv && exempt[k].feat1 == i && exempt[k].feat2 == f;
-    if (!listed) least = fmin(least, fabs(face_depth(sf, f, q) - threshold) - guard);
+    if (!vf_listed_on(exempt, exemptCount, iv, i, jf, f))
+      least = fmin(least, fabs(face_depth(sf, f, q) - threshold) - guard);
   }
   return least;
 }
@@ -204,8 +202,8 @@ static double vertices_margin(const pdPolyhedron* sv, int iv, const pdMat3* rel,
       // a vertex in contact keeps its face while it is over it (find_vf), and takes another once it is not
       double margin = over_face_margin(sf, exempt[listed].feat2, q, over);
       least = margin < least ? margin : least;
-      least = fmin(least, right_edge_face_margin(sf, iv, i, exempt[listed].feat2, q, over + guard, guard, exempt,
-                                                 exemptCount));
+      least = fmin(least, right_edge_face_margin(sf, iv, i, exempt[listed].body2, exempt[listed].feat2, q, over + guard,
+                                                 guard, exempt, exemptCount));
       continue;
     }
     double margin = outside_farthest(sf, q, least + tolerance) - tolerance;

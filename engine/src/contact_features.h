@@ -6,6 +6,7 @@
 
 #include <math.h>
 
+#include "contact_analysis.h"
 #include "polydyn/model.h"
 #include "polydyn/vecmath.h"
 
@@ -65,6 +66,15 @@ static inline bool faces_meet_at_acute_edge(const pdPolyhedron* s, int f, int g)
   if (!(pd_v3_dot(s->faces[f].normal, s->faces[g].normal) < 0.0)) return false;
   for (int e = 0; e < s->edgeCount; ++e)
     if ((s->edges[e].f[0] == f && s->edges[e].f[1] == g) || (s->edges[e].f[0] == g && s->edges[e].f[1] == f)) return true;
+  return false;
+}
+
+// Whether ids[0 .. count) list vertex `vertex` of vertexBody as a VF contact on face `face` of faceBody.
+static inline bool vf_listed_on(const pdContactId* ids, int count, int vertexBody, int vertex, int faceBody, int face) {
+  for (int k = 0; k < count; ++k)
+    if (ids[k].kind == pd_contactVF && ids[k].body1 == vertexBody && ids[k].feat1 == vertex &&
+        ids[k].body2 == faceBody && ids[k].feat2 == face)
+      return true;
   return false;
 }
 
