@@ -177,24 +177,30 @@ def test_state_stepping_matches_one_run():
 
 
 def test_gil_released_while_c_runs():
-    # a Python thread keeps counting while a run is in C (sleep off: a cube at rest asleep would cost next to nothing)
-    scene = polydyn.Scene.from_string("sleep off\n" + CUBE_SCENE)
-    count = [0]
+    # While a run is in C a Python thread keeps running: its clock readings cover the run's window with no gap of half
+    # the window. A run that held the GIL would leave one gap as long as its C part (nearly the whole window), whatever
+    # the load; a count of loop turns would depend on how long the run takes. Sleep off and 30 s simulated so that the
+    # C part dominates the window (a cube asleep at rest would cost next to nothing).
+    scene = polydyn.Scene.from_string("sleep off\n" + CUBE_SCENE.replace("tend 3\n", "tend 30\n"))
+    stamps = []
     done = threading.Event()
 
-    def counter():
+    def reader():
         while not done.is_set():
-            count[0] += 1
-            time.sleep(0.001)
+            stamps.append(time.perf_counter())
 
-    thread = threading.Thread(target=counter)
+    thread = threading.Thread(target=reader)
     thread.start()
-    before = count[0]
+    while not stamps:  # the reader is running before the window opens
+        time.sleep(0.001)
+    t0 = time.perf_counter()
     polydyn.run(scene, sample=1000, contacts=False)
-    during = count[0] - before
+    t1 = time.perf_counter()
     done.set()
     thread.join()
-    assert during > 5
+    inside = [t0] + [s for s in stamps if t0 < s < t1] + [t1]
+    largest_gap = max(b - a for a, b in zip(inside, inside[1:]))
+    assert largest_gap < 0.5 * (t1 - t0), (largest_gap, t1 - t0)
 
 
 def test_runs_in_parallel_threads_agree():
