@@ -433,11 +433,12 @@ __attribute__((noinline)) static int vf_across_right_edge(const pdModel* m, int 
 // that face's normal; the cap's contact, at 90° to the approach, released at 2.4 δ_max, while steps a third as long saw
 // the pair and handed it over to the side face). So a vertex found anew takes the face that hand-over gives when an edge
 // a at it and an edge e of the other body form a pair that began and passed it within the step: at the step's end the
-// pair's Gauss arcs meet, it has crossed (depth > 0 along a × e), its lines' closest points lie inside e and beyond the
-// vertex on a, and the vertex is within a new pair's depth (3 δ_max) of e; at the step's start those closest points lay
-// on a and the lines had not crossed. A pair crossed at the start was a contact then, or refused by the search's rules,
-// and hands over as such or not at all. The contact is a VF contact (eqs. (18a), (18b), §3.1) and starts as a new one
-// (App. C: its onset found from the step).
+// pair's Gauss arcs meet, it has crossed along a × e by more than the flush tolerance (flush faces' edges meet at their
+// shared corners with a depth of rounding: 1e-10 m in a brick wall), its lines' closest points lie inside e and beyond
+// the vertex on a, and the vertex is within a new pair's depth (3 δ_max) of e; at the step's start those closest points
+// lay on a and the lines had not crossed. A pair crossed at the start was a contact then, or refused by the search's
+// rules, and hands over as such or not at all. The contact is a VF contact (eqs. (18a), (18b), §3.1) and starts as a
+// new one (App. C: its onset found from the step).
 
 static bool line_closest(pdVec3 P, pdVec3 u, pdVec3 Q, pdVec3 v, double* s, double* t);
 static bool arcs_meet_within_slack(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d);
@@ -477,7 +478,8 @@ __attribute__((noinline)) static int face_after_passed_edge_pair(const pdModel* 
       pdVec3 u = pd_v3_sub(pd_v3_add(off, pd_mat3_mulv(rel, other)), q);
       double s, t, depth;
       if (!lines_crossed_by(q, u, b0, v, pd_v3_add(nA0, nA1), &s, &t, &depth)) continue;
-      if (!(s < 0.0 && t > 0.0 && t < 1.0 && depth > tol)) continue;
+      // crossed beyond the flush tolerance: flush faces' edges meet at their shared corners with a depth of rounding
+      if (!(s < 0.0 && t > 0.0 && t < 1.0 && depth > over)) continue;
       pdVec3 c = pd_v3_scale(sf->faces[e->f[0]].normal, -1.0), d = pd_v3_scale(sf->faces[e->f[1]].normal, -1.0);
       if (!arcs_meet_within_slack(nA0, nA1, c, d)) continue;
       // at the step's start: on a, not yet crossed
