@@ -183,6 +183,9 @@ struct pdContactSet {
   int unevaluated;
   const pdModel* unevaluatedModel;
   pdPose* settlePoses;
+  // a presented view's invInertiaWorld is due at its poses (formed with its contacts, when first read: the
+  // linearisation settles the state before it reads them)
+  bool inertiasPending;
   double* kinkSum;         // (bodyCount) scratch of pd_contact_events: the step's stick–slip kinks' slopes per body
   struct pdStackScratch* stackScratch;  // the modal dampers' local mode analyses (stack_modes.h); NULL until first needed
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation

@@ -191,13 +191,14 @@ static int compare_slots(const void* a, const void* b) {
 
 // Makes next[0..count) (springs inside the slots) the contact list: sorts it, lays out the springs after
 // the bodies' numbers (already in state->y) in state->y, sets their weights and state->n. May grow the
-// state's vectors: the stepper's scratch is dropped then, so nothing may still point into it.
-static void install(const pdModel* model, pdState* s, int count) {
+// state's vectors: the stepper's scratch is dropped then, so nothing may still point into it. `ordered`: the
+// caller knows next[] sorted (one island's list, its bodies renumbered in the same order).
+static void install(const pdModel* model, pdState* s, int count, bool ordered) {
   pdContactSet* set = s->contacts;
   // a list that changed in no contact comes in sorted (ids are unique, so any sort gives the one order): checked
   // first, since qsort moves slots of ~0.5 kB through a scratch copy (7 % of cases/hard/stack_10.scene's work)
   bool sorted = true;
-  for (int i = 1; i < count && sorted; ++i) sorted = compare_slots(&set->next[i - 1], &set->next[i]) < 0;
+  for (int i = 1; i < count && sorted && !ordered; ++i) sorted = compare_slots(&set->next[i - 1], &set->next[i]) < 0;
   if (!sorted) qsort(set->next, (size_t)count, sizeof *set->next, compare_slots);
   pd_state_reserve_contacts(model, s, count);
   int base = spring_base(model);
@@ -631,7 +632,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
       }
       if (added > 0) {
         s->count.contactsVirtual += added;
-        install(model, s, count);
+        install(model, s, count, false);
         poses_from(model, s->y, set->poses0);
         prepare_list(model, set, s->y, set->poses0);
         verdict = pd_eventRestart;
@@ -779,7 +780,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
     if (set->eval[i].modeCorrected)
       pd_contact_impulse(model, set, s->y, set->poses1, &set->items[i].id, set->eval[i].geom.point,
                          set->eval[i].modeImpulse);
-  install(model, s, count);
+  install(model, s, count, false);
   poses_from(model, s->y, set->poses1);
   s->count.onsetsInterpolated += prepare_list(model, set, s->y, set->poses1);
   if (set->history) pd_history_age(model, set->history, set->poses1);
@@ -800,16 +801,16 @@ void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
   view->unevaluated = 0;
 }
 
-void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y) {
+void pd_contact_set_present(const pdModel* model, pdContactSet* view) {
   int count = view->capturedCount;
   view->count = count;
   view->bodyListValid = false;
   view->unevaluated = 0;
-  // the poses and inverse inertias are read for the bodies of the view's contacts only (the implicit stepper's
-  // linearisation): a view without contacts (a body in flight, presented at every sample) needs none
+  // the inverse inertias are read for the bodies of the view's contacts only (the implicit stepper's linearisation,
+  // which settles the state first): formed with the contacts when first read, at the same poses; a view without
+  // contacts (a body in flight, presented at every sample) needs none
   if (count == 0) return;
-  poses_from(model, y, view->poses1);
-  world_inverse_inertias(model, view, view->poses1);
+  view->inertiasPending = true;
   // each contact as captured (a presentation at another time of the same step evaluated it there), evaluated at
   // the sample only when read (pd_contact_set_settle): most samples' observers read the bodies alone
   for (int i = 0; i < count; ++i) {
@@ -828,6 +829,8 @@ void pd_contact_set_settle(pdContactSet* set, double* y) {
   const pdModel* model = set->unevaluatedModel;
   const pdPose* poses = set->settlePoses;
   poses_from(model, y, set->settlePoses);
+  if (set->inertiasPending) world_inverse_inertias(model, set, poses);
+  set->inertiasPending = false;
   int base = spring_base(model);
   // realigned as a commit realigns the contacts it keeps (one that pulls keeps its springs: a commit drops it),
   // then recorded as record() records: the same geometry and relative velocity, the force of the springs as
@@ -881,11 +884,19 @@ static void remap_slot(contactSlot* c, const pdModel* fromModel, const pdState* 
 }
 
 // Installs next[0 .. count) as the list of `to` (a state of `model`), with no candidates or retries pending.
-static void install_moved(const pdModel* model, pdState* to, int count) {
+static void install_moved(const pdModel* model, pdState* to, int count, bool ordered) {
   to->contacts->candidateCount = 0;
   to->contacts->onsetRetries = 0;
   to->contacts->modeRetries = 0;
-  install(model, to, count);  // sorted by id: the order the slots came in does not matter
+  install(model, to, count, ordered);  // sorted by id: the order the slots came in does not matter
+}
+
+// Whether map[0 .. n) ascends: a list sorted by id (pd_contact_id_compare reads the bodies' order and equality
+// alone) stays sorted with its bodies renumbered by it.
+static bool ascending(const int* map, int n) {
+  for (int i = 1; i < n; ++i)
+    if (!(map[i - 1] < map[i])) return false;
+  return true;
 }
 
 void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int* contacts, int count,
@@ -898,7 +909,7 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
     PD_ASSERT(contacts[k] >= 0 && contacts[k] < from->contacts->count);
     remap_slot(&set->next[k], model, from, contacts[k], toSub);
   }
-  install_moved(sub, to, count);
+  install_moved(sub, to, count, false);
   // what prepare_list derives from the bodies' poses; the slots (modal dampers, forces) come as they were
   poses_from(sub, to->y, set->poses1);
   world_inverse_inertias(sub, set, set->poses1);
@@ -922,7 +933,8 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
   for (int p = 0; p < parts; ++p)
     for (int i = 0; i < from[p]->contacts->count; ++i)
       remap_slot(&set->next[count++], subs[p], from[p], i, toModel[p]);
-  install_moved(model, to, count);
+  // one island's list (sorted: installed so) renumbered in ascending order is sorted (a lone body, every sample)
+  install_moved(model, to, count, parts == 1 && ascending(toModel[0], subs[0]->bodyCount));
   // an island's contacts presented and not read there come unevaluated, with their springs as interpolated: the
   // scene's state evaluates them when read, at the same numbers (its bodies' are the islands')
   for (int i = 0; i < count; ++i) set->unevaluated += set->items[i].unevaluated;

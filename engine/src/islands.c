@@ -354,6 +354,7 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
   s->stageSeconds[pd_stageObserve] += set->observeSeconds;
   s->count.samples = samples;
   compose_set_counters(set, s);
+  set->stagesBehind = false;
 }
 
 // The scene state's counters of the set's own (islands formed, intervals, sleeping ...): all that changes in the
@@ -1001,7 +1002,8 @@ static bool lone_runs(const pdState* s, const struct pdIslandSet* set) {
 // A scene of one moving body asleep, its applied force unchanged: the interval loop would keep the island as it is
 // and gather the same frozen numbers again; over the interval to target only the time asleep grows, as fall_asleep
 // counts it. (A force that changed wakes it there: the interval loop. A step observer keeps the interval loop, as
-// for a lone body awake: lone_runs.)
+// for a lone body awake: lone_runs.) No island steps, so of the scene's counters only the set's change: the stage
+// seconds (the observer's) are composed once, when the call returns.
 static bool lone_sleep_on(const pdModel* model, pdState* s, struct pdIslandSet* set, double target) {
   if (set->movingCount != 1 || set->islandCount != 1 || !set->islands[0]->asleep || s->stepObserver ||
       pd_sleep_force_changed(set->sleep, &model->bodies[model->movingBodies[0]], 0, s->t))
@@ -1009,7 +1011,8 @@ static bool lone_sleep_on(const pdModel* model, pdState* s, struct pdIslandSet* 
   set->t0 = s->t;
   set->startsFormed = false;
   set->sleep->bodySeconds += target - set->t0;
-  compose_counters(set, s);
+  compose_set_counters(set, s);
+  set->stagesBehind = true;
   s->t = target;
   return true;
 }
@@ -1075,5 +1078,6 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
     }
     if (s->t == tSample) observe(model, s, set, observer, user);
   }
+  if (set->stagesBehind) compose_counters(set, s);
   return !s->stopped;
 }
