@@ -25,6 +25,7 @@
 #include "contact_set.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -161,6 +162,7 @@ void pd_contact_set_free(pdContactSet* set) {
 void pd_contact_set_clear(pdContactSet* set) {
   if (set->history) pd_history_clear(set->history);
   set->count = 0;
+  set->gatheredSerial = 0;
   set->unevaluated = 0;
   set->bodyListValid = false;
   set->recordedValid = false;
@@ -211,6 +213,7 @@ static void install(const pdModel* model, pdState* s, int count, bool ordered) {
   set->items = set->next;
   set->next = old;
   set->count = count;
+  set->gatheredSerial = 0;  // a gather from a view sets it after
   set->unevaluated = 0;  // a gather counts the unevaluated slots it moved (pd_contact_set_gather)
   set->bodyListValid = false;
   set->recordedValid = false;
@@ -789,7 +792,11 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
 
 // ---------------------------------------------------------------- dense output (dense_output.c)
 
+// Captures in the whole process, numbered from 1 (islands capture on any thread).
+static atomic_ulong captureSerials;
+
 void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
+  view->captureSerial = atomic_fetch_add(&captureSerials, 1) + 1;
   pd_contact_set_reserve_list(view, from->count > 0 ? from->count : 1);  // never NULL: memcpy of nothing still wants a pointer
   memcpy(view->items, from->items, (size_t)from->count * sizeof *view->items);
   for (int i = 0; i < from->count; ++i) {
@@ -916,6 +923,37 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
   pd_stability_prepare(sub, set, set->poses1);
 }
 
+// The scene's list as gathered from the same capture of one island's view (pd_contact_set_gather): since that gather,
+// the view was presented again (normal, point, depth, unevaluated) and either list may have been evaluated (its
+// springs realigned, its force, geometry and held modes recorded); every other field of every slot is the capture's,
+// renumbered as it was. Renews those fields and the springs: the slots a full gather would write.
+static void regather(const pdModel* model, pdState* to, const pdModel* sub, const pdState* from) {
+  pdContactSet* set = to->contacts;
+  const pdContactSet* view = from->contacts;
+  int base = spring_base(model), fromBase = spring_base(sub);
+  for (int i = 0; i < set->count; ++i) {
+    contactSlot* c = &set->items[i];
+    const contactSlot* v = &view->items[i];
+    c->normal = v->normal;
+    c->point = v->point;
+    c->depth = v->depth;
+    c->force = v->force;
+    c->heldPush = v->heldPush;
+    c->heldSlip = v->heldSlip;
+    c->unevaluated = v->unevaluated;
+    c->springs = springs_load(from->y + fromBase + PD_CONTACT_STATE_SIZE * i);
+    springs_store(to->y + base + PD_CONTACT_STATE_SIZE * i, &c->springs);
+  }
+  set->candidateCount = 0;
+  set->onsetRetries = 0;
+  set->modeRetries = 0;
+  set->bodyListValid = false;
+  set->recordedValid = false;
+  set->unevaluated = 0;
+  for (int i = 0; i < set->count; ++i) set->unevaluated += set->items[i].unevaluated;
+  set->unevaluatedModel = model;
+}
+
 void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const pdModel* const* subs,
                            const pdState* const* from, const int* const* toModel) {
   pdContactSet* set = to->contacts;
@@ -926,6 +964,12 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
     PD_ASSERT(to->n == spring_base(model));
     set->bodyListValid = false;
     set->recordedValid = false;  // its bodies were just gathered: what record() kept is of other numbers
+    return;
+  }
+  // a lone island presenting the same step's list again (a body in contact, gathered at every sample)
+  unsigned long serial = parts == 1 ? from[0]->contacts->captureSerial : 0;
+  if (serial != 0 && serial == set->gatheredSerial && total == set->count) {
+    regather(model, to, subs[0], from[0]);
     return;
   }
   pd_contact_set_reserve_list(set, total);
@@ -939,6 +983,7 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
   // scene's state evaluates them when read, at the same numbers (its bodies' are the islands')
   for (int i = 0; i < count; ++i) set->unevaluated += set->items[i].unevaluated;
   set->unevaluatedModel = model;
+  set->gatheredSerial = serial;
 }
 
 // The state's vectors grow with its contact list: install, above, calls it between steps (state_layout.h).
