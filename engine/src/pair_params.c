@@ -83,7 +83,7 @@ static double stack_mass(const pdModel* model, pdContactSet* set, const pdPose* 
   const pdContactParams* p = &set->items[first].params;
   double omega;
   if (!p->modalN) return 0.0;
-  // ~85 kB: a list that never needs it (a dense output's view, an island of one falling body) makes none; made
+  // ~125 kB: a list that never needs it (a dense output's view, an island of one falling body) makes none; made
   // at the first contacts a list has, as its GSL workspaces are (stack_modes.c)
   if (!set->stackScratch) set->stackScratch = pd_stack_scratch_create();
   if (!pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omega)) return 0.0;

@@ -15,6 +15,9 @@ typedef struct pdStackScratch pdStackScratch;
 
 pdStackScratch* pd_stack_scratch_create(void);
 void pd_stack_scratch_free(pdStackScratch* scratch);
+// How many times pd_stack_pair_frequency read a decomposition again for a matrix equal bit for bit to the last one
+// it decomposed with this scratch (stack_modes.c).
+long pd_stack_scratch_reuses(const pdStackScratch* scratch);
 
 // The slow frequency Ω (rad/s) that pair [first, last) of the list takes part in along the normals, from the
 // undamped normal modes of its local system (the pair's moving bodies and their neighbours in contact, every contact

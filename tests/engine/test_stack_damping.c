@@ -7,14 +7,17 @@
 #include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <cmocka.h>
 
+#include "contact_list.h"
 #include "material.h"
 #include "model_contact.h"
 #include "polydyn/model.h"
 #include "polydyn/state.h"
 #include "scene_run.h"
+#include "stack_modes.h"
 
 // Settled: every body slower than this after SETTLE_TIME (the requirement).
 #define SETTLED_SPEED 1e-3  // m/s
@@ -151,11 +154,80 @@ static void test_heavy_body_on_light_pad_keeps_its_restitution(void** state) {
   }
 }
 
+// The first listed contact of the pair of bodies a < b in a list sorted by pair, and its end; -1 when none.
+static int pair_range(const pdContactSet* set, int a, int b, int* last) {
+  int first = -1;
+  for (int i = 0; i < set->count; ++i) {
+    const pdContactId* id = &set->items[i].id;
+    bool same = (id->body1 == a && id->body2 == b) || (id->body1 == b && id->body2 == a);
+    if (same && first < 0) first = i;
+    if (same) *last = i + 1;
+  }
+  return first;
+}
+
+// A decomposition read again (stack_modes.c, a matrix equal bit for bit to the last one decomposed) gives the slow
+// frequency a fresh scratch computes, bit for bit. A board resting on the floor carries three cubes: the board–floor
+// pair's local system and that of the board with its lowest cube list the same bodies in the same order, so the
+// second reads the first's decomposition; the board with its second cube lists them in another order and decomposes
+// its own.
+static void test_stack_frequency_read_again_equals_recomputed(void** state) {
+  (void)state;
+  pdModel* m = compile_text(
+      "tend 0.05\nsample 100\nsleep off\n"
+      "cube floor grey 3 1 0.2\nfixed\nloc 0 0 -0.1\n"
+      "cube board blue 0.6 0.6 0.03\nloc 0 0 0.015\n"
+      "cube c0 red 0.1 0.1 0.1\nloc -0.12 0 0.08\n"
+      "cube c1 red 0.1 0.1 0.1\nloc 0 0 0.08\n"
+      "cube c2 red 0.1 0.1 0.1\nloc 0.12 0 0.08\n");
+  pdStateOptions options = pd_state_options_default();
+  options.islands = pd_islandsOff;  // one list holds every contact
+  pdState* s = pd_state_create(m, &options);
+  assert_true(pd_advance(m, s, m->settings.tend, NULL, NULL));
+  pdContactSet* set = s->contacts;
+  pd_contact_set_list_bodies(m, set);
+  pdPose* poses = malloc((size_t)m->bodyCount * sizeof *poses);
+  for (int k = 0; k < m->bodyCount; ++k) {
+    pdBodyState b = pd_state_body(m, s, k);
+    poses[k] = pose_of(b.x, b.q);
+  }
+  int floorEnd = 0, firstEnd = 0, secondEnd = 0;
+  int floorPair = pair_range(set, 0, 1, &floorEnd), firstCube = pair_range(set, 1, 2, &firstEnd),
+      secondCube = pair_range(set, 1, 3, &secondEnd);
+  assert_true(floorPair >= 0 && firstCube >= 0 && secondCube >= 0);
+
+  pdStackScratch* shared = pd_stack_scratch_create();
+  double floorOmega = 0.0, firstOmega = 0.0, secondOmega = 0.0;
+  assert_true(pd_stack_pair_frequency(m, set, poses, floorPair, floorEnd, shared, &floorOmega));
+  assert_int_equal(pd_stack_scratch_reuses(shared), 0);
+  assert_true(pd_stack_pair_frequency(m, set, poses, firstCube, firstEnd, shared, &firstOmega));
+  assert_int_equal(pd_stack_scratch_reuses(shared), 1);
+  assert_true(pd_stack_pair_frequency(m, set, poses, secondCube, secondEnd, shared, &secondOmega));
+  assert_int_equal(pd_stack_scratch_reuses(shared), 1);
+
+  const int firsts[2] = {firstCube, secondCube}, lasts[2] = {firstEnd, secondEnd};
+  const double kept[2] = {firstOmega, secondOmega};
+  for (int p = 0; p < 2; ++p) {
+    pdStackScratch* fresh = pd_stack_scratch_create();
+    double omega = 0.0;
+    assert_true(pd_stack_pair_frequency(m, set, poses, firsts[p], lasts[p], fresh, &omega));
+    assert_int_equal(pd_stack_scratch_reuses(fresh), 0);
+    print_message("pair %d: omega %.17g rad/s, recomputed %.17g\n", p, kept[p], omega);
+    assert_memory_equal(&kept[p], &omega, sizeof omega);
+    pd_stack_scratch_free(fresh);
+  }
+  pd_stack_scratch_free(shared);
+  free(poses);
+  pd_state_free(s);
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_stacks_of_any_mass_ratio_settle),
       cmocka_unit_test(test_stack_bounce_has_the_requested_damping_ratio),
       cmocka_unit_test(test_heavy_body_on_light_pad_keeps_its_restitution),
+      cmocka_unit_test(test_stack_frequency_read_again_equals_recomputed),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
