@@ -292,10 +292,11 @@ bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* 
 // The cost of a work-precision point (gedanken/timing.c; docs/validation.md, "The cost of a point")
 
 // One timing repeats a point's run back to back until the runs' spans have taken at least this much CPU time in
-// all, s. A run of a body or two on a floor takes 0.05–1 ms, where one reading is set by the clock, a cold cache and
-// the other processes on a shared machine: the costs of consecutive single runs part by 1.5–4× (max/min), those of
-// consecutive 20 ms timings of the same runs by 1.05–1.3×, and 50 ms timings gain little more (what remains is the
-// machine's load changing over seconds, which the minimum over a point's timings, taken far apart, answers).
+// all, s. A run of a body or two on a floor is a fraction of a millisecond, where one reading is set by the clock, a
+// cold cache and the other processes on a shared machine; the costs of consecutive single runs part by several
+// times, those of consecutive timings of this length mostly by a tenth or less, and longer timings gain little more (what
+// remains is the machine's load changing over seconds, which the least of a point's timings, taken minutes apart,
+// answers). Measured: reports/bench/precision-timing/README.md.
 #define PD_GK_TIMING_MIN_CPU_SECONDS 0.020
 // At most this many runs in one timing: a clock that does not advance must not hang the sweep.
 #define PD_GK_TIMING_MAX_RUNS 100000
