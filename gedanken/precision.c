@@ -152,7 +152,7 @@ static bool run_point(void* user, double* wall, double* cpu) {
   gkPointObserver observer = {r->rec, r->s, p->engine == pd_gkSoft};
   r->rec = NULL;
   if (r->model) {
-    // the span of a reference engine's run (pd_ref_run): the engine's state created, then run to the end
+    // the same span as a reference engine's run (pd_ref_run): the engine's state created, then run to the end
     double t0 = gk_wall_seconds(), c0 = gk_cpu_seconds();
     pdState* state = pd_state_create(r->model, &r->stateOptions);
     bool completed = pd_advance(r->model, state, r->model->settings.tend, observe, &observer);
