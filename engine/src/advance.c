@@ -11,5 +11,5 @@
 bool pd_advance(const pdModel* model, pdState* s, double tEnd, pdObserverFcn* observer, void* user) {
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
   if (s->islands == pd_islandsOn) return pd_islands_advance(model, s, tEnd, observer, user);
-  return pd_step_until(model, s, tEnd, false, observer, user, NULL, NULL);
+  return pd_step_until(model, s, tEnd, false, observer, user, true, NULL, NULL);
 }

@@ -183,6 +183,9 @@ struct pdContactSet {
   int unevaluated;
   const pdModel* unevaluatedModel;
   pdPose* settlePoses;
+  // a presented view's invInertiaWorld is due at its poses (formed with its contacts, when first read: the
+  // linearisation settles the state before it reads them)
+  bool inertiasPending;
   double* kinkSum;         // (bodyCount) scratch of pd_contact_events: the step's stick–slip kinks' slopes per body
   struct pdStackScratch* stackScratch;  // the modal dampers' local mode analyses (stack_modes.h); NULL until first needed
   contactPush* push;       // (capacity) per contact, of the last derivative evaluation
@@ -193,6 +196,10 @@ struct pdContactSet {
   int recordedCapacity;
   bool recordedValid;          // cleared by a list installed or cleared
   int capturedCount;           // a dense output's view (dense_output.h): the captured list's length, its slots in items
+  // A view's capture, unique in the process (0: none, or not a view); and, in a scene's list gathered from one island's
+  // view, the capture it was last gathered from slot by slot (0: none since its list was last installed otherwise):
+  // pd_contact_set_gather then renews only what a presentation and an evaluation change.
+  unsigned long captureSerial, gatheredSerial;
   capturedGeometry* captured;  // (capacity) a view's: each captured slot's normal, point and depth, which a
                                // presentation overwrites in items and the next one restores
   pdHelpDesk* help;        // where the per-contact and per-pair loops post half their work, or NULL (help_desk.h)

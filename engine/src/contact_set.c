@@ -25,6 +25,7 @@
 #include "contact_set.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -161,6 +162,7 @@ void pd_contact_set_free(pdContactSet* set) {
 void pd_contact_set_clear(pdContactSet* set) {
   if (set->history) pd_history_clear(set->history);
   set->count = 0;
+  set->gatheredSerial = 0;
   set->unevaluated = 0;
   set->bodyListValid = false;
   set->recordedValid = false;
@@ -191,13 +193,14 @@ static int compare_slots(const void* a, const void* b) {
 
 // Makes next[0..count) (springs inside the slots) the contact list: sorts it, lays out the springs after
 // the bodies' numbers (already in state->y) in state->y, sets their weights and state->n. May grow the
-// state's vectors: the stepper's scratch is dropped then, so nothing may still point into it.
-static void install(const pdModel* model, pdState* s, int count) {
+// state's vectors: the stepper's scratch is dropped then, so nothing may still point into it. `ordered`: the
+// caller knows next[] sorted (one island's list, its bodies renumbered in the same order).
+static void install(const pdModel* model, pdState* s, int count, bool ordered) {
   pdContactSet* set = s->contacts;
   // a list that changed in no contact comes in sorted (ids are unique, so any sort gives the one order): checked
   // first, since qsort moves slots of ~0.5 kB through a scratch copy (7 % of cases/hard/stack_10.scene's work)
   bool sorted = true;
-  for (int i = 1; i < count && sorted; ++i) sorted = compare_slots(&set->next[i - 1], &set->next[i]) < 0;
+  for (int i = 1; i < count && sorted && !ordered; ++i) sorted = compare_slots(&set->next[i - 1], &set->next[i]) < 0;
   if (!sorted) qsort(set->next, (size_t)count, sizeof *set->next, compare_slots);
   pd_state_reserve_contacts(model, s, count);
   int base = spring_base(model);
@@ -210,6 +213,7 @@ static void install(const pdModel* model, pdState* s, int count) {
   set->items = set->next;
   set->next = old;
   set->count = count;
+  set->gatheredSerial = 0;  // a gather from a view sets it after
   set->unevaluated = 0;  // a gather counts the unevaluated slots it moved (pd_contact_set_gather)
   set->bodyListValid = false;
   set->recordedValid = false;
@@ -631,7 +635,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
       }
       if (added > 0) {
         s->count.contactsVirtual += added;
-        install(model, s, count);
+        install(model, s, count, false);
         poses_from(model, s->y, set->poses0);
         prepare_list(model, set, s->y, set->poses0);
         verdict = pd_eventRestart;
@@ -779,7 +783,7 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
     if (set->eval[i].modeCorrected)
       pd_contact_impulse(model, set, s->y, set->poses1, &set->items[i].id, set->eval[i].geom.point,
                          set->eval[i].modeImpulse);
-  install(model, s, count);
+  install(model, s, count, false);
   poses_from(model, s->y, set->poses1);
   s->count.onsetsInterpolated += prepare_list(model, set, s->y, set->poses1);
   if (set->history) pd_history_age(model, set->history, set->poses1);
@@ -788,7 +792,11 @@ void pd_contact_events_commit(const pdModel* model, pdState* s, const double* y1
 
 // ---------------------------------------------------------------- dense output (dense_output.c)
 
+// Captures in the whole process, numbered from 1 (islands capture on any thread).
+static atomic_ulong captureSerials;
+
 void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
+  view->captureSerial = atomic_fetch_add(&captureSerials, 1) + 1;
   pd_contact_set_reserve_list(view, from->count > 0 ? from->count : 1);  // never NULL: memcpy of nothing still wants a pointer
   memcpy(view->items, from->items, (size_t)from->count * sizeof *view->items);
   for (int i = 0; i < from->count; ++i) {
@@ -800,16 +808,16 @@ void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
   view->unevaluated = 0;
 }
 
-void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y) {
+void pd_contact_set_present(const pdModel* model, pdContactSet* view) {
   int count = view->capturedCount;
   view->count = count;
   view->bodyListValid = false;
   view->unevaluated = 0;
-  // the poses and inverse inertias are read for the bodies of the view's contacts only (the implicit stepper's
-  // linearisation): a view without contacts (a body in flight, presented at every sample) needs none
+  // the inverse inertias are read for the bodies of the view's contacts only (the implicit stepper's linearisation,
+  // which settles the state first): formed with the contacts when first read, at the same poses; a view without
+  // contacts (a body in flight, presented at every sample) needs none
   if (count == 0) return;
-  poses_from(model, y, view->poses1);
-  world_inverse_inertias(model, view, view->poses1);
+  view->inertiasPending = true;
   // each contact as captured (a presentation at another time of the same step evaluated it there), evaluated at
   // the sample only when read (pd_contact_set_settle): most samples' observers read the bodies alone
   for (int i = 0; i < count; ++i) {
@@ -828,6 +836,8 @@ void pd_contact_set_settle(pdContactSet* set, double* y) {
   const pdModel* model = set->unevaluatedModel;
   const pdPose* poses = set->settlePoses;
   poses_from(model, y, set->settlePoses);
+  if (set->inertiasPending) world_inverse_inertias(model, set, poses);
+  set->inertiasPending = false;
   int base = spring_base(model);
   // realigned as a commit realigns the contacts it keeps (one that pulls keeps its springs: a commit drops it),
   // then recorded as record() records: the same geometry and relative velocity, the force of the springs as
@@ -881,11 +891,19 @@ static void remap_slot(contactSlot* c, const pdModel* fromModel, const pdState* 
 }
 
 // Installs next[0 .. count) as the list of `to` (a state of `model`), with no candidates or retries pending.
-static void install_moved(const pdModel* model, pdState* to, int count) {
+static void install_moved(const pdModel* model, pdState* to, int count, bool ordered) {
   to->contacts->candidateCount = 0;
   to->contacts->onsetRetries = 0;
   to->contacts->modeRetries = 0;
-  install(model, to, count);  // sorted by id: the order the slots came in does not matter
+  install(model, to, count, ordered);  // sorted by id: the order the slots came in does not matter
+}
+
+// Whether map[0 .. n) ascends: a list sorted by id (pd_contact_id_compare reads the bodies' order and equality
+// alone) stays sorted with its bodies renumbered by it.
+static bool ascending(const int* map, int n) {
+  for (int i = 1; i < n; ++i)
+    if (!(map[i - 1] < map[i])) return false;
+  return true;
 }
 
 void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int* contacts, int count,
@@ -898,11 +916,42 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
     PD_ASSERT(contacts[k] >= 0 && contacts[k] < from->contacts->count);
     remap_slot(&set->next[k], model, from, contacts[k], toSub);
   }
-  install_moved(sub, to, count);
+  install_moved(sub, to, count, false);
   // what prepare_list derives from the bodies' poses; the slots (modal dampers, forces) come as they were
   poses_from(sub, to->y, set->poses1);
   world_inverse_inertias(sub, set, set->poses1);
   pd_stability_prepare(sub, set, set->poses1);
+}
+
+// The scene's list as gathered from the same capture of one island's view (pd_contact_set_gather): since that gather,
+// the view was presented again (normal, point, depth, unevaluated) and either list may have been evaluated (its
+// springs realigned, its force, geometry and held modes recorded); every other field of every slot is the capture's,
+// renumbered as it was. Renews those fields and the springs: the slots a full gather would write.
+static void regather(const pdModel* model, pdState* to, const pdModel* sub, const pdState* from) {
+  pdContactSet* set = to->contacts;
+  const pdContactSet* view = from->contacts;
+  int base = spring_base(model), fromBase = spring_base(sub);
+  for (int i = 0; i < set->count; ++i) {
+    contactSlot* c = &set->items[i];
+    const contactSlot* v = &view->items[i];
+    c->normal = v->normal;
+    c->point = v->point;
+    c->depth = v->depth;
+    c->force = v->force;
+    c->heldPush = v->heldPush;
+    c->heldSlip = v->heldSlip;
+    c->unevaluated = v->unevaluated;
+    c->springs = springs_load(from->y + fromBase + PD_CONTACT_STATE_SIZE * i);
+    springs_store(to->y + base + PD_CONTACT_STATE_SIZE * i, &c->springs);
+  }
+  set->candidateCount = 0;
+  set->onsetRetries = 0;
+  set->modeRetries = 0;
+  set->bodyListValid = false;
+  set->recordedValid = false;
+  set->unevaluated = 0;
+  for (int i = 0; i < set->count; ++i) set->unevaluated += set->items[i].unevaluated;
+  set->unevaluatedModel = model;
 }
 
 void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const pdModel* const* subs,
@@ -917,16 +966,24 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
     set->recordedValid = false;  // its bodies were just gathered: what record() kept is of other numbers
     return;
   }
+  // a lone island presenting the same step's list again (a body in contact, gathered at every sample)
+  unsigned long serial = parts == 1 ? from[0]->contacts->captureSerial : 0;
+  if (serial != 0 && serial == set->gatheredSerial && total == set->count) {
+    regather(model, to, subs[0], from[0]);
+    return;
+  }
   pd_contact_set_reserve_list(set, total);
   int count = 0;
   for (int p = 0; p < parts; ++p)
     for (int i = 0; i < from[p]->contacts->count; ++i)
       remap_slot(&set->next[count++], subs[p], from[p], i, toModel[p]);
-  install_moved(model, to, count);
+  // one island's list (sorted: installed so) renumbered in ascending order is sorted (a lone body, every sample)
+  install_moved(model, to, count, parts == 1 && ascending(toModel[0], subs[0]->bodyCount));
   // an island's contacts presented and not read there come unevaluated, with their springs as interpolated: the
   // scene's state evaluates them when read, at the same numbers (its bodies' are the islands')
   for (int i = 0; i < count; ++i) set->unevaluated += set->items[i].unevaluated;
   set->unevaluatedModel = model;
+  set->gatheredSerial = serial;
 }
 
 // The state's vectors grow with its contact list: install, above, calls it between steps (state_layout.h).

@@ -109,9 +109,10 @@ pdContactSet* pd_contact_set_create_view(const pdModel* model);
 // Dense output (dense_output.h): copies the list of `from` into `view` (another set of the same model), kept there
 // until the next capture.
 void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view);
-// Makes the captured list the list of `view` at state y (its layout), each contact unevaluated: as captured, its
-// springs in y as interpolated, until pd_contact_set_settle evaluates it.
-void pd_contact_set_present(const pdModel* model, pdContactSet* view, double* y);
+// Makes the captured list the list of `view` (the presented state's, in its layout), each contact unevaluated: as
+// captured, its springs in the state as interpolated, until pd_contact_set_settle evaluates it (and forms the bodies'
+// world inverse inertias at the state's poses).
+void pd_contact_set_present(const pdModel* model, pdContactSet* view);
 // Evaluates the set's unevaluated contacts (a presentation's, and the slots a gather moved from one) at state y
 // (the state whose list it is): each one's springs in y realigned to its normal at y as a commit would (those that
 // pull left as they are), then its geometry and force recorded for output, as a presentation did eagerly. Every

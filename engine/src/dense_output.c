@@ -238,7 +238,7 @@ void pd_dense_present(const pdModel* model, pdState* s, double t) {
     double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     for (int i = 0; i < 4; ++i) q[i] /= norm;
   }
-  pd_contact_set_present(model, d->view, d->yView);
+  pd_contact_set_present(model, d->view);
   d->tOwn = s->t;
   d->yOwn = s->y;
   d->nOwn = s->n;

@@ -677,13 +677,13 @@ static void step_ended(const pdModel* model, const pdState* s, pdStepHookFcn* ho
 }
 
 bool pd_step_until(const pdModel* model, pdState* s, double tEnd, bool landOnEnd, pdObserverFcn* observer, void* user,
-                   pdStepHookFcn* hook, void* hookUser) {
+                   bool observerTimed, pdStepHookFcn* hook, void* hookUser) {
   PD_ASSERT(model != NULL && s != NULL && tEnd >= s->t);
   if (s->failed) return false;
   s->stopped = false;
   // skip samples already behind us (a state advanced without an observer, then with one)
   while (pd_sample_time(model, s->nextSample) < s->t) ++s->nextSample;
-  if (pd_sample_time(model, s->nextSample) == s->t) pd_observe(model, s, observer, user);
+  if (pd_sample_time(model, s->nextSample) == s->t) pd_observe(model, s, observer, user, observerTimed);
   if (s->stopped) return false;
   if (s->stepObserver) s->stepObserver(model, s, true, s->stepUser);
   // a state presented at the last call's end goes on from the integration's own, later, state; that step's end was
@@ -694,7 +694,7 @@ bool pd_step_until(const pdModel* model, pdState* s, double tEnd, bool landOnEnd
     // leaves the state at that sample, presented)
     for (double tSample; (tSample = pd_sample_time(model, s->nextSample)) <= s->t && tSample <= tEnd;) {
       if (tSample < s->t && observer) pd_dense_present(model, s, tSample);
-      pd_observe(model, s, observer, user);
+      pd_observe(model, s, observer, user, observerTimed);
       if (s->stopped) return false;
       pd_dense_resume(s);
     }

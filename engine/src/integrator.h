@@ -13,6 +13,7 @@ typedef void pdStepHookFcn(const pdModel* model, const pdState* state, void* use
 // pd_advance's contract (state.h) for one system, whatever state->islands says: observer (nullable) at every output
 // sample, and `hook` (nullable) with `hookUser` after each step that ends by tEnd and once more with the state
 // presented at tEnd when the last step passed it. With landOnEnd the last step is cut to end on tEnd unless the state
-// is already past it (dense output, dense_output.h).
+// is already past it (dense output, dense_output.h). `observerTimed`: the observer's calls are timed into the state's
+// observe stage (false: an island's observer, which times what it calls itself).
 bool pd_step_until(const pdModel* model, pdState* state, double tEnd, bool landOnEnd, pdObserverFcn* observer, void* user,
-                   pdStepHookFcn* hook, void* hookUser);
+                   bool observerTimed, pdStepHookFcn* hook, void* hookUser);

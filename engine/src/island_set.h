@@ -78,6 +78,7 @@ struct pdIslandSet {
   long retiredWarnings[pd_warnCount];
   double retiredStages[pd_stageCount];
   double observeSeconds;  // the scene's observer calls
+  bool stagesBehind;      // the scene's stage seconds not composed since a lone sleeper's interval (islands.c)
   long formed, largest, intervals, redos;
   pdPool pool;  // the caller and pdState.threads − 1 workers (design note, "Threads"; pool.h)
   // the batch: jobCount islands, all to jobTime

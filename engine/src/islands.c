@@ -261,7 +261,7 @@ static travelProbe start_probe(struct pdIslandSet* set, island* is, bool coarse)
 // over the whole sample interval, and keeps what it measured since T0.
 static bool island_advance(struct pdIslandSet* set, island* is, double tNext, bool land, bool coarse) {
   travelProbe probe = start_probe(set, is, coarse);
-  return pd_step_until(&is->model, is->state, tNext, land, NULL, NULL, measure_travel, &probe);
+  return pd_step_until(&is->model, is->state, tNext, land, NULL, NULL, false, measure_travel, &probe);
 }
 
 // ---------------------------------------------------------------- the pool's jobs
@@ -354,6 +354,7 @@ static void compose_counters(struct pdIslandSet* set, pdState* s) {
   s->stageSeconds[pd_stageObserve] += set->observeSeconds;
   s->count.samples = samples;
   compose_set_counters(set, s);
+  set->stagesBehind = false;
 }
 
 // The scene state's counters of the set's own (islands formed, intervals, sleeping ...): all that changes in the
@@ -846,7 +847,7 @@ static int sync_parts(const pdModel* model, const struct pdIslandSet* set, doubl
 }
 
 static void observe(const pdModel* model, pdState* s, struct pdIslandSet* set, pdObserverFcn* observer, void* user) {
-  set->observeSeconds += pd_observe(model, s, observer, user);
+  set->observeSeconds += pd_observe(model, s, observer, user, true);
 }
 
 // ---------------------------------------------------------------- a lone body across samples
@@ -879,7 +880,6 @@ typedef struct loneRun {
   bool pending;
   double pendingT;
   double pendingY[PD_BODY_STATE_SIZE];
-  double observeSeconds;  // the island's own observe stage before the run (the caller's observer is counted in the set)
   long derivatives;       // the island's derivative evaluations when the scene's counters were last composed
 } loneRun;
 
@@ -978,7 +978,6 @@ static bool lone_sample(const pdModel* sub, const pdState* state, void* user) {
   (void)sub;  // the island's: run->is->model
   loneRun* run = user;
   PD_ASSERT(run->open && state->t == run->tInterval);
-  run->is->state->stageSeconds[pd_stageObserve] = run->observeSeconds;
   lone_measure(run, state->t, state->y);
   lone_interval_end(run, state->t);
   observe(run->model, run->s, run->set, run->observer, run->user);
@@ -1001,7 +1000,8 @@ static bool lone_runs(const pdState* s, const struct pdIslandSet* set) {
 // A scene of one moving body asleep, its applied force unchanged: the interval loop would keep the island as it is
 // and gather the same frozen numbers again; over the interval to target only the time asleep grows, as fall_asleep
 // counts it. (A force that changed wakes it there: the interval loop. A step observer keeps the interval loop, as
-// for a lone body awake: lone_runs.)
+// for a lone body awake: lone_runs.) No island steps, so of the scene's counters only the set's change: the stage
+// seconds (the observer's) are composed once, when the call returns.
 static bool lone_sleep_on(const pdModel* model, pdState* s, struct pdIslandSet* set, double target) {
   if (set->movingCount != 1 || set->islandCount != 1 || !set->islands[0]->asleep || s->stepObserver ||
       pd_sleep_force_changed(set->sleep, &model->bodies[model->movingBodies[0]], 0, s->t))
@@ -1009,7 +1009,8 @@ static bool lone_sleep_on(const pdModel* model, pdState* s, struct pdIslandSet* 
   set->t0 = s->t;
   set->startsFormed = false;
   set->sleep->bodySeconds += target - set->t0;
-  compose_counters(set, s);
+  compose_set_counters(set, s);
+  set->stagesBehind = true;
   s->t = target;
   return true;
 }
@@ -1021,11 +1022,10 @@ static bool lone_run(const pdModel* model, pdState* s, struct pdIslandSet* set, 
   island* is = set->islands[0];
   PD_ASSERT(is->bodyCount == 1 && is->state->t == s->t);
   loneRun run = {.model = model, .s = s, .set = set, .is = is, .observer = observer, .user = user, .tEnd = tEnd,
-                 .observeSeconds = is->state->stageSeconds[pd_stageObserve],
                  .derivatives = is->state->count.derivatives};
   lone_interval_start(&run);
-  bool ok = pd_step_until(&is->model, is->state, tEnd, false, lone_sample, &run, lone_step_end, &run);
-  is->state->stageSeconds[pd_stageObserve] = run.observeSeconds;
+  // lone_sample untimed: it times the caller's observer into the scene's observe stage itself (observe())
+  bool ok = pd_step_until(&is->model, is->state, tEnd, false, lone_sample, &run, false, lone_step_end, &run);
   if (ok && run.open) lone_interval_end(&run, tEnd);  // a call ending between samples: the scene gathered there
   compose_counters(set, s);
   return ok || !is->state->failed;
@@ -1075,5 +1075,6 @@ bool pd_islands_advance(const pdModel* model, pdState* s, double tEnd, pdObserve
     }
     if (s->t == tSample) observe(model, s, set, observer, user);
   }
+  if (set->stagesBehind) compose_counters(set, s);
   return !s->stopped;
 }

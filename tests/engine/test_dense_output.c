@@ -12,7 +12,8 @@
 // - A presented state's contacts are evaluated when first read (pd_contact_set_settle): a run whose observer reads
 //   every contact and the energy at every sample (as an eager evaluation would form them) and one that reads them at
 //   every 9th sample only give the same contacts, energies and bodies there bit for bit, and the same bodies at every
-//   sample, with sliding, sticking and sleeping contacts, islands off and on.
+//   sample, with sliding, sticking and sleeping contacts, islands off and on; a lone body's contacts, gathered into
+//   the scene at every sample from its island's presentation, are those of islands off bit for bit.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -294,6 +295,57 @@ static void test_contacts_read_when_needed_are_those_evaluated_at_every_sample(v
   }
 }
 
+// A lone body's island presents the same step's contacts at every sample, and the scene's list gathered from it is
+// renewed where a presentation and an evaluation change it (pd_contact_set_gather): with islands on, its contacts read
+// at every sample and at every 9th are those of islands off bit for bit, and so are its bodies at every sample,
+// sliding, turning and sticking. (Not the energy: with islands off it counts the springs the presented step's contact
+// history keeps, which a gather does not carry.) With sleep on (islands only) the body falls asleep, and the runs
+// reading at every sample and at every 9th agree.
+static void compare_lone(const readings* ref, const readings* r, const char* what) {
+  assert_int_equal(ref->count, r->count);
+  int read = 0;
+  for (int k = 0; k < ref->count; ++k) {
+    assert_true(same_bits(ref->b[k], r->b[k], sizeof ref->b[k]));
+    if (k % r->every != 0 || k % ref->every != 0) continue;
+    assert_int_equal(ref->contacts[k], r->contacts[k]);
+    for (int i = 0; i < ref->contacts[k] && i < READ_CONTACTS; ++i, ++read)
+      assert_true(same_report(&ref->c[k][i], &r->c[k][i]));
+  }
+  print_message("%s, contacts read at every %d sample(s): %d contact readings the same\n", what, r->every, read);
+}
+
+static void test_a_lone_body_gathered_at_every_sample_is_islands_off(void** state) {
+  (void)state;
+  static const char FLOOR[] =
+      "tend 0.8\nsample 1000\nsleep %s\ncube floor grey 3 2 0.2\nfixed\nloc 0 0 -0.1\nmu 0.5\n%s";
+  // a box sliding and turning to rest on the floor
+  static const char BOX[] =
+      "cube box red 0.2 0.15 0.1\nloc 0 0 0.0505\nvel 0.8 0 0  4 0 0 1\nmu 0.5\nrestitution 0.5\n";
+  // a plank tipping off a fixed ridge (a cube on its edge) onto the floor: the ridge's corners on the plank's face,
+  // normals that turn with it
+  static const char PLANK[] = "cube ridge grey 0.2 0.2 0.2\nfixed\nloc 0.8 0 0.05  45 1 0 0\nmu 0.5\n"
+                              "cube plank blue 0.4 0.3 0.02\nloc 0.8 0.04 0.2016\nmu 0.5\nrestitution 0.3\n";
+  const char* bodies[2] = {BOX, PLANK};
+  char text[1024];
+  for (int scene = 0; scene < 2; ++scene) {
+    snprintf(text, sizeof text, FLOOR, "off", bodies[scene]);
+    readings* off = run_read(text, pd_islandsOff, 1);
+    assert_true(off->sliding > 0 && off->sticking > 0);
+    for (int every = 1; every <= 9; every += 8) {
+      readings* on = run_read(text, pd_islandsOn, every);
+      compare_lone(off, on, scene == 0 ? "box, islands on against off" : "plank, islands on against off");
+      free(on);
+    }
+    free(off);
+  }
+  snprintf(text, sizeof text, FLOOR, "on", BOX);
+  readings* all = run_read(text, pd_islandsOn, 1);
+  readings* some = run_read(text, pd_islandsOn, 9);
+  compare_lone(all, some, "box, sleep on, islands on");
+  free(all);
+  free(some);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_the_samples_do_not_change_the_steps),
@@ -302,6 +354,7 @@ int main(void) {
       cmocka_unit_test(test_a_presented_resting_box_carries_its_weight),
       cmocka_unit_test(test_a_run_stopped_between_samples_is_the_run_that_did_not_stop),
       cmocka_unit_test(test_contacts_read_when_needed_are_those_evaluated_at_every_sample),
+      cmocka_unit_test(test_a_lone_body_gathered_at_every_sample_is_islands_off),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

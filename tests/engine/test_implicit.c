@@ -14,6 +14,7 @@
 
 #include <cmocka.h>
 
+#include "contact_list.h"
 #include "implicit.h"
 #include "polydyn/model.h"
 #include "polydyn/scene.h"
@@ -292,6 +293,55 @@ static void test_a_reset_state_runs_as_a_new_one(void** state) {
   pd_model_free(m);
 }
 
+// Stops a run at its `stopAt`-th sample (user: the count left), the state presented there.
+static bool stop_at_sample(const pdModel* model, const pdState* state, void* user) {
+  (void)model, (void)state;
+  int* left = user;
+  return --*left > 0;
+}
+
+// R I⁻¹ Rᵀ of moving body b at the state's poses, as a commit forms it (contact_set.c).
+static pdMat3 world_inverse_inertia(const pdModel* m, const pdState* s, int b) {
+  pdPose pose = pose_of(pd_layout_x(s->y + PD_BODY_STATE_SIZE * m->bodies[b].stateIndex),
+                        pd_layout_q(s->y + PD_BODY_STATE_SIZE * m->bodies[b].stateIndex));
+  pdMat3 rt = pd_mat3_transpose(&pose.R);
+  pdMat3 tmp = pd_mat3_mul(&m->bodies[b].invInertia, &rt);
+  return pd_mat3_mul(&pose.R, &tmp);
+}
+
+// A presented state's bodies' world inverse inertias are formed when its contacts are first read (the linearisation
+// settles them): at the presented poses, bit for bit, at two samples inside the same steps of a box turning as it
+// slides (so a value left from another presentation, or none, would differ).
+static void test_a_presented_state_linearises_at_its_own_inertias(void** state) {
+  (void)state;
+  pdModel* m = compile_text("tend 0.2\nsample 1000\nsleep off\n"
+                            "cube floor grey 2 2 0.2\nfixed\nloc 0 0 -0.1\nmu 0.3\n"
+                            "cube box red 0.2 0.1 0.1\nloc 0 0 0.05\nvel 1 0 0  6 0 0 1\nmu 0.3\n");
+  int box = m->movingBodies[0];
+  pdMat3 formed[2];
+  for (int k = 0; k < 2; ++k) {
+    pdStateOptions options = pd_state_options_default();
+    options.islands = pd_islandsOff;
+    options.stepper = pd_stepperImplicit;
+    pdState* s = pd_state_create(m, &options);
+    int left = 101 + k;  // samples at 0.1 s and 0.101 s
+    assert_false(pd_advance(m, s, m->settings.tend, stop_at_sample, &left));  // stopped, presented there
+    assert_true(pd_state_contact_count(s) >= 4);
+    pdImplicit* im = pd_implicit_create();
+    pd_implicit_reserve(im, m->movingCount, pd_state_contact_count(s));
+    pd_implicit_linearise(m, s, im, s->y);
+    formed[k] = s->contacts->invInertiaWorld[box];
+    pdMat3 expected = world_inverse_inertia(m, s, box);
+    assert_memory_equal(&formed[k], &expected, sizeof expected);
+    pd_implicit_free(im);
+    pd_state_free(s);
+  }
+  print_message("box turning on a floor: world inverse inertia (0, 1) at two samples 1 ms apart: %.9g and %.9g\n",
+                formed[0].m[0][1], formed[1].m[0][1]);
+  assert_true(memcmp(&formed[0], &formed[1], sizeof formed[0]) != 0);
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_w_matches_finite_differences_of_the_derivative),
@@ -302,6 +352,7 @@ int main(void) {
       cmocka_unit_test(test_a_stack_of_20_steps_implicitly),
       cmocka_unit_test(test_the_same_run_twice_gives_the_same_numbers),
       cmocka_unit_test(test_a_reset_state_runs_as_a_new_one),
+      cmocka_unit_test(test_a_presented_state_linearises_at_its_own_inertias),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
