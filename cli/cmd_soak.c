@@ -19,7 +19,7 @@
 static const char* const help =
     "usage: polydyn soak --out DIR [--scenes N] [--seed S] [--first I] [--generator G]\n"
     "                    [--engines soft,soft-islands-off,ode,bullet] [--budget SECONDS] [--jobs N]\n"
-    "                    [--onsets pair|exact|auto|bounded] [--check steps|samples]\n"
+    "                    [--onsets pair|exact|auto|bounded] [--check steps|samples] [--penetration-limit D]\n"
     "\n"
     "Generates N random scenes (campaign S of generator G: scene i is the same text on every machine) and\n"
     "runs each in every engine, in a child process per run, checking at every output sample: no NaN or Inf;\n"
@@ -46,6 +46,8 @@ static const char* const help =
     "                   the engine's, as polydyn run --onsets; docs/contact-model.md)\n"
     "  --check WHEN     soft engine: penetration, energy and momentum at every accepted step and every sample\n"
     "                   (steps, the default) or at the output samples only (samples)\n"
+    "  --penetration-limit D  soft engine: the plain penetration limit, delta_max (default 3; a pressed pair's\n"
+    "                   D sqrt(M / m_pair)): a tighter one shows a campaign's margin\n"
     "\n"
     "Exit status: 0 no failure, 1 a run failed (or the results could not be written), 2 bad input,\n"
     "130 interrupted (nothing written).\n";
@@ -115,6 +117,13 @@ static bool accept_seed(const char* cmd, const char* v, void* target) {
   return true;
 }
 
+// --penetration-limit: delta_max > 0, at most 1000 (an overlap of many delta_max is a failure whatever the load).
+static bool accept_penetration_limit(const char* cmd, const char* v, void* target) {
+  if (pd_cli_positive(v, target) && *(double*)target <= 1000.0) return true;
+  pd_cli_usage_error(cmd, "--penetration-limit needs delta_max > 0 (at most 1000)");
+  return false;
+}
+
 // --budget: seconds > 0, at most a day (a run that needs more is a finding of its own).
 static bool accept_budget(const char* cmd, const char* v, void* target) {
   if (pd_cli_positive(v, target) && *(double*)target <= 86400) return true;
@@ -125,7 +134,10 @@ static bool accept_budget(const char* cmd, const char* v, void* target) {
 int pd_cmd_soak(int argc, char** argv) {
   soakJob job = {.generator = PD_SOAK_GENERATOR_LATEST,
                  .seed = 1,
-                 .run = {.onsets = PD_ONSETS_DEFAULT, .budgetSeconds = 20.0, .everyStep = true}};
+                 .run = {.onsets = PD_ONSETS_DEFAULT,
+                         .budgetSeconds = 20.0,
+                         .everyStep = true,
+                         .penetrationLimit = PD_SOAK_PENETRATION_LIMIT}};
   long scenes = 100;
   long generator = PD_SOAK_GENERATOR_LATEST;
   int everyStep = 1;
@@ -152,6 +164,8 @@ int pd_cmd_soak(int argc, char** argv) {
       {.name = "--engines", .kind = pd_optText, .target = &engines},
       {.name = "--budget", .kind = pd_optAccept, .target = &job.run.budgetSeconds, .accept = accept_budget},
       {.name = "--onsets", .kind = pd_optAccept, .target = &job.run.onsets, .accept = pd_cli_accept_onsets},
+      {.name = "--penetration-limit", .kind = pd_optAccept, .target = &job.run.penetrationLimit,
+       .accept = accept_penetration_limit},
       {.name = "--jobs", .kind = pd_optJobs, .target = &jobs, .message = jobsMessage},
   };
   pdCliPositionals none = {.max = 0, .tooMany = "unknown argument '%s'"};
@@ -242,8 +256,11 @@ int pd_cmd_soak(int argc, char** argv) {
       pd_soak_scene_free(&scene);
     }
     if (csv) ok = !ferror(csv) && fclose(csv) == 0 && ok;
-    printf("polydyn soak: generator %d, seed %lu, scenes %ld .. %ld, checked at every %s\n", job.generator, job.seed,
+    printf("polydyn soak: generator %d, seed %lu, scenes %ld .. %ld, checked at every %s", job.generator, job.seed,
            job.first, job.first + scenes - 1, job.run.everyStep ? "step" : "sample");
+    if (job.run.penetrationLimit != PD_SOAK_PENETRATION_LIMIT)
+      printf(", penetration limit %.3g delta_max", job.run.penetrationLimit);
+    printf("\n");
     printf("%-12s %8s %8s %12s %8s %10s\n", "engine", "ok", "refused", "over-budget", "failed", "not-built");
     for (int e = 0; e < ENGINES_MAX; ++e) {
       bool used = false;

@@ -300,6 +300,7 @@ typedef struct watch {
   pdSoakResult* out;
   char broke[240];  // the first invariant that broke (soft), empty while all hold
   bool soft;          // the soft engine: overlaps judged against the pair's limit (pair_limit)
+  double limit;       // the plain penetration limit, δ_max (pdSoakRunOptions.penetrationLimit)
   double worst;       // max over samples (and steps) of a pair's overlap over its limit; above 1: failed
   double worstDepth, worstLimit;  // that pair's overlap and limit, δ_max
   char worstPair[160];            // that pair and the time
@@ -352,7 +353,7 @@ static double mass_moving_with(const pdModel* m, int b, pdVec3 into, const pdVec
 // for the scene's vmax estimate (hard cases). Third bodies pressing on the pair make its springs stop more mass: they
 // store the kinetic energy of the closing motion along the pair's normal n of all that moves with either side,
 // ½ M v² with M = M_i M_j / (M_i + M_j), and deflect by δ_max √(M / m_pair) v / vmax. So the limit is
-// PD_SOAK_PENETRATION_LIMIT √(M / m_pair), with M_i (M_j alike) the mass moving with i when i closes on j along −n
+// PD_SOAK_PENETRATION_LIMIT √(M / m_pair) (`plain` for PD_SOAK_PENETRATION_LIMIT: a run may set its own), with M_i (M_j alike) the mass moving with i when i closes on j along −n
 // at unit speed:
 // - a third body k presses on i with F_k, the net force of its contacts on i (springs and friction). A contact
 //   transmits force along F_k only, so k has to follow i along u_k = F_k / |F_k| alone (it slides freely across it),
@@ -369,8 +370,8 @@ static double mass_moving_with(const pdModel* m, int b, pdVec3 into, const pdVec
 // while the pair's own contacts carry the overlap (their largest normal force at least k_n times the overlap beyond
 // the plain limit), and n and stick are that contact's: an overlap that no contact resists, or one a contact reads
 // at a fraction of its depth, is a fault of the contact search whatever the load.
-static double pair_limit(const pdModel* m, const pdState* s, int i, int j, double depthOverDelta) {
-  if (!(depthOverDelta > PD_SOAK_PENETRATION_LIMIT)) return PD_SOAK_PENETRATION_LIMIT;
+static double pair_limit(const pdModel* m, const pdState* s, int i, int j, double depthOverDelta, double plain) {
+  if (!(depthOverDelta > plain)) return plain;
   pdPairContact pair = pd_model_pair_contact(m, i, j);
   double pushed = 0.0;
   pdVec3 outOfJ = {0, 0, 0};  // the carrying contact's normal, from j into i
@@ -393,8 +394,8 @@ static double pair_limit(const pdModel* m, const pdState* s, int i, int j, doubl
       if (on == j) onJ[k] = pd_v3_add(onJ[k], force);
     }
   }
-  double beyond = (depthOverDelta - PD_SOAK_PENETRATION_LIMIT) * pair.deltaMax;
-  double limit = PD_SOAK_PENETRATION_LIMIT;
+  double beyond = (depthOverDelta - plain) * pair.deltaMax;
+  double limit = plain;
   if (pushed > 0.0 && pushed >= pair.kn * beyond) {
     double mi = mass_moving_with(m, i, pd_v3_scale(outOfJ, -1.0), onI, held);
     double mj = mass_moving_with(m, j, outOfJ, onJ, held);
@@ -420,8 +421,8 @@ static double deepest_overlap(const pdModel* m, const pdState* s, watch* w, cons
       if (!pd_interference(&a->shape, sa.x, &ra, &b->shape, sb.x, &rb, PD_SAT_MIN_DEPTH, NULL, &sat)) continue;
       double ratio = sat.depth / pd_model_pair_delta_max(m, i, j);
       deepest = fmax(deepest, ratio);
-      if (!w->soft || !(ratio > PD_SOAK_PENETRATION_LIMIT)) continue;
-      double limit = pair_limit(m, s, i, j, ratio);
+      if (!w->soft || !(ratio > w->limit)) continue;
+      double limit = pair_limit(m, s, i, j, ratio, w->limit);
       if (ratio / limit > w->worst) {
         w->worst = ratio / limit, w->worstDepth = ratio, w->worstLimit = limit;
         snprintf(w->worstPair, sizeof w->worstPair, "%.40s and %.40s at t = %.6g s%s", a->name, b->name, s->t, where);
@@ -517,7 +518,11 @@ static void run_here(const pdSoakScene* scene, const char* engine, const pdSoakR
     pd_model_free(m);
     return;
   }
-  watch w = {.scene = scene, .budget = run->budgetSeconds, .wall0 = pd_wall_seconds(), .out = o};
+  watch w = {.scene = scene,
+             .budget = run->budgetSeconds,
+             .wall0 = pd_wall_seconds(),
+             .out = o,
+             .limit = run->penetrationLimit > 0.0 ? run->penetrationLimit : PD_SOAK_PENETRATION_LIMIT};
   bool completed = false;
   pdIslands islands;
   bool soft = pd_soak_engine_is_soft(engine, &islands);

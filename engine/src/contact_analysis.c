@@ -128,6 +128,17 @@ static int edge_pair_edge_at_vertex(const pdContactId* c, const pdPolyhedron* sv
   return sv->edges[edgeV].v[0] == vertex || sv->edges[edgeV].v[1] == vertex ? edgeF : -1;
 }
 
+// Of the two faces of sf's edge edgeF, the one q lies deeper below than *deepest and over whose polygon it projects
+// (updating *deepest), else `face`: an edge pair's successor on the vertex its crossing passed.
+static int deeper_face_of_edge(const pdPolyhedron* sf, int edgeF, pdVec3 q, double over, double* deepest, int face) {
+  for (int k = 0; k < 2; ++k) {
+    int f = sf->edges[edgeF].f[k];
+    double d = face_depth(sf, f, q);
+    if (d > *deepest && projects_inside(sf, f, q, over)) *deepest = d, face = f;
+  }
+  return face;
+}
+
 static int face_after_edge_pair(const pdModel* m, const pdContactId* previous, int count, int vertexBody, int vertex,
                                 int faceBody, pdVec3 q, double tol, double over, double reach) {
   const pdPolyhedron* sv = &m->bodies[vertexBody].shape;
@@ -139,11 +150,7 @@ static int face_after_edge_pair(const pdModel* m, const pdContactId* previous, i
     if (edgeF < 0) continue;
     const pdEdge* e = &sf->edges[edgeF];
     if (segment_distance(sf->vertices[e->v[0]], sf->vertices[e->v[1]], q) > reach) continue;
-    for (int k = 0; k < 2; ++k) {
-      int f = sf->edges[edgeF].f[k];
-      double d = face_depth(sf, f, q);
-      if (d > deepest && projects_inside(sf, f, q, over)) deepest = d, face = f;
-    }
+    face = deeper_face_of_edge(sf, edgeF, q, over, &deepest, face);
   }
   return face;
 }
@@ -415,6 +422,77 @@ __attribute__((noinline)) static int vf_across_right_edge(const pdModel* m, int 
   return n;
 }
 
+// ---------------------------------------------------------------- an edge pair begun and handed over within one step
+//
+// Design note. An edge pair whose crossing slides off its edge's end hands over to the VF contact of the vertex there,
+// on the deeper of the other edge's two faces (face_after_edge_pair: the face nearer the pair's normal, which carries
+// its force on). A long step (an island alone takes its own) can carry such a pair from before its onset to past that
+// vertex: the search then sees the vertex alone, found anew, and gives it the face whose plane it crossed in the step,
+// at an acute rim edge the cap it grazed rather than the side face the crossing pressed into (soak campaign 70, scene
+// 3505: a frustum's corner 5e-4 δ_max below a plate's cap and 0.78 δ_max inside its side face, the bodies' overlap along
+// that face's normal; the cap's contact, at 90° to the approach, released at 2.4 δ_max, while steps a third as long saw
+// the pair and handed it over to the side face). So a vertex found anew takes the face that hand-over gives when an edge
+// a at it and an edge e of the other body form a pair that began and passed it within the step: at the step's end the
+// pair's Gauss arcs meet, it has crossed along a × e by more than the flush tolerance (flush faces' edges meet at their
+// shared corners with a depth of rounding: 1e-10 m in a brick wall), its lines' closest points lie inside e and beyond
+// the vertex on a, and the vertex is within a new pair's depth (3 δ_max) of e; at the step's start those closest points
+// lay on a and the lines had not crossed. A pair crossed at the start was a contact then, or refused by the search's
+// rules, and hands over as such or not at all. The contact is a VF contact (eqs. (18a), (18b), §3.1) and starts as a
+// new one (App. C: its onset found from the step).
+
+static bool line_closest(pdVec3 P, pdVec3 u, pdVec3 Q, pdVec3 v, double* s, double* t);
+static bool arcs_meet_within_slack(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d);
+
+// How far the lines through q along u and through b0 along v have crossed (m, < 0: apart), along their common normal
+// turned outward from outward (the sum of the normals of u's edge's faces); *s, *t the closest points' parameters.
+// False for parallel lines.
+static bool lines_crossed_by(pdVec3 q, pdVec3 u, pdVec3 b0, pdVec3 v, pdVec3 outward, double* s, double* t,
+                             double* depth) {
+  if (!line_closest(q, u, b0, v, s, t)) return false;
+  pdVec3 n = pd_v3_normalize(pd_v3_cross(u, v));
+  if (pd_v3_dot(n, outward) < 0.0) n = pd_v3_scale(n, -1.0);
+  *depth = pd_v3_dot(n, pd_v3_sub(pd_v3_muladd(q, *s, u), pd_v3_muladd(b0, *t, v)));
+  return true;
+}
+
+// The face vertex i of body iv (q now, q0 at the step's start, both in jf's frame) takes from an edge pair that began and
+// passed it within the step (design note above), or -1. rel, off: iv in jf's frame now; rel0, off0 at the start.
+__attribute__((noinline)) static int face_after_passed_edge_pair(const pdModel* m, int iv, int jf, int i, pdVec3 q,
+                                                                 pdVec3 q0, const pdMat3* rel, pdVec3 off,
+                                                                 const pdMat3* rel0, pdVec3 off0, double tol,
+                                                                 double over, double reach) {
+  const pdPolyhedron* sv = &m->bodies[iv].shape;
+  const pdPolyhedron* sf = &m->bodies[jf].shape;
+  int face = -1;
+  double deepest = tol;
+  for (int j = 0; j < sf->edgeCount; ++j) {
+    const pdEdge* e = &sf->edges[j];
+    pdVec3 b0 = sf->vertices[e->v[0]], b1 = sf->vertices[e->v[1]], v = pd_v3_sub(b1, b0);
+    if (segment_distance(b0, b1, q) > reach) continue;
+    for (int k = 0; k < sv->edgeCount; ++k) {
+      const pdEdge* a = &sv->edges[k];
+      if (a->v[0] != i && a->v[1] != i) continue;
+      pdVec3 other = sv->vertices[a->v[0] == i ? a->v[1] : a->v[0]];
+      pdVec3 nA0 = pd_mat3_mulv(rel, sv->faces[a->f[0]].normal), nA1 = pd_mat3_mulv(rel, sv->faces[a->f[1]].normal);
+      // now: crossed, beyond the vertex on a (s < 0 from the vertex along a), inside e, spanning a Minkowski face
+      pdVec3 u = pd_v3_sub(pd_v3_add(off, pd_mat3_mulv(rel, other)), q);
+      double s, t, depth;
+      if (!lines_crossed_by(q, u, b0, v, pd_v3_add(nA0, nA1), &s, &t, &depth)) continue;
+      // crossed beyond the flush tolerance: flush faces' edges meet at their shared corners with a depth of rounding
+      if (!(s < 0.0 && t > 0.0 && t < 1.0 && depth > over)) continue;
+      pdVec3 c = pd_v3_scale(sf->faces[e->f[0]].normal, -1.0), d = pd_v3_scale(sf->faces[e->f[1]].normal, -1.0);
+      if (!arcs_meet_within_slack(nA0, nA1, c, d)) continue;
+      // at the step's start: on a, not yet crossed
+      pdVec3 u0 = pd_v3_sub(pd_v3_add(off0, pd_mat3_mulv(rel0, other)), q0);
+      pdVec3 outward0 = pd_mat3_mulv(rel0, pd_v3_add(sv->faces[a->f[0]].normal, sv->faces[a->f[1]].normal));
+      if (!lines_crossed_by(q0, u0, b0, v, outward0, &s, &t, &depth)) continue;
+      if (!(s >= 0.0 && s <= 1.0 && depth <= 0.0)) continue;
+      face = deeper_face_of_edge(sf, j, q, over, &deepest, face);
+    }
+  }
+  return face;
+}
+
 // VF contacts of the vertices of body iv inside body jf, and, with mask, each vertex's faces of jf (of the first 64)
 // whose plane it lies outside of by more than the pruning margin (find_ee's edge pruning).
 // (Formed twice, for a face body with an acute edge and for one without (find_vf): without, the loop is the paper's
@@ -492,6 +570,15 @@ __attribute__((always_inline)) static inline int find_vf_formed(const pdModel* m
     // the successor of an edge pair whose crossing passed this vertex: the face that carries its normal on
     if (face < 0) face = face_after_edge_pair(m, previous, previousCount, iv, i, jf, q, tol, fmax(tol, flushTol),
                                              EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax);
+    // the successor of an edge pair that began and passed this vertex within the step (design note above)
+    if (face < 0 && pv0) {
+      pdMat3 rel0;
+      pdVec3 off0;
+      pose_in_frame_of(pf0, pv0, &rel0, &off0);
+      pdVec3 q0 = pd_v3_add(off0, pd_mat3_mulv(&rel0, sv->vertices[i]));
+      face = face_after_passed_edge_pair(m, iv, jf, i, q, q0, &rel, off, &rel0, off0, tol, fmax(tol, flushTol),
+                                         EE_NEW_DEPTH_MAX_DEFLECTIONS * deltaMax);
+    }
     // a new contact: the face whose plane it crossed during the step. Depth alone misleads where the
     // vertex also lies just inside another plane (a brick's corner a roundoff inside the side plane of
     // the brick below, which it slides along, while it sinks into the top face).
@@ -596,6 +683,9 @@ static arcMeeting arcs_meet_formed(const gaussArc* ab, const gaussArc* cd, doubl
 static arcMeeting arcs_meet(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d, double slack) {
   gaussArc ab = gauss_arc(a, b), cd = gauss_arc(c, d);
   return arcs_meet_formed(&ab, &cd, slack);
+}
+static bool arcs_meet_within_slack(pdVec3 a, pdVec3 b, pdVec3 c, pdVec3 d) {
+  return arcs_meet(a, b, c, d, EE_ARC_SLACK) != arcsApart;
 }
 
 // Overlap of A and B along unit u (A's frame, pointing from A to B), m; B's pose in A's frame (rel, off).

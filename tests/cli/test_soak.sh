@@ -77,7 +77,14 @@ check "over budget: it says why" 'head -1 "$SCRATCH/budget/over-budget/000013-so
 run_pd "$SCRATCH/replay.out" "$SCRATCH/replay.err" run "$SCRATCH/budget/over-budget/000013-soft.scene" --out "$SCRATCH/replay"
 check "over budget: the scene replays with polydyn run" '[ $rc -eq 0 ] && [ -f "$SCRATCH/replay/trajectory.csv" ]'
 
-for bad in "--scenes 0" "--scenes x" "--seed -1" "--generator 0" "--generator 3" "--check often" "--engines soft,box" "--engines soft,soft" "--budget 0" "--jobs 0" "--onsets late" "--frobnicate 1"; do
+# a penetration limit below any loaded contact's depth fails a scene whose bodies collide; the default passes it
+run_pd "$SCRATCH/limit.out" "$SCRATCH/limit.err" soak --seed 49 --first 439 --scenes 1 --budget "$BUDGET" \
+  --penetration-limit 1e-6 --out "$SCRATCH/limit"
+check "--penetration-limit 1e-6: seed 49 scene 439 fails (exit 1), judged against that limit" \
+  '[ $rc -eq 1 ] && grep -q "^49,439,free,.*,soft,failed," "$SCRATCH/limit/summary.csv" && head -1 "$SCRATCH/limit/failures/000439-soft.scene" | grep -q "(limit 1e-06)"'
+check "--penetration-limit: the campaign's header names it" 'grep -q "penetration limit 1e-06 delta_max" "$SCRATCH/limit.out"'
+
+for bad in "--scenes 0" "--scenes x" "--seed -1" "--generator 0" "--generator 3" "--check often" "--engines soft,box" "--engines soft,soft" "--budget 0" "--jobs 0" "--onsets late" "--penetration-limit 0" "--penetration-limit 1001" "--penetration-limit x" "--frobnicate 1"; do
   # shellcheck disable=SC2086
   run_pd "$SCRATCH/bad.out" "$SCRATCH/bad.err" soak $bad --out "$SCRATCH/bad"
   check "bad argument '$bad': exit 2 with a message, nothing written" \

@@ -571,6 +571,53 @@ static void test_an_edge_pairs_end_through_a_thin_plate_is_found_on_the_face(voi
   pd_model_free(m);
 }
 
+// Soak campaign 70, scene 3505 (cases/hard/prism_vertex_at_plate_rim_long_step.scene): the poses at the start and the
+// end of the 62 us step in which the frustum f1's edge 11 crossed the plate f6's acute rim edge 9 (cap face 1, side
+// face 6) from before the pair's onset to past the edge's end, vertex 7 (as the engine before reached them). Found
+// anew, vertex 7 takes the face the pair's hand-over gives, the side face (0.78 delta_max deep, the deeper of the rim
+// edge's two faces), not the cap whose plane it crossed (5e-4 delta_max); without the step's start, or with the step
+// starting where it ends (the pair's crossing already past the vertex), it takes the cap as before.
+static pdPose pose_q(double x, double y, double z, double qw, double qx, double qy, double qz) {
+  pdQuat q = {qw, qx, qy, qz};
+  return (pdPose){{x, y, z}, pd_quat_to_mat3(q)};
+}
+static int vertex_contact_face(const pdContactGeom* c, int n, int body, int vertex, double* depth) {
+  for (int k = 0; k < n && k < CAPACITY; ++k)
+    if (c[k].id.kind == pd_contactVF && c[k].id.body1 == body && c[k].id.feat1 == vertex) {
+      *depth = c[k].depth;
+      return c[k].id.feat2;
+    }
+  return -1;
+}
+static void test_a_vertex_an_edge_pair_passed_within_the_step_takes_the_pairs_face(void** state) {
+  (void)state;
+  pdModel* m = compile_file(PD_SOURCE_DIR "/cases/hard/prism_vertex_at_plate_rim_long_step.scene");
+  const int frustum = 0, plate = 1, vertex = 7, cap = 1, side = 6;
+  double deltaMax = pd_model_pair_delta_max(m, frustum, plate);
+  pdPose f0 = pose_q(0.097890679906785599, -0.057264619827454379, -0.0062303098908068743, 0.39008598464570715,
+                     -0.047183019979544397, -0.55101476769474123, 0.73619930249281651);
+  pdPose p0 = pose_q(0.092063965627048217, -0.087973608263498981, 0.0068526819592374544, 0.34577015118209425,
+                     0.80290589471426643, -0.31730021735949243, -0.36756727118748472);
+  pdPose f1 = pose_q(0.097748604310665801, -0.057455862810404212, -0.0062279001018962143, 0.38950057804361993,
+                     -0.048014988947847614, -0.55084413563846224, 0.73658305626231968);
+  pdPose p1 = pose_q(0.092087431408150719, -0.087746886721731698, 0.0068526819592374544, 0.34574551788961161,
+                     0.80286632545909908, -0.31741309519769256, -0.36757941631716662);
+  pdContactGeom c[CAPACITY];
+  double depth = 0.0;
+  // the step as the engine took it: the side face, at the bodies' overlap along its normal
+  int n = pd_contacts_find(m, frustum, &f1, plate, &p1, &f0, &p0, NULL, 0, c, CAPACITY);
+  assert_int_equal(vertex_contact_face(c, n, frustum, vertex, &depth), side);
+  expect_near(depth / deltaMax, 0.778, 1e-3, "depth below the side face / delta_max");
+  // no step seen, or a step with no motion (the pair's crossing past the vertex at its start too): the cap, the face
+  // crossed or the shallowest
+  n = pd_contacts_find(m, frustum, &f1, plate, &p1, NULL, NULL, NULL, 0, c, CAPACITY);
+  assert_int_equal(vertex_contact_face(c, n, frustum, vertex, &depth), cap);
+  assert_true(depth < 1e-3 * deltaMax);
+  n = pd_contacts_find(m, frustum, &f1, plate, &p1, &f1, &p1, NULL, 0, c, CAPACITY);
+  assert_int_equal(vertex_contact_face(c, n, frustum, vertex, &depth), cap);
+  pd_model_free(m);
+}
+
 static void test_small_capacity_reports_the_needed_count(void** state) {
   (void)state;
   pdModel* m = compile(cubeOnFloor);
@@ -601,6 +648,7 @@ int main(void) {
       cmocka_unit_test(test_edge_along_a_rim_face_gives_both_crossings),
       cmocka_unit_test(test_a_vertex_pressed_through_a_thin_plate_keeps_its_face),
       cmocka_unit_test(test_an_edge_pairs_end_through_a_thin_plate_is_found_on_the_face),
+      cmocka_unit_test(test_a_vertex_an_edge_pair_passed_within_the_step_takes_the_pairs_face),
       cmocka_unit_test(test_small_capacity_reports_the_needed_count),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

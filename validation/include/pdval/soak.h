@@ -108,6 +108,10 @@ typedef struct pdSoakRunOptions {
   // islands on; over E(0) of the scene: a step of a dissipative system never adds energy, and the samples check
   // what the stretches add up to). False: at the output samples only, as campaigns before the step observer.
   bool everyStep;
+  // Soft engine: the plain penetration limit, δ_max (0, as a struct left unset has it: PD_SOAK_PENETRATION_LIMIT); a
+  // pair that third bodies press together may reach it times √(M / m_pair). A tighter one shows a campaign's margin,
+  // and one below any contact's depth fails every run whose bodies touch (tests/cli/test_determinism.sh).
+  double penetrationLimit;
 } pdSoakRunOptions;
 
 // Runs the scene in `engine` ("soft", "soft-islands-off", "ode", "bullet") in a child process with the wall-time budget
