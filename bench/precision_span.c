@@ -1,7 +1,7 @@
 // pd_bench_span — the span `polydyn gedanken --precision` times for a soft point, repeated: the scene compiled with
 // the point's tol (outside the span), then pd_state_create and pd_advance with the sample record as the observer
 // (gedanken/precision.c's measure_point; the implicit stepper, the report's `soft implicit`). The record is kept on
-// the first repeat only, as there; --no-record leaves it out of every repeat (the repeats the report's median falls
+// the first repeat only, as there; --no-record leaves it out of every repeat (the runs the report's least timing falls
 // on). The span is the function measured_span, so an instruction count can be taken over exactly it:
 //   valgrind --tool=callgrind --toggle-collect=measured_span pd_bench_span SCENE --tol T --repeats 1 --no-record
 // A Gedanken experiment's scene: `polydyn gedanken --only NAME --engines soft --out DIR` writes it to

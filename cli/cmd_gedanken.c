@@ -11,6 +11,9 @@
 #include "pdrun/batch.h"
 #include "pdgk/gedanken.h"
 
+#define PD_GK_TEXT_OF(x) #x
+#define PD_GK_TEXT(x) PD_GK_TEXT_OF(x)
+
 static const char* const help =
     "usage: polydyn gedanken --out DIR [--only NAME[,NAME...]] [--engines ENGINE[,ENGINE...]] [--fast]\n"
     "                        [--jobs N] [--tolerance-scale F] [--precision [--repeats R]]\n"
@@ -38,15 +41,18 @@ static const char* const help =
     "                       middle input, at soft tol 1e-1 ... 1e-10 and fixed-step RK4 dt 1e-3 ... 1e-5 s, ODE\n"
     "                       and Bullet (native, matched) at steps 1/60 ... 1/16000 s, Bullet also at 5 ... 200\n"
     "                       solver iterations; writes DIR/precision.csv\n"
-    "                       (error against the closed form and wall time per point)\n"
-    "  --repeats R          with --precision: runs per point, the wall time is their median (default 1, at\n"
-    "                       most 21; the error is the first run's: every run is deterministic)\n"
+    "                       (error against the closed form and cost per point)\n"
+    "  --repeats R          with --precision: timings per point (default 4, at most 21), each the run repeated\n"
+    "                       back to back to " PD_GK_TEXT(PD_GK_TIMING_MIN_CPU_SECONDS) " s of CPU time; the cost is the least\n"
+    "                       (precision.csv also has their median and spread); the error is the first run's:\n"
+    "                       every run is deterministic\n"
     "\n"
     "Progress goes to stderr when it is a terminal. Exit status: 0 every soft-engine experiment passed (other\n"
     "engines may fail some: see results.csv), 1 a soft-engine experiment failed or the results could not be\n"
     "written, 2 bad input, 130 interrupted (nothing written).\n";
 
-enum { MAX_ONLY = 64, MAX_REPEATS = 21 };
+// The speed-accuracy protocol's "minimum of at least 4 runs" (docs/validation.md, "The cost of a point").
+enum { MAX_ONLY = 64, MAX_REPEATS = 21, DEFAULT_REPEATS = 4 };
 
 static volatile sig_atomic_t interrupted = 0;
 static void on_signal(int sig) {
@@ -160,7 +166,7 @@ int pd_cmd_gedanken(int argc, char** argv) {
   bool enginesGiven = engines.given;
   options.jobs = pd_cli_default_jobs(options.jobs, 2);
   if (options.repeats && !options.precision) return pd_cli_usage_error("gedanken", "--repeats goes with --precision");
-  if (!options.repeats) options.repeats = 1;
+  if (!options.repeats) options.repeats = DEFAULT_REPEATS;
   if (listOnly) {
     list(options.fast);
     return PD_EXIT_OK;

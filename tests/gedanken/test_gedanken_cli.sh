@@ -96,7 +96,7 @@ check "a law: every variant judged, no reason" \
 
 # --- work-precision against the closed form (--precision) -------------------------------------------
 PREC=$SCRATCH/precision
-PHEADER='experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,judged,status,wall_seconds,wall_per_sim_second,steps,repeats,cpu_seconds,cpu_per_sim_second,derivatives,steps_error,steps_largest,steps_stability,steps_travel,steps_event,steps_landing,note'
+PHEADER='experiment,kind,engine,variant,setting,value,input,quantity,unit,measured,expected,error,relative,tolerance,judged,status,wall_seconds,wall_per_sim_second,steps,repeats,cpu_seconds,cpu_per_sim_second,derivatives,steps_error,steps_largest,steps_stability,steps_travel,steps_event,steps_landing,note,cpu_seconds_median,cpu_max_over_min,wall_seconds_median,wall_max_over_min,runs_per_timing'
 run_pd gedanken --only a1_restitution,c3_eccentric_bar --precision --repeats 2 --out "$PREC"
 check "--precision: exit 0 and precision.csv with the fixed header" '[ $rc -eq 0 ] && [ "$(head -n 1 "$PREC/precision.csv")" = "$PHEADER" ]'
 # what set polydyn's steps: each error-controlled point's accepted steps counted once, under one limit; none for the fixed
@@ -116,6 +116,17 @@ check "--precision: every ok point's error is |measured - expected| (relative: |
   '[ "$(csv_query "$PREC/precision.csv" "all(abs(float(r[\"error\"]) - (abs(float(r[\"measured\"]) / float(r[\"expected\"]) - 1) if r[\"relative\"] == \"true\" else abs(float(r[\"measured\"]) - float(r[\"expected\"])))) <= 1e-15 * max(1.0, abs(float(r[\"expected\"]))) for r in rows if r[\"status\"] == \"ok\")")" = True ]'
 check "--precision: ok points have a positive wall time and steps; the repeats column says 2" \
   '[ "$(csv_query "$PREC/precision.csv" "all(float(r[\"wall_seconds\"]) > 0 and int(r[\"steps\"]) > 0 for r in rows if r[\"status\"] == \"ok\") and {r[\"repeats\"] for r in rows} == {\"2\"}")" = True ]'
+# the cost protocol (gedanken/include/pdgk/gedanken.h, docs/validation.md "The cost of a point"): a timing repeats the
+# run until it has spent the minimum CPU time, the cost is the least of the timings, their median and spread beside it
+MIN_CPU=$(sed -n 's/^#define PD_GK_TIMING_MIN_CPU_SECONDS \([0-9.e-]*\).*/\1/p' "$(dirname "${BASH_SOURCE[0]}")/../../gedanken/include/pdgk/gedanken.h")
+check "--precision: the minimum CPU time of a timing is read from the header ($MIN_CPU s)" '[ -n "$MIN_CPU" ]'
+check "--precision: every ok point's cheapest timing ran the run back to back for at least the minimum CPU time (runs_per_timing x cpu_seconds)" \
+  '[ "$(csv_query "$PREC/precision.csv" "all(int(r[\"runs_per_timing\"]) >= 1 and int(r[\"runs_per_timing\"]) * float(r[\"cpu_seconds\"]) >= $MIN_CPU * (1 - 1e-12) for r in rows if r[\"status\"] == \"ok\")")" = True ]'
+# with 2 timings a and b the median is (a + b) / 2: the cost c is the least of them when median = c (1 + max/min) / 2
+check "--precision: the cost is the least of the 2 timings (median = cost x (1 + max/min) / 2, max/min >= 1; CPU and wall time)" \
+  '[ "$(csv_query "$PREC/precision.csv" "all(float(r[c + \"_max_over_min\"]) >= 1 and abs(float(r[c + \"_seconds_median\"]) - float(r[c + \"_seconds\"]) * (1 + float(r[c + \"_max_over_min\"])) / 2) <= 1e-12 * float(r[c + \"_seconds_median\"]) for r in rows if r[\"status\"] == \"ok\" for c in (\"cpu\", \"wall\"))")" = True ]'
+check "--precision: the timing columns are empty unless ok" \
+  '[ "$(csv_query "$PREC/precision.csv" "all(r[c] == \"\" for r in rows if r[\"status\"] != \"ok\" for c in (\"cpu_seconds\", \"cpu_seconds_median\", \"cpu_max_over_min\", \"wall_seconds_median\", \"wall_max_over_min\", \"runs_per_timing\"))")" = True ]'
 check "--precision: judged follows the kind (c3, a soft-model prediction: native variants not judged; a1, a law: all judged)" \
   '[ "$(csv_query "$PREC/precision.csv" "all((r[\"judged\"] == \"false\") == (r[\"experiment\"] == \"c3_eccentric_bar\" and r[\"variant\"] == \"native\") for r in rows)")" = True ]'
 # eq. (15) is exact for the model: its restitution converges to the requested e as the tolerance tightens, with
@@ -124,13 +135,15 @@ for V in adaptive embedded dopri; do
   check "--precision: soft $V restitution converges to e = 0.5: within the 0.005 tolerance at tol <= 1e-4, 1e-6 at tol 1e-10" \
     '[ "$(csv_query "$PREC/precision.csv" "all(float(r[\"error\"]) <= 0.005 for r in rows if r[\"experiment\"] == \"a1_restitution\" and r[\"variant\"] == \"$V\" and float(r[\"value\"]) <= 1e-4) and [float(r[\"error\"]) < 1e-6 for r in rows if r[\"experiment\"] == \"a1_restitution\" and r[\"variant\"] == \"$V\" and r[\"value\"] == \"1e-10\"] == [True]")" = True ]'
 done
-# the wall and CPU times: every column but those
+# the timings: every column but those (wall and CPU seconds, their median and spread, runs per timing)
 strip_precision_wall() { python3 -c 'import csv, sys
-for r in csv.reader(open(sys.argv[1], newline="")): print(r[:16] + r[18:20] + r[22:])' "$1"; }
-run_pd gedanken --only c2_momentum,a1_restitution --engines soft,ode --precision --jobs 1 --out "$SCRATCH/pdet1"
-run_pd gedanken --only c2_momentum,a1_restitution --engines soft,ode --precision --jobs 2 --out "$SCRATCH/pdet2"
+for r in csv.reader(open(sys.argv[1], newline="")): print(r[:16] + r[18:20] + r[22:30])' "$1"; }
+run_pd gedanken --only c2_momentum,a1_restitution --engines soft,ode --precision --repeats 1 --jobs 1 --out "$SCRATCH/pdet1"
+run_pd gedanken --only c2_momentum,a1_restitution --engines soft,ode --precision --repeats 1 --jobs 2 --out "$SCRATCH/pdet2"
 check "--precision: precision.csv identical with 1 and 2 worker processes (but wall times)" \
   '[ -s "$SCRATCH/pdet1/precision.csv" ] && [ "$(strip_precision_wall "$SCRATCH/pdet1/precision.csv")" = "$(strip_precision_wall "$SCRATCH/pdet2/precision.csv")" ]'
+check "--precision: with one timing its cost is its median and its spread 1" \
+  '[ "$(csv_query "$SCRATCH/pdet1/precision.csv" "all(r[\"cpu_seconds\"] == r[\"cpu_seconds_median\"] and float(r[\"cpu_max_over_min\"]) == 1 and r[\"repeats\"] == \"1\" for r in rows if r[\"status\"] == \"ok\")")" = True ]'
 check "--precision: engines not asked for have no rows" \
   '[ "$(csv_query "$SCRATCH/pdet1/precision.csv" "sorted({r[\"engine\"] for r in rows})")" = "['"'"'ode'"'"', '"'"'soft'"'"']" ]'
 run_pd gedanken --only c2_momentum --engines soft --out "$SCRATCH/noprec"

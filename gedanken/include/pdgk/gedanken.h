@@ -256,7 +256,8 @@ typedef struct pdGkOptions {
   int jobs;                   // >= 1: worker processes of this process (or MPI rank) for the runs
   double toleranceScale;      // > 0: every tolerance is multiplied by it (1 = the catalogue's); for tests
   bool precision;             // also the work-precision runs: out/precision.csv (pd_gk_precision_input)
-  int repeats;                // >= 1 with precision: runs per work-precision point, the wall time is their median
+  int repeats;                // >= 1 with precision: timings per work-precision point, its cost their minimum
+                              // (pd_gk_cost)
   volatile sig_atomic_t* interrupt;  // nullable: non-zero stops the suite (nothing is written)
   pdGkProgressFcn* progress;  // nullable
   void* progressUser;
@@ -286,3 +287,40 @@ bool pd_gk_out_replaceable(const char* out, pdError* err);
 // or when a generated scene does not compile (a bug in the catalogue); nothing is left behind then.
 // Returns false with summary->interrupted when interrupted.
 bool pd_gk_run_suite(const pdGkOptions* options, pdGkSummary* summary, pdError* err);
+
+// ---------------------------------------------------------------------------------------------------------
+// The cost of a work-precision point (gedanken/timing.c; docs/validation.md, "The cost of a point")
+
+// One timing repeats a point's run back to back until the runs' spans have taken at least this much CPU time in
+// all, s. A run of a body or two on a floor is a fraction of a millisecond, where one reading is set by the clock, a
+// cold cache and the other processes on a shared machine; the costs of consecutive single runs part by several
+// times, those of consecutive timings of this length mostly by a tenth or less, and longer timings gain little more (what
+// remains is the machine's load changing over seconds, which the least of a point's timings, taken minutes apart,
+// answers). Measured: reports/bench/precision-timing/README.md.
+#define PD_GK_TIMING_MIN_CPU_SECONDS 0.020
+// At most this many runs in one timing: a clock that does not advance must not hang the sweep.
+#define PD_GK_TIMING_MAX_RUNS 100000
+
+// One run of the span a point times: sets the run's wall and CPU seconds over that span; false when the run did not
+// complete (it failed, was refused or interrupted), which ends the timing.
+typedef bool pdGkTimedRunFcn(void* user, double* wallSeconds, double* cpuSeconds);
+
+typedef struct pdGkTiming {
+  double wall, cpu;  // the runs' summed spans over their number, s per run
+  long runs;         // runs back to back in the timing (>= 1)
+  bool completed;    // every run completed
+} pdGkTiming;
+
+// Calls run back to back until the summed CPU seconds reach minCpuSeconds (> 0) or PD_GK_TIMING_MAX_RUNS runs, or
+// a run does not complete; the timing's cost per run.
+pdGkTiming pd_gk_time_runs(pdGkTimedRunFcn* run, void* user, double minCpuSeconds);
+
+// A point's cost from its timings: the least (wall and CPU each its own minimum), what the report reads; their
+// median and max/min, the spread.
+typedef struct pdGkCost {
+  double wall, cpu;                    // minimum over the timings, s per run
+  double wallMedian, cpuMedian;        // median over the timings, s per run
+  double wallMaxOverMin, cpuMaxOverMin;
+  long runs;                           // runs of the timing with the least CPU time
+} pdGkCost;
+pdGkCost pd_gk_cost(const pdGkTiming* timings, int count);

@@ -18,11 +18,16 @@ export const SWEEP_HEADER_V2 = [...SWEEP_HEADER_V1, 'self_error', 'self_referenc
 export const SWEEP_HEADER = [...SWEEP_HEADER_V2, 'derivatives'];
 // what set the size of polydyn's accepted steps (pdStepLimit, docs/integration.md), one column each
 export const STEP_LIMITS = ['error', 'largest', 'stability', 'travel', 'event', 'landing'];
-export const PRECISION_HEADER = ['experiment', 'kind', 'engine', 'variant', 'setting', 'value', 'input', 'quantity', 'unit',
+// the timings' median and spread, appended after note (a point's cost is the least of its timings)
+export const PRECISION_TIMING_COLUMNS = ['cpu_seconds_median', 'cpu_max_over_min', 'wall_seconds_median', 'wall_max_over_min',
+  'runs_per_timing'];
+// before the timings' median and spread: wall_seconds and cpu_seconds were the median of the repeats' single runs
+const PRECISION_HEADER_MEDIAN = ['experiment', 'kind', 'engine', 'variant', 'setting', 'value', 'input', 'quantity', 'unit',
   'measured', 'expected', 'error', 'relative', 'tolerance', 'judged', 'status', 'wall_seconds', 'wall_per_sim_second', 'steps',
   'repeats', 'cpu_seconds', 'cpu_per_sim_second', 'derivatives', ...STEP_LIMITS.map((l) => `steps_${l}`), 'note'];
+export const PRECISION_HEADER = [...PRECISION_HEADER_MEDIAN, ...PRECISION_TIMING_COLUMNS];
 // before the derivative evaluations and the steps' limits were counted
-const PRECISION_HEADER_CPU = PRECISION_HEADER.filter((h) => h !== 'derivatives' && !STEP_LIMITS.some((l) => h === `steps_${l}`));
+const PRECISION_HEADER_CPU = PRECISION_HEADER_MEDIAN.filter((h) => h !== 'derivatives' && !STEP_LIMITS.some((l) => h === `steps_${l}`));
 // before the CPU time was measured
 const PRECISION_HEADER_WALL_ONLY = PRECISION_HEADER_CPU.filter((h) => !h.startsWith('cpu_'));
 export const PRECISION_STATUSES = ['ok', 'failed', 'no_measure', 'refused', 'not_built'];
@@ -268,7 +273,7 @@ export function readPrecision(dir) {
   const src = readText(dir, 'precision.csv');
   if (!src) return null;
   const rows = [];
-  for (const { line, f } of table(src, PRECISION_HEADER, [PRECISION_HEADER_CPU, PRECISION_HEADER_WALL_ONLY])) {
+  for (const { line, f } of table(src, PRECISION_HEADER, [PRECISION_HEADER_MEDIAN, PRECISION_HEADER_CPU, PRECISION_HEADER_WALL_ONLY])) {
     if (f.experiment === '') throw new InputError(src.file, line, 'experiment: empty');
     const status = oneOf(f.status, PRECISION_STATUSES, 'status', src.file, line);
     if (status !== 'not_built' && !['tol', 'step', 'iterations'].includes(f.setting))
@@ -303,6 +308,12 @@ export function readPrecision(dir) {
         ? Object.fromEntries(STEP_LIMITS.map((l) => [l, number(f[`steps_${l}`], `steps_${l}`, src.file, line, { integer: true })]))
         : null,
       note: f.note,
+      // the timings' median and spread (null in files from before them, whose costs are medians of single runs)
+      cpu_seconds_median: number(f.cpu_seconds_median ?? '', 'cpu_seconds_median', src.file, line),
+      cpu_max_over_min: number(f.cpu_max_over_min ?? '', 'cpu_max_over_min', src.file, line),
+      wall_seconds_median: number(f.wall_seconds_median ?? '', 'wall_seconds_median', src.file, line),
+      wall_max_over_min: number(f.wall_max_over_min ?? '', 'wall_max_over_min', src.file, line),
+      runs_per_timing: number(f.runs_per_timing ?? '', 'runs_per_timing', src.file, line, { integer: true }),
     };
     if (status === 'ok' && (row.error === null || row.wall_per_sim_second === null))
       throw new InputError(src.file, line, 'an ok point needs its error and wall_per_sim_second');

@@ -2,6 +2,7 @@
 // curve per engine-variant and knob, each curve's cost to reach the experiment's own tolerance, and, when no
 // setting reaches it, the error floor and why. Pure functions: no file access, no HTML.
 import { costToReach, median, orderEngineVariants } from './derive.mjs';
+import { num } from './html.mjs';
 
 // Two finest usable points closer than this (relative) mean the error no longer falls with the setting: it
 // stalls at a floor that refining does not move (the model or the solver, not the discretisation).
@@ -87,7 +88,34 @@ export function precision(prec, experiments) {
       not_applicable_reason: m && typeof m.not_applicable_reason === 'string' ? m.not_applicable_reason : null, curves,
     };
   });
-  return { experiments: out, engine_variants: evs, curves: curveKeys.map((k) => k.label), summary: summarize(out, evs) };
+  return { experiments: out, engine_variants: evs, curves: curveKeys.map((k) => k.label), summary: summarize(out, evs),
+    timing: timingProtocol(rows) };
+}
+
+// The least CPU time of one timing (gedanken/include/pdgk/gedanken.h, PD_GK_TIMING_MIN_CPU_SECONDS), s.
+const TIMING_MIN_CPU_SECONDS = 0.020;
+
+// How the file's costs were taken: the least of `repeats` timings, each the run repeated back to back to a minimum
+// CPU time, with the median over the points of their spread (max/min); or, in files from before the timings, the
+// median of `repeats` single runs.
+function timingProtocol(rows) {
+  const ok = rows.filter((r) => r.status === 'ok');
+  const repeats = Math.max(0, ...ok.map((r) => r.repeats ?? 0));
+  const timed = ok.filter((r) => r.runs_per_timing !== null && r.runs_per_timing !== undefined);
+  if (!timed.length) return { kind: 'median_of_runs', repeats, median_cpu_max_over_min: null };
+  return { kind: 'least_of_timings', repeats,
+    median_cpu_max_over_min: median(timed.map((r) => r.cpu_max_over_min).filter((x) => Number.isFinite(x))) };
+}
+
+// What a point's cost is, in a sentence of the report.
+export function costProtocolText(timing) {
+  if (!timing || timing.kind !== 'least_of_timings')
+    return `a point’s cost is the median of its ${timing ? timing.repeats : ''} runs, each timed once`;
+  const n = timing.repeats;
+  return `a point’s cost is the least of its ${n} timing${n === 1 ? '' : 's'}; a timing repeats the run back to back until it ` +
+    `has spent ${TIMING_MIN_CPU_SECONDS * 1e3} ms of CPU time and divides by the runs` +
+    (n > 1 ? ` — the minimum of several, as the speed–accuracy protocol asks; precision.csv also has the timings’ median and ` +
+      `spread (max/min: a median ${num(timing.median_cpu_max_over_min)} over the points)` : '');
 }
 
 const KNOB_ORDER = ['tol', 'step', 'iterations'];

@@ -7,6 +7,7 @@
 import { esc, num, table } from '../lib/html.mjs';
 import { median } from '../lib/derive.mjs';
 import { STEP_LIMITS } from '../lib/inputs.mjs';
+import { costProtocolText } from '../lib/precision.mjs';
 
 const SOFT = 'soft implicit';
 // The project's targets for the median ratio (docs/validation.md, "Cost against the rigid engines").
@@ -112,7 +113,8 @@ export default {
     const what = hasCpu ? 'CPU time' : 'wall time';
     let html = `<p>Over the experiments that polydyn (${esc(SOFT)}, the default) and the other engine-variant both reach at the ` +
       `experiment’s tolerance: the median of polydyn’s cost to reach it over the other’s (${what} per simulated second` +
-      `${hasCpu ? '; the wall-time median beside it' : ''}), and on how many polydyn is the cheaper.</p>`;
+      `${hasCpu ? '; the wall-time median beside it' : ''}), and on how many polydyn is the cheaper. Every engine is timed alike: ` +
+      `${esc(costProtocolText(pr.timing))}.</p>`;
     html += table(['against', 'experiments both reach', `median cost ratio (${what})`, ...(hasCpu ? ['median ratio (wall time)'] : []),
       'polydyn cheaper on', 'target'], summary.map((s) => [
       { html: esc(s.ev) },
@@ -142,7 +144,7 @@ export default {
       'below (Work-precision against the closed form).</p>';
     return {
       html,
-      data: { unit, summary, experiments: perExperiment.map((x) => ({ experiment: x.experiment, soft: x.soft,
+      data: { unit, timing: pr.timing, summary, experiments: perExperiment.map((x) => ({ experiment: x.experiment, soft: x.soft,
         ratios: Object.fromEntries(others.map((ev) => [ev, x.ratios[ev] ? x.ratios[ev].ratio : null])) })) },
       csv: [{ name: 'against', header: ['experiment', 'unit', ...others.map((ev) => `ratio_${ev.replace(' ', '_')}`), 'soft_cost',
         'soft_to_tolerance', 'soft_setting_value', 'soft_steps', 'soft_derivatives', ...STEP_LIMITS.map((l) => `soft_steps_${l}`)],

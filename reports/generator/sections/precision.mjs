@@ -4,6 +4,7 @@
 // the experiment's tolerance" per engine-variant, or "never" with the floor the error stalls at and why.
 import { esc, num, errText, table } from '../lib/html.mjs';
 import { logLogLine, logLogOption } from '../lib/charts.mjs';
+import { costProtocolText } from '../lib/precision.mjs';
 
 const KIND_TEXT = { law: 'law (every engine judged)', model_prediction: 'prediction of the soft model' };
 
@@ -64,7 +65,7 @@ export default {
     let html = '<p>Each Gedanken experiment with a closed form, run at every setting of each engine’s accuracy knob (soft: ' +
       'tolerance of the default implicit stepper (step doubling switching to ROS34PW2 where contacts rest), of the adaptive RK4 (step doubling alone) and of the embedded RK4(3) pair, the step of fixed-step RK4; ODE and Bullet: the time step, native and matched). The error is the ' +
       'experiment’s own measure against its closed form — the same number the PASS/FAIL matrix judges — and the cost the wall time per ' +
-      'simulated second (median of the repeats). Read a diagram from the right: a curve that falls below the dashed tolerance line reaches ' +
+      `simulated second (${esc(costProtocolText(pr.timing))}). Read a diagram from the right: a curve that falls below the dashed tolerance line reaches ` +
       'the answer, and how far left it does so is what it costs; a curve that flattens above the line has an error floor that a finer ' +
       'setting does not remove — the engine’s model or solver differs from the closed form, not its step.</p>';
     html += '<h3>Cost to reach each experiment’s tolerance (wall s per simulated s)</h3>';
