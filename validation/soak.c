@@ -353,8 +353,8 @@ static double mass_moving_with(const pdModel* m, int b, pdVec3 into, const pdVec
 // for the scene's vmax estimate (hard cases). Third bodies pressing on the pair make its springs stop more mass: they
 // store the kinetic energy of the closing motion along the pair's normal n of all that moves with either side,
 // ½ M v² with M = M_i M_j / (M_i + M_j), and deflect by δ_max √(M / m_pair) v / vmax. So the limit is
-// PD_SOAK_PENETRATION_LIMIT √(M / m_pair) (`plain` for PD_SOAK_PENETRATION_LIMIT: a run may set its own), with M_i (M_j alike) the mass moving with i when i closes on j along −n
-// at unit speed:
+// plain √(M / m_pair), plain being PD_SOAK_PENETRATION_LIMIT unless the run sets its own, with M_i (M_j alike) the
+// mass moving with i when i closes on j along −n at unit speed:
 // - a third body k presses on i with F_k, the net force of its contacts on i (springs and friction). A contact
 //   transmits force along F_k only, so k has to follow i along u_k = F_k / |F_k| alone (it slides freely across it),
 //   and only if F_k presses i towards j (cos θ_k = −u_k · n > 0): a body pulling away or pressing sideways stores
