@@ -200,7 +200,8 @@ static void install(const pdModel* model, pdState* s, int count, bool ordered) {
   // a list that changed in no contact comes in sorted (ids are unique, so any sort gives the one order): checked
   // first, since qsort moves slots of ~0.5 kB through a scratch copy (7 % of cases/hard/stack_10.scene's work)
   bool sorted = true;
-  for (int i = 1; i < count && sorted && !ordered; ++i) sorted = compare_slots(&set->next[i - 1], &set->next[i]) < 0;
+  if (!ordered)
+    for (int i = 1; i < count && sorted; ++i) sorted = compare_slots(&set->next[i - 1], &set->next[i]) < 0;
   if (!sorted) qsort(set->next, (size_t)count, sizeof *set->next, compare_slots);
   pd_state_reserve_contacts(model, s, count);
   int base = spring_base(model);
@@ -931,6 +932,7 @@ static void regather(const pdModel* model, pdState* to, const pdModel* sub, cons
   pdContactSet* set = to->contacts;
   const pdContactSet* view = from->contacts;
   int base = spring_base(model), fromBase = spring_base(sub);
+  set->unevaluated = 0;
   for (int i = 0; i < set->count; ++i) {
     contactSlot* c = &set->items[i];
     const contactSlot* v = &view->items[i];
@@ -941,6 +943,7 @@ static void regather(const pdModel* model, pdState* to, const pdModel* sub, cons
     c->heldPush = v->heldPush;
     c->heldSlip = v->heldSlip;
     c->unevaluated = v->unevaluated;
+    set->unevaluated += c->unevaluated;
     c->springs = springs_load(from->y + fromBase + PD_CONTACT_STATE_SIZE * i);
     springs_store(to->y + base + PD_CONTACT_STATE_SIZE * i, &c->springs);
   }
@@ -949,8 +952,6 @@ static void regather(const pdModel* model, pdState* to, const pdModel* sub, cons
   set->modeRetries = 0;
   set->bodyListValid = false;
   set->recordedValid = false;
-  set->unevaluated = 0;
-  for (int i = 0; i < set->count; ++i) set->unevaluated += set->items[i].unevaluated;
   set->unevaluatedModel = model;
 }
 
