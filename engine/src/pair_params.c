@@ -86,7 +86,10 @@ static double stack_mass(const pdModel* model, pdContactSet* set, const pdPose* 
   // ~125 kB: a list that never needs it (a dense output's view, an island of one falling body) makes none; made
   // at the first contacts a list has, as its GSL workspaces are (stack_modes.c)
   if (!set->stackScratch) set->stackScratch = pd_stack_scratch_create();
-  if (!pd_stack_pair_frequency(model, set, poses, first, last, set->stackScratch, &omega)) return 0.0;
+  // the weight below is 0 for any Ω from √(k_s / (PD_STACK_SLOW_FROM own)) up: the analysis may stop there
+  double fast = sqrt(pd_series(p->k1n, p->k2n) / (PD_STACK_SLOW_FROM * own));
+  if (!isfinite(fast)) fast = 0.0;
+  if (!pd_stack_pair_frequency(model, set, poses, first, last, fast, set->stackScratch, &omega)) return 0.0;
   double mass = pd_series(p->k1n, p->k2n) / (omega * omega);
   double weight = log(mass / own / PD_STACK_SLOW_FROM) / log(PD_STACK_SLOW_FULL / PD_STACK_SLOW_FROM);
   return weight > 0.0 ? fmin(1.0, weight) * mass : 0.0;

@@ -11,6 +11,11 @@
 // light body resting on a heavy one holds ~(m/M)² of the heavy one's bounce and keeps its own, faster mode). The
 // local system: the pair's moving bodies and their neighbours in contact (one ring, every contact touching them,
 // bodies beyond held fixed); its undamped modes by GSL's symmetric eigensolver on 𝕄^-½ K 𝕄^-½ (≤ 72 × 72).
+// Most pairs' answer is only "no mode slow enough" (a light body on a heavy one keeps its own dampers), which needs
+// no eigenvectors: when the caller says how fast is fast enough, the eigenvalues alone (GSL's values-only solver, the
+// same tridiagonalisation and QR steps, values bit for bit those of the solver with vectors) bound every mode's term,
+// the few modes below the mark by an approximate eigenvector (inverse iteration) and its residual's angle bound; the
+// vectors are computed, as before, only where that bound cannot show the slow frequency to be fast enough.
 #include <gsl/gsl_complex_math.h>
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_errno.h>
@@ -39,6 +44,19 @@
 // The same for the roots of the damped modes (pd_state_stack_modes: |λ|, not λ = ω²); a free motion's root is 0
 // to the eigensolver's rounding, ~1e-16 of the largest.
 #define PD_STACK_FREE_MODE_ROOT 1e-9
+// The bound that spares the eigenvectors (fast_enough) answers "fast enough" only with this relative margin on Ω,
+// far above the rounding that separates its estimates from the computed modes' (~1e-13 here), so that the answer is
+// the one the eigenvectors would give.
+#define PD_STACK_BOUND_MARGIN 1e-6
+// The error allowed on a computed eigenvalue, relative to the largest: GSL's tridiagonalisation and QR are backward
+// stable to ~n ε (~1.6e-14 at 72 rows); the residual bound's gaps are taken this much narrower.
+#define PD_STACK_EIGEN_ERROR 1e-13
+// An approximate eigenvector whose angle bound to the true one exceeds this is not used (the bound falls back to
+// the eigenvectors): its energy bound would be loose by 3 sin θ of the pair's springs' trace.
+#define PD_STACK_ANGLE_MAX 1e-3
+// Inverse iteration steps at most for one slow mode; at a shift within rounding of a simple eigenvalue one step
+// leaves a residual at rounding level, a second one what a poor start vector left.
+#define PD_STACK_INVERSE_STEPS 3
 
 #define LOCAL_DOFS (6 * PD_STACK_LOCAL_BODIES_MAX)
 
@@ -51,6 +69,7 @@ typedef struct massScale {
 
 struct pdStackScratch {
   gsl_eigen_symmv_workspace* work[PD_STACK_LOCAL_BODIES_MAX + 1];  // by body count, made when first needed
+  gsl_eigen_symm_workspace* valuesWork[PD_STACK_LOCAL_BODIES_MAX + 1];  // the values-only solver's, likewise
   int members[PD_STACK_LOCAL_BODIES_MAX];
   int memberCount;  // the pair's own moving bodies first
   massScale scale[PD_STACK_LOCAL_BODIES_MAX];
@@ -61,16 +80,27 @@ struct pdStackScratch {
   // matrix bit for bit: the decomposition is then read again rather than repeated (~6 M instructions at 72 rows).
   double decomposed[LOCAL_DOFS * LOCAL_DOFS];
   int decomposedDofs;
+  bool vectorsKept;  // `vectors` hold the decomposition's vectors (false: its values only)
+  // The values alone did not answer the last pair that asked (fast_enough): the next goes to the eigenvectors
+  // first, and its answer from them says whether the values would have done. The pairs around one body, analysed
+  // in turn at one commit, share their local systems' slow mechanisms (a board rocking on two of its contacts).
+  bool valuesFailed;
   long reuses;
+  // fast_enough's work: a copy of the matrix for the values-only solver, then its shifted LU factors
+  double lu[LOCAL_DOFS * LOCAL_DOFS];
+  int pivot[LOCAL_DOFS];
+  double u[LOCAL_DOFS], au[LOCAL_DOFS];
 };
 
 // Not zeroed: ~125 kB that a contact list's first modal dampers would otherwise clear (a tenth of a short drop's whole
 // run); the matrices are cleared or written where they are used, the members counted from 0 there.
 pdStackScratch* pd_stack_scratch_create(void) {
   pdStackScratch* s = pd_grow(NULL, 1, sizeof *s);
-  for (int k = 0; k <= PD_STACK_LOCAL_BODIES_MAX; ++k) s->work[k] = NULL;
+  for (int k = 0; k <= PD_STACK_LOCAL_BODIES_MAX; ++k) s->work[k] = NULL, s->valuesWork[k] = NULL;
   s->memberCount = 0;
   s->decomposedDofs = 0;
+  s->vectorsKept = false;
+  s->valuesFailed = false;
   s->reuses = 0;
   return s;
 }
@@ -79,8 +109,10 @@ long pd_stack_scratch_reuses(const pdStackScratch* scratch) { return scratch->re
 
 void pd_stack_scratch_free(pdStackScratch* scratch) {
   if (!scratch) return;
-  for (int k = 0; k <= PD_STACK_LOCAL_BODIES_MAX; ++k)
+  for (int k = 0; k <= PD_STACK_LOCAL_BODIES_MAX; ++k) {
     if (scratch->work[k]) gsl_eigen_symmv_free(scratch->work[k]);
+    if (scratch->valuesWork[k]) gsl_eigen_symm_free(scratch->valuesWork[k]);
+  }
   free(scratch);
 }
 
@@ -191,9 +223,154 @@ static void contact_ends(const pdStackScratch* s, const contactSlot* c, pdVec3 d
   ends[1] = scaled_end(local_index(s, c->id.body2), s->scale, -1.0, c->point, d);
 }
 
-// 1/Ω along the normals (0: no normal stiffness).
-static double slow_period(const pdContactSet* set, int first, int last, pdStackScratch* s) {
+// Σ k |h|² over the pair's contacts: the trace of its springs' share of the matrix, which bounds that share's norm.
+static double pair_trace(const pdContactSet* set, int first, int last, const pdStackScratch* s) {
+  double trace = 0.0;
+  for (int i = first; i < last; ++i) {
+    const contactSlot* c = &set->items[i];
+    scaledEnd ends[2];
+    contact_ends(s, c, c->normal, ends);
+    double sum = 0.0;
+    for (int e = 0; e < 2; ++e)
+      if (ends[e].member >= 0)
+        for (int r = 0; r < 6; ++r) sum += ends[e].h[r] * ends[e].h[r];
+    trace += pd_series(c->params.k1n, c->params.k2n) * sum;
+  }
+  return trace;
+}
+
+// Factorises a − shift I (n rows, from s->decomposed) into s->lu with partial pivoting; a zero pivot is replaced by
+// `tiny` (inverse iteration at an eigenvalue wants the near-singular solve, not its refusal).
+static void factor_shifted(pdStackScratch* s, int n, double shift, double tiny) {
+  double* t = s->lu;
+  memcpy(t, s->decomposed, sizeof(double) * (size_t)(n * n));
+  for (int i = 0; i < n; ++i) t[i * n + i] -= shift;
+  for (int col = 0; col < n; ++col) {
+    int p = col;
+    for (int i = col + 1; i < n; ++i)
+      if (fabs(t[i * n + col]) > fabs(t[p * n + col])) p = i;
+    s->pivot[col] = p;
+    if (p != col)
+      for (int j = 0; j < n; ++j) {
+        double x = t[col * n + j];
+        t[col * n + j] = t[p * n + j], t[p * n + j] = x;
+      }
+    if (t[col * n + col] == 0.0) t[col * n + col] = tiny;
+    double d = 1.0 / t[col * n + col];
+    for (int i = col + 1; i < n; ++i) {
+      double f = t[i * n + col] * d;
+      t[i * n + col] = f;
+      if (f == 0.0) continue;
+      for (int j = col + 1; j < n; ++j) t[i * n + j] -= f * t[col * n + j];
+    }
+  }
+}
+
+static void solve_shifted(const pdStackScratch* s, int n, double* x) {
+  const double* t = s->lu;
+  for (int col = 0; col < n; ++col) {
+    int p = s->pivot[col];
+    if (p != col) {
+      double v = x[col];
+      x[col] = x[p], x[p] = v;
+    }
+    for (int i = col + 1; i < n; ++i) x[i] -= t[i * n + col] * x[col];
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    double acc = x[i];
+    for (int j = i + 1; j < n; ++j) acc -= t[i * n + j] * x[j];
+    x[i] = acc / t[i * n + i];
+  }
+}
+
+// An upper bound on the strain energy of mode j (eigenvalue values[j], the decomposition's) in the pair's springs,
+// Σ k (h · v_j)², from an approximate eigenvector u by inverse iteration: with ρ = uᵀAu and r = Au − ρu, the angle
+// between u and v_j is at most |r| / gap (the sin θ theorem; gap: ρ to the nearest other eigenvalue), and
+// |v_jᵀ P v_j − uᵀ P u| <= 3 |P| sin θ for the pair's share P (|P| <= its trace). The computed vector the solver
+// with vectors would give lies within its own rounding of v_j, allowed for as an eigenvalue error `error`.
+// Negative: no bound (a cluster of eigenvalues, or a residual too large).
+static double slow_mode_energy(const pdContactSet* set, int first, int last, pdStackScratch* s, int n, int j,
+                               double error, double trace) {
+  double mu = s->values[j], gap = INFINITY;
+  for (int i = 0; i < n; ++i)
+    if (i != j) gap = fmin(gap, fabs(s->values[i] - mu));
+  if (!(gap > 4.0 * error)) return -1.0;
+  factor_shifted(s, n, mu, error);
+  double* u = s->u;
+  for (int i = 0; i < n; ++i) u[i] = 1.0 + 0.1 * (double)(i % 7) + 0.01 * (double)i;  // not special to any mode
+  double sinTheta = INFINITY;
+  for (int step = 0; step < PD_STACK_INVERSE_STEPS && !(sinTheta <= PD_STACK_ANGLE_MAX * 1e-6); ++step) {
+    solve_shifted(s, n, u);
+    double norm = 0.0;
+    for (int i = 0; i < n; ++i) norm += u[i] * u[i];
+    norm = sqrt(norm);
+    if (!(norm > 0.0) || !isfinite(norm)) return -1.0;
+    for (int i = 0; i < n; ++i) u[i] /= norm;
+    double rho = 0.0;
+    for (int r = 0; r < n; ++r) {
+      double acc = 0.0;
+      for (int q = 0; q < n; ++q) acc += s->decomposed[r * n + q] * u[q];
+      s->au[r] = acc;
+      rho += u[r] * acc;
+    }
+    double residual = 0.0;
+    for (int r = 0; r < n; ++r) residual += (s->au[r] - rho * u[r]) * (s->au[r] - rho * u[r]);
+    double away = gap - fabs(rho - mu) - error;
+    // the residual's own rounding and the solver's vector's distance from v_j: two eigenvalue errors more
+    sinTheta = away > 0.0 ? (sqrt(residual) + 2.0 * error) / away : INFINITY;
+  }
+  if (!(sinTheta <= PD_STACK_ANGLE_MAX)) return -1.0;
+  double energy = 0.0;
+  for (int i = first; i < last; ++i) {
+    const contactSlot* c = &set->items[i];
+    scaledEnd ends[2];
+    contact_ends(s, c, c->normal, ends);
+    double x = project(ends, u, 1, 0);  // u as a one-column matrix
+    energy += pd_series(c->params.k1n, c->params.k2n) * x * x;
+  }
+  return energy + trace * (3.0 * sinTheta + PD_STACK_EIGEN_ERROR);
+}
+
+// Whether every mode's term min(1, s_j / PD_STACK_SHARE) / ω_j is at most 1/fast with PD_STACK_BOUND_MARGIN to
+// spare, from the decomposition's eigenvalues: a mode at or above `fast` by its eigenvalue alone (its term is at most
+// 1/ω_j), one below it by its energy bound (slow_mode_energy). The free modes are those slow_period skips: the
+// values-only solver's eigenvalues are the other's bit for bit (tests/engine/test_stack_damping.c).
+static bool fast_enough(const pdContactSet* set, int first, int last, pdStackScratch* s, int n, double fast) {
+  double largest = 0.0;
+  for (int j = 0; j < n; ++j) largest = fmax(largest, s->values[j]);
+  if (!(largest > 0.0)) return false;
+  double error = PD_STACK_EIGEN_ERROR * largest;
+  double mark = fast * (1.0 + PD_STACK_BOUND_MARGIN);
+  double trace = -1.0;  // not yet formed: most matrices have no mode below the mark
+  // first the modes no energy bound can clear, before any inverse iteration: the term reaches 1/mark at an energy
+  // below the bound's own allowance (a mechanism of the normal springs, ω_j ~ 1e-5 of the largest)
+  for (int j = 0; j < n; ++j) {
+    double lambda = s->values[j];
+    if (!(lambda > PD_STACK_FREE_MODE * largest)) continue;
+    double low = lambda - error;  // the smallest the true eigenvalue may be
+    if (!(low > 0.0)) return false;
+    if (sqrt(low) >= mark) continue;
+    if (trace < 0.0) trace = pair_trace(set, first, last, s);
+    if (low * sqrt(low) * PD_STACK_SHARE / mark <= 2.0 * PD_STACK_EIGEN_ERROR * trace) return false;
+  }
+  for (int j = 0; j < n; ++j) {
+    double lambda = s->values[j];
+    if (!(lambda > PD_STACK_FREE_MODE * largest)) continue;
+    double low = lambda - error;
+    if (sqrt(low) >= mark) continue;
+    double energy = slow_mode_energy(set, first, last, s, n, j, error, trace);
+    if (!(energy >= 0.0)) return false;
+    if (fmin(1.0, energy / low / PD_STACK_SHARE) / sqrt(low) * mark > 1.0) return false;
+  }
+  return true;
+}
+
+// 1/Ω along the normals (0: no normal stiffness). With fast > 0, *isFast when the eigenvalues alone show 1/Ω to be
+// at most 1/fast (fast_enough; the period is then not computed: 0).
+static double slow_period(const pdContactSet* set, int first, int last, pdStackScratch* s, double fast,
+                          bool* isFast) {
   int n = 6 * s->memberCount;
+  *isFast = false;
   memset(s->a, 0, sizeof(double) * (size_t)(n * n));
   bool any = false;
   for (int m = 0; m < s->memberCount; ++m) {
@@ -212,9 +389,31 @@ static double slow_period(const pdContactSet* set, int first, int last, pdStackS
   }
   if (!any) return 0.0;
   size_t bytes = sizeof(double) * (size_t)(n * n);
-  if (s->decomposedDofs == n && memcmp(s->a, s->decomposed, bytes) == 0) {
-    ++s->reuses;
-  } else {
+  bool same = s->decomposedDofs == n && memcmp(s->a, s->decomposed, bytes) == 0;
+  if (same) ++s->reuses;
+  if (fast > 0.0 && !s->valuesFailed) {
+    if (!same) {
+      memcpy(s->decomposed, s->a, bytes);
+      s->decomposedDofs = 0;
+      gsl_eigen_symm_workspace** w = &s->valuesWork[s->memberCount];
+      if (!*w) *w = gsl_eigen_symm_alloc((size_t)n);
+      PD_ASSERT(*w != NULL);
+      memcpy(s->lu, s->a, bytes);  // the solver overwrites its matrix
+      gsl_matrix_view a = gsl_matrix_view_array(s->lu, (size_t)n, (size_t)n);
+      gsl_vector_view values = gsl_vector_view_array(s->values, (size_t)n);
+      if (gsl_eigen_symm(&a.matrix, &values.vector, *w) == GSL_SUCCESS) {
+        s->decomposedDofs = n;
+        s->vectorsKept = false;
+        same = true;
+      }
+    }
+    if (same && fast_enough(set, first, last, s, n, fast)) {
+      *isFast = true;
+      return 0.0;
+    }
+    s->valuesFailed = true;
+  }
+  if (!same || !s->vectorsKept) {
     memcpy(s->decomposed, s->a, bytes);  // before the solver overwrites a
     s->decomposedDofs = 0;
     gsl_eigen_symmv_workspace** w = &s->work[s->memberCount];
@@ -225,6 +424,12 @@ static double slow_period(const pdContactSet* set, int first, int last, pdStackS
     gsl_vector_view values = gsl_vector_view_array(s->values, (size_t)n);
     if (gsl_eigen_symmv(&a.matrix, &values.vector, &v.matrix, *w) != GSL_SUCCESS) return 0.0;
     s->decomposedDofs = n;
+    s->vectorsKept = true;
+    if (fast > 0.0 && s->valuesFailed && fast_enough(set, first, last, s, n, fast)) {
+      s->valuesFailed = false;  // the values would have answered: the next pair tries them first
+      *isFast = true;
+      return 0.0;
+    }
   }
   double largest = 0.0;
   for (int j = 0; j < n; ++j) largest = fmax(largest, s->values[j]);
@@ -246,7 +451,7 @@ static double slow_period(const pdContactSet* set, int first, int last, pdStackS
 }
 
 bool pd_stack_pair_frequency(const pdModel* model, const pdContactSet* set, const pdPose* poses, int first, int last,
-                             pdStackScratch* scratch, double* omega) {
+                             double fast, pdStackScratch* scratch, double* omega) {
   PD_ASSERT(set->bodyListValid);
   const pdContactId* id = &set->items[first].id;
   int a = id->body1 < id->body2 ? id->body1 : id->body2, b = id->body1 < id->body2 ? id->body2 : id->body1;
@@ -257,10 +462,6 @@ bool pd_stack_pair_frequency(const pdModel* model, const pdContactSet* set, cons
     heaviest = fmax(heaviest, model->bodies[scratch->members[m]].mass);
   }
   if (!(heaviest > PD_STACK_MASS_RATIO * lightest)) return false;
-  for (int m = 0; m < scratch->memberCount; ++m)
-    scratch->scale[m] = mass_scale(&model->bodies[scratch->members[m]], &poses[scratch->members[m]]);
-  double period = slow_period(set, first, last, scratch);
-  if (!(period > 0.0)) return false;
   // A mode slower than the whole local system's mass on the pair's springs, each in series with one spring per
   // body, is a mechanism of the normal springs alone (a box rocking about a line of two contacts, which gravity and
   // the tangential springs hold), not a bounce: Ω² >= count k_s / (members · Σ m).
@@ -268,6 +469,12 @@ bool pd_stack_pair_frequency(const pdModel* model, const pdContactSet* set, cons
   double total = 0.0;
   for (int m = 0; m < scratch->memberCount; ++m) total += model->bodies[scratch->members[m]].mass;
   double slowest = (last - first) * pd_series(p->k1n, p->k2n) / (scratch->memberCount * total);
+  if (fast > 0.0 && sqrt(slowest) >= fast * (1.0 + PD_STACK_BOUND_MARGIN)) return false;  // fast enough unanalysed
+  for (int m = 0; m < scratch->memberCount; ++m)
+    scratch->scale[m] = mass_scale(&model->bodies[scratch->members[m]], &poses[scratch->members[m]]);
+  bool isFast;
+  double period = slow_period(set, first, last, scratch, fast, &isFast);
+  if (isFast || !(period > 0.0)) return false;
   *omega = fmax(1.0 / period, sqrt(slowest));
   return true;
 }

@@ -25,10 +25,13 @@ long pd_stack_scratch_reuses(const pdStackScratch* scratch);
 // share of mode j's strain energy in the pair's springs. Returns false (*omega unset) for a pair whose bodies touch
 // nothing else, whose local system's masses are within PD_STACK_MASS_RATIO of each other, or which has no normal
 // stiffness: its dampers are the pair's own. The body lists (bodyFirst, bodyList) must be current.
+// fast (rad/s; 0: none) is the frequency from which the caller's answer no longer depends on Ω: false also when Ω
+// is shown to be at least fast (with a margin of 1e-6 of it) from the eigenvalues alone, the eigenvectors
+// uncomputed; where it is not shown, Ω as without it, bit for bit.
 // The modes of stack `stack` (pd_state_stack_modes, state.h; engine/src/state_stack_modes.c) from the contact list
 // and every body's state.
 int pd_stack_modes(const pdModel* model, const pdContactSet* set, const pdBodyState* bodies, const int* stackOf,
                    int stack, pdStackMode* modes, int capacity);
 
 bool pd_stack_pair_frequency(const pdModel* model, const pdContactSet* set, const pdPose* poses, int first,
-                             int last, pdStackScratch* scratch, double* omega);
+                             int last, double fast, pdStackScratch* scratch, double* omega);
