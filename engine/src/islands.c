@@ -925,13 +925,14 @@ static void lone_near_thresholds(loneRun* run) {
 static bool lone_near_path(const loneRun* run, double t, const double* y) {
   const travelProbe* probe = &run->probe;
   double tau = t - probe->t0;
-  pdVec3 ballistic = pd_v3_add(
-      probe->x0[0], pd_v3_add(pd_v3_scale(probe->v0[0], tau), pd_v3_scale(run->model->settings.gravity, 0.5 * tau * tau)));
+  pdVec3 fall = pd_v3_scale(run->model->settings.gravity, 0.5 * tau * tau);
+  pdVec3 ballistic = pd_v3_add(probe->x0[0], pd_v3_add(pd_v3_scale(probe->v0[0], tau), fall));
   pdVec3 d = pd_v3_sub(pd_layout_x(y), ballistic);
   if (!(pd_v3_dot(d, d) <= run->nearDistance2)) return false;
   pdQuat q = pd_layout_q(y), q0 = probe->q0[0];
   double dot = q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z;
-  double norms = (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z);
+  double norms =
+      (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z);
   return dot * dot >= run->nearCos2 * norms;
 }
 
