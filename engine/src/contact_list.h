@@ -200,6 +200,8 @@ struct pdContactSet {
   // view, the capture it was last gathered from slot by slot (0: none since its list was last installed otherwise):
   // pd_contact_set_gather then renews only what a presentation and an evaluation change.
   unsigned long captureSerial, gatheredSerial;
+  // pd_contact_set_settle's calls that evaluated slots; in a scene's list, the view's count when last gathered from it
+  unsigned long evaluations, gatheredEvaluations;
   capturedGeometry* captured;  // (capacity) a view's: each captured slot's normal, point and depth, which a
                                // presentation overwrites in items and the next one restores
   pdHelpDesk* help;        // where the per-contact and per-pair loops post half their work, or NULL (help_desk.h)

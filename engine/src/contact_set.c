@@ -811,17 +811,22 @@ void pd_contact_set_capture(const pdContactSet* from, pdContactSet* view) {
 
 void pd_contact_set_present(const pdModel* model, pdContactSet* view) {
   int count = view->capturedCount;
-  view->count = count;
   view->bodyListValid = false;
-  view->unevaluated = 0;
   // the inverse inertias are read for the bodies of the view's contacts only (the implicit stepper's linearisation,
   // which settles the state first): formed with the contacts when first read, at the same poses; a view without
   // contacts (a body in flight, presented at every sample) needs none
-  if (count == 0) return;
+  if (count == 0) {
+    view->count = 0;
+    view->unevaluated = 0;
+    return;
+  }
+  // every slot still as the last presentation left it (none evaluated since: a settle evaluates them all)
+  bool asPresented = view->count == count && view->unevaluated == count;
+  view->count = count;
   view->inertiasPending = true;
   // each contact as captured (a presentation at another time of the same step evaluated it there), evaluated at
   // the sample only when read (pd_contact_set_settle): most samples' observers read the bodies alone
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < count && !asPresented; ++i) {
     contactSlot* c = &view->items[i];
     c->normal = view->captured[i].normal;
     c->point = view->captured[i].point;
@@ -865,6 +870,7 @@ void pd_contact_set_settle(pdContactSet* set, double* y) {
     c->unevaluated = false;
   }
   set->unevaluated = 0;
+  ++set->evaluations;
 }
 
 // ---------------------------------------------------------------- islands (islands.c)
@@ -927,13 +933,22 @@ void pd_contact_set_scatter(const pdModel* model, const pdState* from, const int
 // The scene's list as gathered from the same capture of one island's view (pd_contact_set_gather): since that gather,
 // the view was presented again (normal, point, depth, unevaluated) and either list may have been evaluated (its
 // springs realigned, its force, geometry and held modes recorded); every other field of every slot is the capture's,
-// renumbered as it was. Renews those fields and the springs: the slots a full gather would write.
+// renumbered as it was. Renews those fields and the springs: the slots a full gather would write. Where neither list
+// was evaluated since (the scene's slots all still unevaluated, the view's all presented anew and it evaluated nothing
+// since), the fields are the capture's in both and only the springs, interpolated at each presentation, are renewed.
 static void regather(const pdModel* model, pdState* to, const pdModel* sub, const pdState* from) {
   pdContactSet* set = to->contacts;
   const pdContactSet* view = from->contacts;
   int base = spring_base(model), fromBase = spring_base(sub);
-  set->unevaluated = 0;
-  for (int i = 0; i < set->count; ++i) {
+  bool unread = set->unevaluated == set->count && view->unevaluated == set->count &&
+                view->evaluations == set->gatheredEvaluations;
+  for (int i = 0; i < set->count && unread; ++i) {
+    contactSlot* c = &set->items[i];
+    c->springs = springs_load(from->y + fromBase + PD_CONTACT_STATE_SIZE * i);
+    springs_store(to->y + base + PD_CONTACT_STATE_SIZE * i, &c->springs);
+  }
+  set->unevaluated = unread ? set->count : 0;
+  for (int i = 0; i < set->count && !unread; ++i) {
     contactSlot* c = &set->items[i];
     const contactSlot* v = &view->items[i];
     c->normal = v->normal;
@@ -971,6 +986,7 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
   unsigned long serial = parts == 1 ? from[0]->contacts->captureSerial : 0;
   if (serial != 0 && serial == set->gatheredSerial && total == set->count) {
     regather(model, to, subs[0], from[0]);
+    set->gatheredEvaluations = from[0]->contacts->evaluations;
     return;
   }
   pd_contact_set_reserve_list(set, total);
@@ -985,6 +1001,7 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
   for (int i = 0; i < count; ++i) set->unevaluated += set->items[i].unevaluated;
   set->unevaluatedModel = model;
   set->gatheredSerial = serial;
+  set->gatheredEvaluations = parts == 1 ? from[0]->contacts->evaluations : 0;
 }
 
 // The state's vectors grow with its contact list: install, above, calls it between steps (state_layout.h).

@@ -219,8 +219,9 @@ typedef struct travelProbe {
   pdSleepSet* sleep;      // nullable: the bodies' speed peaks (sleep.h)
 } travelProbe;
 
-// Island body j's numbers y at time t: its travel from the path and its speed peak.
-static void measure_body(const pdModel* sub, const travelProbe* probe, int j, double t, const double* y) {
+// Island body j's distance from the probe's path at time t, its numbers y: centre displacement plus radius ×
+// rotation angle.
+static double path_distance(const pdModel* sub, const travelProbe* probe, int j, double t, const double* y) {
   double tau = t - probe->t0;
   int k = probe->is->bodies[j];
   pdQuat q = pd_layout_q(y), q0 = probe->q0[k];
@@ -231,9 +232,14 @@ static void measure_body(const pdModel* sub, const travelProbe* probe, int j, do
   const pdBody* b = &sub->bodies[sub->movingBodies[j]];
   pdVec3 ballistic = pd_v3_add(
       probe->x0[k], pd_v3_add(pd_v3_scale(probe->v0[k], tau), pd_v3_scale(sub->settings.gravity, 0.5 * tau * tau)));
-  double moved = pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
-  probe->travel[k] = fmax(probe->travel[k], moved);
-  if (probe->sleep) pd_sleep_step_end(probe->sleep, b, k, y);
+  return pd_v3_norm(pd_v3_sub(pd_layout_x(y), ballistic)) + b->radius * angle;
+}
+
+// Island body j's numbers y at time t: its travel from the path and its speed peak.
+static void measure_body(const pdModel* sub, const travelProbe* probe, int j, double t, const double* y) {
+  int k = probe->is->bodies[j];
+  probe->travel[k] = fmax(probe->travel[k], path_distance(sub, probe, j, t, y));
+  if (probe->sleep) pd_sleep_step_end(probe->sleep, &sub->bodies[sub->movingBodies[j]], k, y);
 }
 
 static void measure_travel(const pdModel* sub, const pdState* state, void* user) {
@@ -639,6 +645,12 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
   for (int j = 0; j < set->islandCount; ++j) {
     island* is = set->islands[j];
     if (is->asleep || set->free[is->bodies[0]]) continue;  // a free body touches nothing: never at rest
+    // nor is an island without a contact, whatever its speed: its settle time is infinite (pd_sleep_settle_time), so
+    // pd_sleep_quiet finds none of its bodies quiet (a lone body in flight, tested at every sample)
+    if (pd_state_contact_count(is->state) == 0) {
+      for (int m = 0; m < is->bodyCount; ++m) sleep->quietSince[is->bodies[m]] = NAN;
+      continue;
+    }
     // the cheap test first: one body above the speed threshold keeps the island awake, and the quiet time of every
     // body in it starts again (an island comes to rest as a whole)
     bool slow = true;
@@ -874,7 +886,17 @@ typedef struct loneRun {
   double tInterval;  // s: the end of the sample interval under way (the next sample, or tEnd)
   bool open;         // an interval under way (none once the one ending at tEnd is closed)
   bool untouched;    // the body had no contact at the interval's start (lone_interval_start)
-  travelProbe probe;  // the interval's
+  travelProbe probe;  // the interval's (a body without contact at its start: against its path from there)
+  double slack;       // m: the body's (pd_island_slack)
+  bool contactsAtEnd;  // the island's contacts at the last interval's end, which the gather gave the scene
+  // A distance from the path below half the slack (the body's lowest bound) can change no decision: lone_near_path
+  // tells such a state without the norm and the arc cosine. The squared distance and the squared cosine of the
+  // angle's half that each leave a quarter of the slack (nearCos2 infinite: never told).
+  double nearDistance2, nearCos2;
+  // The speed peak (sleep.h) starts at the interval's start from the scene's numbers there (s->y until the gather),
+  // when first needed: a step end in the interval, or the sleep test at its end. Its end's speed is the sleep
+  // test's own (pd_sleep_slow, on the same numbers gathered), so the sample adds nothing to it.
+  bool peakStarted;
   // A step end past tInterval, shown to the hook before the samples it passed are presented: it belongs to the
   // interval it ends in, and is measured when that interval starts.
   bool pending;
@@ -883,16 +905,57 @@ typedef struct loneRun {
   long derivatives;       // the island's derivative evaluations when the scene's counters were last composed
 } loneRun;
 
-// The lone body's numbers y at time t inside the interval. A body with no contact at the interval's start has its
-// travel from its path measured (its stray counted: lone_interval_end) and its speed peak; one in contact only its
-// speed peak (the sleep test): its box, bound and travel serve the partition and the redo, which with one moving
-// body form the same one island every time.
-static void lone_measure(loneRun* run, double t, const double* y) {
+// The thresholds of lone_near_path for the body: its distance (centre displacement + radius × angle) below half its
+// slack, a quarter from each part. The angle's is a cosine of its half, a/2 = slack / (8 r), and is used only where
+// that half angle is wide enough (at least 1e-6 rad) for the rounding of the cosines compared (~1e-16) to move the
+// arc cosine by a small part of it (acos near 1 turns an error e into about √(2e)).
+static void lone_near_thresholds(loneRun* run) {
+  const pdModel* model = run->model;
+  const pdBody* b = &model->bodies[model->movingBodies[0]];
+  double slack = run->slack;
+  run->nearDistance2 = 0.0625 * slack * slack;
+  double half = b->radius > 0.0 ? slack / (8.0 * b->radius) : INFINITY;
+  run->nearCos2 = INFINITY;
+  if (half >= 1e-6 && half <= 0.5) run->nearCos2 = cos(half) * cos(half);
+}
+
+// Whether the lone body's numbers y at t lie so near its path (the interval's probe) that path_distance is below half
+// the slack (each part below a quarter: the roundings of the squares compared move it by far less than the other
+// half).
+static bool lone_near_path(const loneRun* run, double t, const double* y) {
+  const travelProbe* probe = &run->probe;
+  double tau = t - probe->t0;
+  pdVec3 fall = pd_v3_scale(run->model->settings.gravity, 0.5 * tau * tau);
+  pdVec3 ballistic = pd_v3_add(probe->x0[0], pd_v3_add(pd_v3_scale(probe->v0[0], tau), fall));
+  pdVec3 d = pd_v3_sub(pd_layout_x(y), ballistic);
+  if (!(pd_v3_dot(d, d) <= run->nearDistance2)) return false;
+  pdQuat q = pd_layout_q(y), q0 = probe->q0[0];
+  double dot = q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z;
+  double norms =
+      (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (q0.w * q0.w + q0.x * q0.x + q0.y * q0.y + q0.z * q0.z);
+  return dot * dot >= run->nearCos2 * norms;
+}
+
+// The speed peak of the interval under way, started (above).
+static void lone_start_peak(loneRun* run) {
   const pdModel* sub = &run->is->model;
-  if (run->untouched)
-    measure_body(sub, &run->probe, 0, t, y);
-  else if (run->set->sleep)
-    pd_sleep_step_end(run->set->sleep, &sub->bodies[sub->movingBodies[0]], 0, y);
+  pd_sleep_interval_start(run->set->sleep, &sub->bodies[sub->movingBodies[0]], 0, run->s->y);
+  run->peakStarted = true;
+}
+
+// The lone body's numbers y at time t inside the interval, at a step end (`sample` false) or the interval's end. A
+// body with no contact at the interval's start has its travel from its path measured (its stray counted:
+// lone_interval_end); a step end grows the speed peak (the sleep test): the body's box, bound and travel serve the
+// partition and the redo, which with one moving body form the same one island every time. A travel below half the
+// slack is left out of the largest: lone_interval_end compares that with the slack and the bound (never below the
+// slack) only, and the largest is the same wherever it exceeds the slack.
+static void lone_measure(loneRun* run, double t, const double* y, bool sample) {
+  const pdModel* sub = &run->is->model;
+  if (run->untouched && !lone_near_path(run, t, y))
+    run->set->ctravel[0] = fmax(run->set->ctravel[0], path_distance(sub, &run->probe, 0, t, y));
+  if (sample || !run->set->sleep) return;
+  if (!run->peakStarted) lone_start_peak(run);
+  pd_sleep_step_end(run->set->sleep, &sub->bodies[sub->movingBodies[0]], 0, y);
 }
 
 // The sample interval from the scene's time to the next sample (or tEnd) starts, as advance_interval starts it for
@@ -902,26 +965,28 @@ static void lone_measure(loneRun* run, double t, const double* y) {
 static void lone_interval_start(loneRun* run) {
   pdState* s = run->s;
   struct pdIslandSet* set = run->set;
-  double target = fmin(run->tEnd, pd_sample_time(run->model, s->nextSample));
+  double tSample = pd_sample_time(run->model, s->nextSample);
   set->t0 = set->ct0 = s->t;
   set->startsFormed = false;
   set->free[0] = false;
   ++set->intervals;
-  run->untouched = pd_state_contact_count(s) == 0;
+  run->untouched = !run->contactsAtEnd;
   set->touching[0] = !run->untouched;
-  run->probe = start_probe(set, run->is, false);
+  set->travel[0] = 0.0;  // start_probe's, but for the speed peak (lone_start_peak)
+  run->is->advanced = true;
+  run->peakStarted = false;
   if (run->untouched) {
     const double* y = s->y;
     set->cx0[0] = pd_layout_x(y);
     set->cv0[0] = pd_layout_v(y);
     set->cq0[0] = pd_layout_q(y);
     set->ctravel[0] = 0.0;
-    run->probe = (travelProbe){run->is, set->ct0, set->cx0, set->cv0, set->cq0, set->ctravel, set->sleep};
+    run->probe.t0 = set->ct0;  // the rest is lone_run's: set->cx0, cv0, cq0, ctravel
   }
-  run->tInterval = target;
+  run->tInterval = tSample < run->tEnd ? tSample : run->tEnd;
   run->open = true;
-  if (run->pending && run->pendingT <= target) {
-    lone_measure(run, run->pendingT, run->pendingY);
+  if (run->pending && run->pendingT <= run->tInterval) {
+    lone_measure(run, run->pendingT, run->pendingY, false);
     run->pending = false;
   }
 }
@@ -937,19 +1002,33 @@ static void lone_interval_end(loneRun* run, double tNext) {
   const pdModel* model = run->model;
   pdState* s = run->s;
   struct pdIslandSet* set = run->set;
-  if (run->untouched && (set->ctravel[0] > pd_island_slack(model, &model->bodies[model->movingBodies[0]]) ||
-                         pd_state_contact_count(run->is->state) > 0)) {
+  island* is = run->is;
+  bool contacts = pd_state_contact_count(is->state) > 0;
+  if (run->untouched && (contacts || set->ctravel[0] > run->slack)) {
     set_start(model, s, set, 0, tNext - s->t);
     set->cbound[0] = set->bound[0];
     set->free[0] = !set->touching[0];
     if (set->free[0] && set->ctravel[0] > set->cbound[0]) ++set->strays;
   }
-  gather(model, s, set, tNext, true);
+  // fall_asleep for the one island, awake: a free body is skipped; a body without a contact is not quiet (its quiet
+  // time unset), whatever its speed; the time asleep grows by nothing; else the test, which reads the speed peak,
+  // started from the numbers at T0 before the gather overwrites them
+  bool sleepTest = set->sleep && !set->free[0] && contacts;
+  if (sleepTest && !run->peakStarted) lone_start_peak(run);
+  // gather(), for the one island (the gather's lists are lone_run's)
+  memcpy(s->y, is->state->y, PD_BODY_STATE_SIZE * sizeof *s->y);
+  set->h[0] = is->state->h;
+  pd_contact_set_gather(model, s, 1, set->subModels, set->subStates, set->subMaps);
+  run->contactsAtEnd = contacts;
+  if (sleepTest)
+    fall_asleep(model, s, set, tNext);
+  else if (set->sleep && !set->free[0])
+    set->sleep->quietSince[0] = NAN;
   // every counter of the island's but the samples (the scene's own) changes with a step tried, which evaluates the
   // derivative: without one, only the set's change (the stage timers wait for the run's end)
-  if (run->is->state->count.derivatives != run->derivatives) {
+  if (is->state->count.derivatives != run->derivatives) {
     compose_counters(set, s);
-    run->derivatives = run->is->state->count.derivatives;
+    run->derivatives = is->state->count.derivatives;
   } else {
     compose_set_counters(set, s);
   }
@@ -963,7 +1042,7 @@ static void lone_step_end(const pdModel* sub, const pdState* state, void* user) 
   loneRun* run = user;
   if (!run->open) return;  // the presented end of a call whose last sample closed the interval, measured there
   if (state->t <= run->tInterval) {
-    lone_measure(run, state->t, state->y);
+    lone_measure(run, state->t, state->y, false);
     return;
   }
   run->pending = true;
@@ -978,7 +1057,7 @@ static bool lone_sample(const pdModel* sub, const pdState* state, void* user) {
   (void)sub;  // the island's: run->is->model
   loneRun* run = user;
   PD_ASSERT(run->open && state->t == run->tInterval);
-  lone_measure(run, state->t, state->y);
+  lone_measure(run, state->t, state->y, true);
   lone_interval_end(run, state->t);
   observe(run->model, run->s, run->set, run->observer, run->user);
   if (run->s->stopped || run->is->asleep) return false;
@@ -1023,6 +1102,13 @@ static bool lone_run(const pdModel* model, pdState* s, struct pdIslandSet* set, 
   PD_ASSERT(is->bodyCount == 1 && is->state->t == s->t);
   loneRun run = {.model = model, .s = s, .set = set, .is = is, .observer = observer, .user = user, .tEnd = tEnd,
                  .derivatives = is->state->count.derivatives};
+  run.slack = pd_island_slack(model, &model->bodies[model->movingBodies[0]]);
+  run.contactsAtEnd = pd_state_contact_count(s) > 0;
+  run.probe = (travelProbe){is, s->t, set->cx0, set->cv0, set->cq0, set->ctravel, set->sleep};
+  lone_near_thresholds(&run);
+  set->subModels[0] = &is->model;
+  set->subStates[0] = is->state;
+  set->subMaps[0] = is->toScene;
   lone_interval_start(&run);
   // lone_sample untimed: it times the caller's observer into the scene's observe stage itself (observe())
   bool ok = pd_step_until(&is->model, is->state, tEnd, false, lone_sample, &run, false, lone_step_end, &run);
