@@ -158,6 +158,13 @@ static void force_and_rates(const contactSlot* c, bool held, const double s[PD_C
   springs_store(out + 3, &f.rate);
 }
 
+// force_and_rates of contact c as record() left it (c->force, at the state it recorded).
+static void recorded_rates(const contactSlot* c, double out[3 + PD_CONTACT_STATE_SIZE]) {
+  pdVec3 force = pd_contact_force_pulls(&c->force) ? (pdVec3){0, 0, 0} : c->force.force;
+  out[0] = force.x, out[1] = force.y, out[2] = force.z;
+  springs_store(out + 3, &c->force.rate);
+}
+
 // Body b's centre at state y (a fixed body's where it stands).
 static pdVec3 centre_at(const pdModel* model, const double* y, int b) {
   const pdBody* body = &model->bodies[b];
@@ -167,6 +174,9 @@ static pdVec3 centre_at(const pdModel* model, const double* y, int b) {
 void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const double* y, pdContactLinear* out) {
   int base = spring_base(model);
   double vmax = model->settings.vmax;
+  // at the very state record() evaluated (a step's start after a commit), with the law free as there, each contact's
+  // unperturbed F and ṡ are its recorded force's: the same normal, Δu and springs (recorded_range reads them so too)
+  bool recorded = !set->holdModes && pd_contact_set_recorded_at(model, set, y);
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     int b1 = c->id.body1, b2 = c->id.body2;
@@ -180,7 +190,10 @@ void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const dou
     pdVec3 du = pd_v3_sub(velocity_at(model, y, b1, l->r1), velocity_at(model, y, b2, l->r2));
     double s[PD_CONTACT_STATE_SIZE], f0[3 + PD_CONTACT_STATE_SIZE], f1[3 + PD_CONTACT_STATE_SIZE];
     for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) s[j] = y[base + PD_CONTACT_STATE_SIZE * i + j];
-    force_and_rates(c, set->holdModes, s, c->normal, du, f0);
+    if (recorded)
+      recorded_rates(c, f0);
+    else
+      force_and_rates(c, set->holdModes, s, c->normal, du, f0);
     for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) {
       double keep = s[j];
       s[j] += PD_LINEARISE_STEP_REL * fmax(fabs(keep), c->deltaMax);
