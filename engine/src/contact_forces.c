@@ -113,6 +113,24 @@ static void recorded_range(void* ctx, int part, int begin, int end) {
   }
 }
 
+// Contacts [begin, end) at the state pd_contact_events just tracked them to (pd_contact_set_tracked_at): a vertex–face contact's
+// geometry is formed alike tracked or not (contact_motion), and its relative velocity and force (the law free) from the
+// same numbers, so its rates and push are set->eval's; the others as forces_range forms them.
+static void tracked_range(void* ctx, int part, int begin, int end) {
+  const contactLoop* job = ctx;
+  pdContactSet* set = job->set;
+  int base = spring_base(job->model);
+  for (int i = begin; i < end; ++i) {
+    if (set->items[i].id.kind != pd_contactVF) {
+      forces_range(ctx, part, i, i + 1);
+      continue;
+    }
+    const contactEval* e = &set->eval[i];
+    springs_store(job->dydt + base + PD_CONTACT_STATE_SIZE * i, &e->force.rate);
+    set->push[i] = (contactPush){e->geom.point, e->force.force, pd_contact_force_pulls(&e->force)};
+  }
+}
+
 bool pd_contact_set_recorded_at(const pdModel* model, const pdContactSet* set, const double* y) {
   // a step's stages evaluate in the stepper's scratch: only the place the recorded state was is compared (the list
   // is the recorded one while recordedValid, so is the state's length)
@@ -123,12 +141,23 @@ bool pd_contact_set_recorded_at(const pdModel* model, const pdContactSet* set, c
 
 void pd_contact_set_forget_recorded(pdContactSet* set) { set->recordedValid = false; }
 
+bool pd_contact_set_tracked_at(const pdModel* model, const pdContactSet* set, const double* y) {
+  if (!set->trackedValid || y != set->trackedFrom || set->holdModes) return false;
+  int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
+  return memcmp(y, set->trackedY, (size_t)n * sizeof *y) == 0;
+}
+
+void pd_contact_set_forget_tracked(pdContactSet* set) { set->trackedValid = false; }
+
 void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y, double* dydt) {
   contactLoop job = {.model = model, .set = set, .y = y, .dydt = dydt};
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, poses_range, &job);
   // the first derivative of a step after a commit is at the state record() has just evaluated (bit for bit)
   bool recorded = pd_contact_set_recorded_at(model, set, y);
-  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, recorded ? recorded_range : forces_range, &job);
+  // an implicit trial's end (its dense output's slope) is at the state its contact events just tracked the list to
+  bool tracked = !recorded && pd_contact_set_tracked_at(model, set, y);
+  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS,
+              recorded ? recorded_range : tracked ? tracked_range : forces_range, &job);
   // a list installed without pd_stability_prepare (a gather)
   if (!set->bodyListValid) pd_contact_set_list_bodies(model, set);
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, sums_range, &job);
