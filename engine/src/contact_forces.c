@@ -113,6 +113,24 @@ static void recorded_range(void* ctx, int part, int begin, int end) {
   }
 }
 
+// Contacts [begin, end) at the state pd_contact_events just tracked them to (pd_contact_set_tracked_at): a vertex–face contact's
+// geometry is formed alike tracked or not (contact_motion), and its relative velocity and force (the law free) from the
+// same numbers, so its rates and push are set->eval's; the others as forces_range forms them.
+static void tracked_range(void* ctx, int part, int begin, int end) {
+  const contactLoop* job = ctx;
+  pdContactSet* set = job->set;
+  int base = spring_base(job->model);
+  for (int i = begin; i < end; ++i) {
+    if (set->items[i].id.kind != pd_contactVF) {
+      forces_range(ctx, part, i, i + 1);
+      continue;
+    }
+    const contactEval* e = &set->eval[i];
+    springs_store(job->dydt + base + PD_CONTACT_STATE_SIZE * i, &e->force.rate);
+    set->push[i] = (contactPush){e->geom.point, e->force.force, pd_contact_force_pulls(&e->force)};
+  }
+}
+
 bool pd_contact_set_recorded_at(const pdModel* model, const pdContactSet* set, const double* y) {
   // a step's stages evaluate in the stepper's scratch: only the place the recorded state was is compared (the list
   // is the recorded one while recordedValid, so is the state's length)
@@ -123,12 +141,23 @@ bool pd_contact_set_recorded_at(const pdModel* model, const pdContactSet* set, c
 
 void pd_contact_set_forget_recorded(pdContactSet* set) { set->recordedValid = false; }
 
+bool pd_contact_set_tracked_at(const pdModel* model, const pdContactSet* set, const double* y) {
+  if (!set->trackedValid || y != set->trackedFrom || set->holdModes) return false;
+  int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
+  return memcmp(y, set->trackedY, (size_t)n * sizeof *y) == 0;
+}
+
+void pd_contact_set_forget_tracked(pdContactSet* set) { set->trackedValid = false; }
+
 void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y, double* dydt) {
   contactLoop job = {.model = model, .set = set, .y = y, .dydt = dydt};
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, poses_range, &job);
   // the first derivative of a step after a commit is at the state record() has just evaluated (bit for bit)
   bool recorded = pd_contact_set_recorded_at(model, set, y);
-  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, recorded ? recorded_range : forces_range, &job);
+  // an implicit trial's end (its dense output's slope) is at the state its contact events just tracked the list to
+  bool tracked = !recorded && pd_contact_set_tracked_at(model, set, y);
+  pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS,
+              recorded ? recorded_range : tracked ? tracked_range : forces_range, &job);
   // a list installed without pd_stability_prepare (a gather)
   if (!set->bodyListValid) pd_contact_set_list_bodies(model, set);
   pd_help_for(set->help, model->movingCount, PD_HELP_MIN_BODIES, sums_range, &job);
@@ -158,6 +187,13 @@ static void force_and_rates(const contactSlot* c, bool held, const double s[PD_C
   springs_store(out + 3, &f.rate);
 }
 
+// force_and_rates of contact c as record() left it (c->force, at the state it recorded).
+static void recorded_rates(const contactSlot* c, double out[3 + PD_CONTACT_STATE_SIZE]) {
+  pdVec3 force = pd_contact_force_pulls(&c->force) ? (pdVec3){0, 0, 0} : c->force.force;
+  out[0] = force.x, out[1] = force.y, out[2] = force.z;
+  springs_store(out + 3, &c->force.rate);
+}
+
 // Body b's centre at state y (a fixed body's where it stands).
 static pdVec3 centre_at(const pdModel* model, const double* y, int b) {
   const pdBody* body = &model->bodies[b];
@@ -167,6 +203,9 @@ static pdVec3 centre_at(const pdModel* model, const double* y, int b) {
 void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const double* y, pdContactLinear* out) {
   int base = spring_base(model);
   double vmax = model->settings.vmax;
+  // at the very state record() evaluated (a step's start after a commit), with the law free as there, each contact's
+  // unperturbed F and ṡ are its recorded force's: the same normal, Δu and springs (recorded_range reads them so too)
+  bool recorded = !set->holdModes && pd_contact_set_recorded_at(model, set, y);
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     int b1 = c->id.body1, b2 = c->id.body2;
@@ -180,7 +219,10 @@ void pd_contact_set_linearise(const pdModel* model, pdContactSet* set, const dou
     pdVec3 du = pd_v3_sub(velocity_at(model, y, b1, l->r1), velocity_at(model, y, b2, l->r2));
     double s[PD_CONTACT_STATE_SIZE], f0[3 + PD_CONTACT_STATE_SIZE], f1[3 + PD_CONTACT_STATE_SIZE];
     for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) s[j] = y[base + PD_CONTACT_STATE_SIZE * i + j];
-    force_and_rates(c, set->holdModes, s, c->normal, du, f0);
+    if (recorded)
+      recorded_rates(c, f0);
+    else
+      force_and_rates(c, set->holdModes, s, c->normal, du, f0);
     for (int j = 0; j < PD_CONTACT_STATE_SIZE; ++j) {
       double keep = s[j];
       s[j] += PD_LINEARISE_STEP_REL * fmax(fabs(keep), c->deltaMax);

@@ -195,6 +195,13 @@ struct pdContactSet {
   const double* recordedFrom;  // where that state was (only a derivative at those numbers there is compared)
   int recordedCapacity;
   bool recordedValid;          // cleared by a list installed or cleared
+  // the state pd_contact_events last tracked C0 to (set->eval: each contact's geometry, Δu and force there, the law
+  // free), while trackedValid: a derivative at the very same numbers there (the implicit trial's end, for its dense
+  // output) takes its vertex–face contacts' from there (pd_contact_forces)
+  double* trackedY;
+  const double* trackedFrom;
+  int trackedCapacity;
+  bool trackedValid;           // cleared with recordedValid (a list installed, cleared or gathered)
   int capturedCount;           // a dense output's view (dense_output.h): the captured list's length, its slots in items
   // A view's capture, unique in the process (0: none, or not a view); and, in a scene's list gathered from one island's
   // view, the capture it was last gathered from slot by slot (0: none since its list was last installed otherwise):

@@ -238,6 +238,8 @@ static double vertex_move(const double* at, double lambda, const double* toward,
 // `moves`) that may get beyond `plane` over a fraction lambda of the step: the vertices whose bound exceeds their
 // distance outside it (inside ones all count), and where an edge crosses from such a vertex to one that cannot.
 // Between vertices the bound is taken as their barycentric mix, which is at least the convex bound's value there.
+// Once the largest so far reaches `stopAbove` the rest is not looked at: the result is then at least stopAbove and at
+// most the bound (reaching_move keeps the smaller of it and a best at most stopAbove, or only compares it).
 static double plane_reach(const pdPolyhedron* shape, const double* moves, const double* plane, double lambda,
                           bool alongNormal, double sagAlong, double stopAbove, double* scratch) {
   const double* toward = alongNormal ? plane : NULL;
@@ -250,7 +252,10 @@ static double plane_reach(const pdPolyhedron* shape, const double* moves, const 
     over[v] = move[v] - beyond(plane, at);
     // the larger inline, not fmax's libm call (1.8 M calls on cases/bench/pile_300.scene's first 0.2 s): the moves are
     // finite and at least +0, so the same value
-    if (over[v] > 0.0 && move[v] > most) most = move[v];
+    if (over[v] > 0.0 && move[v] > most) {
+      most = move[v];
+      if (most >= stopAbove) return most;
+    }
   }
   for (int e = 0; e < shape->edgeCount && most < stopAbove; ++e) {
     int u = shape->edges[e].v[0], w = shape->edges[e].v[1];

@@ -137,6 +137,7 @@ void pd_contact_set_free(pdContactSet* set) {
   free(set->next);
   free(set->captured);
   free(set->recordedY);
+  free(set->trackedY);
   for (int part = 0; part < 2; ++part) free(set->search[part].previous);
   free(set->force);
   free(set->stability);
@@ -165,7 +166,7 @@ void pd_contact_set_clear(pdContactSet* set) {
   set->gatheredSerial = 0;
   set->unevaluated = 0;
   set->bodyListValid = false;
-  set->recordedValid = false;
+  set->recordedValid = set->trackedValid = false;
   set->stableStep = set->stableCheap = INFINITY;
   set->dampingMin = 1.0;
   set->stableKnown = true;
@@ -217,7 +218,7 @@ static void install(const pdModel* model, pdState* s, int count, bool ordered) {
   set->gatheredSerial = 0;  // a gather from a view sets it after
   set->unevaluated = 0;  // a gather counts the unevaluated slots it moved (pd_contact_set_gather)
   set->bodyListValid = false;
-  set->recordedValid = false;
+  set->recordedValid = set->trackedValid = false;
   s->n = base + PD_CONTACT_STATE_SIZE * count;
 }
 
@@ -342,6 +343,20 @@ static void tracking_range(void* ctx, int part, int begin, int end) {
     e->modeCorrected = false;
     e->slipChanged = false;
   }
+}
+
+// Keeps the state C0 was just tracked to (set->eval's), for a derivative there (pd_contact_forces).
+static void keep_tracked(const pdModel* model, pdContactSet* set, const double* y1) {
+  set->trackedValid = false;
+  if (set->count == 0) return;  // nothing to take
+  int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
+  if (n > set->trackedCapacity) {  // grown with the list, between trials
+    set->trackedCapacity = 2 * n;
+    set->trackedY = pd_grow(set->trackedY, (size_t)set->trackedCapacity, sizeof *set->trackedY);
+  }
+  memcpy(set->trackedY, y1, (size_t)n * sizeof *y1);
+  set->trackedFrom = y1;
+  set->trackedValid = true;
 }
 
 // The time since a switching quantity crossed zero inside a step of h, from its values at the start (g0) and the
@@ -536,6 +551,11 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   // 1. C0 at y1: tracking, forces, reversals
   contactLoop job = {.model = model, .set = set, .y = y1};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, tracking_range, &job);
+  // only an implicit trial evaluates the derivative at its end after its contact events (its dense output's slope)
+  if (s->implicit && pd_implicit_active(s->implicit))
+    keep_tracked(model, set, y1);
+  else
+    set->trackedValid = false;
   double refineStep = 0.0;  // the largest refinement bound among the contacts that changed mode (0: none)
   double locate = h;        // the step that ends just past the earliest held mode's change to locate (h: none)
   pdOnsets mode = pd_onsets_effective(s->onsets, model->movingCount);
@@ -966,7 +986,7 @@ static void regather(const pdModel* model, pdState* to, const pdModel* sub, cons
   set->onsetRetries = 0;
   set->modeRetries = 0;
   set->bodyListValid = false;
-  set->recordedValid = false;
+  set->recordedValid = set->trackedValid = false;
   set->unevaluatedModel = model;
 }
 
@@ -979,7 +999,7 @@ void pd_contact_set_gather(const pdModel* model, pdState* to, int parts, const p
   if (total == 0 && set->count == 0) {  // an empty list stays empty (a lone body in flight, gathered every sample)
     PD_ASSERT(to->n == spring_base(model));
     set->bodyListValid = false;
-    set->recordedValid = false;  // its bodies were just gathered: what record() kept is of other numbers
+    set->recordedValid = set->trackedValid = false;  // its bodies were just gathered: what was kept is of other numbers
     return;
   }
   // a lone island presenting the same step's list again (a body in contact, gathered at every sample)

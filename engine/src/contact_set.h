@@ -48,6 +48,13 @@ void pd_contact_forces(const pdModel* model, pdContactSet* set, const double* y,
 bool pd_contact_set_recorded_at(const pdModel* model, const pdContactSet* set, const double* y);
 // Forgets them now: the next derivative forms every contact (tests compare the two).
 void pd_contact_set_forget_recorded(pdContactSet* set);
+// Whether a derivative at y takes its vertex–face contacts' force and spring rates from the contact events' tracking:
+// pd_contact_events tracked the list to a state of the very same numbers in the same place while the implicit method
+// was active (the implicit trial's end, whose derivative its dense output needs), and modes are not held. Any list
+// installed, cleared or gathered forgets it; so does the next pd_contact_events.
+bool pd_contact_set_tracked_at(const pdModel* model, const pdContactSet* set, const double* y);
+// Forgets it now (tests compare the two).
+void pd_contact_set_forget_tracked(pdContactSet* set);
 // Results of the last pd_contact_forces call: poses indexed by body; force and torque (N, N·m, about the
 // centre of mass) indexed by moving body (stateIndex).
 const pdPose* pd_contact_set_poses(const pdContactSet* set);

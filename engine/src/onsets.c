@@ -386,9 +386,13 @@ static pdVec3 group_force(const onsetPoint* p, double x, pdVec3 q, pdVec3 du, pd
   return pd_v3_sub(pd_v3_scale(p->normal, fn), ft);
 }
 
+// The state's components the bodies and contacts [0, active) take: the rest of a group's state stays as it is.
+static int group_size(int active) { return G_BODIES + G_POINT * active; }
+
 // The rate of state s, the contacts [0, active) begun (they are sorted by their onsets): the system is autonomous.
+// Only the group_size(active) components that move are written.
 static void group_rate(const onsetGroup* g, int active, const double* s, double* r) {
-  for (int j = 0; j < G_STATE; ++j) r[j] = 0.0;
+  for (int j = 0; j < group_size(active); ++j) r[j] = 0.0;
   for (int i = 0; i < active; ++i) {
     const onsetPoint* p = &g->points[i];
     const double* sp = s + G_BODIES + G_POINT * i;
@@ -447,15 +451,19 @@ static void onset_group_motion(const onsetGroup* g, double s[G_STATE]) {
     if ((end - time) * rate > PD_ONSET_PAIR_SUBSTEPS * PD_ONSET_SUBSTEP_DAMPING)
       substeps = (int)ceil((end - time) * rate / PD_ONSET_SUBSTEP_DAMPING);
     double dt = (end - time) / substeps;
+    // the contacts not begun yet have no rate: their components are not stepped but for the one change adding a
+    // zero rate makes (a −0 becomes +0)
+    int n = group_size(active);
+    for (int j = n; j < group_size(g->count); ++j) s[j] += 0.0;
     for (int i = 0; i < substeps; ++i) {
       group_rate(g, active, s, k[0]);
-      for (int j = 0; j < G_STATE; ++j) tmp[j] = s[j] + 0.5 * dt * k[0][j];
+      for (int j = 0; j < n; ++j) tmp[j] = s[j] + 0.5 * dt * k[0][j];
       group_rate(g, active, tmp, k[1]);
-      for (int j = 0; j < G_STATE; ++j) tmp[j] = s[j] + 0.5 * dt * k[1][j];
+      for (int j = 0; j < n; ++j) tmp[j] = s[j] + 0.5 * dt * k[1][j];
       group_rate(g, active, tmp, k[2]);
-      for (int j = 0; j < G_STATE; ++j) tmp[j] = s[j] + dt * k[2][j];
+      for (int j = 0; j < n; ++j) tmp[j] = s[j] + dt * k[2][j];
       group_rate(g, active, tmp, k[3]);
-      for (int j = 0; j < G_STATE; ++j) s[j] += dt / 6.0 * (k[0][j] + 2.0 * k[1][j] + 2.0 * k[2][j] + k[3][j]);
+      for (int j = 0; j < n; ++j) s[j] += dt / 6.0 * (k[0][j] + 2.0 * k[1][j] + 2.0 * k[2][j] + k[3][j]);
     }
     time = end;
   }
