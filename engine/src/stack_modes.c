@@ -19,7 +19,9 @@
 #include <gsl/gsl_complex_math.h>
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
 #include <gsl/gsl_matrix.h>
+#include <gsl/gsl_permutation.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,9 +88,10 @@ struct pdStackScratch {
   // in turn at one commit, share their local systems' slow mechanisms (a board rocking on two of its contacts).
   bool valuesFailed;
   long reuses;
-  // fast_enough's work: a copy of the matrix for the values-only solver, then its shifted LU factors
+  // fast_enough's work: a copy of the matrix for the values-only solver, then its shifted LU factors and their row
+  // permutation's storage (a gsl_permutation of the local system's rows is made over it where it is used)
   double lu[LOCAL_DOFS * LOCAL_DOFS];
-  int pivot[LOCAL_DOFS];
+  size_t pivot[LOCAL_DOFS];
   double u[LOCAL_DOFS], au[LOCAL_DOFS];
 };
 
@@ -239,48 +242,21 @@ static double pair_trace(const pdContactSet* set, int first, int last, const pdS
   return trace;
 }
 
-// Factorises a − shift I (n rows, from s->decomposed) into s->lu with partial pivoting; a zero pivot is replaced by
-// `tiny` (inverse iteration at an eigenvalue wants the near-singular solve, not its refusal).
-static void factor_shifted(pdStackScratch* s, int n, double shift, double tiny) {
+// Factorises a − shift I (n rows, from s->decomposed) into s->lu and *perm by GSL's LU with partial pivoting. False
+// at an exactly zero pivot (a shift at an eigenvalue can make the matrix singular in floating point): GSL 2.7 divides
+// the column by it (the factors below it NaN, the status still success), later versions stop there (the factors
+// incomplete), so no pivot can be patched; the eigenvectors decide instead, the same answer. gsl_linalg_LU_svx, which
+// refuses a zero diagonal through GSL's error handler (abort by default), only ever sees a nonsingular factor.
+static bool factor_shifted(pdStackScratch* s, int n, double shift, gsl_permutation* perm) {
   double* t = s->lu;
   memcpy(t, s->decomposed, sizeof(double) * (size_t)(n * n));
   for (int i = 0; i < n; ++i) t[i * n + i] -= shift;
-  for (int col = 0; col < n; ++col) {
-    int p = col;
-    for (int i = col + 1; i < n; ++i)
-      if (fabs(t[i * n + col]) > fabs(t[p * n + col])) p = i;
-    s->pivot[col] = p;
-    if (p != col)
-      for (int j = 0; j < n; ++j) {
-        double x = t[col * n + j];
-        t[col * n + j] = t[p * n + j], t[p * n + j] = x;
-      }
-    if (t[col * n + col] == 0.0) t[col * n + col] = tiny;
-    double d = 1.0 / t[col * n + col];
-    for (int i = col + 1; i < n; ++i) {
-      double f = t[i * n + col] * d;
-      t[i * n + col] = f;
-      if (f == 0.0) continue;
-      for (int j = col + 1; j < n; ++j) t[i * n + j] -= f * t[col * n + j];
-    }
-  }
-}
-
-static void solve_shifted(const pdStackScratch* s, int n, double* x) {
-  const double* t = s->lu;
-  for (int col = 0; col < n; ++col) {
-    int p = s->pivot[col];
-    if (p != col) {
-      double v = x[col];
-      x[col] = x[p], x[p] = v;
-    }
-    for (int i = col + 1; i < n; ++i) x[i] -= t[i * n + col] * x[col];
-  }
-  for (int i = n - 1; i >= 0; --i) {
-    double acc = x[i];
-    for (int j = i + 1; j < n; ++j) acc -= t[i * n + j] * x[j];
-    x[i] = acc / t[i * n + i];
-  }
+  gsl_matrix_view lu = gsl_matrix_view_array(t, (size_t)n, (size_t)n);
+  int signum;
+  if (gsl_linalg_LU_decomp(&lu.matrix, perm, &signum) != GSL_SUCCESS) return false;
+  for (int i = 0; i < n; ++i)
+    if (!(fabs(t[i * n + i]) > 0.0) || !isfinite(t[i * n + i])) return false;
+  return true;
 }
 
 // An upper bound on the strain energy of mode j (eigenvalue values[j], the decomposition's) in the pair's springs,
@@ -288,19 +264,22 @@ static void solve_shifted(const pdStackScratch* s, int n, double* x) {
 // between u and v_j is at most |r| / gap (the sin θ theorem; gap: ρ to the nearest other eigenvalue), and
 // |v_jᵀ P v_j − uᵀ P u| <= 3 |P| sin θ for the pair's share P (|P| <= its trace). The computed vector the solver
 // with vectors would give lies within its own rounding of v_j, allowed for as an eigenvalue error `error`.
-// Negative: no bound (a cluster of eigenvalues, or a residual too large).
+// Negative: no bound (a cluster of eigenvalues, a residual too large, or an exactly singular shifted matrix).
 static double slow_mode_energy(const pdContactSet* set, int first, int last, pdStackScratch* s, int n, int j,
                                double error, double trace) {
   double mu = s->values[j], gap = INFINITY;
   for (int i = 0; i < n; ++i)
     if (i != j) gap = fmin(gap, fabs(s->values[i] - mu));
   if (!(gap > 4.0 * error)) return -1.0;
-  factor_shifted(s, n, mu, error);
+  gsl_permutation perm = {.size = (size_t)n, .data = s->pivot};
+  if (!factor_shifted(s, n, mu, &perm)) return -1.0;
+  gsl_matrix_const_view lu = gsl_matrix_const_view_array(s->lu, (size_t)n, (size_t)n);
+  gsl_vector_view uv = gsl_vector_view_array(s->u, (size_t)n);
   double* u = s->u;
   for (int i = 0; i < n; ++i) u[i] = 1.0 + 0.1 * (double)(i % 7) + 0.01 * (double)i;  // not special to any mode
   double sinTheta = INFINITY;
   for (int step = 0; step < PD_STACK_INVERSE_STEPS && !(sinTheta <= PD_STACK_ANGLE_MAX * 1e-6); ++step) {
-    solve_shifted(s, n, u);
+    gsl_linalg_LU_svx(&lu.matrix, &perm, &uv.vector);
     double norm = 0.0;
     for (int i = 0; i < n; ++i) norm += u[i] * u[i];
     norm = sqrt(norm);
