@@ -39,6 +39,7 @@ pdState* measured_span(const pdModel* model, pdGkRecord* rec);
 __attribute__((noinline)) pdState* measured_span(const pdModel* model, pdGkRecord* rec) {
   pdStateOptions options = pd_state_options_default();
   options.stepper = pd_stepperImplicit;
+  options.stageTimers = false;  // as gedanken/precision.c times a point
   pdState* state = pd_state_create(model, &options);
   pd_advance(model, state, model->settings.tend, record_sample, rec);
   return state;

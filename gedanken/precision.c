@@ -206,6 +206,8 @@ static pdGkTiming measure_point(const gkPrecision* s, gkPoint* p, bool first) {
                                                                 : pd_stepperRK4Adaptive;
     // the reference variant of the contact events: every onset located (docs/events.md)
     if (strcmp(p->variant, "exact-events") == 0) options.onsets = pd_onsetsExact;
+    // the span is timed whole, as a reference engine's is: no stage timers (their clock reads are not the run's work)
+    options.stageTimers = false;
     run.stateOptions = options;
   } else {
     run.adapter = pd_ref_adapter(pdGkEngineNames[p->engine]);

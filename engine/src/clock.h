@@ -1,6 +1,7 @@
 // polydyn (internal) — the monotonic clock the step stages are timed with.
 #pragma once
 
+#include <stdbool.h>
 #include <time.h>
 
 static inline double pd_clock_seconds(void) {
@@ -22,14 +23,17 @@ static inline double pd_clock_read_seconds(void) {
 }
 
 // Consecutive stages timed with one clock read per boundary instead of two per stage: each lap adds the time
-// since the previous one to a stage's seconds.
+// since the previous one to a stage's seconds. A stopwatch started off (pdStateOptions.stageTimers false) reads no
+// clock and adds nothing.
 typedef struct pdStopwatch {
   double last;  // s, the clock at the previous boundary
+  bool on;
 } pdStopwatch;
 
-static inline pdStopwatch pd_stopwatch_start(void) { return (pdStopwatch){pd_clock_seconds()}; }
+static inline pdStopwatch pd_stopwatch_start(bool on) { return (pdStopwatch){on ? pd_clock_seconds() : 0.0, on}; }
 
 static inline void pd_stopwatch_lap(pdStopwatch* w, double* stageSeconds) {
+  if (!w->on) return;
   double now = pd_clock_seconds();
   *stageSeconds += now - w->last;
   w->last = now;

@@ -77,7 +77,7 @@ void pd_state_derivative(const pdModel* model, pdState* state, double t, const d
 
 void pd_state_derivative_sampled(const pdModel* model, pdState* state, double t, const double* y, double* dydt,
                                  double timedScale) {
-  bool timed = timedScale > 0.0;
+  bool timed = timedScale > 0.0 && state->stageTimers;
   if (timed) pthread_once(&clockReadOnce, measure_clock_read);
   double t0 = timed ? pd_clock_seconds() : 0.0;
   pdContactSet* set = state->contacts;

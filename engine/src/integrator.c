@@ -432,7 +432,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
     pdStepLimit limit = !cut ? s->hLimit : eventCut ? cutLimit : pd_limitLanding;
     bool atMinimum = h <= set->dtmin;
     // the trial, then the contact events and the commit, timed as consecutive laps
-    pdStopwatch watch = pd_stopwatch_start();
+    pdStopwatch watch = pd_stopwatch_start(s->stageTimers);
     double tDerivative = derivative_seconds(s);
 
     double norm = trial(model, s, &w, h);
@@ -622,7 +622,7 @@ static double fixed_step(const pdModel* model, pdState* s, double hMax) {
   derivative(model, s, s->t, s->y, w.k1);
   pdStopwatch watch;
   for (;;) {
-    watch = pd_stopwatch_start();
+    watch = pd_stopwatch_start(s->stageTimers);
     double tDerivative = derivative_seconds(s);
     rk4(model, s, &w, s->t, s->y, w.k1, h, w.trial);
     integrate_lap(s, &watch, tDerivative);

@@ -191,6 +191,7 @@ static void island_load(const pdModel* model, const pdState* s, struct pdIslandS
   sub->stepper = s->stepper;
   sub->onsets = s->onsets;
   sub->searchCertificates = s->searchCertificates;
+  sub->stageTimers = s->stageTimers;
   sub->stepObserver = s->stepObserver;
   sub->stepUser = s->stepUser;
   sub->t = s->t;

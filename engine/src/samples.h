@@ -16,7 +16,7 @@ static inline double pd_sample_time(const pdModel* model, long k) { return (doub
 // nanoseconds), so a call whose time nobody keeps (no observer; an island's, which the scene times itself) reads
 // none.
 static inline double pd_observe(const pdModel* model, pdState* s, pdObserverFcn* observer, void* user, bool timed) {
-  timed = timed && observer;
+  timed = timed && observer && s->stageTimers;
   double t0 = timed ? pd_clock_seconds() : 0.0;
   if (observer && !observer(model, s, user)) s->stopped = true;
   ++s->count.samples;

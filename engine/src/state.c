@@ -27,6 +27,7 @@ pdStateOptions pd_state_options_default(void) {
   o.islands = PD_ISLANDS_DEFAULT;
   o.threads = 1;
   o.searchCertificates = true;
+  o.stageTimers = true;
   o.h = 0.0;
   o.valid = OPTIONS_VALID;
   return o;
@@ -61,6 +62,7 @@ void pd_state_reset_own(const pdModel* model, pdState* s) {
   s->islands = s->options.islands;
   s->threads = s->options.threads;
   s->searchCertificates = s->options.searchCertificates;
+  s->stageTimers = s->options.stageTimers;
   s->stepObserver = s->options.stepObserver;
   s->stepUser = s->options.stepUser;
   pd_implicit_free(s->implicit);  // its switch (active, on probation, backing off) is the last run's

@@ -85,6 +85,7 @@ static void test_a_state_keeps_its_options_across_reset(void** unused) {
   assert_int_equal(d.islands, PD_ISLANDS_DEFAULT);
   assert_int_equal(d.threads, 1);
   assert_true(d.searchCertificates);
+  assert_true(d.stageTimers);
   pdState* plain = pd_state_create(model, NULL);
   assert_int_equal(plain->stepper, PD_STEPPER_DEFAULT);
   assert_true(plain->h == model->settings.dt);  // h = 0: the scene's dt

@@ -716,6 +716,40 @@ static void test_whole_stages_add_up_to_at_most_the_run(void** state) {
   pd_model_free(m);
 }
 
+// pdStateOptions.stageTimers false: a caller timing the run whole gets the same run, bit for bit, and no stage time;
+// with islands on and off, since each times its own stages and samples.
+static void test_a_run_without_stage_timers_is_the_same_run_timing_nothing(void** state) {
+  (void)state;
+  pdModel* m = pile_30();
+  const pdIslands modes[] = {pd_islandsOn, pd_islandsOff};
+  for (size_t i = 0; i < sizeof modes / sizeof *modes; ++i) {
+    trace* timed = calloc(1, sizeof *timed);
+    trace* untimed = calloc(1, sizeof *untimed);
+    assert_non_null(timed);
+    assert_non_null(untimed);
+    pdStateOptions o = pd_state_options_default();
+    o.islands = modes[i];
+    pdState* a = pd_state_create(m, &o);
+    o.stageTimers = false;
+    pdState* b = pd_state_create(m, &o);
+    assert_true(pd_advance(m, a, m->settings.tend, record_trace, timed));
+    assert_true(pd_advance(m, b, m->settings.tend, record_trace, untimed));
+    assert_int_equal(timed->count, untimed->count);
+    assert_memory_equal(timed->body, untimed->body, sizeof timed->body);
+    assert_int_equal(a->n, b->n);
+    assert_memory_equal(a->y, b->y, sizeof(double) * (size_t)a->n);
+    assert_int_equal(a->count.accepted, b->count.accepted);
+    assert_int_equal(a->count.derivatives, b->count.derivatives);
+    assert_true(a->stageSeconds[pd_stageObserve] > 0.0);
+    for (int g = 0; g < pd_stageCount; ++g) assert_true(b->stageSeconds[g] == 0.0);
+    pd_state_free(a);
+    pd_state_free(b);
+    free(timed);
+    free(untimed);
+  }
+  pd_model_free(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_far_groups_compute_as_if_alone),
@@ -732,6 +766,7 @@ int main(void) {
       cmocka_unit_test(test_a_free_body_reached_late_keeps_falling),
       cmocka_unit_test(test_a_free_body_reached_in_the_first_interval),
       cmocka_unit_test(test_whole_stages_add_up_to_at_most_the_run),
+      cmocka_unit_test(test_a_run_without_stage_timers_is_the_same_run_timing_nothing),
       cmocka_unit_test(test_a_lone_body_runs_across_samples_as_the_interval_loop),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -85,7 +85,7 @@ static void expect_tracked_derivative_is_fresh(const char* scene, double t) {
   assert_true(y1 && tracked && fresh);
   memcpy(y1, s->y, bytes);  // not at the recorded place: only the tracking can be taken
   double hRetry = 0.0;
-  pdStopwatch watch = pd_stopwatch_start();
+  pdStopwatch watch = pd_stopwatch_start(s->stageTimers);
   pd_contact_events(model, s, 1e-4, y1, NULL, &hRetry, &watch);
   assert_true(pd_contact_set_tracked_at(model, s->contacts, y1));
   assert_false(pd_contact_set_tracked_at(model, s->contacts, s->y));
