@@ -167,14 +167,10 @@ static int pair_range(const pdContactSet* set, int a, int b, int* last) {
   return first;
 }
 
-// A decomposition read again (stack_modes.c, a matrix equal bit for bit to the last one decomposed) gives the slow
-// frequency a fresh scratch computes, bit for bit. A board resting on the floor carries three cubes: the board–floor
-// pair's local system and that of the board with its lowest cube list the same bodies in the same order, so the
-// second reads the first's decomposition; the board with its second cube lists them in another order and decomposes
-// its own.
-static void test_stack_frequency_read_again_equals_recomputed(void** state) {
-  (void)state;
-  pdModel* m = compile_text(
+// A board resting on the floor carrying three cubes, run 0.05 s with islands off (one list holds every contact),
+// its contacts' bodies listed; *poses the bodies' poses at the end (the caller frees them, the state and *m).
+static pdState* board_with_three_cubes(pdModel** m, pdPose** poses) {
+  *m = compile_text(
       "tend 0.05\nsample 100\nsleep off\n"
       "cube floor grey 3 1 0.2\nfixed\nloc 0 0 -0.1\n"
       "cube board blue 0.6 0.6 0.03\nloc 0 0 0.015\n"
@@ -182,16 +178,30 @@ static void test_stack_frequency_read_again_equals_recomputed(void** state) {
       "cube c1 red 0.1 0.1 0.1\nloc 0 0 0.08\n"
       "cube c2 red 0.1 0.1 0.1\nloc 0.12 0 0.08\n");
   pdStateOptions options = pd_state_options_default();
-  options.islands = pd_islandsOff;  // one list holds every contact
-  pdState* s = pd_state_create(m, &options);
-  assert_true(pd_advance(m, s, m->settings.tend, NULL, NULL));
-  pdContactSet* set = s->contacts;
-  pd_contact_set_list_bodies(m, set);
-  pdPose* poses = malloc((size_t)m->bodyCount * sizeof *poses);
-  for (int k = 0; k < m->bodyCount; ++k) {
-    pdBodyState b = pd_state_body(m, s, k);
-    poses[k] = pose_of(b.x, b.q);
+  options.islands = pd_islandsOff;
+  pdState* s = pd_state_create(*m, &options);
+  assert_true(pd_advance(*m, s, (*m)->settings.tend, NULL, NULL));
+  pd_contact_set_list_bodies(*m, s->contacts);
+  *poses = malloc((size_t)(*m)->bodyCount * sizeof **poses);
+  assert_non_null(*poses);
+  for (int k = 0; k < (*m)->bodyCount; ++k) {
+    pdBodyState b = pd_state_body(*m, s, k);
+    (*poses)[k] = pose_of(b.x, b.q);
   }
+  return s;
+}
+
+// A decomposition read again (stack_modes.c, a matrix equal bit for bit to the last one decomposed) gives the slow
+// frequency a fresh scratch computes, bit for bit. A board resting on the floor carries three cubes: the board–floor
+// pair's local system and that of the board with its lowest cube list the same bodies in the same order, so the
+// second reads the first's decomposition; the board with its second cube lists them in another order and decomposes
+// its own.
+static void test_stack_frequency_read_again_equals_recomputed(void** state) {
+  (void)state;
+  pdModel* m = NULL;
+  pdPose* poses = NULL;
+  pdState* s = board_with_three_cubes(&m, &poses);
+  pdContactSet* set = s->contacts;
   int floorEnd = 0, firstEnd = 0, secondEnd = 0;
   int floorPair = pair_range(set, 0, 1, &floorEnd), firstCube = pair_range(set, 1, 2, &firstEnd),
       secondCube = pair_range(set, 1, 3, &secondEnd);
@@ -229,24 +239,10 @@ static void test_stack_frequency_read_again_equals_recomputed(void** state) {
 // their own, far above the board's bounce, are answered from the values at half their Ω.
 static void test_stack_frequency_fast_enough_only_when_it_is(void** state) {
   (void)state;
-  pdModel* m = compile_text(
-      "tend 0.05\nsample 100\nsleep off\n"
-      "cube floor grey 3 1 0.2\nfixed\nloc 0 0 -0.1\n"
-      "cube board blue 0.6 0.6 0.03\nloc 0 0 0.015\n"
-      "cube c0 red 0.1 0.1 0.1\nloc -0.12 0 0.08\n"
-      "cube c1 red 0.1 0.1 0.1\nloc 0 0 0.08\n"
-      "cube c2 red 0.1 0.1 0.1\nloc 0.12 0 0.08\n");
-  pdStateOptions options = pd_state_options_default();
-  options.islands = pd_islandsOff;
-  pdState* s = pd_state_create(m, &options);
-  assert_true(pd_advance(m, s, m->settings.tend, NULL, NULL));
+  pdModel* m = NULL;
+  pdPose* poses = NULL;
+  pdState* s = board_with_three_cubes(&m, &poses);
   pdContactSet* set = s->contacts;
-  pd_contact_set_list_bodies(m, set);
-  pdPose* poses = malloc((size_t)m->bodyCount * sizeof *poses);
-  for (int k = 0; k < m->bodyCount; ++k) {
-    pdBodyState b = pd_state_body(m, s, k);
-    poses[k] = pose_of(b.x, b.q);
-  }
   const int others[4] = {0, 2, 3, 4};
   const double marks[6] = {0.5, 0.9, 0.999, 1.001, 1.1, 2.0};
   for (int p = 0; p < 4; ++p) {
