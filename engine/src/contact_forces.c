@@ -36,6 +36,9 @@ static void forces_range(void* ctx, int part, int begin, int end) {
     } else {
       evaluate(job->model, c, job->y, set->poses, &frame, &s, &g, NULL, &du, &f);
       pulls = pd_contact_force_pulls(&f);
+      // an implicit trial's stage out of the slip its step started in (contact_set.h, pd_contact_set_slip_reversals)
+      if (set->slipReversals && c->force.slip && !pulls && (!f.slip || pd_v3_dot(f.ft, c->force.ft) < 0.0))
+        set->items[i].crossed = true;
     }
     springs_store(job->dydt + base + PD_CONTACT_STATE_SIZE * i, &f.rate);
     set->push[i] = (contactPush){g.point, f.force, pulls};

@@ -41,6 +41,9 @@ typedef struct contactSlot {
   // presented at a sample and not evaluated there yet (pd_contact_set_settle): its springs in y as interpolated, its
   // normal, point and depth as captured at the step's start, its force and held modes not those of the sample
   bool unevaluated;
+  // an implicit trial's stage found it out of the slip it started the step in: stuck, or slipping against it
+  // (slipReversals; cleared at each trial's start)
+  bool crossed;
 } contactSlot;
 
 // A pair's search certificate (contact_analysis.h, "search certificates") and when to issue its next, kept beside
@@ -160,6 +163,7 @@ struct pdContactSet {
   int modeRetries;         // trials of the step under way cut to a held mode's change (holdModes)
   bool holdModes;          // the derivative holds each contact's modes of the step's start (pd_contact_set_hold_modes)
   bool correctHeld;        // every held change corrected, none located (pd_contact_set_correct_held)
+  bool slipReversals;      // a stage leaving the start's slip is a change to refine (pd_contact_set_slip_reversals)
   // stability bound (pd_stability_prepare, stability_tight), sized with the list
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])

@@ -35,6 +35,14 @@ void pd_contact_set_hold_modes(pdContactSet* set, bool hold);
 // With `all`, every held mode's change is corrected whatever its bound, none located (tests measure the bound
 // against the located run's answer); off (the default), the bound decides.
 void pd_contact_set_correct_held(pdContactSet* set, bool all);
+// Whether a contact that slipped at a step's start and that a stage found stuck or slipping against that friction
+// (`crossed`), or that slips at both ends with its friction turned against itself, changed mode inside the step
+// (pd_contact_events), refined whatever the kink bound. Set by the stepper before a step: on for the implicit
+// method's trials, whose W holds the start's slip and whose stages overshoot a stop (docs/events.md, "A stop inside
+// an implicit step").
+void pd_contact_set_slip_reversals(pdContactSet* set, bool on);
+// Forgets which contacts a trial's stages found out of their slip (slipReversals): before each trial.
+void pd_contact_set_clear_crossings(pdContactSet* set);
 
 // Inside the derivative: poses of every body from y (fixed bodies keep theirs), then for every contact
 // its force and moment on both bodies (summed per moving body, world: pd_contact_set_force/_torque) and

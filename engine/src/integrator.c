@@ -322,6 +322,7 @@ static double trial_implicit(const pdModel* model, pdState* s, stepperWork* w, d
   int n = s->n;
   if (!w->linearised) pd_implicit_linearise(model, s, s->implicit, s->y);
   w->linearised = true;
+  pd_contact_set_clear_crossings(s->contacts);
   if (!pd_implicit_factor(model, s, s->implicit, ROSW_GAMMA * h)) return NAN;
   double* u[4] = {w->acc, w->full, w->half, w->k1half};
   for (int i = 0; i < 4; ++i) {
@@ -421,6 +422,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
   stepperWork w = work_of(s);
   // held events hold each contact's modes over the step (contact_set.h); the others let the law decide
   pd_contact_set_hold_modes(s->contacts, s->onsets == pd_onsetsHeld);
+  pd_contact_set_slip_reversals(s->contacts, trial == trial_implicit);
   derivative(model, s, s->t, s->y, w.k1);
   bool eventCut = false;
   pdStepLimit cutLimit = pd_limitEvent;  // what cut the step, when eventCut
