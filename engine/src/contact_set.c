@@ -288,20 +288,26 @@ static void record_range(void* ctx, int part, int begin, int end) {
   }
 }
 
+// Copies the state y the list's forces were just formed at into *kept (grown with the list, between steps and
+// trials), for a derivative at those very numbers to take them (pd_contact_set_recorded_at, _tracked_at). False,
+// nothing kept, for an empty list: not worth a copy and a comparison per derivative.
+static bool keep_state(const pdModel* model, const pdContactSet* set, const double* y, double** kept, int* capacity) {
+  if (set->count == 0) return false;
+  int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
+  if (n > *capacity) {
+    *capacity = 2 * n;
+    *kept = pd_grow(*kept, (size_t)*capacity, sizeof **kept);
+  }
+  memcpy(*kept, y, (size_t)n * sizeof *y);
+  return true;
+}
+
 static void record(const pdModel* model, pdContactSet* set, const double* y, const pdPose* poses) {
   contactLoop job = {.model = model, .set = set, .y = y, .poses1 = poses};
   pd_help_for(set->help, set->count, PD_HELP_MIN_CONTACTS, record_range, &job);
   // the next step's first derivative is at this state (after an accepted step: its k1)
-  set->recordedValid = false;
-  if (set->count == 0) return;  // nothing to take: not worth a copy and a comparison per derivative
-  int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
-  if (n > set->recordedCapacity) {  // grown with the list, after a step
-    set->recordedCapacity = 2 * n;
-    set->recordedY = pd_grow(set->recordedY, (size_t)set->recordedCapacity, sizeof *set->recordedY);
-  }
-  memcpy(set->recordedY, y, (size_t)n * sizeof *y);
+  set->recordedValid = keep_state(model, set, y, &set->recordedY, &set->recordedCapacity);
   set->recordedFrom = y;
-  set->recordedValid = true;
 }
 
 // Each moving body's inverse inertia in the world frame, R I⁻¹ Rᵀ, at `poses`.
@@ -358,16 +364,8 @@ static void tracking_range(void* ctx, int part, int begin, int end) {
 
 // Keeps the state C0 was just tracked to (set->eval's), for a derivative there (pd_contact_forces).
 static void keep_tracked(const pdModel* model, pdContactSet* set, const double* y1) {
-  set->trackedValid = false;
-  if (set->count == 0) return;  // nothing to take
-  int n = spring_base(model) + PD_CONTACT_STATE_SIZE * set->count;
-  if (n > set->trackedCapacity) {  // grown with the list, between trials
-    set->trackedCapacity = 2 * n;
-    set->trackedY = pd_grow(set->trackedY, (size_t)set->trackedCapacity, sizeof *set->trackedY);
-  }
-  memcpy(set->trackedY, y1, (size_t)n * sizeof *y1);
+  set->trackedValid = keep_state(model, set, y1, &set->trackedY, &set->trackedCapacity);
   set->trackedFrom = y1;
-  set->trackedValid = true;
 }
 
 // The time since a switching quantity crossed zero inside a step of h, from its values at the start (g0) and the
