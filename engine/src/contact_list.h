@@ -164,6 +164,7 @@ struct pdContactSet {
   bool holdModes;          // the derivative holds each contact's modes of the step's start (pd_contact_set_hold_modes)
   bool correctHeld;        // every held change corrected, none located (pd_contact_set_correct_held)
   bool slipReversals;      // a stage leaving the start's slip is a change to refine (pd_contact_set_slip_reversals)
+  const double* startSlope;  // f(y) at the step's start while slipReversals is on: the stop's prediction reads it
   // stability bound (pd_stability_prepare, stability_tight), sized with the list
   stabilityTerms* stability;  // (capacity)
   int* bodyFirst;          // (bodyCount + 1) contacts of body k: bodyList[bodyFirst[k] … bodyFirst[k + 1])

@@ -47,6 +47,10 @@
 // evaluations (205 376 against 149 568 for cases/sweep/pile_10.scene): its steps are already ~2.5 % of
 // the period (the stability bound), and every halving throws away a whole trial step.
 #define PD_REFINE_PERIOD_FRACTION 0.05
+// A stop's aimed retry once the stop is predicted within 1.5 floors of the step's start: a step of this many floors,
+// under the two whose half would be refined again, holds the stop wherever the prediction's error of up to a floor
+// puts it.
+#define PD_STOP_HOLD_FLOORS 1.9
 // A held mode's change located by a retry (holdModes) is aimed this fraction of the τ since it past its interpolated
 // time: the retried step then holds the change (its bound ~ this³ of the first's) rather than stopping short of it
 // and meeting it again at the start of the next.
@@ -185,7 +189,10 @@ void pd_contact_set_hold_modes(pdContactSet* set, bool hold) { set->holdModes = 
 
 void pd_contact_set_correct_held(pdContactSet* set, bool all) { set->correctHeld = all; }
 
-void pd_contact_set_slip_reversals(pdContactSet* set, bool on) { set->slipReversals = on; }
+void pd_contact_set_slip_reversals(pdContactSet* set, const double* startSlope) {
+  set->slipReversals = startSlope != NULL;
+  set->startSlope = startSlope;
+}
 
 void pd_contact_set_clear_crossings(pdContactSet* set) {
   for (int i = 0; i < set->count; ++i) set->items[i].crossed = false;
@@ -538,6 +545,45 @@ static double held_change(const pdModel* model, pdContactSet* set, int i, const 
   return PD_MODE_BOUND_SAFETY * fmax(fmax(velocity, spring * spread / c->deltaMax), position);
 }
 
+// When contact i (slipping at the step's start, state y0) stops slipping, s after the start, predicted from its
+// relative tangential velocity there and the rate the start's slope gives it (each body's v̇ + ω̇ × r + ω × (ω × r)):
+// the time that velocity's component along itself takes to reach zero at that rate; INFINITY where it does not
+// decelerate. A block sliding to rest decelerates at μ g: the prediction is then its stop up to the contact's own
+// spring, which turns it within a fraction of the contact's period.
+static double predicted_stop(const pdModel* model, const pdContactSet* set, int i, const double* y0) {
+  const contactSlot* c = &set->items[i];
+  pdVec3 u = {0, 0, 0}, a = {0, 0, 0};
+  const int bodies[2] = {c->id.body1, c->id.body2};
+  for (int k = 0; k < 2; ++k) {
+    const pdBody* body = &model->bodies[bodies[k]];
+    if (body->fixed) continue;
+    const double* yb = y0 + PD_BODY_STATE_SIZE * body->stateIndex;
+    const double* fb = set->startSlope + PD_BODY_STATE_SIZE * body->stateIndex;
+    pdVec3 r = pd_v3_sub(c->point, pd_layout_x(yb)), w = pd_layout_w(yb);
+    pdVec3 uk = pd_v3_add(pd_layout_v(yb), pd_v3_cross(w, r));
+    pdVec3 ak = pd_v3_add(pd_layout_v(fb), pd_v3_cross(pd_layout_w(fb), r));
+    ak = pd_v3_add(ak, pd_v3_cross(w, pd_v3_cross(w, r)));
+    double sign = k == 0 ? 1.0 : -1.0;
+    u = pd_v3_add(u, pd_v3_scale(uk, sign)), a = pd_v3_add(a, pd_v3_scale(ak, sign));
+  }
+  pdVec3 n = c->normal;
+  pdVec3 ut = pd_v3_sub(u, pd_v3_scale(n, pd_v3_dot(u, n))), at = pd_v3_sub(a, pd_v3_scale(n, pd_v3_dot(a, n)));
+  double closing = -pd_v3_dot(ut, at);  // m²/s³
+  return closing > 0.0 ? pd_v3_dot(ut, ut) / closing : INFINITY;
+}
+
+// The retry of a step of h whose stages passed a stop predicted at stopAt (s after its start), refined to `floor`
+// (refine_step): a step ending half a floor before the stop, which slips to its end and is kept, then one of just
+// under two floors that holds the stop and is not refined again; halving where the prediction is not inside the step
+// (then it was wrong, and halving closes in on the stop as before). Each aimed retry is shorter than the trial it
+// retries, so retries from one start end: the prediction, from the start alone, is the same for each, and a step that
+// ends before it and still crosses is halved.
+static double stop_aimed_retry(double stopAt, double floor, double h) {
+  if (!(stopAt < h)) return 0.5 * h;
+  if (stopAt > 1.5 * floor) return stopAt - 0.5 * floor;
+  return fmin(0.5 * h, PD_STOP_HOLD_FLOORS * floor);
+}
+
 pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, const double* y1, const double* yMid,
                                  double* hRetry, pdStopwatch* watch) {
   pdContactSet* set = s->contacts;
@@ -570,6 +616,8 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
   pdOnsets mode = pd_onsets_effective(s->onsets, model->movingCount);
   bool bounded = mode == pd_onsetsBounded || mode == pd_onsetsHeld;
   int slipChanges = 0;
+  bool stopAimed = set->slipReversals;  // every change refined is a crossed contact's stop (predicted_stop)
+  double stopAt = INFINITY;             // s after the step's start: the earliest stop predicted among them
   for (int i = 0; i < set->count; ++i) {
     const contactSlot* c = &set->items[i];
     contactEval* e = &set->eval[i];
@@ -599,6 +647,7 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
       continue;
     }
     refineStep = fmax(refineStep, refine_step(model, &c->params));
+    stopAimed = false;
   }
   if (slipChanges > 0) sum_kinks(model, set);
   for (int i = 0; slipChanges > 0 && i < set->count; ++i) {
@@ -610,14 +659,16 @@ pdEventVerdict pd_contact_events(const pdModel* model, pdState* s, double h, con
     // an implicit trial's stage that left the start's slip is refined whatever the bound, which is step doubling's:
     // W, linearised in that slip, does not hold the stick it crossed into (docs/events.md, "A stop inside an implicit
     // step"); at the refinement's floor it stays in its step, counted with its bound as any change left there
-    if (!allowed || (set->slipReversals && set->items[i].crossed))
-      refineStep = fmax(refineStep, refine_step(model, &set->items[i].params));
+    bool crossed = set->slipReversals && set->items[i].crossed;
+    if (!allowed || crossed) refineStep = fmax(refineStep, refine_step(model, &set->items[i].params));
+    if (!allowed && !crossed) stopAimed = false;
+    if (crossed && stopAimed) stopAt = fmin(stopAt, predicted_stop(model, set, i, s->y));
   }
   pd_stopwatch_lap(watch, analysisSeconds);
   // only the adaptive stepper refines: the fixed one keeps its step (work-precision sweeps compare steps)
   if (refineStep > 0.0 && s->stepper != pd_stepperRK4Fixed && 0.5 * h >= refineStep) {
     ++s->count.refinements;
-    *hRetry = 0.5 * h;
+    *hRetry = stopAimed ? stop_aimed_retry(stopAt, refineStep, h) : 0.5 * h;
     return pd_eventRetry;
   }
   if (locate < h) {

@@ -40,7 +40,9 @@ void pd_contact_set_correct_held(pdContactSet* set, bool all);
 // (pd_contact_events), refined whatever the kink bound. Set by the stepper before a step: on for the implicit
 // method's trials, whose W holds the start's slip and whose stages overshoot a stop (docs/events.md, "A stop inside
 // an implicit step").
-void pd_contact_set_slip_reversals(pdContactSet* set, bool on);
+// `startSlope`, f(y) at the step's start (NULL: off), aims the refinement's retry at the stop it predicts
+// (pd_contact_events); it must stay valid over the step.
+void pd_contact_set_slip_reversals(pdContactSet* set, const double* startSlope);
 // Forgets which contacts a trial's stages found out of their slip (slipReversals): before each trial.
 void pd_contact_set_clear_crossings(pdContactSet* set);
 

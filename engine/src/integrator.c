@@ -422,7 +422,7 @@ static double adaptive_step(const pdModel* model, pdState* s, double hMax, trial
   stepperWork w = work_of(s);
   // held events hold each contact's modes over the step (contact_set.h); the others let the law decide
   pd_contact_set_hold_modes(s->contacts, s->onsets == pd_onsetsHeld);
-  pd_contact_set_slip_reversals(s->contacts, trial == trial_implicit);
+  pd_contact_set_slip_reversals(s->contacts, trial == trial_implicit ? w.k1 : NULL);
   derivative(model, s, s->t, s->y, w.k1);
   bool eventCut = false;
   pdStepLimit cutLimit = pd_limitEvent;  // what cut the step, when eventCut

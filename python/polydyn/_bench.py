@@ -84,11 +84,12 @@ def gedanken(out=None, *, only=None, engines=ENGINES, fast=False, jobs=2):
     return _suite(out, only, engines, fast, jobs, False, 1)[0]
 
 
-def precision(out=None, *, only=None, engines=ENGINES, fast=False, jobs=2, repeats=1):
+def precision(out=None, *, only=None, engines=ENGINES, fast=False, jobs=2, repeats=4):
     """The work-precision runs of `polydyn gedanken --precision`: every quantitative experiment at every setting of
     each engine's accuracy knob, its error against the closed form and its cost. Returns precision.csv as a Table
     (the same columns: experiment, kind, engine, variant, setting, value, input, quantity, unit, measured, expected,
-    error, relative, tolerance, ...); its attribute ``results`` holds results.csv."""
+    error, relative, tolerance, ...); its attribute ``results`` holds results.csv. repeats: timings per point, each
+    the run repeated back to back to a minimum of CPU time, the least kept: `--repeats`, with the CLI's default."""
     results, points = _suite(out, only, engines, fast, jobs, True, repeats)
     points.results = results
     return points

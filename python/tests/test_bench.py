@@ -64,9 +64,9 @@ def test_gedanken_rows_are_results_csv(tmp_path, polydyn_command):
 
 def test_precision_rows_are_precision_csv(tmp_path, polydyn_command):
     run_command(polydyn_command, "gedanken", "--out", tmp_path / "cli", "--only", "a1_restitution", "--engines", "soft",
-                "--jobs", "1", "--precision", "--repeats", "1")  # the Python call's default
+                "--jobs", "1", "--precision", "--repeats", "1")
     header, rows = read_csv(tmp_path / "cli" / "precision.csv")
-    p = polydyn.precision(tmp_path / "py", only=["a1_restitution"], engines=["soft"], jobs=1)
+    p = polydyn.precision(tmp_path / "py", only=["a1_restitution"], engines=["soft"], jobs=1, repeats=1)
     assert p.columns == header and len(p) == len(rows) > 10
     assert [r["setting"] for r in p] == [r[header.index("setting")] for r in rows]
     mine = p["measured"]
