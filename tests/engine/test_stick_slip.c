@@ -177,7 +177,7 @@ static void test_the_implicit_stepper_stops_a_launched_block_without_a_rebound(v
     assert_true(after <= before);
     // the stop is aimed at from its prediction (a block decelerating at μ g): one retry ends the step just before it,
     // one more holds it within the refinement's floor, where halving from the implicit step's tens of ms down to that
-    // floor (5 % of the contact's period, ~0.1 ms) took about ten
+    // floor (5 % of the contact's period, 67 µs here) took about ten
     print_message("tol %g: %ld refinements, %ld accepted steps\n", tols[k], st->count.refinements, st->count.accepted);
     assert_true(st->count.refinements <= STOP_AIMED_REFINEMENTS_MAX);
     free(r);
