@@ -584,7 +584,7 @@ static void wake_island(const pdModel* model, const pdState* s, struct pdIslandS
   for (int m = 0; m < is->bodyCount; ++m) {
     int k = is->bodies[m];
     set->sleep->asleep[k] = false;
-    set->sleep->quietSince[k] = NAN;
+    pd_sleep_restless(set->sleep, k);
     set->islandOld[k] = -1;
     set_start(model, s, set, k, dt);
   }
@@ -649,7 +649,7 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
     // nor is an island without a contact, whatever its speed: its settle time is infinite (pd_sleep_settle_time), so
     // pd_sleep_quiet finds none of its bodies quiet (a lone body in flight, tested at every sample)
     if (pd_state_contact_count(is->state) == 0) {
-      for (int m = 0; m < is->bodyCount; ++m) sleep->quietSince[is->bodies[m]] = NAN;
+      for (int m = 0; m < is->bodyCount; ++m) pd_sleep_restless(sleep, is->bodies[m]);
       continue;
     }
     // the cheap test first: one body above the speed threshold keeps the island awake, and the quiet time of every
@@ -660,7 +660,7 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
       slow = pd_sleep_slow(sleep, &model->bodies[model->movingBodies[k]], k, s->y + PD_BODY_STATE_SIZE * k);
     }
     if (!slow) {
-      for (int m = 0; m < is->bodyCount; ++m) sleep->quietSince[is->bodies[m]] = NAN;
+      for (int m = 0; m < is->bodyCount; ++m) pd_sleep_restless(sleep, is->bodies[m]);
       continue;
     }
     double settle = pd_sleep_settle_time(&is->model, is->state);
@@ -675,20 +675,39 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
       for (int e = 0; e < 2; ++e)
         if (!is->model.bodies[b[e]].fixed) sleep->inContact[is->bodies[is->model.bodies[b[e]].stateIndex]] = true;
     }
-    bool quiet = true;
-    double since = -INFINITY;
+    bool quiet = true, slowAll = true;
+    double since = -INFINITY, slowSince = -INFINITY;
     for (int m = 0; m < is->bodyCount; ++m) {
       int k = is->bodies[m];
       const pdBody* b = &model->bodies[model->movingBodies[k]];
       bool bodyQuiet = pd_sleep_quiet(sleep, b, k, s->y + PD_BODY_STATE_SIZE * k, set->t0, tNext, horizon);
+      if (!sleep->inContact[k]) pd_sleep_restless(sleep, k);
       if (!bodyQuiet || !sleep->inContact[k]) {
         sleep->quietSince[k] = NAN;
         quiet = false;
       } else {
         since = fmax(since, sleep->quietSince[k]);
       }
+      if (isnan(sleep->slowSince[k]))
+        slowAll = false;
+      else
+        slowSince = fmax(slowSince, sleep->slowSince[k]);
     }
-    if (!quiet || tNext - since < settle) continue;
+    // quiet at every interval for a settle time; else slow for one, its acceleration read over the whole window
+    // (sleep.h): a body ringing within the speed threshold, its velocity going nowhere
+    bool rests = quiet && tNext - since >= settle;
+    if (!rests && slowAll && tNext - slowSince >= settle) {
+      rests = true;
+      for (int m = 0; m < is->bodyCount; ++m) {
+        int k = is->bodies[m];
+        if (!pd_sleep_still(sleep, &model->bodies[model->movingBodies[k]], k, s->y + PD_BODY_STATE_SIZE * k, tNext,
+                            horizon)) {
+          sleep->slowSince[k] = NAN;  // its window starts again
+          rests = false;
+        }
+      }
+    }
+    if (!rests) continue;
     is->asleep = true;
     ++sleep->sleeps;
     for (int m = 0; m < is->bodyCount; ++m) pd_sleep_fall_asleep(sleep, is->bodies[m], tNext, horizon);
@@ -1024,7 +1043,7 @@ static void lone_interval_end(loneRun* run, double tNext) {
   if (sleepTest)
     fall_asleep(model, s, set, tNext);
   else if (set->sleep && !set->free[0])
-    set->sleep->quietSince[0] = NAN;
+    pd_sleep_restless(set->sleep, 0);
   // every counter of the island's but the samples (the scene's own) changes with a step tried, which evaluates the
   // derivative: without one, only the set's change (the stage timers wait for the run's end)
   if (is->state->count.derivatives != run->derivatives) {

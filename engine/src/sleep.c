@@ -22,13 +22,16 @@ pdSleepSet* pd_sleep_create(const pdModel* model) {
   set->v0 = pd_grow(NULL, (size_t)m, sizeof *set->v0);
   set->w0 = pd_grow(NULL, (size_t)m, sizeof *set->w0);
   set->quietSince = pd_grow(NULL, (size_t)m, sizeof *set->quietSince);
+  set->slowSince = pd_grow(NULL, (size_t)m, sizeof *set->slowSince);
+  set->vSlow = pd_grow(NULL, (size_t)m, sizeof *set->vSlow);
+  set->wSlow = pd_grow(NULL, (size_t)m, sizeof *set->wSlow);
   set->asleep = pd_grow(NULL, (size_t)m, sizeof *set->asleep);
   set->asleepSince = pd_grow(NULL, (size_t)m, sizeof *set->asleepSince);
   set->horizon = pd_grow(NULL, (size_t)m, sizeof *set->horizon);
   set->inContact = pd_grow(NULL, (size_t)m, sizeof *set->inContact);
   for (int k = 0; k < model->movingCount; ++k) {
     set->speedPeak[k] = 0.0;
-    set->quietSince[k] = NAN;
+    pd_sleep_restless(set, k);
     set->asleep[k] = false;
   }
   return set;
@@ -40,6 +43,9 @@ void pd_sleep_free(pdSleepSet* set) {
   free(set->v0);
   free(set->w0);
   free(set->quietSince);
+  free(set->slowSince);
+  free(set->vSlow);
+  free(set->wSlow);
   free(set->asleep);
   free(set->asleepSince);
   free(set->horizon);
@@ -79,13 +85,30 @@ bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb
   double dt = t1 - t0;
   pdVec3 dv = pd_v3_sub(pd_layout_v(yb), set->v0[k]), dw = pd_v3_sub(pd_layout_w(yb), set->w0[k]);
   double accel = dt > 0.0 ? (pd_v3_norm(dv) + pd_v3_norm(dw) * body->radius) / dt : 0.0;
-  bool quiet = isfinite(horizon) && pd_sleep_slow(set, body, k, yb) && accel * horizon < set->speedMax;
+  bool slow = isfinite(horizon) && pd_sleep_slow(set, body, k, yb);
+  bool quiet = slow && accel * horizon < set->speedMax;
   if (!quiet)
     set->quietSince[k] = NAN;
   else if (isnan(set->quietSince[k]))
     set->quietSince[k] = t0;
+  if (!slow) {
+    set->slowSince[k] = NAN;
+  } else if (isnan(set->slowSince[k])) {
+    set->slowSince[k] = t0;
+    set->vSlow[k] = set->v0[k];
+    set->wSlow[k] = set->w0[k];
+  }
   return quiet;
 }
+
+bool pd_sleep_still(const pdSleepSet* set, const pdBody* body, int k, const double* yb, double t, double horizon) {
+  double dt = t - set->slowSince[k];
+  pdVec3 dv = pd_v3_sub(pd_layout_v(yb), set->vSlow[k]), dw = pd_v3_sub(pd_layout_w(yb), set->wSlow[k]);
+  double accel = dt > 0.0 ? (pd_v3_norm(dv) + pd_v3_norm(dw) * body->radius) / dt : 0.0;
+  return accel * horizon < set->speedMax;
+}
+
+void pd_sleep_restless(pdSleepSet* set, int k) { set->quietSince[k] = set->slowSince[k] = NAN; }
 
 void pd_sleep_fall_asleep(pdSleepSet* set, int k, double t, double horizon) {
   set->asleep[k] = true;

@@ -9,7 +9,11 @@
 //   time (a body that accelerated faster would leave the speed threshold before the end);
 // - contact: every body of the island touches something (a body in free flight is never at rest);
 // - both held since quietSince for the island's settle time: PD_SLEEP_SETTLE_PERIODS of the slowest period
-//   of its contacts (pd_sleep_settle_time).
+//   of its contacts (pd_sleep_settle_time);
+// - or, the speed alone held since slowSince for the settle time, the acceleration over that whole window (the
+//   change of v and ω since slowSince over its length) below the same threshold (pd_sleep_still): a body ringing
+//   within the speed threshold (the tolerance's own noise) fails the acceleration over each interval though its
+//   velocity goes nowhere, and over the window it reads its drift; a steady acceleration reads the same either way.
 // A sleeping body wakes when the applied force on it has changed since it fell asleep by what would give it
 // the acceleration threshold (pd_sleep_force_changed); islands.c wakes it too when a body outside its island
 // may reach it (the islands' partition).
@@ -37,6 +41,8 @@ typedef struct pdSleepSet {
   double* speedPeak;    // (movingCount) m/s: the largest speed at the interval's start and step ends so far
   pdVec3 *v0, *w0;      // (movingCount) velocity and angular velocity at the interval's start
   double* quietSince;   // (movingCount) s: start of the quiet intervals leading here (NAN: the last was not quiet)
+  double* slowSince;    // (movingCount) s: start of the slow intervals leading here (NAN: the last was not slow)
+  pdVec3 *vSlow, *wSlow;  // (movingCount) velocity and angular velocity at slowSince
   bool* asleep;         // (movingCount)
   double* asleepSince;  // (movingCount) s: when it fell asleep
   double* horizon;      // (movingCount) s: the horizon of its acceleration threshold when it fell asleep
@@ -71,9 +77,17 @@ bool pd_sleep_slow(const pdSleepSet* set, const pdBody* body, int k, const doubl
 
 // At the end of the interval [t0, t1] with body k's numbers yb there: whether the body was quiet over it (speed
 // peak below the speed threshold, mean acceleration below it over `horizon`), and quietSince updated
-// (set to t0 when the body turns quiet, NAN when it is not).
+// (set to t0 when the body turns quiet, NAN when it is not); slowSince likewise for the speed alone, with the
+// velocities there.
 bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb, double t0, double t1,
                     double horizon);
+
+// Whether body k, its numbers yb at t, has kept its mean acceleration since slowSince below the speed threshold over
+// `horizon` (the window's test, once the speed alone has held for a settle time).
+bool pd_sleep_still(const pdSleepSet* set, const pdBody* body, int k, const double* yb, double t, double horizon);
+
+// Body k's quiet and slow times start again (it moved, lost its contacts, or woke).
+void pd_sleep_restless(pdSleepSet* set, int k);
 
 // Body k falls asleep at t, its acceleration threshold that of `horizon` (pd_sleep_quiet).
 void pd_sleep_fall_asleep(pdSleepSet* set, int k, double t, double horizon);

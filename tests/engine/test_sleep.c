@@ -14,7 +14,11 @@
 //   steady acceleration would take it past the threshold long before the run ends; its speed at the end is the
 //   closed form's within SLIDE_SPEED_TOL_REL;
 // - threads: the woken pile gives every body's numbers at every sample and every counter bit for bit on 1, 2 and 3
-//   threads.
+//   threads;
+// - a cube that rings on its edges within the speed threshold after it lands (the Gedanken experiment
+//   d3_landing_energy's scene at tol 0.1) falls asleep, the acceleration read over its window of slow intervals (its
+//   velocity's drift), and its frozen height is the resting height that tol 1e-7 integrates within
+//   RINGING_REST_TOL_REL.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -43,6 +47,10 @@
 // on the stack); sleeping may add no more than about that (measured: 1.5e-4 and 0.011).
 #define WOKEN_POS_TOL_REL 1e-3  // of each body's size
 #define WOKEN_VEL_TOL_REL 0.02  // of vmax, on |Δv| + |Δω| r
+
+// The ringing cube's frozen height against the rest that tol 1e-7 integrates (measured 1.3e-4 of its size; the run at
+// tol 0.1 that never sleeps rocks on and sinks 9.7e-4 below it by the end).
+#define RINGING_REST_TOL_REL 2e-4
 
 // The incline's box: the run at tol 1e-1 against g (sin θ − μ cos θ) t; the onset and the implicit steps at that tol
 // are within 1e-4 of it (measured), a box frozen early is off by nearly 100 %.
@@ -303,6 +311,43 @@ static void accelerating_box_stays_awake(void** unused) {
   free(r);
 }
 
+// ---------------------------------------------------------------- ringing within the tolerance: sleep
+
+// d3_landing_energy's scene (gedanken/group_d.c): a 0.1 m cube of 1 kg thrown spinning onto a floor, μ 2, stiff
+// tangential dampers. At tol 0.1 (a speed threshold of 0.1 m/s) it stops by 0.31 s and then rocks on its edges at
+// ~2 kHz, two corners lifting and landing, at ~1e-3 of the threshold: each 0.25 ms sample interval sees accelerations
+// of m/s², which over the 0.3 s left would pass the threshold, but its velocity goes nowhere. At tol 1e-7 it rests
+// on its four corners.
+static const char* const ringingCube =
+    "tend 0.6\nsample 4000\ntol %g\nvmax 1\n"
+    "cube floor grey 2 1 0.2\nfixed\nloc 0.5 0 -0.1\nmu 2\nrestitution 0.01\nkn 2e+06\nkt 2e+06\nct 20000\n"
+    "cube box red 0.1 0.1 0.1\nloc 0 0 0.05\nvel 0.5 0 0.5  572.95779513082323 0 1 0\nmu 2\nrestitution 0.01\n"
+    "kn 2e+06\nkt 2e+06\nct 20000\n";
+
+static void ringing_cube_sleeps(void** unused) {
+  (void)unused;
+  char text[512];
+  double heights[2];
+  pdCounters counts[2];
+  const double tols[2] = {0.1, 1e-7};
+  for (int k = 0; k < 2; ++k) {
+    snprintf(text, sizeof text, ringingCube, tols[k]);
+    pdModel* model = compile_text(text);
+    pdState* s = NULL;
+    record* r = run(model, &s);
+    heights[k] = r->body[0][r->count - 1].x.z;
+    counts[k] = s->count;
+    free(r);
+    pd_state_free(s);
+    pd_model_free(model);
+  }
+  print_message("tol 0.1: slept %ld, %.3g s asleep, height %.9f m; tol 1e-7: %.9f m\n", counts[0].islandsSlept,
+                counts[0].bodySecondsAsleep, heights[0], heights[1]);
+  assert_true(counts[0].islandsSlept >= 1);
+  assert_true(counts[0].bodySecondsAsleep >= 0.2);  // asleep within 0.1 s of its stop, to the end
+  assert_true(fabs(heights[0] - heights[1]) <= RINGING_REST_TOL_REL * 0.1);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(box_at_rest_sleeps_frozen),
@@ -311,6 +356,7 @@ int main(void) {
       cmocka_unit_test(touched_island_stays_awake),
       cmocka_unit_test(force_change_wakes),
       cmocka_unit_test(accelerating_box_stays_awake),
+      cmocka_unit_test(ringing_cube_sleeps),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
