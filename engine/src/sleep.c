@@ -80,11 +80,16 @@ bool pd_sleep_slow(const pdSleepSet* set, const pdBody* body, int k, const doubl
   return fmax(set->speedPeak[k], pd_sleep_speed(body, yb)) < set->speedMax;
 }
 
+// The mean acceleration of a body's fastest surface point over dt, from its velocity's change dv and its angular
+// velocity's change dw (the speed's measure, pd_sleep_speed, of the change over its length).
+static double mean_acceleration(const pdBody* body, pdVec3 dv, pdVec3 dw, double dt) {
+  return dt > 0.0 ? (pd_v3_norm(dv) + pd_v3_norm(dw) * body->radius) / dt : 0.0;
+}
+
 bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb, double t0, double t1,
                     double horizon) {
-  double dt = t1 - t0;
   pdVec3 dv = pd_v3_sub(pd_layout_v(yb), set->v0[k]), dw = pd_v3_sub(pd_layout_w(yb), set->w0[k]);
-  double accel = dt > 0.0 ? (pd_v3_norm(dv) + pd_v3_norm(dw) * body->radius) / dt : 0.0;
+  double accel = mean_acceleration(body, dv, dw, t1 - t0);
   bool slow = isfinite(horizon) && pd_sleep_slow(set, body, k, yb);
   bool quiet = slow && accel * horizon < set->speedMax;
   if (!quiet)
@@ -102,10 +107,8 @@ bool pd_sleep_quiet(pdSleepSet* set, const pdBody* body, int k, const double* yb
 }
 
 bool pd_sleep_still(const pdSleepSet* set, const pdBody* body, int k, const double* yb, double t, double horizon) {
-  double dt = t - set->slowSince[k];
   pdVec3 dv = pd_v3_sub(pd_layout_v(yb), set->vSlow[k]), dw = pd_v3_sub(pd_layout_w(yb), set->wSlow[k]);
-  double accel = dt > 0.0 ? (pd_v3_norm(dv) + pd_v3_norm(dw) * body->radius) / dt : 0.0;
-  return accel * horizon < set->speedMax;
+  return mean_acceleration(body, dv, dw, t - set->slowSince[k]) * horizon < set->speedMax;
 }
 
 void pd_sleep_restless(pdSleepSet* set, int k) { set->quietSince[k] = set->slowSince[k] = NAN; }
