@@ -558,11 +558,10 @@ static double predicted_stop(const pdModel* model, const pdContactSet* set, int 
     const pdBody* body = &model->bodies[bodies[k]];
     if (body->fixed) continue;
     const double* yb = y0 + PD_BODY_STATE_SIZE * body->stateIndex;
-    const double* fb = set->startSlope + PD_BODY_STATE_SIZE * body->stateIndex;
     pdVec3 r = pd_v3_sub(c->point, pd_layout_x(yb)), w = pd_layout_w(yb);
-    pdVec3 uk = pd_v3_add(pd_layout_v(yb), pd_v3_cross(w, r));
-    pdVec3 ak = pd_v3_add(pd_layout_v(fb), pd_v3_cross(pd_layout_w(fb), r));
-    ak = pd_v3_add(ak, pd_v3_cross(w, pd_v3_cross(w, r)));
+    pdVec3 uk = velocity_at(model, y0, bodies[k], r);
+    // the slope's rows are v̇ and ω̇ where y's are v and ω: the same point velocity of them is v̇ + ω̇ × r
+    pdVec3 ak = pd_v3_add(velocity_at(model, set->startSlope, bodies[k], r), pd_v3_cross(w, pd_v3_cross(w, r)));
     double sign = k == 0 ? 1.0 : -1.0;
     u = pd_v3_add(u, pd_v3_scale(uk, sign)), a = pd_v3_add(a, pd_v3_scale(ak, sign));
   }
