@@ -16,7 +16,7 @@
 
 // The help in two literals (each within the 4095 characters C requires a compiler to take), joined in pd_cmd_run.
 static const char helpHead[] =
-    "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ]\n"
+    "usage: polydyn run SCENE [--out DIR] [--engine soft|ode|bullet] [--tend T] [--sample HZ] [--tol E]\n"
     "                         [--stepper implicit|adaptive|fixed|embedded|dopri]\n"
     "                         [--variant native|matched]\n"
     "                         [--events bounded|exact|held] [--onsets pair|exact|auto|bounded] [--islands on|off]\n"
@@ -30,6 +30,8 @@ static const char helpHead[] =
     "                   a reference engine (docs/validation.md)\n"
     "  --tend T         simulated seconds, overrides the scene's tend\n"
     "  --sample HZ      output samples per second, overrides the scene's sample\n"
+    "  --tol E          soft engine: the integration tolerance, 0 < E < 1, overrides the scene's tol\n"
+    "                   (its largest step and event shares follow it; docs/integration.md)\n"
     "  --stepper NAME   implicit (default): RK4 with step-doubling error control, switching island by\n"
     "                   island to a linearly implicit method (ROS34PW2) where the contacts' stability\n"
     "                   bound holds RK4 to a fraction of the steps its error allows: resting and\n"
@@ -171,6 +173,8 @@ int pd_cmd_run(int argc, char** argv) {
       {.name = "--tend", .kind = pd_optPositive, .target = &overrides.tend, .message = "--tend needs a number > 0"},
       {.name = "--sample", .kind = pd_optPositive, .target = &overrides.sample,
        .message = "--sample needs a number > 0"},
+      {.name = "--tol", .kind = pd_optPositive, .target = &overrides.tol, .message = "--tol needs a number in (0, 1)",
+       .given = &softOptionGiven},
       {.name = "--stepper", .kind = pd_optChoice, .target = &stepper,
        .message = "--stepper must be adaptive, fixed, embedded, implicit, dopri or implicit-dopri", .words = stepperWords,
        .values = stepperValues, .given = &softOptionGiven},
@@ -198,6 +202,8 @@ int pd_cmd_run(int argc, char** argv) {
   ref.variant = (pdRefVariant)variant;
   ref.odeFriction = (pdOdeFriction)odeFriction;
   if (!scene) return pd_cli_usage_error("run", "no scene given");
+  // the scene's own range for tol (docs/scene-language.md)
+  if (overrides.tol >= 1.0) return pd_cli_usage_error("run", "--tol needs a number in (0, 1)");
   bool soft = strcmp(engine, "soft") == 0;
   if (soft && refOptionGiven)
     return pd_cli_usage_error("run", "--variant and --ode-friction are for --engine ode or bullet");
@@ -206,7 +212,8 @@ int pd_cmd_run(int argc, char** argv) {
   if (soft && stepGiven) overrides.dt = ref.step;
   if (!soft && softOptionGiven)
     return pd_cli_usage_error("run",
-                              "--stepper, --events, --onsets, --islands, --sleep and --threads are for the soft engine");
+                              "--tol, --stepper, --events, --onsets, --islands, --sleep and --threads are for the soft "
+                              "engine");
   // islands off is one system on one thread: more threads would be silently idle
   if (threads > 1 && islands != pd_islandsOn) return pd_cli_usage_error("run", "--threads N > 1 needs --islands on");
   if (strcmp(engine, "bullet") == 0 && ref.odeFriction != pd_odeFrictionPyramid)

@@ -30,6 +30,12 @@ message_at() {
   if [ "$3" = line ]; then [[ $rest =~ ^[0-9]+:[0-9]+:\  ]]; else [[ $rest == " "* ]]; fi
 }
 line_count() { wc -l <"$1" | tr -d ' '; }
+# summary_field FILE EXPR: EXPR evaluated in Python with d the summary's JSON
+summary_field() {
+  python3 -c 'import json, sys
+d = json.load(open(sys.argv[1]))
+print(eval(sys.argv[2], {"d": d}))' "$1" "$2"
+}
 # summary.json without its "timing" object (the only part allowed to differ between two runs)
 summary_without_timing() {
   python3 -c 'import json, sys
@@ -143,7 +149,19 @@ check "--tend 0.5 --sample 10 gives 6 x 3 rows" '[ "$(line_count "$RUN3/trajecto
 TIMES="0 0.10000000000000001 0.20000000000000001 0.29999999999999999 0.40000000000000002 0.5 "
 sample_times() { tail -n +2 "$1" | cut -d, -f1 | uniq | tr "\n" " "; }
 check "samples at 0, 0.1, ..., 0.5" '[ "$(sample_times "$RUN3/trajectory.csv")" = "$TIMES" ]'
+# --tol replaces the scene's tol (the demo's is 1e-8): summary.json says which was in force, and the largest step
+# follows it (docs/events.md, "The largest step": 1e-2 s at tol 1e-6 and tighter, longer at a looser one); the
+# scene's own tol given again changes no byte
+RUN_TOL=$SCRATCH/run_tol
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN_TOL" --tend 0.5 --sample 10 --tol 1e-4
+check "--tol 1e-4 exits 0" '[ $rc -eq 0 ]'
+check "--tol 1e-4: summary.json's tol is 1e-4 and its dtmax above 1e-2 s" \
+  '[ "$(summary_field "$RUN_TOL/summary.json" "d[\"settings\"][\"tol\"] == 1e-4 and d[\"settings\"][\"dtmax\"] > 1e-2")" = True ]'
+run_pd "$OUT" "$ERR" run "$DEMO" --out "$RUN_TOL" --tend 0.5 --sample 10 --tol 1e-8
+check "--tol with the scene's own tol gives the same trajectory" \
+  '[ $rc -eq 0 ] && cmp -s "$RUN_TOL/trajectory.csv" "$RUN3/trajectory.csv"'
 for bad in "--tend abc" "--tend -1" "--tend nan" "--sample 0" "--tend" "--islands maybe" "--islands" \
+  "--tol 0" "--tol 1" "--tol abc" "--tol" "--engine ode --tol 1e-4" \
   "--engine ode --islands on" "--islands on --threads 0" "--islands on --threads 65" "--islands on --threads 2x" \
   "--islands on --threads" "--islands off --threads 2" "--engine ode --threads 1" "--sleep maybe" "--sleep" \
   "--engine bullet --sleep off"; do
@@ -235,11 +253,6 @@ check "check lists the pair adjustments (§3.3.1) of both sides" \
 check "check lists the surface-element adjustments (§3.3.2)" 'grep -q "^  a: cn 1 -> 0 N·s/m in contacts with b (§3.3.2" "$OUT"'
 RUNADJ=$SCRATCH/run_adjusted
 run_pd "$OUT" "$ERR" run "$ADJ" --out "$RUNADJ"
-summary_field() {
-  python3 -c 'import json, sys
-d = json.load(open(sys.argv[1]))
-print(eval(sys.argv[2], {"d": d}))' "$1" "$2"
-}
 check "summary.json lists the adjustments" \
   '[ "$(summary_field "$RUNADJ/summary.json" "sum(\"§3.3\" in a for a in d[\"adjustments\"])")" -ge 5 ]'
 check "summary.json has each pair's kn and damping ratio" \
