@@ -72,6 +72,12 @@ bool pd_cli_onsets(const char* text, pdOnsets* onsets) {
   return true;
 }
 
+bool pd_cli_accept_tol(const char* cmd, const char* value, void* tol) {
+  if (pd_cli_positive(value, tol) && *(double*)tol < 1.0) return true;
+  pd_cli_usage_error(cmd, "--tol needs a number in (0, 1)");
+  return false;
+}
+
 bool pd_cli_accept_onsets(const char* cmd, const char* value, void* onsets) {
   if (pd_cli_onsets(value, onsets)) return true;
   pd_cli_usage_error(cmd, "--onsets must be pair, exact, auto or bounded");

@@ -53,6 +53,9 @@ bool pd_cli_list_has(const char* list, const char* word);
 
 // Parses a finite number > 0 from an option value; false when it is not one.
 bool pd_cli_positive(const char* text, double* value);
+// --tol's value as an option table's accept function (options.h): a number in (0, 1), the scene's own range for tol
+// (docs/scene-language.md); a usage error for anything else.
+bool pd_cli_accept_tol(const char* cmd, const char* value, void* tol);
 
 // Parses --onsets' value, "pair", "exact", "auto" or "bounded"; false when it is none of them.
 bool pd_cli_onsets(const char* text, pdOnsets* onsets);

@@ -178,12 +178,6 @@ static bool accept_label(const char* cmd, const char* v, void* target) {
   return true;
 }
 
-static bool accept_tol(const char* cmd, const char* v, void* target) {
-  if (pd_cli_positive(v, target) && *(double*)target < 1.0) return true;
-  pd_cli_usage_error(cmd, "--tol needs a number in (0, 1)");
-  return false;
-}
-
 static bool accept_inertia(const char* cmd, const char* v, void* target) {
   if (strcmp(v, "uniform") == 0) {
     *(double*)target = 0.0;
@@ -234,7 +228,7 @@ static int parse_options(int argc, char** argv, options* o) {
       {.name = "--variant", .kind = pd_optChoice, .target = &variant, .message = "--variant must be native or matched",
        .words = variantWords, .values = variantValues},
       {.name = "--step", .kind = pd_optPositive, .target = &o->step, .message = "--step needs a number > 0"},
-      {.name = "--tol", .kind = pd_optAccept, .target = &o->tol, .accept = accept_tol},
+      {.name = "--tol", .kind = pd_optAccept, .target = &o->tol, .accept = pd_cli_accept_tol},
       {.name = "--inertia", .kind = pd_optAccept, .target = &o->inertia, .accept = accept_inertia,
        .given = &o->inertiaGiven},
       {.name = "--jobs", .kind = pd_optJobs, .target = &o->jobs, .message = jobsMessage},

@@ -173,7 +173,7 @@ int pd_cmd_run(int argc, char** argv) {
       {.name = "--tend", .kind = pd_optPositive, .target = &overrides.tend, .message = "--tend needs a number > 0"},
       {.name = "--sample", .kind = pd_optPositive, .target = &overrides.sample,
        .message = "--sample needs a number > 0"},
-      {.name = "--tol", .kind = pd_optPositive, .target = &overrides.tol, .message = "--tol needs a number in (0, 1)",
+      {.name = "--tol", .kind = pd_optAccept, .target = &overrides.tol, .accept = pd_cli_accept_tol,
        .given = &softOptionGiven},
       {.name = "--stepper", .kind = pd_optChoice, .target = &stepper,
        .message = "--stepper must be adaptive, fixed, embedded, implicit, dopri or implicit-dopri", .words = stepperWords,
@@ -202,8 +202,6 @@ int pd_cmd_run(int argc, char** argv) {
   ref.variant = (pdRefVariant)variant;
   ref.odeFriction = (pdOdeFriction)odeFriction;
   if (!scene) return pd_cli_usage_error("run", "no scene given");
-  // the scene's own range for tol (docs/scene-language.md)
-  if (overrides.tol >= 1.0) return pd_cli_usage_error("run", "--tol needs a number in (0, 1)");
   bool soft = strcmp(engine, "soft") == 0;
   if (soft && refOptionGiven)
     return pd_cli_usage_error("run", "--variant and --ode-friction are for --engine ode or bullet");
