@@ -681,13 +681,12 @@ static void fall_asleep(const pdModel* model, const pdState* s, struct pdIslandS
       int k = is->bodies[m];
       const pdBody* b = &model->bodies[model->movingBodies[k]];
       bool bodyQuiet = pd_sleep_quiet(sleep, b, k, s->y + PD_BODY_STATE_SIZE * k, set->t0, tNext, horizon);
+      // pd_sleep_quiet has already cleared quietSince for a body that was not quiet
       if (!sleep->inContact[k]) pd_sleep_restless(sleep, k);
-      if (!bodyQuiet || !sleep->inContact[k]) {
-        sleep->quietSince[k] = NAN;
+      if (!bodyQuiet || !sleep->inContact[k])
         quiet = false;
-      } else {
+      else
         since = fmax(since, sleep->quietSince[k]);
-      }
       if (isnan(sleep->slowSince[k]))
         slowAll = false;
       else
